@@ -1,0 +1,44 @@
+# ligwf set-up and entry points. `make demo` and `make test` install whatever is missing
+# (Debian packages, a .venv with ligwf, mpi4py built against the system OpenMPI), then run.
+# Re-running is quick: each step checks before it installs.
+
+SHELL := /bin/bash
+VENV ?= .venv
+PY := $(VENV)/bin/python
+LIGWF := $(VENV)/bin/ligwf
+APT_PACKAGES := liggghts openmpi-bin libopenmpi-dev python3-venv python3-dev
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+STAMP := $(VENV)/.ligwf-installed
+DEMO_OUT ?= runs/demo
+PYTEST_ARGS ?=
+
+.PHONY: demo test install system-packages clean
+
+demo: install
+	$(LIGWF) render workflows/demo.yaml --out $(DEMO_OUT)
+	$(LIGWF) check workflows/demo.yaml
+
+test: install
+	$(PY) -m pytest $(PYTEST_ARGS)
+
+install: system-packages $(STAMP)
+
+# liggghts RECOMMENDS paraview (~280 packages): installed without recommends on purpose.
+system-packages:
+	@if ! dpkg -s $(APT_PACKAGES) >/dev/null 2>&1; then \
+	  echo "installing Debian packages: $(APT_PACKAGES)"; \
+	  $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $(APT_PACKAGES); \
+	fi
+
+# mpi4py must be compiled against the system OpenMPI (the PyPI wheel brings its own MPI,
+# which cannot talk to the system mpirun or to libliggghts).
+$(STAMP): pyproject.toml
+	@[ -x $(PY) ] || python3 -m venv $(VENV)
+	$(PY) -m pip install -q --upgrade pip
+	$(PY) -m pip install -q --no-binary mpi4py "mpi4py>=3.1"
+	$(PY) -m pip install -q -e '.[test]'
+	@touch $(STAMP)
+
+clean:
+	rm -rf $(VENV) runs .pytest_cache

@@ -1,0 +1,167 @@
+"""Rendering: a scaled scene in, LIGGGHTS input text out. No I/O.
+
+``render(scaled)`` returns ``{file name: text}``; writing is a separate step (``cases``).
+Templates are Jinja2 with StrictUndefined (a missing value is an error, not an empty
+string) and are looked up through a ChoiceLoader: user folders first, then ligwf's own,
+so a site can override one template without copying the rest.
+
+Every value substituted into a template goes through :func:`_finalize`, which refuses
+strings carrying a newline, '&', '$', '#' or a quote: no scene value can inject a
+LIGGGHTS command (the engine has ``shell``).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any, Iterable
+
+import jinja2
+
+from . import __version__
+from .bridges import engine_contact_angle_deg
+from .errors import RenderError
+from .mesh import axis_frame
+from .scaling import ScaledScene
+from .scene import FORBIDDEN_INPUT_CHARS, GRAVITY
+
+#: Name of the main input file in a case folder.
+INPUT_NAME = "in.liggghts"
+#: Name of the drum mesh in a case folder (the input refers to it by this name).
+MESH_NAME = "drum.stl"
+#: Sub-folders the input writes into (the case writer creates them).
+OUTPUT_DIRS = ("post", "restart")
+
+
+def shipped_template_dir() -> Path:
+    """ligwf's own templates: inside the installed wheel, or the source tree's templates/."""
+    packaged = resources.files("ligwf") / "templates"
+    if packaged.is_dir():
+        return Path(str(packaged))
+    return Path(__file__).resolve().parent.parent / "templates"
+
+
+def fmt_float(value: float) -> str:
+    """Number as LIGGGHTS reads it: shortest round-trip form, no locale, no 'nan'/'inf'."""
+    if isinstance(value, bool):
+        raise RenderError(f"boolean {value!r} where a number is expected")
+    if not math.isfinite(float(value)):
+        raise RenderError(f"non-finite number {value!r} in a LIGGGHTS input")
+    if isinstance(value, int):
+        return str(value)
+    text = repr(float(value))
+    return text.replace("e+", "e")
+
+
+def _finalize(value: Any) -> Any:
+    if isinstance(value, str):
+        bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
+        if bad:
+            raise RenderError(f"refusing to render {value!r}: contains {bad!r}, which could "
+                              "inject a LIGGGHTS command")
+        return value
+    if isinstance(value, float):
+        return fmt_float(value)
+    return value
+
+
+@lru_cache(maxsize=16)
+def _environment(user_dirs: tuple[str, ...]) -> jinja2.Environment:
+    loaders = [jinja2.FileSystemLoader(d) for d in user_dirs]
+    loaders.append(jinja2.FileSystemLoader(str(shipped_template_dir())))
+    env = jinja2.Environment(
+        loader=jinja2.ChoiceLoader(loaders),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+        autoescape=False,
+        finalize=_finalize,
+    )
+    env.filters["num"] = fmt_float
+    env.filters["vec"] = lambda xs: " ".join(fmt_float(x) for x in xs)
+    return env
+
+
+def _unit(index: int, sign: float = 1.0) -> list[float]:
+    v = [0.0, 0.0, 0.0]
+    v[index] = sign
+    return v
+
+
+def template_context(s: ScaledScene) -> dict[str, Any]:
+    """Everything the drum template needs, derived from the scaled scene (pure)."""
+    ia, iu, iv = axis_frame(s.axis)
+    r = 0.5 * s.drum_diameter
+    half_box = 1.05 * r + s.d_max
+    lo = [-half_box] * 3
+    hi = [half_box] * 3
+    if s.periodic:
+        lo[ia], hi[ia] = 0.0, s.drum_length
+    else:
+        pad = 0.02 * s.drum_length + s.d_max
+        lo[ia], hi[ia] = -pad, s.drum_length + pad
+    boundary = ["f", "f", "f"]
+    if s.periodic:
+        boundary[ia] = "p"
+    templates = [
+        {"id": f"pts{k + 1}", "radius": 0.5 * d, "fraction": f, "seed": s.seeds[k]}
+        for k, (d, f) in enumerate(zip(s.diameters, s.number_fractions))
+    ]
+    k0 = len(templates)
+    waves = [{"id": f"ins{k + 1}", "count": n, "seed": s.seeds[k0 + 1 + k]}
+             for k, n in enumerate(s.insertion_waves)]
+    return {
+        "s": s,
+        "version": __version__,
+        "boundary": " ".join(boundary),
+        "box_lo": lo,
+        "box_hi": hi,
+        "axis": s.axis,
+        "axial_lo": 0.0 if s.periodic else 0.55 * s.d_max,
+        "axial_hi": s.drum_length if s.periodic else s.drum_length - 0.55 * s.d_max,
+        "axis_vector": _unit(ia),
+        "gravity": GRAVITY,
+        "gravity_vector": _unit(iv, -1.0),
+        "templates": templates,
+        "distribution_seed": s.seeds[k0],
+        "waves": waves,
+        "rolling": s.rolling_friction > 0.0,
+        "wet": s.wet,
+        "cohesion_model": {"washino": "washino/capillary/viscous",
+                           "easo": "easo/capillary/viscous"}.get(s.liquid_model),
+        "engine_contact_angle": engine_contact_angle_deg(s.contact_angle_deg,
+                                                         s.contact_angle_compensation),
+        "mesh_name": MESH_NAME,
+    }
+
+
+def render(scaled: ScaledScene, template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:
+    """LIGGGHTS input files for one case: ``{file name: text}`` (pure, no I/O)."""
+    env = _environment(tuple(str(Path(d)) for d in template_dirs))
+    try:
+        text = env.get_template("drum.in.j2").render(**template_context(scaled))
+    except jinja2.TemplateError as exc:
+        raise RenderError(f"cannot render drum.in.j2: {exc}") from exc
+    return {INPUT_NAME: text}
+
+
+def render_bridge_probe(scaled: ScaledScene, gap_ratio: float, model_approach: bool,
+                        template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:
+    """Input of a two-particle probe: two smallest particles of ``scaled`` held (no
+    integrator) at surface gap ``gap_ratio * r_eff``; the thermo prints the force on
+    particle 2 (``v_fx2``). With ``model_approach`` the pair touches first and is then
+    separated, which the easo model needs to form its bridge.
+    """
+    env = _environment(tuple(str(Path(d)) for d in template_dirs))
+    ctx = template_context(scaled)
+    radius = 0.5 * scaled.d_min
+    r_eff = 0.5 * radius
+    ctx.update(probe_radius=radius, probe_gap=gap_ratio * r_eff, approach=model_approach)
+    try:
+        text = env.get_template("bridge_probe.in.j2").render(**ctx)
+    except jinja2.TemplateError as exc:
+        raise RenderError(f"cannot render bridge_probe.in.j2: {exc}") from exc
+    return {INPUT_NAME: text}
