@@ -8,6 +8,7 @@ is left half-done.
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 from pathlib import Path
 
@@ -37,7 +38,7 @@ def case_table(rendered, title: str) -> Table:
     return table
 
 
-def _add_workflow_args(p: argparse.ArgumentParser) -> None:
+def add_workflow_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("workflow", type=Path, help="workflow YAML file")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a workflow value, e.g. scene.drum.lifters.count=12 (repeatable)")
@@ -60,6 +61,11 @@ def cmd_render(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
+#: (One module per stage keeps this file small and the stages independent.)
+COMMAND_MODULES: tuple[str, ...] = ()
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="ligwf", description="Coarse-grained LIGGGHTS studies of wet rotating drums.")
@@ -67,15 +73,18 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("check", help="validate a workflow and render it in memory (writes nothing)")
-    _add_workflow_args(p)
+    add_workflow_args(p)
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("render", help="write one folder per case (input, mesh, scene.json)")
-    _add_workflow_args(p)
+    add_workflow_args(p)
     p.add_argument("--out", type=Path, required=True, help="study folder to write")
     p.add_argument("--mesh-cache", type=Path, default=None,
                    help="mesh cache folder (default $LIGWF_MESH_CACHE or ./meshes)")
     p.set_defaults(func=cmd_render)
+
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).register(sub)
     return parser
 
 
