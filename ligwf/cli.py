@@ -21,7 +21,7 @@ from .errors import LigwfError
 from .workflow import load_workflow
 
 console = Console(width=None if sys.stdout.isatty() else 160)
-err_console = Console(stderr=True)
+err_console = Console(stderr=True, soft_wrap=True)
 
 
 def case_table(rendered, title: str) -> Table:

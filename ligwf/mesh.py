@@ -24,7 +24,7 @@ from .fsio import atomic_write_text
 from .scene import Drum
 
 #: Bump when the mesh algorithm changes, so cached meshes are rebuilt.
-MESH_VERSION = 2
+MESH_VERSION = 3
 #: Largest gap between the polygon chord and the true circle, as a fraction of the radius.
 SAG_TOLERANCE = 2.5e-4
 #: Largest axial length of a shell triangle, in units of its circumferential width.
@@ -104,7 +104,10 @@ def drum_triangles(drum: Drum) -> np.ndarray:
                         np.full(len(outline), w), drum.axis)
             a = _to_xyz(outline[:, 0], outline[:, 1], np.full(len(outline), w), drum.axis)
             b = _to_xyz(nxt[:, 0], nxt[:, 1], np.full(len(outline), w), drum.axis)
-            tris.append(np.stack([c, a, b], axis=1))
+            fan = np.stack([c, a, b], axis=1)
+            # the radial sides of a lifter are collinear with the centre: drop those slivers
+            area2 = np.linalg.norm(np.cross(fan[:, 1] - fan[:, 0], fan[:, 2] - fan[:, 0]), axis=1)
+            tris.append(fan[area2 > 1e-12 * drum.radius**2])
     tri = np.concatenate(tris)
     return _orient_inward(tri, drum)
 

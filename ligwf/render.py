@@ -44,15 +44,15 @@ def shipped_template_dir() -> Path:
 
 
 def fmt_float(value: float) -> str:
-    """Number as LIGGGHTS reads it: shortest round-trip form, no locale, no 'nan'/'inf'."""
+    """Number as LIGGGHTS reads it: 12 significant digits (readable, far below any physical
+    tolerance), no locale, never 'nan'/'inf'."""
     if isinstance(value, bool):
         raise RenderError(f"boolean {value!r} where a number is expected")
     if not math.isfinite(float(value)):
         raise RenderError(f"non-finite number {value!r} in a LIGGGHTS input")
     if isinstance(value, int):
         return str(value)
-    text = repr(float(value))
-    return text.replace("e+", "e")
+    return format(float(value), ".12g").replace("e+", "e")
 
 
 def _finalize(value: Any) -> Any:

@@ -296,7 +296,9 @@ def _allowed_range(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str |
     """The full interval of a numeric field, e.g. '(0, 0.7]', from its declared bounds."""
     field = None
     for part in loc:
-        if model is None or not isinstance(part, str) or part not in model.model_fields:
+        if isinstance(part, int):  # index into a tuple of models: same element model
+            continue
+        if model is None or part not in model.model_fields:
             return None
         field = model.model_fields[part]
         ann = field.annotation
@@ -328,8 +330,12 @@ def _allowed_range(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str |
 def format_validation_error(exc: ValidationError, root: type[BaseModel], prefix: str) -> str:
     """One line per problem: ``field = value: reason (allowed: range)``."""
     lines = []
-    for err in exc.errors():
+    errors = exc.errors()
+    deeper = {tuple(e["loc"][:-1]) for e in errors if len(e["loc"]) > 1}
+    for err in errors:
         loc = tuple(err["loc"])
+        if err["type"] == "too_short" and any(d[:len(loc)] == loc for d in deeper):
+            continue  # a collection emptied by its own invalid items: already reported
         path = ".".join(str(p) for p in (prefix, *loc) if p != "")
         value = err.get("input")
         msg = err["msg"].removeprefix("Value error, ")
