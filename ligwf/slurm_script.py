@@ -97,7 +97,13 @@ def _environment(site: SlurmSite) -> list[str]:
 
 
 def _launcher_env(site: SlurmSite) -> list[str]:
-    """Tell the runner which launcher to use inside the allocation (see ligwf.engine)."""
+    """Tell the runner which launcher to use inside the allocation (see ligwf.engine).
+
+    Nothing when the site sets no Slurm launcher: the engine settings then apply as they
+    do for local runs (the job inherits the submitting environment).
+    """
+    if site.launcher is None:
+        return []
     words = shlex.split(site.launcher)
     lines = [f"export LIGWF_MPIRUN={_q(words[0])}"]
     if len(words) > 1:

@@ -12,7 +12,8 @@ environment variables ``LIGWF_SLURM_*``, then the ``slurm:`` mapping of the site
       max_concurrent: 8         # the %K of --array=0-M%K
       modules: [openmpi/4.1, liggghts/3.8.0]
       setup: ["source /opt/ligwf/venv/bin/activate"]
-      launcher: mpirun          # or "srun --mpi=pmix": how the engine starts in the allocation
+      launcher: srun --mpi=pmix # how the engine starts inside the allocation; unset = the
+                                # engine settings (LIGWF_MPIRUN / site 'mpirun', default mpirun)
       ligwf: /opt/ligwf/venv/bin/ligwf
       sbatch_args: ["--mem-per-cpu=2G"]
       analysis_time: "00:30:00"
@@ -66,7 +67,7 @@ class SlurmSite:
     max_concurrent: int | None = None
     modules: tuple[str, ...] = ()
     setup: tuple[str, ...] = ()
-    launcher: str = "mpirun"
+    launcher: str | None = None
     ligwf: str = "ligwf"
     sbatch_args: tuple[str, ...] = ()
     analysis_time: str | None = None
@@ -99,7 +100,8 @@ class SlurmSite:
             if not arg.startswith("--"):
                 raise ConfigError(f"slurm sbatch_args entry {arg!r}: must be a long option "
                                   "such as --mem=4G")
-        if not self.launcher.strip() or _UNSAFE.search(self.launcher):
+        if self.launcher is not None and (not self.launcher.strip()
+                                          or _UNSAFE.search(self.launcher)):
             raise ConfigError(f"slurm launcher = {self.launcher!r}: must be one command line")
         if not self.ligwf.strip() or _UNSAFE.search(self.ligwf):
             raise ConfigError(f"slurm ligwf = {self.ligwf!r}: must be one command line")
