@@ -17,6 +17,7 @@ from rich.table import Table
 
 from . import __version__
 from .cases import render_workflow, write_study
+from .cli_stability import add_allow_unstable, preflight_or_refuse
 from .errors import LigwfError
 from .workflow import load_workflow
 
@@ -44,11 +45,13 @@ def add_workflow_args(p: argparse.ArgumentParser) -> None:
                    help="override a workflow value, e.g. scene.drum.lifters.count=12 (repeatable)")
     p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR",
                    help="user template folder searched before ligwf's own (repeatable)")
+    add_allow_unstable(p)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
     wf = load_workflow(args.workflow, args.overrides)
     rendered = render_workflow(wf, args.templates)
+    preflight_or_refuse(rendered, args.allow_unstable)
     console.print(case_table(rendered, f"{wf.name}: {len(rendered)} case(s), valid"))
     return 0
 
@@ -56,6 +59,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 def cmd_render(args: argparse.Namespace) -> int:
     wf = load_workflow(args.workflow, args.overrides)
     rendered = render_workflow(wf, args.templates)
+    preflight_or_refuse(rendered, args.allow_unstable)
     write_study(wf, rendered, args.out, args.mesh_cache)
     console.print(case_table(rendered, f"{wf.name}: {len(rendered)} case(s) -> {args.out}"))
     return 0
@@ -63,7 +67,8 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
 #: (One module per stage keeps this file small and the stages independent.)
-COMMAND_MODULES: tuple[str, ...] = ("ligwf.cli_slurm", "ligwf.cli_analysis")
+COMMAND_MODULES: tuple[str, ...] = ("ligwf.cli_run", "ligwf.cli_slurm", "ligwf.cli_analysis",
+                                     "ligwf.cli_stability")
 
 
 def build_parser() -> argparse.ArgumentParser:
