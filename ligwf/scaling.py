@@ -305,7 +305,8 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
 
     factor = liquid_factor(cg, rule) if liq.wet else 1.0
     t_r = rayleigh_time(0.5 * min(diameters), p.density, p.youngs_modulus, p.poisson_ratio)
-    dt = num.dt_rayleigh_fraction * t_r
+    # the time step comes from the safety fraction unless the scene fixes it
+    dt = num.dt if num.dt is not None else num.dt_rayleigh_fraction * t_r
     omega = scene.process.rotation.omega(drum.radius)
     thermo_every = _every(num.thermo_interval, dt)
     r_ins, waves = insertion_waves(scene, diameters, fractions, count)
@@ -331,7 +332,8 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
         min_separation_ratio=liq.min_separation_ratio,
         max_separation_ratio=liq.max_separation_ratio,
         contact_angle_compensation=num.contact_angle_compensation,
-        rayleigh_time=t_r, dt=dt, dt_rayleigh_fraction=num.dt_rayleigh_fraction,
+        rayleigh_time=t_r, dt=dt,
+        dt_rayleigh_fraction=num.dt_rayleigh_fraction if num.dt is None else dt / t_r,
         settle_steps=_steps(scene.process.settle_time, dt),
         run_steps=_steps(scene.process.run_time, dt),
         dump_every=_every(num.dump_interval, dt),

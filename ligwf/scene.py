@@ -244,6 +244,9 @@ class Numerics(_Frozen):
     dt_rayleigh_fraction: float = Field(0.15, gt=0.0, le=2.0,
                                         description="time step / Rayleigh time of the "
                                         "smallest (scaled) particle")
+    dt: float | None = Field(None, gt=0.0, le=1.0,
+                             description="fixed time step, s; unset (default): "
+                             "dt_rayleigh_fraction x Rayleigh time at every CG level")
     dump_interval: float = Field(0.05, gt=0.0, le=1e3, description="s between dumps")
     thermo_interval: float = Field(0.005, gt=0.0, le=1e3, description="s between thermo lines")
     restart_interval: float = Field(0.25, gt=0.0, le=1e4,
