@@ -154,7 +154,7 @@ def observe(case_dir: Path, s: ScaledScene) -> Observation:
             s.drum_diameter, s.omega))
     issues = health.assess(rows, parsed.lines, expect)
     last = rows[-1].step if rows else 0
-    if not any(i.kind == "error" for i in issues) and last < s.total_steps:
+    if not issues and last < s.total_steps:
         issues.append(health.HealthIssue("incomplete", last,
                                          f"run ended at step {last} of {s.total_steps}"))
     atoms = [r.get("atoms") for r in rows if math.isfinite(r.get("atoms"))]
