@@ -1,0 +1,162 @@
+"""ligwf on a real single-node Slurm with real LIGGGHTS: arrays, dependency, cancel, resubmit.
+
+Needs root (the fixture installs and starts slurmctld/slurmd/munge) and the engine; it
+fails, never skips, when either is missing. Each case is ~200 CG3 particles for ~0.2 s of
+simulated time on one rank, so the whole test takes about a minute on 2 cores.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from ligwf.manifest import MANIFEST_FILE, SCREEN_FILE
+from ligwf.slurm import read_record, study_status
+from ligwf.slurm_parse import task_records
+
+HERE = Path(__file__).resolve().parent
+WORKFLOW = HERE / "tiny_drum.yaml"
+LIGWF = str(Path(sys.executable).parent / "ligwf")
+
+pytestmark = [pytest.mark.slurm, pytest.mark.engine, pytest.mark.slow]
+
+
+def ligwf(*args: str, env: dict[str, str]) -> subprocess.CompletedProcess:
+    out = subprocess.run([LIGWF, *args], capture_output=True, text=True, env=env, timeout=120,
+                         stdin=subprocess.DEVNULL)
+    assert out.returncode == 0, f"ligwf {' '.join(args)} exited {out.returncode}:\n" \
+                                f"{out.stdout}\n{out.stderr}"
+    return out
+
+
+def wait_until_idle(study: Path, timeout: float) -> None:
+    """Poll squeue/scontrol until no task or analysis job of ``study`` is queued."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        st = study_status(study)
+        jobs_busy = [j for j in st.jobs if j["kind"] != "array" and j.get("state")
+                     not in (None, "COMPLETED", "FAILED", "CANCELLED", "TIMEOUT")]
+        if not any(c.queued for c in st.cases) and not jobs_busy:
+            return
+        time.sleep(1.0)
+    raise AssertionError(f"{study}: jobs still queued after {timeout:.0f} s:\n"
+                         + subprocess.run(["squeue"], capture_output=True, text=True).stdout
+                         + _logs(study))
+
+
+def _logs(study: Path) -> str:
+    parts = []
+    for log in sorted((study / "slurm" / "logs").glob("*.out")):
+        parts.append(f"--- {log.name} ---\n" + "\n".join(log.read_text().splitlines()[-12:]))
+    return "\n".join(parts)
+
+
+def manifest_states(study: Path) -> dict[str, str]:
+    cases = json.loads((study / "study.json").read_text())["cases"]
+    out = {}
+    for c in cases:
+        path = study / c["case_id"] / MANIFEST_FILE
+        out[c["case_id"]] = json.loads(path.read_text())["status"] if path.is_file() else "missing"
+    return out
+
+
+def jobcomp_states(cluster, job_id: str) -> dict[int | None, str]:
+    recs = task_records(cluster.jobcomp.read_text()) if cluster.jobcomp.is_file() else []
+    return {r.array_task_id: r.state for r in recs
+            if r.array_job_id == job_id or (r.array_job_id is None and r.job_id == job_id)}
+
+
+@pytest.fixture
+def env(tmp_path):
+    e = dict(os.environ, LIGWF_MESH_CACHE=str(tmp_path / "meshes"))
+    e.pop("LIGWF_SLURM_PARTITION", None)
+    return e
+
+
+def test_array_analysis_cancel_and_resubmit(slurm_cluster, tmp_path, env):
+    t0 = time.monotonic()
+    # -- 1. four cases as one array plus the dependent analysis job ----------------------
+    study = tmp_path / "study-a"
+    ligwf("slurm", "submit", str(WORKFLOW), "--out", str(study), "--ntasks", "1",
+          "--max-concurrent", "2", "--time", "00:10:00", env=env)
+    record = read_record(study)
+    assert [s["kind"] for s in record] == ["array", "analysis"]
+    array_id, analysis_id = record[0]["job_id"], record[1]["job_id"]
+    assert record[0]["indices"] == [0, 1, 2, 3]
+    assert record[1]["after"] == array_id
+    assert f"--dependency=afterany:{array_id}" in record[1]["command"]
+    assert "#SBATCH --array=0-3%2" in (study / "slurm" / "array-1.sh").read_text()
+
+    wait_until_idle(study, timeout=150)
+    assert manifest_states(study) == {f"cg3-weber-r{i}": "done" for i in range(4)}, _logs(study)
+    for i in range(4):  # %A_%a logs, one per task
+        assert (study / "slurm" / "logs" / f"ligwf-slurm-tiny_{array_id}_{i}.out").is_file()
+    comp = jobcomp_states(slurm_cluster, array_id)
+    assert comp == {0: "COMPLETED", 1: "COMPLETED", 2: "COMPLETED", 3: "COMPLETED"}
+    assert jobcomp_states(slurm_cluster, analysis_id) == {None: "COMPLETED"}, _logs(study)
+    analysis_log = study / "slurm" / "logs" / f"ligwf-slurm-tiny-analysis_{analysis_id}.out"
+    assert analysis_log.is_file()
+    check_analysis_output(study)
+    t1 = time.monotonic()
+
+    # -- 2. a second array; cancel one task mid-run; resubmit exactly that case ----------
+    study_b = tmp_path / "study-b"
+    ligwf("slurm", "submit", str(WORKFLOW), "--out", str(study_b), "--ntasks", "1",
+          "--max-concurrent", "2", "--no-analysis", "--set", "scene.process.run_time=0.2",
+          env=env)
+    array_b = read_record(study_b)[0]["job_id"]
+    victim = 1
+    log = study_b / "cg3-weber-r1" / SCREEN_FILE
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline:  # running, and the engine has started stepping
+        st = {c.index: c for c in study_status(study_b).cases}
+        if st[victim].slurm_state == "RUNNING" and log.is_file() and "Step" in log.read_text():
+            break
+        time.sleep(0.5)
+    else:
+        raise AssertionError(f"task {array_b}_{victim} never ran:\n{_logs(study_b)}")
+    time.sleep(2.0)
+    subprocess.run(["scancel", f"{array_b}_{victim}"], check=True)
+    wait_until_idle(study_b, timeout=150)
+    states = manifest_states(study_b)
+    assert states["cg3-weber-r1"] != "done", states
+    assert {k: v for k, v in states.items() if k != "cg3-weber-r1"} == {
+        f"cg3-weber-r{i}": "done" for i in (0, 2, 3)}
+    assert jobcomp_states(slurm_cluster, array_b)[victim] == "CANCELLED"
+
+    status = ligwf("slurm", "status", str(study_b), "--json", env=env)
+    by_index = {c["index"]: c for c in json.loads(status.stdout)["cases"]}
+    assert by_index[victim]["job"] == f"{array_b}_{victim}"
+    assert by_index[victim]["slurm_state"] == "CANCELLED"
+
+    ligwf("slurm", "resubmit", str(study_b), "--no-analysis", env=env)
+    record_b = read_record(study_b)
+    assert [s["kind"] for s in record_b] == ["array", "array"]
+    assert record_b[1]["indices"] == [victim]
+    assert f"#SBATCH --array={victim}%2" in (study_b / "slurm" / "array-2.sh").read_text()
+    wait_until_idle(study_b, timeout=120)
+    assert manifest_states(study_b) == {f"cg3-weber-r{i}": "done" for i in range(4)}, \
+        _logs(study_b)
+    # nothing left to resubmit
+    again = ligwf("slurm", "resubmit", str(study_b), env=env)
+    assert "nothing to resubmit" in again.stdout
+    t2 = time.monotonic()
+    print(f"\nslurm integration: first study {t1 - t0:.1f} s, cancel+resubmit {t2 - t1:.1f} s")
+
+
+def check_analysis_output(study: Path) -> None:
+    """``ligwf analyse`` wrote analysis/analysis.json with frames of all four done cases."""
+    summary = study / "analysis" / "analysis.json"
+    assert summary.is_file(), f"no analysis output under {study}:\n{_logs(study)}"
+    data = json.loads(summary.read_text())
+    cases = {c["case_id"]: c for c in data["cases"]}
+    assert set(cases) == {f"cg3-weber-r{i}" for i in range(4)}
+    assert not data["skipped_cases"], data["skipped_cases"]
+    assert all(c["analysed"] >= 1 for c in cases.values()), (cases, data["skipped_frames"])
+    assert (study / "analysis" / "gsd.csv").is_file()
