@@ -1,0 +1,256 @@
+"""Dump reading: LIGGGHTS particle and contact ``.vtu`` files -> numpy arrays, per frame.
+
+The drum input (``templates/drum.in.j2``) writes, every ``dump_every`` production steps,
+
+* ``post/particles_<step>.vtu``: one vertex per particle, point arrays ``id``, ``type``,
+  ``v`` (m/s), ``radius`` (m) and, when wet, ``f_surfaceLiquidContent`` (fraction of the
+  particle volume, despite the LIGGGHTS docs saying %);
+* ``post/contacts_<step>.vtu``: one line cell per interacting pair from
+  ``compute pair/gran/local`` with cell arrays ``id1``, ``id2`` (stored as doubles),
+  ``vel1``, ``vel2``, ``force``, ``force_normal`` (N) and ``delta`` (overlap, m; negative
+  for a liquid bridge between separated spheres).
+
+Both are read with meshio (the ``.vtu`` flavour is the one meshio can read, see
+LIGGGHTS_NOTES "Output"). Particles are returned sorted by id, so a particle's index is
+the same in every frame of a run and contacts refer to particles by id only: pairs across
+the periodic boundary have line cells that span the whole box, their geometry is useless.
+
+Every failure to read a file (missing, empty, truncated XML, corrupt base64, a missing
+array, zero particles, ids a contact refers to that are not in the particle frame) raises
+:class:`~ligwf.errors.DumpReadError` naming the file, so a whole-run analysis can report
+and skip that frame instead of analysing garbage.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import DumpReadError
+
+PARTICLE_ARRAYS = ("id", "type", "v", "radius")
+CONTACT_ARRAYS = ("id1", "id2", "delta")
+_PARTICLE_RE = re.compile(r"^particles_(\d+)\.vtu$")
+_CONTACT_RE = re.compile(r"^contacts_(\d+)\.vtu$")
+
+
+@dataclass(frozen=True)
+class ParticleFrame:
+    """Particles of one dump, sorted by id. Positions in m, velocities in m/s."""
+
+    path: Path
+    step: int
+    time: float                  # s, step * dt
+    ids: np.ndarray              # (N,) int64, ascending
+    types: np.ndarray            # (N,) int32
+    positions: np.ndarray        # (N, 3) float64 (the dump stores float32)
+    velocities: np.ndarray       # (N, 3) float64
+    radii: np.ndarray            # (N,) float64
+    liquid_content: np.ndarray | None   # (N,) float64 fraction of particle volume, or None (dry)
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    @property
+    def volumes(self) -> np.ndarray:
+        """Sphere volumes, m^3."""
+        return 4.0 / 3.0 * np.pi * self.radii**3
+
+    def index_of(self, ids: np.ndarray) -> np.ndarray:
+        """Row index of each particle id in ``ids``; DumpReadError if one is not present."""
+        idx = np.searchsorted(self.ids, ids)
+        idx = np.minimum(idx, len(self.ids) - 1)
+        missing = self.ids[idx] != ids
+        if np.any(missing):
+            raise DumpReadError(f"{self.path}: no particle with id {int(np.asarray(ids)[missing][0])} "
+                                "(referred to by the contact dump of the same step)")
+        return idx
+
+
+@dataclass(frozen=True)
+class ContactFrame:
+    """Interacting pairs of one dump (each unordered pair once)."""
+
+    path: Path
+    step: int
+    id1: np.ndarray              # (M,) int64
+    id2: np.ndarray              # (M,) int64
+    delta: np.ndarray            # (M,) float64 overlap, m (negative: separated, bridged)
+    force_normal: np.ndarray | None     # (M, 3) N, if dumped
+
+    def __len__(self) -> int:
+        return len(self.id1)
+
+
+@dataclass(frozen=True)
+class FrameFiles:
+    """The dump files of one output step of a run."""
+
+    step: int
+    particles: Path
+    contacts: Path | None
+
+
+def discover_frames(case_dir: Path) -> list[FrameFiles]:
+    """Frames of a case folder (its ``post/`` subfolder or itself), sorted by step.
+
+    A particle dump without its contact dump is listed with ``contacts=None`` (a dry run
+    or a run without granule analysis); a contact dump without particles is ignored.
+    The ``particles_boundingBox_*`` files LIGGGHTS writes next to each dump do not match.
+    """
+    case_dir = Path(case_dir)
+    post = case_dir / "post" if (case_dir / "post").is_dir() else case_dir
+    parts: dict[int, Path] = {}
+    contacts: dict[int, Path] = {}
+    for path in post.iterdir():
+        if m := _PARTICLE_RE.match(path.name):
+            parts[int(m.group(1))] = path
+        elif m := _CONTACT_RE.match(path.name):
+            contacts[int(m.group(1))] = path
+    return [FrameFiles(step, parts[step], contacts.get(step)) for step in sorted(parts)]
+
+
+def _read_mesh(path: Path):
+    """meshio.read with every failure turned into a DumpReadError naming the file."""
+    import meshio
+
+    path = Path(path)
+    if not path.is_file():
+        raise DumpReadError(f"{path}: dump file does not exist")
+    if path.stat().st_size == 0:
+        raise DumpReadError(f"{path}: dump file is empty (0 bytes)")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return meshio.read(path, file_format="vtu")
+    except (KeyboardInterrupt, MemoryError):
+        raise
+    except BaseException as exc:  # meshio raises ParseError, ReadError, ValueError, SystemExit...
+        reason = f"{type(exc).__name__}: {exc}".strip().rstrip(":")
+        raise DumpReadError(f"{path}: not a readable VTU file (truncated or corrupt?): "
+                            f"{reason}") from None
+
+
+_PIECE_RE = re.compile(rb'<Piece\s+NumberOfPoints="(\d+)"\s+NumberOfCells="(\d+)"')
+
+
+def _piece_counts(path: Path) -> tuple[int, int] | None:
+    """(points, cells) from the ``<Piece>`` header, read before meshio: meshio cannot read
+    a VTU without points (it fails concatenating zero arrays), which an empty frame is."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(4096)
+    except OSError:
+        return None
+    m = _PIECE_RE.search(head)
+    return (int(m.group(1)), int(m.group(2))) if m else None
+
+
+def _need(path: Path, data: dict, names: tuple[str, ...], kind: str) -> None:
+    missing = [n for n in names if n not in data]
+    if missing:
+        raise DumpReadError(f"{path}: {kind} dump lacks the array(s) {', '.join(missing)} "
+                            f"(has: {', '.join(sorted(data)) or 'none'})")
+
+
+def _check_rows(path: Path, name: str, arr: np.ndarray, rows: int, cols: int | None) -> None:
+    shape_ok = arr.shape[0] == rows and (arr.ndim == 1 if cols is None else
+                                         arr.ndim == 2 and arr.shape[1] == cols)
+    if not shape_ok:
+        raise DumpReadError(f"{path}: array {name} has shape {arr.shape}, expected "
+                            f"({rows}{'' if cols is None else f', {cols}'})")
+    if not np.all(np.isfinite(arr)):
+        raise DumpReadError(f"{path}: array {name} holds nan or inf values")
+
+
+def read_particles(path: Path, step: int | None = None, dt: float = 0.0) -> ParticleFrame:
+    """Read one particle dump; ``step`` defaults to the number in the file name.
+
+    ``dt`` (s) converts the step to a time (LIGGGHTS' time is step * dt with a fixed dt).
+    """
+    path = Path(path)
+    if step is None:
+        m = _PARTICLE_RE.match(path.name)
+        step = int(m.group(1)) if m else 0
+    counts = _piece_counts(path)
+    if counts is not None and counts[0] == 0:
+        raise DumpReadError(f"{path}: particle dump holds zero particles")
+    mesh = _read_mesh(path)
+    n = len(mesh.points)
+    if n == 0:
+        raise DumpReadError(f"{path}: particle dump holds zero particles")
+    data = mesh.point_data
+    _need(path, data, PARTICLE_ARRAYS, "particle")
+    ids = np.asarray(data["id"]).astype(np.int64).reshape(-1)
+    _check_rows(path, "id", ids, n, None)
+    order = np.argsort(ids, kind="stable")
+    ids = ids[order]
+    if np.any(ids[1:] == ids[:-1]):
+        raise DumpReadError(f"{path}: duplicate particle ids")
+    arrays = {}
+    for name, cols in (("type", None), ("v", 3), ("radius", None),
+                       ("f_surfaceLiquidContent", None)):
+        if name not in data:
+            arrays[name] = None
+            continue
+        arr = np.asarray(data[name])
+        if cols is None:
+            arr = arr.reshape(-1) if arr.ndim == 2 and arr.shape[1] == 1 else arr
+        _check_rows(path, name, arr, n, cols)
+        arrays[name] = arr[order]
+    positions = np.asarray(mesh.points, dtype=np.float64)
+    _check_rows(path, "points", positions, n, 3)
+    if np.any(arrays["radius"] <= 0):
+        raise DumpReadError(f"{path}: non-positive particle radius")
+    liquid = arrays["f_surfaceLiquidContent"]
+    return ParticleFrame(
+        path=path, step=int(step), time=int(step) * float(dt), ids=ids,
+        types=arrays["type"].astype(np.int32), positions=positions[order],
+        velocities=arrays["v"].astype(np.float64), radii=arrays["radius"].astype(np.float64),
+        liquid_content=None if liquid is None else liquid.astype(np.float64))
+
+
+def read_contacts(path: Path, step: int | None = None) -> ContactFrame:
+    """Read one contact dump (zero contacts is a valid frame: a dispersed or dry bed)."""
+    path = Path(path)
+    if step is None:
+        m = _CONTACT_RE.match(path.name)
+        step = int(m.group(1)) if m else 0
+    counts = _piece_counts(path)
+    if counts is not None and counts[1] == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return ContactFrame(path, int(step), empty, empty.copy(), np.zeros(0), None)
+    mesh = _read_mesh(path)
+    m_rows = sum(len(block.data) for block in mesh.cells)
+    data = {name: np.concatenate(arrs) if len(arrs) > 1 else arrs[0]
+            for name, arrs in mesh.cell_data.items()}
+    if m_rows == 0:
+        empty = np.zeros(0, dtype=np.int64)
+        return ContactFrame(path, int(step), empty, empty.copy(), np.zeros(0), None)
+    _need(path, data, CONTACT_ARRAYS, "contact")
+    for name in CONTACT_ARRAYS:
+        _check_rows(path, name, np.asarray(data[name]), m_rows, None)
+    id1 = np.asarray(data["id1"]).astype(np.int64)
+    id2 = np.asarray(data["id2"]).astype(np.int64)
+    if np.any(id1 < 1) or np.any(id2 < 1) or np.any(id1 == id2):
+        raise DumpReadError(f"{path}: contact ids out of range or a particle paired with itself")
+    fn = None
+    if "force_normal" in data:
+        fn = np.asarray(data["force_normal"], dtype=np.float64)
+        _check_rows(path, "force_normal", fn, m_rows, 3)
+    # Each unordered pair once: a pair straddling two MPI subdomains could be listed by both.
+    lo, hi = np.minimum(id1, id2), np.maximum(id1, id2)
+    key = lo * (int(hi.max()) + 1) + hi
+    _, first = np.unique(key, return_index=True)
+    if len(first) != m_rows:
+        first.sort()
+        lo, hi = lo[first], hi[first]
+        data_delta = np.asarray(data["delta"], dtype=np.float64)[first]
+        fn = None if fn is None else fn[first]
+    else:
+        data_delta = np.asarray(data["delta"], dtype=np.float64)
+    return ContactFrame(path, int(step), lo, hi, data_delta, fn)

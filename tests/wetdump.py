@@ -1,0 +1,55 @@
+"""Real LIGGGHTS dumps for the analysis tests, made once per test session.
+
+A CG3 Weber-scaled slice of workflows/demo.yaml (222 particles, 0.05 s settling, 0.2 s
+production, a particle and a contact .vtu every 0.05 s) is rendered and run on 2 ranks
+(~8 s). The study folder also gets a replica copy and a failed case, with manifests.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+from conftest import DEMO, run_liggghts
+from ligwf.cases import render_workflow, write_study
+from ligwf.workflow import load_workflow
+
+_CACHE: dict[str, Path] = {}
+
+
+def write_manifest(case_dir: Path, status: str = "done") -> None:
+    """The two fields analysis checks, as the runner writes them (status, scene_hash)."""
+    scene = json.loads((case_dir / "scene.json").read_text())
+    (case_dir / "manifest.json").write_text(json.dumps(
+        {"case_id": scene["case_id"], "status": status, "scene_hash": scene["scene_hash"],
+         "reason": "" if status == "done" else "test: marked " + status}))
+
+
+def wet_study(engine, tmp_path_factory) -> Path:
+    """Study folder: cg3-weber-r0 (run), cg3-weber-r1 (its copy as a replica), both done,
+    and cg3-bond-r0 rendered with a ``failed`` manifest and no dumps."""
+    if "study" in _CACHE:
+        return _CACHE["study"]
+    out = tmp_path_factory.mktemp("wetstudy")
+    wf = load_workflow(DEMO, ["sweep.cg_levels=[3]", "sweep.rules=[weber,bond]",
+                              "scene.process.run_time=0.2", "scene.process.settle_time=0.05"])
+    rendered = render_workflow(wf)
+    write_study(wf, rendered, out, out / "meshes")
+    case = out / "cg3-weber-r0"
+    proc = run_liggghts(engine, case, nprocs=2, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-3000:]
+    write_manifest(case)
+    write_manifest(out / "cg3-bond-r0", "failed")
+    rep = out / "cg3-weber-r1"
+    shutil.copytree(case, rep)
+    scene = json.loads((rep / "scene.json").read_text())
+    scene["case_id"], scene["replica"] = "cg3-weber-r1", 1
+    (rep / "scene.json").write_text(json.dumps(scene))
+    write_manifest(rep)
+    study = json.loads((out / "study.json").read_text())
+    study["cases"].append({"case_id": "cg3-weber-r1", "cg": 3.0, "rule": "weber", "replica": 1,
+                           "index": 2, "scene_hash": scene["scene_hash"]})
+    (out / "study.json").write_text(json.dumps(study))
+    _CACHE["study"] = out
+    return out
