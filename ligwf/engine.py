@@ -77,10 +77,15 @@ class EngineConfig:
         return path
 
     def mpirun_prefix(self, nprocs: int) -> list[str]:
-        """``mpirun -np N`` (+ --allow-run-as-root for root, + site arguments)."""
+        """``mpirun -np N`` (+ --allow-run-as-root for root, + site arguments); ``srun
+        --ntasks=N`` when the launcher is Slurm's srun."""
         if nprocs < 1:
             raise ConfigError(f"np = {nprocs}: need at least 1 MPI process (allowed range [1, inf))")
         cmd = [self.mpirun_path()]
+        if Path(cmd[0]).name == "srun":
+            # inside a Slurm allocation (ligwf slurm, launcher "srun --mpi=pmix"): srun has
+            # its own rank option and no root switch
+            return cmd + list(self.mpirun_args) + [f"--ntasks={nprocs}"]
         if os.geteuid() == 0:
             cmd.append("--allow-run-as-root")
         cmd += list(self.mpirun_args) + ["-np", str(nprocs)]

@@ -72,7 +72,8 @@ def node_line() -> str:
     raise SlurmUnavailable(f"slurmd -C printed no NodeName line: {out!r}")
 
 
-def slurm_conf(host: str, node: str, root: Path = ROOT, log_dir: Path = LOG_DIR) -> str:
+def slurm_conf(host: str, node: str, root: Path = ROOT, log_dir: Path = LOG_DIR,
+               extra: tuple[str, ...] = ()) -> str:
     """The slurm.conf text of the one-node cluster (pure)."""
     name = node.split()[0].split("=", 1)[1]
     return "\n".join([
@@ -103,16 +104,23 @@ def slurm_conf(host: str, node: str, root: Path = ROOT, log_dir: Path = LOG_DIR)
         f"SlurmdLogFile={log_dir}/slurmd.log",
         node,
         f"PartitionName=debug Nodes={name} Default=YES MaxTime=INFINITE State=UP",
+        *extra,
         "",
     ])
 
 
 @dataclass
 class LocalSlurm:
-    """Start and stop the one-node cluster; ``jobcomp`` is the finished-jobs record."""
+    """Start and stop the one-node cluster; ``jobcomp`` is the finished-jobs record.
+
+    ``extra_conf`` lines are appended to slurm.conf (the failure test uses a bad one).
+    Only a munged this object started is stopped again; the original slurm.conf, if any,
+    is put back.
+    """
 
     root: Path = ROOT
     log_dir: Path = LOG_DIR
+    extra_conf: tuple[str, ...] = ()
     munged_pid: int | None = None
     started: bool = False
     conf_backup: str | None = field(default=None, repr=False)
@@ -143,8 +151,7 @@ class LocalSlurm:
             shutil.chown(d, "munge", "munge")
         pidfile = run / "munged.pid"
         if pidfile.is_file() and _alive(int(pidfile.read_text().split()[0])):
-            self.munged_pid = int(pidfile.read_text().split()[0])
-            return
+            return  # someone else's munged: use it, never stop it
         _run(["runuser", "-u", "munge", "--", "munged", "--force"])
         for _ in range(50):
             if pidfile.is_file():
@@ -167,10 +174,10 @@ class LocalSlurm:
         if CONF.is_file():
             self.conf_backup = CONF.read_text()
         CONF.write_text(slurm_conf(socket.gethostname().split(".")[0], node_line(),
-                                   self.root, self.log_dir))
+                                   self.root, self.log_dir, self.extra_conf))
         _run(["slurmctld", "-c"])  # -c: clean start, no jobs from an earlier session
+        self.started = True  # from here on stop() must shut the controller down
         _run(["slurmd"])
-        self.started = True
         deadline = time.monotonic() + timeout
         last = ""
         while time.monotonic() < deadline:
@@ -192,6 +199,9 @@ class LocalSlurm:
         if self.munged_pid and _alive(self.munged_pid):
             os.kill(self.munged_pid, signal.SIGTERM)
         self.munged_pid = None
+        if self.conf_backup is not None:
+            CONF.write_text(self.conf_backup)
+            self.conf_backup = None
 
 
 def _alive(pid: int) -> bool:

@@ -160,3 +160,18 @@ def check_analysis_output(study: Path) -> None:
     assert not data["skipped_cases"], data["skipped_cases"]
     assert all(c["analysed"] >= 1 for c in cases.values()), (cases, data["skipped_frames"])
     assert (study / "analysis" / "gsd.csv").is_file()
+
+
+def test_srun_launcher_inside_the_allocation(slurm_cluster, tmp_path, env):
+    """Site launcher ``srun --mpi=pmix``: the case's engine runs as a Slurm job step."""
+    study = tmp_path / "study-srun"
+    env = dict(env, LIGWF_SLURM_LAUNCHER="srun --mpi=pmix")
+    ligwf("slurm", "submit", str(WORKFLOW), "--out", str(study), "--ntasks", "1",
+          "--no-analysis", "--set", "sweep.replicas=1", env=env)
+    script = (study / "slurm" / "array-1.sh").read_text()
+    assert "export LIGWF_MPIRUN=srun\n" in script and "LIGWF_MPIRUN_ARGS=--mpi=pmix" in script
+    wait_until_idle(study, timeout=120)
+    assert manifest_states(study) == {"cg3-weber-r0": "done"}, _logs(study)
+    manifest = json.loads((study / "cg3-weber-r0" / MANIFEST_FILE).read_text())
+    assert Path(manifest["command"][0]).name == "srun", manifest["command"]
+    assert "--ntasks=1" in manifest["command"] and "--allow-run-as-root" not in manifest["command"]
