@@ -1,0 +1,201 @@
+"""ligwf.granules: reference (networkx BFS) vs fast path (scipy) on real dumps and random
+graphs; bond criterion against a per-contact scalar evaluation; volumes and periodic CoM."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import networkx as nx
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from ligwf import bridges
+from ligwf.dumps import ParticleFrame, discover_frames, read_contacts, read_particles
+from ligwf.granules import (BondCriterion, Liquid, bonded_contacts, comoving, granule_table,
+                            label_fast, label_reference, louvain_labels, unwrap_fast,
+                            unwrap_reference)
+from wetdump import wet_study
+
+
+@pytest.fixture(scope="module")
+def real(engine, tmp_path_factory):
+    case = wet_study(engine, tmp_path_factory) / "cg3-weber-r0"
+    scaled = json.loads((case / "scene.json").read_text())["scaled"]
+    frames = [(read_particles(f.particles, dt=scaled["dt"]), read_contacts(f.contacts))
+              for f in discover_frames(case)]
+    return scaled, frames
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+@pytest.mark.parametrize("angle", [30.0, 5.0, 180.0])
+def test_reference_equals_fast_on_real_dumps(real, angle):
+    scaled, frames = real
+    liquid = Liquid.from_scaled(scaled)
+    counts = []
+    for p, c in frames:
+        i, j, _ = bonded_contacts(p, c, liquid, BondCriterion(0.0, angle))
+        ref, fast = label_reference(len(p), i, j), label_fast(len(p), i, j)
+        np.testing.assert_array_equal(ref, fast)
+        u_ref = unwrap_reference(p.positions, ref, i, j, 1, scaled["drum_length"])
+        u_fast = unwrap_fast(p.positions, fast, i, j, 1, scaled["drum_length"])
+        np.testing.assert_allclose(u_fast, u_ref, rtol=0, atol=1e-15)
+        t_ref = granule_table(p, ref, scaled["cg"], u_ref, 1, 0.0, scaled["drum_length"])
+        t_fast = granule_table(p, fast, scaled["cg"], u_fast, 1, 0.0, scaled["drum_length"])
+        np.testing.assert_array_equal(t_ref["members"], t_fast["members"])
+        np.testing.assert_array_equal(t_ref["volume"], t_fast["volume"])
+        np.testing.assert_allclose(t_ref[["com_x", "com_y", "com_z"]],
+                                   t_fast[["com_x", "com_y", "com_z"]], atol=1e-15)
+        # volumes sum to the total particle volume, singletons included
+        assert t_fast["volume"].sum() == pytest.approx(p.volumes.sum(), rel=1e-12)
+        assert t_fast["members"].sum() == len(p)
+        np.testing.assert_allclose(t_fast["primary_volume"], t_fast["volume"] / 27.0)
+        counts.append(len(t_fast))
+    if angle == 5.0:
+        assert max(counts) > 5, "a strict angle splits the bed into several granules"
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_bond_criterion_matches_scalar_evaluation(real):
+    """Vectorised bond decision == a per-contact loop over the scalar force law."""
+    scaled, frames = real
+    liquid = Liquid.from_scaled(scaled)
+    p, c = frames[0]
+    crit = BondCriterion(min_bridge_force=1e-4, max_velocity_angle_deg=30.0)
+    i, j, force = bonded_contacts(p, c, liquid, crit)
+    got = set(zip(p.ids[i].tolist(), p.ids[j].tolist()))
+    expected, near = set(), 0
+    for a, b, delta in zip(c.id1.tolist(), c.id2.tolist(), c.delta.tolist()):
+        ia, ib = int(np.searchsorted(p.ids, a)), int(np.searchsorted(p.ids, b))
+        f = bridges.washino_capillary_force(p.radii[ia], p.radii[ib], -delta,
+                                            scaled["surface_tension"],
+                                            math.radians(scaled["contact_angle_deg"]),
+                                            p.liquid_content[ia], p.liquid_content[ib])
+        va, vb = p.velocities[ia], p.velocities[ib]
+        cosang = float(va @ vb) / (float(np.linalg.norm(va)) * float(np.linalg.norm(vb)))
+        angle = math.degrees(math.acos(max(-1.0, min(1.0, cosang))))
+        if abs(f - 1e-4) < 1e-12 or abs(angle - 30.0) < 1e-9:
+            near += 1
+            continue
+        if f > 1e-4 and angle < 30.0:
+            expected.add((a, b))
+    assert near == 0
+    assert got == expected and 0 < len(got) < len(c)
+    # separated pairs (non-touching bridges) are among the bonds
+    bonded_delta = c.delta[np.isin(c.id1 * 10**6 + c.id2, p.ids[i] * 10**6 + p.ids[j])]
+    assert (bonded_delta < 0).any()
+
+
+def test_comoving_rules():
+    v = np.array([[1.0, 0, 0], [1.0, 0, 0], [0, 0, 0], [1.0, 0, 0]])
+    w = np.array([[1.0, 0.5, 0], [-1.0, 0, 0], [3.0, 1, 0], [1.0, 1.0, 0]])
+    np.testing.assert_array_equal(comoving(v, w, 30.0), [True, False, True, False])
+    np.testing.assert_array_equal(comoving(v, w, 46.0), [True, False, True, True])
+
+
+def _frame(radii, positions, velocities, content=0.02) -> ParticleFrame:
+    n = len(radii)
+    return ParticleFrame(Path("synthetic"), 0, 0.0, np.arange(1, n + 1), np.ones(n, np.int32),
+                         np.asarray(positions, float), np.asarray(velocities, float),
+                         np.asarray(radii, float), np.full(n, content))
+
+
+def test_broken_bridge_and_threshold():
+    """Beyond the rupture distance there is no bond; a threshold drops weak bridges."""
+    from ligwf.dumps import ContactFrame
+
+    r = 0.0005
+    p = _frame([r] * 4, np.zeros((4, 3)), np.tile([0.1, 0, 0], (4, 1)))
+    liquid = Liquid("washino", 0.024, math.radians(30), 0.02)
+    vol = bridges.washino_bridge_volume(r, r, 0.02, 0.02)
+    rupture = bridges.rupture_distance(vol, math.radians(30))
+    c = ContactFrame(Path("synthetic"), 0, np.array([1, 2, 3]), np.array([2, 3, 4]),
+                     np.array([1e-6, -0.5 * rupture, -1.01 * rupture]), None)
+    i, j, f = bonded_contacts(p, c, liquid)
+    assert list(zip(i, j)) == [(0, 1), (1, 2)]
+    strong = float(f[0])
+    i, j, _ = bonded_contacts(p, c, liquid, BondCriterion(min_bridge_force=0.99 * strong))
+    assert list(zip(i, j)) == [(0, 1)]
+
+
+def test_periodic_centre_of_mass():
+    """A granule straddling y = 0 / y = L has its centre at the boundary, not mid-box."""
+    L, r = 0.009, 0.0005
+    pos = [[0, 0.0004, 0], [0, L - 0.0004, 0], [0.01, 0.0045, 0]]
+    p = _frame([r, r, r], pos, np.zeros((3, 3)))
+    i, j = np.array([0]), np.array([1])
+    labels = label_fast(3, i, j)
+    t = granule_table(p, labels, 1.0, unwrap_fast(p.positions, labels, i, j, 1, L), 1, 0.0, L)
+    assert t["members"].tolist() == [2, 1]
+    com_y = t.loc[0, "com_y"]
+    assert min(com_y, L - com_y) < 1e-12          # at the boundary (0 or L)
+    naive = granule_table(p, labels, 1.0, None, 1, 0.0, L)
+    assert naive.loc[0, "com_y"] == pytest.approx(L / 2)   # what not unwrapping gives
+
+
+@st.composite
+def graphs(draw):
+    n = draw(st.integers(1, 60))
+    m = draw(st.integers(0, 2 * n))
+    a = draw(st.lists(st.integers(0, n - 1), min_size=m, max_size=m))
+    b = draw(st.lists(st.integers(0, n - 1), min_size=m, max_size=m))
+    pairs = sorted({(min(x, y), max(x, y)) for x, y in zip(a, b) if x != y})
+    i = np.array([x for x, _ in pairs], dtype=np.int64)
+    j = np.array([y for _, y in pairs], dtype=np.int64)
+    perm = draw(st.permutations(range(len(pairs))))
+    return n, i[list(perm)], j[list(perm)]
+
+
+@settings(max_examples=200, deadline=None)
+@given(graphs())
+def test_reference_equals_fast_on_random_graphs(g):
+    n, i, j = g
+    ref, fast = label_reference(n, i, j), label_fast(n, i, j)
+    np.testing.assert_array_equal(ref, fast)
+    # a partition into connected components: bonded pairs share a label, and there are as
+    # many labels as networkx counts components; canonical numbering by first member
+    assert np.all(fast[i] == fast[j])
+    graph = nx.Graph()
+    graph.add_nodes_from(range(n))
+    graph.add_edges_from(zip(i.tolist(), j.tolist()))
+    assert fast.max() + 1 == nx.number_connected_components(graph)
+    assert np.all(np.unique(fast, return_index=True)[1] == np.sort(np.unique(fast, return_index=True)[1]))
+
+
+@settings(max_examples=100, deadline=None)
+@given(graphs(), st.integers(0, 2**31 - 1))
+def test_unwrap_reference_equals_fast_on_random_graphs(g, seed):
+    n, i, j = g
+    L = 1.0
+    rng = np.random.default_rng(seed)
+    pos = rng.uniform(0, L, size=(n, 3))
+    labels = label_fast(n, i, j)
+    np.testing.assert_allclose(unwrap_fast(pos, labels, i, j, 1, L),
+                               unwrap_reference(pos, labels, i, j, 1, L), rtol=0, atol=1e-12)
+
+
+def test_unwrap_chain_across_boundary():
+    """A chain of bonded particles crossing y = L is laid out continuously."""
+    L = 1.0
+    y = np.array([0.8, 0.9, 0.0, 0.1, 0.2])       # 0.8 -> 1.2 unwrapped
+    pos = np.column_stack([np.zeros(5), y, np.zeros(5)])
+    i, j = np.array([3, 0, 2, 1]), np.array([4, 1, 3, 2])
+    labels = label_fast(5, i, j)
+    out = unwrap_fast(pos, labels, i, j, 1, L)
+    np.testing.assert_allclose(out[:, 1], [0.8, 0.9, 1.0, 1.1, 1.2])
+
+
+@settings(max_examples=30, deadline=None)
+@given(graphs(), st.integers(0, 1000))
+def test_louvain_refines_components(g, seed):
+    n, i, j = g
+    force = np.random.default_rng(seed).uniform(0.1, 1.0, len(i))
+    comm = louvain_labels(n, i, j, force, seed=seed)
+    comp = label_fast(n, i, j)
+    # every community lies inside one connected component
+    for k in np.unique(comm):
+        assert len(np.unique(comp[comm == k])) == 1
