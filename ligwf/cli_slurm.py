@@ -21,7 +21,7 @@ from rich.table import Table
 from .cases import render_workflow, write_study
 from .cli import add_workflow_args, case_table, console, err_console
 from .errors import SubmitError
-from .slurm import (active_tasks, cases_to_resubmit, dry_run_text, next_round, plan_jobs,
+from .slurm import (active_tasks, require_scheduler, cases_to_resubmit, dry_run_text, next_round, plan_jobs,
                     read_record, read_study, recorded_site, study_status, submit_jobs)
 from .slurm_site import SlurmSite, load_slurm_site
 from .workflow import load_workflow
@@ -89,6 +89,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
         console.print(case_table(rendered, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
         print(dry_run_text(jobs))
         return 0
+    require_scheduler()
     if read_record(out):
         busy = active_tasks(study_status(out).cases)
         if busy:
@@ -102,7 +103,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
 
 
 def status_table(study_dir: Path) -> tuple[Table, dict]:
-    st = study_status(study_dir)
+    st = study_status(study_dir, tolerant=True)
     table = Table(title=f"{study_dir}")
     for col in ("index", "case", "manifest", "slurm task", "slurm state", "reason"):
         table.add_column(col)
@@ -111,7 +112,8 @@ def status_table(study_dir: Path) -> tuple[Table, dict]:
         counts[c.manifest] = counts.get(c.manifest, 0) + 1
         table.add_row(str(c.index), c.case_id, c.manifest, c.job or "-", c.slurm_state or "-",
                       c.reason[:60])
-    data = {"cases": [asdict(c) for c in st.cases], "jobs": st.jobs, "counts": counts}
+    data = {"cases": [asdict(c) for c in st.cases], "jobs": st.jobs, "counts": counts,
+            "scheduler_error": st.scheduler_error}
     return table, data
 
 
@@ -121,6 +123,9 @@ def cmd_status(args: argparse.Namespace) -> int:
         print(json.dumps(data, indent=2, default=str))
         return 0
     console.print(table)
+    if data["scheduler_error"]:
+        err_console.print(f"[yellow]Slurm not reachable, manifests only:[/] "
+                          f"{data['scheduler_error']}", highlight=False)
     for job in data["jobs"]:
         if job["kind"] != "array":
             console.print(f"{job['kind']} job {job['job_id']} (after {job.get('after')}): "

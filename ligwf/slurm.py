@@ -44,6 +44,13 @@ RETRY_STATES = frozenset({"failed", "killed", "running"})
 Runner = Callable[[Sequence[str]], subprocess.CompletedProcess]
 
 
+def require_scheduler() -> None:
+    """SubmitError unless sbatch is on the PATH (checked before anything is written)."""
+    if shutil.which("sbatch") is None:
+        raise SubmitError("sbatch not found: is this a Slurm login node? "
+                          "(use --dry-run to see the scripts without submitting)")
+
+
 def run_command(argv: Sequence[str]) -> subprocess.CompletedProcess:
     """Run a scheduler command, capturing text; a missing command is a SubmitError."""
     if shutil.which(argv[0]) is None:
@@ -211,6 +218,7 @@ class CaseStatus:
 class StudyStatus:
     cases: list[CaseStatus]
     jobs: list[dict] = field(default_factory=list)  # record entries + "state"
+    scheduler_error: str | None = None  # why Slurm's view is missing (tolerant mode)
 
 
 def slurm_view(job_ids: Iterable[str], run: Runner = run_command,
@@ -239,9 +247,14 @@ def slurm_view(job_ids: Iterable[str], run: Runner = run_command,
     return states
 
 
-def study_status(study_dir: Path, run: Runner = run_command,
-                 user: str | None = None) -> StudyStatus:
-    """Every case with its manifest state and its latest task's Slurm state."""
+def study_status(study_dir: Path, run: Runner = run_command, user: str | None = None,
+                 tolerant: bool = False) -> StudyStatus:
+    """Every case with its manifest state and its latest task's Slurm state.
+
+    With ``tolerant`` an unreachable scheduler leaves the Slurm states empty and says why
+    (for ``status``); without it, it is an error (``resubmit`` must not guess what is
+    still queued, or a case could run twice).
+    """
     study_dir = Path(study_dir)
     study = read_study(study_dir)
     record = read_record(study_dir)
@@ -250,7 +263,13 @@ def study_status(study_dir: Path, run: Runner = run_command,
         if sub.get("kind") == "array":
             for i in sub.get("indices", []):
                 latest[int(i)] = str(sub["job_id"])
-    states = slurm_view([s["job_id"] for s in record], run, user)
+    scheduler_error = None
+    try:
+        states = slurm_view([s["job_id"] for s in record], run, user)
+    except SubmitError as exc:
+        if not tolerant:
+            raise
+        states, scheduler_error = {}, str(exc)
     cases = []
     for c in study["cases"]:
         man = read_manifest(study_dir / c["case_id"])
@@ -267,7 +286,7 @@ def study_status(study_dir: Path, run: Runner = run_command,
         if sub.get("kind") != "array":
             entry["state"] = states.get((str(sub["job_id"]), None))
         jobs.append(entry)
-    return StudyStatus(cases, jobs)
+    return StudyStatus(cases, jobs, scheduler_error)
 
 
 def cases_to_resubmit(cases: Iterable[CaseStatus], include_unstable: bool = False) -> list[int]:
