@@ -68,7 +68,7 @@ def cmd_render(args: argparse.Namespace) -> int:
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
 #: (One module per stage keeps this file small and the stages independent.)
 COMMAND_MODULES: tuple[str, ...] = ("ligwf.cli_run", "ligwf.cli_slurm", "ligwf.cli_analysis",
-                                     "ligwf.cli_stability")
+                                     "ligwf.cli_stability", "ligwf.cli_report")
 
 
 def build_parser() -> argparse.ArgumentParser:
