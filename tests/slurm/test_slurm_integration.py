@@ -103,6 +103,10 @@ def test_array_analysis_cancel_and_resubmit(slurm_cluster, tmp_path, env):
     analysis_log = study / "slurm" / "logs" / f"ligwf-slurm-tiny-analysis_{analysis_id}.out"
     assert analysis_log.is_file()
     check_analysis_output(study)
+    analysis_script = (study / "slurm" / "analysis-1.sh").read_text()
+    assert f"{LIGWF} analyse {study}" in analysis_script
+    assert f"{LIGWF} report {study}" in analysis_script  # the report stage runs after it
+    assert (study / "report" / "summary.md").is_file(), _logs(study)
     t1 = time.monotonic()
 
     # -- 2. a second array; cancel one task mid-run; resubmit exactly that case ----------
