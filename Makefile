@@ -6,7 +6,7 @@ SHELL := /bin/bash
 VENV ?= .venv
 PY := $(VENV)/bin/python
 LIGWF := $(VENV)/bin/ligwf
-APT_PACKAGES := liggghts openmpi-bin libopenmpi-dev python3-venv python3-dev
+APT_PACKAGES := liggghts openmpi-bin libopenmpi-dev python3-venv python3-dev libgl1 libegl1 libxrender1
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 STAMP := $(VENV)/.ligwf-installed
 DEMO_OUT ?= runs/demo
@@ -14,9 +14,9 @@ PYTEST_ARGS ?=
 
 .PHONY: demo test install system-packages clean
 
+# The demo study: run (2 MPI ranks per case) + analyse + report -> $(DEMO_OUT)/report/
 demo: install
-	$(LIGWF) render workflows/demo.yaml --out $(DEMO_OUT)
-	$(LIGWF) check workflows/demo.yaml
+	$(LIGWF) study workflows/demo.yaml --out $(DEMO_OUT) --np 2
 
 test: install
 	$(PY) -m pytest $(PYTEST_ARGS)
@@ -24,6 +24,7 @@ test: install
 install: system-packages $(STAMP)
 
 # liggghts RECOMMENDS paraview (~280 packages): installed without recommends on purpose.
+# libgl1/libegl1/libxrender1: off-screen pyvista snapshots in the report.
 system-packages:
 	@if ! dpkg -s $(APT_PACKAGES) >/dev/null 2>&1; then \
 	  echo "installing Debian packages: $(APT_PACKAGES)"; \
