@@ -6,7 +6,9 @@ Inputs (all already on disk): ``study.json``, each case's ``scene.json`` and
 granule stage when granules were analysed).
 
 Per case: CG level, rule, particles, dt, steps, wall and core-seconds, speedup vs CG1
-(core-seconds of the CG1 cases of the same sweep group over this case's), and errors vs
+(core-seconds per simulated second of the CG1 cases of the same sweep group over this
+case's: CG levels may simulate different times, e.g. more revolutions where they are
+cheap), and errors vs
 CG1: angle of repose (relative), velocity profile (relative L2), GSD error below/above the
 size limit, largest-cluster fraction. Per condition (CG level, rule, group): mean and 95 %
 confidence interval over replicas (Student t; a single replica has no interval).
@@ -62,7 +64,9 @@ def case_rows(study: Path) -> tuple[pd.DataFrame, list[dict]]:
         rows.append({
             "case_id": c.case_id, "group": c.group, "cg": rec["cg"], "rule": rec["rule"],
             "replica": rec["replica"], "particles": s["particle_count"], "dt": s["dt"],
-            "steps": man.get("steps_done", 0), "wall_seconds": man.get("wall_seconds", math.nan),
+            "steps": man.get("steps_done", 0),
+            "simulated_seconds": man.get("steps_done", 0) * s["dt"],
+            "wall_seconds": man.get("wall_seconds", math.nan),
             "core_seconds": man.get("core_seconds", math.nan),
             "production_core_seconds": prod.get("core_seconds", math.nan),
             "nprocs": man.get("nprocs", 1),
@@ -106,7 +110,10 @@ def compare_to_cg1(df: pd.DataFrame, profiles: dict) -> pd.DataFrame:
         ref = sub[sub["cg"] == 1]
         if ref.empty:
             continue
-        core1, wall1 = ref["core_seconds"].mean(), ref["wall_seconds"].mean()
+        # cost per simulated second, so cases simulated for different times compare
+        sim = df.loc[sub.index, "simulated_seconds"]
+        core1 = (ref["core_seconds"] / ref["simulated_seconds"]).mean()
+        wall1 = (ref["wall_seconds"] / ref["simulated_seconds"]).mean()
         ang1 = ref["angle_of_repose"].mean()
         ref_prof = [profiles[c] for c in ref["case_id"] if c in profiles]
         if ref_prof:
@@ -115,8 +122,8 @@ def compare_to_cg1(df: pd.DataFrame, profiles: dict) -> pd.DataFrame:
                 warnings.simplefilter("ignore", RuntimeWarning)  # bins empty in every CG1 case
                 v_ref = np.nanmean(np.array([p["v_mean"] for p in ref_prof], dtype=float), axis=0)
         idx = sub.index
-        df.loc[idx, "speedup_core"] = core1 / df.loc[idx, "core_seconds"]
-        df.loc[idx, "speedup_wall"] = wall1 / df.loc[idx, "wall_seconds"]
+        df.loc[idx, "speedup_core"] = core1 / (df.loc[idx, "core_seconds"] / sim)
+        df.loc[idx, "speedup_wall"] = wall1 / (df.loc[idx, "wall_seconds"] / sim)
         df.loc[idx, "angle_error"] = (df.loc[idx, "angle_of_repose"] - ang1).abs() / ang1
         if ref_prof:
             for i in idx:

@@ -120,7 +120,7 @@ def write_report(study: Path, out: Path | None = None, snapshots: bool = True,
     md = "\n".join([
         f"# {name}: error against run time", "",
         f"Study folder `{study}`; report by ligwf {__version__}. Errors are relative to the "
-        "CG1 cases of the same sweep group; speedup is CG1 core-seconds over the case's.", "",
+        "CG1 cases of the same sweep group; speedup is CG1 core-seconds per simulated second over the case's.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
         "## Skipped cases (not done or stale)", "", skipped_md, "",
         "## Figures", "",

@@ -376,7 +376,9 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
 
     if s.periodic:
         ratio = s.drum_length / s.d_max
-        verdict = REFUSED if ratio < SLICE_MIN else (MARGINAL if ratio < SLICE_WARN else OK)
+        # 1e-9: a slice of exactly 6 diameters (0.018 / 0.003) is not 'below 6'
+        verdict = (REFUSED if ratio < SLICE_MIN * (1 - 1e-9) else
+                   (MARGINAL if ratio < SLICE_WARN * (1 - 1e-9) else OK))
         msg = (f"drum.length: periodic slice {s.drum_length:.3g} m is {ratio:.3g} largest "
                f"{tag} diameters ({s.d_max:.3g} m); warn below {SLICE_WARN:g}, limit "
                f"{SLICE_MIN:g}")

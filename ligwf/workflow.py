@@ -8,6 +8,7 @@ sweep:
   rules: [weber, bond]
   replicas: {1: 1, 2: 3, 3: 3}   # or a single number for every CG level
   scene.process.rotation.rpm: [20, 30]   # any scene field as a list
+  per_cg: {2: {process.run_time: 6.0}}    # scene fields for one CG level only
 ```
 
 CLI overrides (``--set scene.drum.lifters.count=12``) are applied to the raw mapping before
@@ -40,6 +41,9 @@ class Sweep(_Frozen):
     cg_levels: tuple[float, ...] = Field((1.0,), min_length=1)
     rules: tuple[Rule, ...] = Field((Rule.WEBER,), min_length=1)
     replicas: int | dict[float, int] = Field(1, description="seeds per case, or per CG level")
+    per_cg: dict[float, dict[str, Any]] = Field(
+        default_factory=dict, description="scene fields set for one CG level only, e.g. "
+        "{2: {process.run_time: 6.0}} (more revolutions where they are cheap)")
 
     def replicas_for(self, cg: float) -> int:
         if isinstance(self.replicas, int):
@@ -151,7 +155,7 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
         sweep = Sweep.model_validate(known)
     except ValidationError as exc:
         raise ConfigError("invalid sweep:\n" + format_validation_error(exc, Sweep, "sweep")) from None
-    for cg in sweep.cg_levels:
+    for cg in list(sweep.cg_levels) + list(sweep.per_cg):
         if cg < 1:
             raise ConfigError(f"sweep.cg_levels: CG level {cg:g} is < 1 (allowed range [1, inf))")
     reps = sweep.replicas.values() if isinstance(sweep.replicas, dict) else [sweep.replicas]
@@ -189,9 +193,16 @@ def expand(raw: dict[str, Any]) -> Workflow:
         data = copy.deepcopy(base_scene)
         for (path, _), value in zip(varied, combo):
             _set_path(data, path, value)
-        scene = build_scene(data)
+        base = build_scene(data)
         tag = "".join(f"_{path.split('.')[-1]}-{_slug(v)}" for (path, _), v in zip(varied, combo))
         for cg in sweep.cg_levels:
+            if cg in sweep.per_cg:
+                cg_data = copy.deepcopy(data)
+                for path, value in sweep.per_cg[cg].items():
+                    _set_path(cg_data, path.removeprefix("scene."), value)
+                scene = build_scene(cg_data, prefix=f"sweep.per_cg.{cg:g} -> scene")
+            else:
+                scene = base
             rules = [Rule.NONE] if cg == 1 else list(sweep.rules)
             for rule in rules:
                 for rep in range(sweep.replicas_for(cg)):
