@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
-DEMO = ROOT / "workflows" / "demo.yaml"
+DRUM = ROOT / "tests" / "workflows" / "drum.yaml"
 WET_POLY = ROOT / "tests" / "workflows" / "wet_poly.yaml"
 
 

@@ -10,13 +10,13 @@ import pytest
 
 from ligwf.cli import main
 
-from conftest import DEMO
+from conftest import DRUM
 
 
 def test_render_writes_one_folder_per_case(tmp_path, capsys, monkeypatch):
     monkeypatch.setenv("LIGWF_MESH_CACHE", str(tmp_path / "cache"))
     out = tmp_path / "study"
-    assert main(["render", str(DEMO), "--out", str(out), "--set", "sweep.cg_levels=[1,2]"]) == 0
+    assert main(["render", str(DRUM), "--out", str(out), "--set", "sweep.cg_levels=[1,2]"]) == 0
     table = capsys.readouterr().out
     for col in ("CG", "rule", "particles", "dt", "steps"):
         assert col in table
@@ -33,7 +33,7 @@ def test_render_writes_one_folder_per_case(tmp_path, capsys, monkeypatch):
     assert len(list((tmp_path / "cache").glob("drum_*.stl"))) == 1
     # rendering is deterministic: same hash again
     out2 = tmp_path / "again"
-    main(["render", str(DEMO), "--out", str(out2), "--set", "sweep.cg_levels=[1,2]"])
+    main(["render", str(DRUM), "--out", str(out2), "--set", "sweep.cg_levels=[1,2]"])
     h1 = json.loads((out / "study.json").read_text())["cases"]
     h2 = json.loads((out2 / "study.json").read_text())["cases"]
     assert [c["scene_hash"] for c in h1] == [c["scene_hash"] for c in h2]
@@ -41,7 +41,7 @@ def test_render_writes_one_folder_per_case(tmp_path, capsys, monkeypatch):
 
 def test_check_writes_nothing(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
-    assert main(["check", str(DEMO)]) == 0
+    assert main(["check", str(DRUM)]) == 0
     assert "5 case(s), valid" in capsys.readouterr().out
     assert list(tmp_path.iterdir()) == []
 
@@ -54,7 +54,7 @@ def test_check_writes_nothing(tmp_path, monkeypatch, capsys):
 ])
 def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, override, field):
     out = tmp_path / "study"
-    assert main(["render", str(DEMO), "--out", str(out), "--set", override]) == 2
+    assert main(["render", str(DRUM), "--out", str(out), "--set", override]) == 2
     err = capsys.readouterr().err
     assert "ConfigError" in err and field in err
     assert not out.exists()

@@ -17,7 +17,7 @@ from ligwf.render import render_bridge_probe
 from ligwf.scaling import scale
 from ligwf.workflow import load_workflow
 
-from conftest import DEMO, run_liggghts
+from conftest import DRUM, run_liggghts
 
 pytestmark = [pytest.mark.engine]
 
@@ -48,7 +48,7 @@ def forces(engine, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("bridge")
     out = {}
     for model in ("washino", "easo"):
-        scene = load_workflow(DEMO, [f"scene.liquid.model={model}"]).cases[0].scene
+        scene = load_workflow(DRUM, [f"scene.liquid.model={model}"]).cases[0].scene
         out[(model, 1, "none")] = (scale(scene, 1, "none"),
                                    measure(engine, tmp, scale(scene, 1, "none"), f"{model}-1"))
         for n in (2, 3):
@@ -72,7 +72,7 @@ def test_engine_force_ratio(forces, model, n, rule, power):
 def test_engine_applies_the_intended_contact_angle(engine, tmp_path, model):
     """Measured force equals the published law at the scene's angle (30 deg), not at the
     angle the uncompensated engine would apply (about 7.9 deg)."""
-    scene = load_workflow(DEMO, [f"scene.liquid.model={model}"]).cases[0].scene
+    scene = load_workflow(DRUM, [f"scene.liquid.model={model}"]).cases[0].scene
     s = scale(scene, 1, "none")
     measured = measure(engine, tmp_path, s, model, ANGLE_GAP_RATIO)
     r = 0.5 * s.d_min
@@ -88,7 +88,7 @@ def test_engine_applies_the_intended_contact_angle(engine, tmp_path, model):
 
 def test_uncompensated_engine_applies_the_product_angle(engine, tmp_path):
     """Pins the engine bug itself: with compensation off, 30 deg acts as 0.5*theta^2."""
-    scene = load_workflow(DEMO, ["scene.numerics.contact_angle_compensation=false"]).cases[0].scene
+    scene = load_workflow(DRUM, ["scene.numerics.contact_angle_compensation=false"]).cases[0].scene
     s = scale(scene, 1, "none")
     measured = measure(engine, tmp_path, s, "raw", ANGLE_GAP_RATIO)
     r = 0.5 * s.d_min

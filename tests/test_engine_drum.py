@@ -9,7 +9,7 @@ import pytest
 
 from ligwf.cases import render_workflow, write_study
 
-from conftest import DEMO, WET_POLY, run_liggghts
+from conftest import DRUM, WET_POLY, run_liggghts
 from ligwf.workflow import load_workflow
 
 pytestmark = [pytest.mark.engine, pytest.mark.mpi]
@@ -18,9 +18,9 @@ SHORT = ["scene.process.settle_time=0.05", "scene.process.run_time=0.1",
          "scene.numerics.dump_interval=0.04"]
 
 SCENES = {
-    "wet-lifters-cg3": (DEMO, ["sweep.cg_levels=[3]", "sweep.rules=[weber]"], "cg3-weber-r0"),
+    "wet-lifters-cg3": (DRUM, ["sweep.cg_levels=[3]", "sweep.rules=[weber]"], "cg3-weber-r0"),
     "poly-rolling-cg3-bond": (WET_POLY, ["sweep.cg_levels=[3]", "sweep.rules=[bond]"], "cg3-bond-r0"),
-    "closed-easo-cg3": (DEMO, ["sweep.cg_levels=[3]", "sweep.rules=[weber]",
+    "closed-easo-cg3": (DRUM, ["sweep.cg_levels=[3]", "sweep.rules=[weber]",
                                "scene.drum.periodic=false", "scene.liquid.model=easo"], "cg3-weber-r0"),
 }
 

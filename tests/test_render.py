@@ -16,7 +16,7 @@ from ligwf.errors import RenderError
 from ligwf.render import render
 from ligwf.workflow import load_workflow
 
-from conftest import DEMO, ROOT, WET_POLY
+from conftest import DRUM, ROOT, WET_POLY
 
 sys.path.insert(0, str(ROOT / "scripts"))
 from regen_golden import GOLDEN, golden_cases, render_golden  # noqa: E402
@@ -30,7 +30,7 @@ def test_golden(entry):
         "intended run scripts/regen_golden.py and review the diff")
 
 
-def text(workflow=DEMO, overrides=(), case=0) -> str:
+def text(workflow=DRUM, overrides=(), case=0) -> str:
     wf = load_workflow(workflow, list(overrides))
     return render(wf.cases[case].scaled())["in.liggghts"]
 
@@ -102,17 +102,17 @@ def test_engine_angle_compensated_and_switchable():
 
 
 def test_unsafe_value_refused_even_if_it_bypasses_validation():
-    wf = load_workflow(DEMO)
+    wf = load_workflow(DRUM)
     bad = dataclasses.replace(wf.cases[0].scaled(), name="x\nshell touch /tmp/pwned")
     with pytest.raises(RenderError, match="inject"):
         render(bad)
 
 
 def test_user_template_folder_overrides_and_strict_undefined(tmp_path):
-    scaled = load_workflow(DEMO).cases[0].scaled()
+    scaled = load_workflow(DRUM).cases[0].scaled()
     (tmp_path / "_header.j2").write_text("# site header for {{ s.name }}\natom_style granular\n")
     src = render(scaled, [tmp_path])["in.liggghts"]
-    assert src.startswith("# site header for demo\n")
+    assert src.startswith("# site header for drum-slice\n")
     assert "fix pdd all particledistribution" in src  # the rest still comes from ligwf
     (tmp_path / "_header.j2").write_text("# {{ no_such_value }}\n")
     with pytest.raises(RenderError, match="no_such_value"):
@@ -121,7 +121,7 @@ def test_user_template_folder_overrides_and_strict_undefined(tmp_path):
 
 def test_render_is_pure(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    files = render(load_workflow(DEMO).cases[1].scaled())
+    files = render(load_workflow(DRUM).cases[1].scaled())
     assert set(files) == {"in.liggghts"}
     assert list(tmp_path.iterdir()) == []
 

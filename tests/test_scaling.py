@@ -11,13 +11,13 @@ from ligwf.scaling import (Rule, bond_number, rayleigh_time, replica_seeds, is_p
                            weber_number)
 from ligwf.workflow import load_workflow
 
-from conftest import DEMO, WET_POLY
+from conftest import DRUM, WET_POLY
 
 GAP_RATIOS = [0.0, 0.01, 0.05, 0.1]  # surface gap / effective radius
 
 
 def base_scene(model: str = "washino"):
-    return load_workflow(DEMO, [f"scene.liquid.model={model}"]).cases[0].scene
+    return load_workflow(DRUM, [f"scene.liquid.model={model}"]).cases[0].scene
 
 
 def bridge_force(s, gap_ratio: float) -> float:

@@ -11,11 +11,11 @@ from ligwf.errors import ConfigError
 from ligwf.scene import build_scene
 from ligwf.workflow import expand, load_workflow
 
-from conftest import DEMO
+from conftest import DRUM
 
 
 def demo_raw() -> dict:
-    return yaml.safe_load(DEMO.read_text())
+    return yaml.safe_load(DRUM.read_text())
 
 
 def expect_error(raw: dict, *fragments: str) -> str:
@@ -38,7 +38,7 @@ def with_value(path: str, value):
 
 
 def test_demo_is_valid():
-    wf = load_workflow(DEMO)
+    wf = load_workflow(DRUM)
     assert [c.case_id for c in wf.cases] == [
         "cg1-none-r0", "cg2-weber-r0", "cg2-bond-r0", "cg3-weber-r0", "cg3-bond-r0"]
 
@@ -140,12 +140,12 @@ def test_sweep_over_scene_field_expands_cases():
 
 
 def test_set_override_applies_and_validates():
-    wf = load_workflow(DEMO, ["scene.drum.lifters.count=6", "sweep.cg_levels=[2]"])
+    wf = load_workflow(DRUM, ["scene.drum.lifters.count=6", "sweep.cg_levels=[2]"])
     assert wf.cases[0].scene.drum.lifters.count == 6
     with pytest.raises(ConfigError, match="scene.drum.lifters.count"):
-        load_workflow(DEMO, ["scene.drum.lifters.count=-3"])
+        load_workflow(DRUM, ["scene.drum.lifters.count=-3"])
     with pytest.raises(ConfigError, match="unknown top-level key"):
-        load_workflow(DEMO, ["scen.drum.length=1"])
+        load_workflow(DRUM, ["scen.drum.length=1"])
 
 
 def test_scene_is_frozen():

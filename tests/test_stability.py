@@ -18,7 +18,7 @@ from ligwf.workflow import load_workflow
 
 ROOT = Path(__file__).resolve().parent.parent
 SUITE = ROOT / "workflows" / "stability.yaml"
-DEMO = ROOT / "workflows" / "demo.yaml"
+DRUM = ROOT / "tests" / "workflows" / "drum.yaml"
 
 # Hand computation for r = 1 mm, rho = 2500 kg/m^3, E = 1e7 Pa, nu = 0.3:
 #   G = E / 2.6 = 3.846e6 Pa; t_R = pi 1e-3 sqrt(2500 / 3.846e6) / (0.1631*0.3 + 0.8766)
@@ -74,7 +74,7 @@ def test_froude_regime_and_critical_speed_hand_values():
     assert st.regime(0.02) == "cascading"
     assert st.regime(1e-3) == "rolling"
     assert st.regime(1e-5) == "slumping"
-    wf = load_workflow(DEMO, ["scene.drum.diameter=0.1", "scene.process.rotation.rpm=60",
+    wf = load_workflow(DRUM, ["scene.drum.diameter=0.1", "scene.process.rotation.rpm=60",
                               "scene.drum.lifters.count=0", "sweep.cg_levels=[1]"])
     sc = st.time_scales(wf.cases[0].scaled())
     assert sc.froude == pytest.approx(0.2012, rel=1e-3)
@@ -83,7 +83,7 @@ def test_froude_regime_and_critical_speed_hand_values():
 
 
 def test_demo_is_not_refused():
-    wf = load_workflow(DEMO)
+    wf = load_workflow(DRUM)
     for case in wf.cases:
         assert st.preflight(case.scaled(), case.case_id).verdict != st.REFUSED
 
@@ -108,7 +108,7 @@ def test_every_refusal_names_field_value_limit_and_suggestion():
 
 
 def test_refusal_message_example_shape():
-    wf = load_workflow(DEMO, ["scene.numerics.dt=1.0e-4", "sweep.cg_levels=[3]",
+    wf = load_workflow(DRUM, ["scene.numerics.dt=1.0e-4", "sweep.cg_levels=[3]",
                               "sweep.rules=[weber]"])
     case = wf.cases[0]
     rep = st.preflight(case.scaled(), case.case_id, explicit_dt=True)
@@ -120,13 +120,13 @@ def test_refusal_message_example_shape():
 
 
 def test_explicit_dt_overrides_the_fraction_and_is_reported():
-    wf = load_workflow(DEMO, ["scene.numerics.dt=2.0e-6", "sweep.cg_levels=[1, 2]",
+    wf = load_workflow(DRUM, ["scene.numerics.dt=2.0e-6", "sweep.cg_levels=[1, 2]",
                               "sweep.rules=[weber]"])
     for case in wf.cases:
         s = case.scaled()
         assert s.dt == 2.0e-6
         assert s.dt_rayleigh_fraction == pytest.approx(2.0e-6 / s.rayleigh_time)
-    default = load_workflow(DEMO).cases[0].scaled()
+    default = load_workflow(DRUM).cases[0].scaled()
     assert default.dt == pytest.approx(0.16 * default.rayleigh_time)
     assert default.dt_rayleigh_fraction == 0.16
 
@@ -134,16 +134,16 @@ def test_explicit_dt_overrides_the_fraction_and_is_reported():
 @pytest.mark.parametrize("modulus, line", [(1e10, "hard_particles yes"),
                                            (1e6, "soft_particles yes")])
 def test_extreme_moduli_render_the_engine_switch(modulus, line):
-    wf = load_workflow(DEMO, [f"scene.particles.youngs_modulus={modulus}",
+    wf = load_workflow(DRUM, [f"scene.particles.youngs_modulus={modulus}",
                               "sweep.cg_levels=[1]"])
     text = render(wf.cases[0].scaled())["in.liggghts"]
     assert line in text.splitlines()
-    normal = render(load_workflow(DEMO).cases[0].scaled())["in.liggghts"]
+    normal = render(load_workflow(DRUM).cases[0].scaled())["in.liggghts"]
     assert "hard_particles" not in normal and "soft_particles" not in normal
 
 
 def test_enforce_refuses_unless_overridden():
-    wf = load_workflow(DEMO, ["scene.numerics.dt_rayleigh_fraction=0.5", "sweep.cg_levels=[1]"])
+    wf = load_workflow(DRUM, ["scene.numerics.dt_rayleigh_fraction=0.5", "sweep.cg_levels=[1]"])
     reps = [st.preflight(c.scaled(), c.case_id) for c in wf.cases]
     with pytest.raises(st.UnstableCase, match="0.5x the Rayleigh time"):
         st.enforce(reps)
@@ -153,15 +153,15 @@ def test_enforce_refuses_unless_overridden():
 
 def test_cli_check_and_render_refuse_and_override(tmp_path, capsys):
     bad = ["--set", "scene.numerics.dt_rayleigh_fraction=1.0", "--set", "sweep.cg_levels=[1]"]
-    assert main(["check", str(DEMO), *bad]) == 2
+    assert main(["check", str(DRUM), *bad]) == 2
     err = capsys.readouterr().err
     assert "UnstableCase" in err and "Rayleigh time" in err and "--allow-unstable" in err
     out = tmp_path / "study"
-    assert main(["render", str(DEMO), *bad, "--out", str(out),
+    assert main(["render", str(DRUM), *bad, "--out", str(out),
                  "--mesh-cache", str(tmp_path / "m")]) == 2
     assert not out.exists(), "a refused workflow must not be written"
-    assert main(["check", str(DEMO), *bad, "--allow-unstable"]) == 0
-    assert main(["render", str(DEMO), *bad, "--allow-unstable", "--out", str(out),
+    assert main(["check", str(DRUM), *bad, "--allow-unstable"]) == 0
+    assert main(["render", str(DRUM), *bad, "--allow-unstable", "--out", str(out),
                  "--mesh-cache", str(tmp_path / "m")]) == 0
     assert (out / "cg1-none-r0" / "in.liggghts").is_file()
 

@@ -11,7 +11,7 @@ import json
 import shutil
 from pathlib import Path
 
-from conftest import DEMO, run_liggghts
+from conftest import DRUM, run_liggghts
 from ligwf.cases import render_workflow, write_study
 from ligwf.workflow import load_workflow
 
@@ -32,7 +32,7 @@ def wet_study(engine, tmp_path_factory) -> Path:
     if "study" in _CACHE:
         return _CACHE["study"]
     out = tmp_path_factory.mktemp("wetstudy")
-    wf = load_workflow(DEMO, ["sweep.cg_levels=[3]", "sweep.rules=[weber,bond]",
+    wf = load_workflow(DRUM, ["sweep.cg_levels=[3]", "sweep.rules=[weber,bond]",
                               "scene.process.run_time=0.2", "scene.process.settle_time=0.05"])
     rendered = render_workflow(wf)
     write_study(wf, rendered, out, out / "meshes")
