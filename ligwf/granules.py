@@ -92,15 +92,20 @@ class Liquid:
 def bridge_forces(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
                   i: np.ndarray | None = None, j: np.ndarray | None = None) -> np.ndarray:
     """Capillary force magnitude of every contact, N (0 for a dry run or a broken bridge)."""
-    if liquid.model == "none" or len(contacts) == 0:
-        return np.zeros(len(contacts))
     i = particles.index_of(contacts.id1) if i is None else i
     j = particles.index_of(contacts.id2) if j is None else j
+    return _capillary(particles, i, j, -contacts.delta, liquid)
+
+
+def _capillary(particles: ParticleFrame, i: np.ndarray, j: np.ndarray, gap: np.ndarray,
+               liquid: Liquid) -> np.ndarray:
+    if liquid.model == "none" or len(i) == 0:
+        return np.zeros(len(i))
     content = particles.liquid_content
     if content is None:
         content = np.full(len(particles), liquid.liquid_content)
     return np.asarray(bridges.capillary_force(
-        liquid.model, particles.radii[i], particles.radii[j], -contacts.delta,
+        liquid.model, particles.radii[i], particles.radii[j], gap,
         liquid.surface_tension, liquid.contact_angle_rad, content[i], content[j]), dtype=float)
 
 
@@ -119,15 +124,33 @@ def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Li
     """Indices (i, j) of bonded pairs into the particle arrays, and their bridge forces (N)."""
     i = particles.index_of(contacts.id1)
     j = particles.index_of(contacts.id2)
-    force = bridge_forces(particles, contacts, liquid, i, j)
+    # the cheap velocity test first; the force law only for the pairs that pass it
+    sel = np.flatnonzero(comoving(particles.velocities[i], particles.velocities[j],
+                                  criterion.max_velocity_angle_deg))
+    i, j = i[sel], j[sel]
+    force = _capillary(particles, i, j, -contacts.delta[sel], liquid)
     keep = force > criterion.min_bridge_force
-    keep &= comoving(particles.velocities[i], particles.velocities[j],
-                     criterion.max_velocity_angle_deg)
     return i[keep], j[keep], force[keep]
+
+
+def _is_canonical(labels: np.ndarray) -> bool:
+    """True when label k first appears after labels 0..k-1 (then the running maximum
+    never jumps by more than one), checked in one pass instead of a sort."""
+    if len(labels) == 0:
+        return True
+    return labels[0] == 0 and bool(np.all(np.diff(np.maximum.accumulate(labels)) <= 1))
+
+
+def first_members(labels: np.ndarray) -> np.ndarray:
+    """Index of the first particle of each granule, for canonical labels (no sort)."""
+    running = np.maximum.accumulate(labels)
+    return np.flatnonzero(np.concatenate([[True], np.diff(running) > 0]))
 
 
 def _canonical(labels: np.ndarray) -> np.ndarray:
     """Relabel so granule k is the k-th distinct label met in particle (id) order."""
+    if _is_canonical(labels):      # scipy numbers components in this order already
+        return labels.astype(np.int64, copy=False)
     _, first, inverse = np.unique(labels, return_index=True, return_inverse=True)
     rank = np.empty(len(first), dtype=np.int64)
     rank[np.argsort(first, kind="stable")] = np.arange(len(first))
@@ -206,7 +229,7 @@ def unwrap_fast(positions: np.ndarray, labels: np.ndarray, i: np.ndarray, j: np.
     out = positions.copy()
     if len(i) == 0 or length <= 0:
         return out
-    roots = np.unique(labels, return_index=True)[1]
+    roots = first_members(labels)
     super_root = n
     rows = np.concatenate([i, j, np.full(len(roots), super_root)])
     cols = np.concatenate([j, i, roots])
@@ -242,8 +265,7 @@ def granule_table(particles: ParticleFrame, labels: np.ndarray, cg: float,
                            for a in range(3)]) / volume[:, None]
     if periodic_axis is not None and box_length > 0:
         com[:, periodic_axis] = box_lo + np.mod(com[:, periodic_axis] - box_lo, box_length)
-    first_id = np.full(n_gran, np.iinfo(np.int64).max)
-    np.minimum.at(first_id, labels, particles.ids)
+    first_id = particles.ids[first_members(labels)] if n_gran else np.zeros(0, np.int64)
     return pd.DataFrame({
         "granule": np.arange(n_gran, dtype=np.int64),
         "members": members.astype(np.int64),

@@ -93,10 +93,11 @@ def _bad(src: Path, dst_dir: Path, edit) -> Path:
     ("empty", lambda t: "", "empty"),
     ("not xml", lambda t: "hello\n", "not a readable VTU"),
 ])
-def test_bad_particle_dump(frame, tmp_path, kind, edit, message):
+@pytest.mark.parametrize("reader", ["fast", "meshio"])
+def test_bad_particle_dump(frame, tmp_path, kind, edit, message, reader):
     bad = _bad(frame.particles, tmp_path, edit)
     with pytest.raises(DumpReadError, match=re.escape(message)) as err:
-        read_particles(bad)
+        read_particles(bad, reader=reader)
     assert str(bad) in str(err.value), "the error names the file"
 
 
@@ -152,3 +153,17 @@ def test_empty_contact_frame_is_valid(tmp_path):
                     '  </UnstructuredGrid>\n</VTKFile>\n')
     c = read_contacts(path)
     assert len(c) == 0 and c.step == 7
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_fast_reader_equals_meshio(case):
+    """The direct base64 decoder (fast path) gives meshio's arrays (the reference)."""
+    for f in discover_frames(case):
+        for read, path in ((read_particles, f.particles), (read_contacts, f.contacts)):
+            fast, ref = read(path), read(path, reader="meshio")
+            for name, value in vars(fast).items():
+                if isinstance(value, np.ndarray):
+                    other = getattr(ref, name)
+                    assert value.dtype == other.dtype, name
+                    np.testing.assert_array_equal(value, other, err_msg=name)

@@ -114,7 +114,7 @@ def test_broken_bridge_and_threshold():
     vol = bridges.washino_bridge_volume(r, r, 0.02, 0.02)
     rupture = bridges.rupture_distance(vol, math.radians(30))
     c = ContactFrame(Path("synthetic"), 0, np.array([1, 2, 3]), np.array([2, 3, 4]),
-                     np.array([1e-6, -0.5 * rupture, -1.01 * rupture]), None)
+                     np.array([1e-6, -0.5 * rupture, -1.01 * rupture]))
     i, j, f = bonded_contacts(p, c, liquid)
     assert list(zip(i, j)) == [(0, 1), (1, 2)]
     strong = float(f[0])

@@ -1,0 +1,174 @@
+"""Granule identification speed: networkx reference vs scipy fast path, and a whole frame.
+
+Usage: ``.venv/bin/python benchmarks/bench_granules.py [--sizes 13000 45000 360000]
+[--real CASE_DIR]`` (one core; prints, never asserts).
+
+Synthetic frames: N particles of 1 mm on a jittered simple-cubic lattice in a box periodic
+along y, each bonded to lattice neighbours so that every particle has about 5 contacts
+(coordination number 5, i.e. 2.5 N contact rows), gaps spread from 2% overlap to beyond the
+rupture distance, and a rotating-drum-like velocity field with noise so the velocity-angle
+criterion splits the bed into many granules (like a real flowing bed). The same frame is
+also written as particle and contact ``.vtu`` files (meshio, binary) to time the whole
+frame: read + identify + GSD.
+
+Per size it prints the time per frame of
+* reference: shared bond criterion + networkx BFS components + networkx BFS unwrap + table;
+* fast:      shared bond criterion + scipy components + vectorised unwrap + table;
+* floor:     one streaming pass over the contact arrays identification needs (id1, id2,
+  delta: a sum over each, in memory), the least any implementation must do;
+* read floor: reading those contact arrays from the dump file with meshio;
+and the ratios reference/fast (target >= 100x at 360k) and fast/floor (target <= 25x),
+plus whole frames per second (target >= 2 at 360k).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ligwf import gsd
+from ligwf.dumps import (ContactFrame, ParticleFrame, discover_frames, read_contacts,
+                         read_particles)
+from ligwf.granules import (BondCriterion, Liquid, bonded_contacts, granule_table, label_fast,
+                            label_reference, unwrap_fast, unwrap_reference)
+
+R = 0.0005
+LIQUID = Liquid("washino", 0.024, math.radians(30.0), 0.02)
+
+
+def synthetic_frame(n: int, seed: int = 1) -> tuple[ParticleFrame, ContactFrame, float]:
+    """A frame of about n particles with ~5 contacts per particle; returns (p, c, L_y)."""
+    rng = np.random.default_rng(seed)
+    side = round(n ** (1 / 3))
+    nx_, ny, nz = side, max(2, n // (side * side)), side
+    n = nx_ * ny * nz
+    a = 2 * R * 1.02
+    ix, iy, iz = np.unravel_index(np.arange(n), (nx_, ny, nz))
+    pos = np.column_stack([ix, iy, iz]) * a + rng.normal(0, 0.02 * R, (n, 3))
+    length = ny * a
+    pos[:, 1] = np.mod(pos[:, 1], length)
+    # drum-like rotation about y plus noise: neighbours mostly co-move, some do not
+    centre = pos.mean(axis=0)
+    vel = np.column_stack([-(pos[:, 2] - centre[2]), np.zeros(n), pos[:, 0] - centre[0]]) * 3.0
+    vel += rng.normal(0, 0.01, (n, 3))
+    # forward lattice neighbours (+x, +y periodic, +z), each kept with probability 5/6
+    pairs = []
+    for dx, dy, dz in ((1, 0, 0), (0, 1, 0), (0, 0, 1)):
+        jx, jy, jz = ix + dx, (iy + dy) % ny, iz + dz
+        ok = (jx < nx_) & (jz < nz)
+        j = np.ravel_multi_index((jx[ok], jy[ok], jz[ok]), (nx_, ny, nz))
+        pairs.append(np.column_stack([np.nonzero(ok)[0], j]))
+    pairs = np.concatenate(pairs)
+    pairs = pairs[rng.uniform(size=len(pairs)) < 2.5 * n / len(pairs)]   # 2.5 n rows
+    m = len(pairs)
+    delta = rng.uniform(-2.5e-4, 2e-5, m)          # rupture of 1 mm spheres is ~1.6e-4 m
+    ids = np.arange(1, n + 1, dtype=np.int64)
+    p = ParticleFrame(Path("synthetic"), 0, 0.0, ids, np.ones(n, np.int32), pos, vel,
+                      np.full(n, R), np.full(n, 0.02))
+    lo, hi = np.minimum(pairs[:, 0], pairs[:, 1]), np.maximum(pairs[:, 0], pairs[:, 1])
+    c = ContactFrame(Path("synthetic"), 0, lo + 1, hi + 1, delta)
+    return p, c, length
+
+
+def write_frame(p: ParticleFrame, c: ContactFrame, folder: Path, step: int = 1000) -> None:
+    """The frame as LIGGGHTS-like particle and contact .vtu dumps (meshio, binary)."""
+    import meshio
+
+    n = len(p)
+    meshio.write(folder / f"particles_{step}.vtu", meshio.Mesh(
+        p.positions.astype(np.float32), [("vertex", np.arange(n).reshape(-1, 1))],
+        point_data={"id": p.ids.astype(np.int32), "type": p.types, "v": p.velocities,
+                    "radius": p.radii, "f_surfaceLiquidContent": p.liquid_content}),
+        file_format="vtu", binary=True, compression=None)
+    i, j = c.id1 - 1, c.id2 - 1
+    pts = np.concatenate([p.positions[i], p.positions[j]]).astype(np.float32)
+    m = len(c)
+    lines = np.column_stack([np.arange(m), np.arange(m) + m])
+    meshio.write(folder / f"contacts_{step}.vtu", meshio.Mesh(
+        pts, [("line", lines)], cell_data={
+            "vel1": [p.velocities[i]], "vel2": [p.velocities[j]],
+            "id1": [c.id1.astype(float)], "id2": [c.id2.astype(float)],
+            "force": [np.zeros((m, 3))], "force_normal": [np.zeros((m, 3))],
+            "delta": [c.delta]}), file_format="vtu", binary=True, compression=None)
+
+
+def timed(fn, repeat: int = 1) -> tuple[float, object]:
+    best, out = math.inf, None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t0)
+    return best, out
+
+
+def identify(p, c, length, liquid, fast: bool):
+    i, j, _ = bonded_contacts(p, c, liquid, BondCriterion())
+    label, unwrap = (label_fast, unwrap_fast) if fast else (label_reference, unwrap_reference)
+    labels = label(len(p), i, j)
+    unwrapped = unwrap(p.positions, labels, i, j, 1, length)
+    return granule_table(p, labels, 1.0, unwrapped, 1, 0.0, length)
+
+
+def stream_floor(c: ContactFrame) -> float:
+    return float(c.id1.sum() + c.id2.sum() + c.delta.sum())
+
+
+def whole_frame(folder: Path, step: int, length: float, liquid) -> int:
+    p = read_particles(folder / f"particles_{step}.vtu")
+    c = read_contacts(folder / f"contacts_{step}.vtu")
+    table = identify(p, c, length, liquid, fast=True)
+    v = table["primary_volume"].to_numpy()
+    gsd.histogram(v, gsd.log_edges(v.min(), v.max(), 5))
+    gsd.percentile_diameters(v)
+    return len(table)
+
+
+def report(label: str, p, c, length, liquid, folder: Path | None, step: int,
+           skip_reference: bool) -> None:
+    t_fast, table = timed(lambda: identify(p, c, length, liquid, True), 3)
+    t_floor, _ = timed(lambda: stream_floor(c), 5)
+    if skip_reference:
+        t_ref = math.nan
+    else:
+        t_ref, ref_table = timed(lambda: identify(p, c, length, liquid, False), 1)
+        assert ref_table["members"].tolist() == table["members"].tolist()
+    line = (f"{label:>16}: N={len(p):>7,} contacts={len(c):>8,} granules={len(table):>7,} | "
+            f"reference {t_ref:8.3f} s  fast {t_fast * 1e3:8.1f} ms  ratio {t_ref / t_fast:7.1f}x | "
+            f"floor {t_floor * 1e3:6.2f} ms  fast/floor {t_fast / t_floor:6.1f}x")
+    if folder is not None:
+        t_read, _ = timed(lambda: read_contacts(folder / f"contacts_{step}.vtu"), 3)
+        t_whole, _ = timed(lambda: whole_frame(folder, step, length, liquid), 3)
+        line += (f" | read contacts {t_read * 1e3:7.1f} ms  fast/read {t_fast / t_read:5.2f}x"
+                 f" | whole frame {t_whole:6.3f} s = {1 / t_whole:5.2f} frames/s")
+    print(line, flush=True)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", type=int, nargs="*", default=[13000, 45000, 360000])
+    ap.add_argument("--real", type=Path, default=None, help="a case folder with dumps")
+    ap.add_argument("--skip-reference-above", type=int, default=10**9)
+    args = ap.parse_args()
+    print("one core; times are best of 3 (fast, whole frame) / 1 (reference) runs")
+    for n in args.sizes:
+        p, c, length = synthetic_frame(n)
+        with tempfile.TemporaryDirectory() as tmp:
+            write_frame(p, c, Path(tmp))
+            report(f"synthetic {n // 1000}k", p, c, length, LIQUID, Path(tmp), 1000,
+                   n > args.skip_reference_above)
+    if args.real is not None:
+        scaled = json.loads((args.real / "scene.json").read_text())["scaled"]
+        f = discover_frames(args.real)[-1]
+        p, c = read_particles(f.particles), read_contacts(f.contacts)
+        report(f"real {args.real.name}", p, c, scaled["drum_length"], Liquid.from_scaled(scaled),
+               f.particles.parent, f.step, False)
+
+
+if __name__ == "__main__":
+    main()
