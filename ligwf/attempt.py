@@ -84,10 +84,19 @@ def begin_attempt(case_dir: Path, plan: Plan, nprocs: int, launcher: str,
     return manifest, attempt
 
 
-def _merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int) -> list[ThermoRow]:
-    """Thermo of earlier attempts up to the restart step, then this attempt's rows."""
-    kept = [r for r in previous if r.step < from_step] if from_step else []
-    return kept + [r for r in new if r.step >= from_step]
+def _merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int,
+                dt: float) -> list[ThermoRow]:
+    """Thermo of earlier attempts up to the restart step, then this attempt's rows.
+
+    LIGGGHTS restarts its ``time`` thermo column at 0 after ``read_restart``; the
+    simulated time of a resumed row is put back on the case's clock (+ from_step x dt, s).
+    """
+    if not from_step:
+        return list(new)
+    kept = [r for r in previous if r.step < from_step]
+    shifted = [ThermoRow(r.step, {**r.values, "time": r.get("time", 0.0) + from_step * dt},
+                         r.phase) for r in new if r.step >= from_step]
+    return kept + shifted
 
 
 def finish_attempt(case_dir: Path, manifest: Manifest, attempt: Attempt, exit_code: int | None,
@@ -102,7 +111,7 @@ def finish_attempt(case_dir: Path, manifest: Manifest, attempt: Attempt, exit_co
     previous: list[ThermoRow] = []
     if attempt.from_step and (case_dir / THERMO_FILE).exists():
         previous = rows_from_csv((case_dir / THERMO_FILE).read_text())
-    rows = _merge_rows(previous, parser.rows, attempt.from_step)
+    rows = _merge_rows(previous, parser.rows, attempt.from_step, s.dt)
     expect = expectation(s)
     issues = assess(rows, parser.lines, expect)
     steps_done = rows[-1].step if rows else attempt.from_step
