@@ -137,7 +137,7 @@ def insertion_shortfall(rows: Sequence[ThermoRow], particle_count: int,
     return []
 
 
-_STEP_IN_LINE = re.compile(r"\bstep\s+(\d+)", re.IGNORECASE)
+_LOST_RE = re.compile(r"original (\d+) current (\d+)")
 
 
 def _step_at(lines: Sequence[str], index: int) -> int | None:
@@ -173,7 +173,11 @@ def log_warnings(lines: Sequence[str]) -> list[HealthIssue]:
         elif "time step too large" in text:
             kind = "timestep_warning"
         elif "Lost atoms" in text:
-            kind = "lost_atoms"
+            # LIGGGHTS also prints "original 0 current 0" once a nan reaches the atom
+            # count: only a real drop is an atom loss (the nan is reported by itself)
+            m = _LOST_RE.search(text)
+            if m is None or int(m.group(2)) < int(m.group(1)):
+                kind = "lost_atoms"
         if kind and kind not in seen:
             seen.add(kind)
             issues.append(HealthIssue(kind, _step_at(lines, i), text))
