@@ -147,6 +147,21 @@ def report(label: str, p, c, length, liquid, folder: Path | None, step: int,
         line += (f" | read contacts {t_read * 1e3:7.1f} ms  fast/read {t_fast / t_read:5.2f}x"
                  f" | whole frame {t_whole:6.3f} s = {1 / t_whole:5.2f} frames/s")
     print(line, flush=True)
+    # where the time goes: the bond criterion is shared by both implementations
+    t_bond, (i, j, _) = timed(lambda: bonded_contacts(p, c, liquid, BondCriterion()), 3)
+    t_lf, labels = timed(lambda: label_fast(len(p), i, j), 3)
+    t_uf, _ = timed(lambda: unwrap_fast(p.positions, labels, i, j, 1, length), 3)
+    t_tab, _ = timed(lambda: granule_table(p, labels, 1.0, None, 1, 0.0, length), 3)
+    if skip_reference:
+        t_lr = t_ur = math.nan
+    else:
+        t_lr, _ = timed(lambda: label_reference(len(p), i, j), 1)
+        t_ur, _ = timed(lambda: unwrap_reference(p.positions, labels, i, j, 1, length), 1)
+    print(f"{'':>16}  split: bond criterion (shared) {t_bond * 1e3:7.1f} ms, table "
+          f"{t_tab * 1e3:6.1f} ms | components ref {t_lr:7.3f} s fast {t_lf * 1e3:6.1f} ms "
+          f"({t_lr / t_lf:6.1f}x) | unwrap ref {t_ur:7.3f} s fast {t_uf * 1e3:6.1f} ms "
+          f"({t_ur / t_uf:6.1f}x) | components+unwrap {(t_lr + t_ur) / (t_lf + t_uf):6.1f}x",
+          flush=True)
 
 
 def main() -> None:
