@@ -79,25 +79,43 @@ class Liggghts:
     def run_file(self, comm, case_dir: Path, input_name: str) -> None:
         """Run ``input_name`` in ``case_dir`` on the mpi4py communicator ``comm``.
 
-        The screen goes to run.log (``-screen none`` segfaults when a mesh is read).
+        The engine's screen is the process's stdout, pointed at ``run.log`` of the case on
+        the group leader and line-buffered (:func:`line_buffered_stdout`): an Error::one
+        ends in MPI_Abort, which drops whatever a fully buffered ``-screen FILE`` still
+        held -- including the ERROR line that names the culprit.
         """
         from mpi4py import MPI
 
-        args = [b"liggghts", b"-screen", SCREEN_FILE.encode(), b"-log", b"log.liggghts"]
+        args = [b"liggghts", b"-log", b"log.liggghts"]
         argv = (ctypes.c_char_p * len(args))(*args)
         handle = ctypes.c_void_p()
         comm_ptr = ctypes.c_void_p.from_address(MPI._addressof(comm))
         cwd = os.getcwd()
+        saved = None
+        _libc.fflush(None)
+        if comm.rank == 0:
+            saved = os.dup(1)
+            fd = os.open(Path(case_dir) / SCREEN_FILE, os.O_WRONLY | os.O_CREAT | os.O_TRUNC,
+                         0o644)
+            os.dup2(fd, 1)
+            os.close(fd)
         os.chdir(case_dir)
         try:
             self.lib.lammps_open(len(args), argv, comm_ptr, ctypes.byref(handle))
             self.lib.lammps_file(handle, input_name.encode())
             self.lib.lammps_close(handle)
         finally:
-            # lammps_close leaves the -screen FILE open: flush it so the leader judges the
-            # complete screen, not what happened to leave the stdio buffer
             _libc.fflush(None)
             os.chdir(cwd)
+            if saved is not None:
+                os.dup2(saved, 1)
+                os.close(saved)
+
+
+def line_buffered_stdout() -> None:
+    """Make C stdout line-buffered (must run before anything is written to it)."""
+    stdout = ctypes.c_void_p.in_dll(_libc, "stdout")
+    _libc.setvbuf(stdout, None, 1, 0)  # 1 = _IOLBF
 
 
 def claim_next(ens_dir: Path, cases: list[str], record: dict) -> tuple[int, str] | None:
@@ -121,6 +139,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--group-size", type=int, default=1)
     args = parser.parse_args(argv)
 
+    line_buffered_stdout()
     from mpi4py import MPI
 
     world = MPI.COMM_WORLD
