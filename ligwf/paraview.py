@@ -17,6 +17,7 @@ import meshio
 import numpy as np
 
 from .dumps import discover_frames
+from .flow_run import production_start_step
 from .fsio import atomic_write_text
 from .mesh import axis_frame
 
@@ -33,8 +34,7 @@ def rotation_matrix(axis: str, angle: float) -> np.ndarray:
 def drum_angle(case_dir: Path, step: int) -> float:
     """Angle (rad) the drum has turned by at ``step`` (it starts turning after settling)."""
     s = json.loads((Path(case_dir) / "scene.json").read_text())["scaled"]
-    start = len(s["insertion_waves"]) * s["wave_steps"] + s["settle_steps"]
-    return s["omega"] * max(0, step - start) * s["dt"]
+    return s["omega"] * max(0, step - production_start_step(s)) * s["dt"]
 
 
 def _pvd(entries: list[tuple[float, int, str]]) -> str:
