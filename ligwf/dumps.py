@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import base64
 import binascii
+import mmap
 import re
 import warnings
 from dataclasses import dataclass
@@ -32,6 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .dumps_numba import decode_base64, first_of_each_pair
 from .errors import DumpReadError
 
 PARTICLE_ARRAYS = ("id", "type", "v", "radius")
@@ -178,13 +180,23 @@ _SECTION_TAGS = ((b"<Points", "points"), (b"<PointData", "point"), (b"<CellData"
                  (b"<Cells", "cells"))
 
 
-def _data_arrays(raw: bytes):
-    """(section, attribute bytes, content bytes) of every DataArray element.
+def _skip_space(raw, pos: int) -> int:
+    while raw[pos:pos + 1] in (b" ", b"\n", b"\r", b"\t"):
+        pos += 1
+    return pos
 
-    Found with bytes.find (a regular expression over megabytes of base64 is several times
-    slower); the section (points, point, cell, cells) is the last section tag seen in the
-    short XML between two arrays, so the base64 is scanned once only.
+
+def _data_arrays(raw, header: np.dtype):
+    """(section, attributes, content start, content end) of every DataArray element.
+
+    A binary array is one base64 block whose first bytes are its byte count (``header``);
+    decoding just those gives the block's length, and the closing tag is looked for right
+    there, so the megabytes of base64 in between (of arrays the caller may not even want)
+    are never scanned or paged in. Where it is not there (header in a block of its own,
+    line breaks, ASCII), bytes.find scans as before. The section (points, point, cell,
+    cells) is the last section tag seen in the short XML between two arrays.
     """
+    head_chars = 4 * -(-header.itemsize // 3)
     pos, where = 0, None
     while (start := raw.find(b"<DataArray", pos)) >= 0:
         gap = raw[pos:start]
@@ -192,23 +204,47 @@ def _data_arrays(raw: bytes):
         if last[0] >= 0:
             where = last[1]
         tag_end = raw.find(b">", start)
-        end = raw.find(b"</DataArray>", tag_end)
-        if tag_end < 0 or end < 0:
+        if tag_end < 0:
             raise ValueError("unterminated DataArray element")
-        yield where, raw[start + 10:tag_end], raw[tag_end + 1:end]
-        pos = end + 12
+        attrs = dict(_ATTR_RE.findall(raw[start + 10:tag_end]))
+        content = _skip_space(raw, tag_end + 1)
+        length = None
+        if attrs.get(b"format") == b"binary":
+            try:
+                nbytes = int(np.frombuffer(binascii.a2b_base64(
+                    raw[content:content + head_chars])[:header.itemsize], header)[0])
+                length = 4 * -(-(header.itemsize + nbytes) // 3)
+            except (binascii.Error, ValueError, IndexError):
+                length = None
+        end = close = -1
+        if length is not None:
+            guess = _skip_space(raw, content + length)
+            if raw[guess:guess + 12] == b"</DataArray>":
+                end, close = content + length, guess
+        if end < 0:
+            end = close = raw.find(b"</DataArray>", tag_end)
+            if end < 0:
+                raise ValueError("unterminated DataArray element")
+        yield where, attrs, content, end
+        pos = close + 12
 
 
 def _read_vtu_fast(path: Path, wanted: frozenset[str] | None) -> _VtuData | None:
     """Decode LIGGGHTS' binary inline VTU directly: base64 of only the wanted arrays.
 
     meshio parses the whole XML tree and decodes every array; for a 360k-particle contact
-    dump that is seconds per frame. This reads the bytes once, finds the DataArray elements
-    with one regular expression and decodes only what the analysis uses. Returns None for
-    any other flavour (ASCII, compressed, appended, big-endian), which meshio then reads;
-    tests check both give identical arrays on real dumps.
+    dump that is seconds per frame. This maps the file into memory, walks the DataArray
+    elements (jumping over each one's base64 by its known length) and decodes only what the
+    analysis uses, stopping once it has all of it: of a contact dump (seven cell arrays,
+    points and connectivity) only id1, id2 and delta are ever read from disk. Returns None
+    for any other flavour (ASCII, compressed, appended, big-endian), which meshio then
+    reads; tests check both give identical arrays on real dumps.
     """
-    raw = path.read_bytes()
+    with open(path, "rb") as fh, mmap.mmap(fh.fileno(), 0, access=mmap.ACCESS_READ) as raw:
+        return _decode_vtu(path, raw, wanted)
+
+
+def _decode_vtu(path: Path, raw, wanted: frozenset[str] | None) -> _VtuData | None:
     head = raw[:1024]
     if (b'type="UnstructuredGrid"' not in head or b"compressor" in head
             or b"BigEndian" in head or b"<AppendedData" in raw[-4096:]):
@@ -221,34 +257,41 @@ def _read_vtu_fast(path: Path, wanted: frozenset[str] | None) -> _VtuData | None
     if m is None:
         return None
     n_points, n_cells = int(m.group(1)), int(m.group(2))
+
     point_data, cell_data, points = {}, {}, None
-    for where, attr_text, text in _data_arrays(raw):
+    missing = None if wanted is None else set(wanted)
+    for where, attrs, start, end in _data_arrays(raw, header):
         if where not in ("points", "point", "cell"):     # Cells: connectivity, offsets, types
             continue
-        if where == "points" and wanted is not None and "Points" not in wanted:
-            continue
-        attrs = dict(_ATTR_RE.findall(attr_text))
         name = attrs.get(b"Name", b"").decode()
-        if where != "points" and wanted is not None and name not in wanted:
+        key = "Points" if where == "points" else name
+        if missing is not None and key not in missing:
             continue
         if attrs.get(b"format") != b"binary":
             return None
         comps = int(attrs.get(b"NumberOfComponents", b"1"))
         dtype = np.dtype("<" + _VTK_DTYPES[attrs[b"type"].decode()])
         rows = n_cells if where == "cell" else n_points
-        data = binascii.a2b_base64(text)
-        nbytes = int(np.frombuffer(data[:header.itemsize], header)[0]) \
-            if len(data) >= header.itemsize else -1
-        if len(data) == header.itemsize:               # header encoded as its own block
-            data = binascii.a2b_base64(text[len(base64.b64encode(data)):])
-        else:
-            data = data[header.itemsize:]
+        text = raw[start:end].rstrip()
+        decoded = decode_base64(text, header.itemsize)
+        if decoded is not None and len(decoded) > header.itemsize:
+            nbytes = int(decoded[:header.itemsize].view(header)[0])
+            data = decoded[header.itemsize:]
+        else:       # not one plain block: binascii (which skips stray characters)
+            raw_data = binascii.a2b_base64(text)
+            nbytes = int(np.frombuffer(raw_data[:header.itemsize], header)[0]) \
+                if len(raw_data) >= header.itemsize else -1
+            if len(raw_data) == header.itemsize:       # header encoded as its own block
+                raw_data = binascii.a2b_base64(text[len(base64.b64encode(raw_data)):])
+            else:
+                raw_data = raw_data[header.itemsize:]
+            data = np.frombuffer(raw_data, np.uint8)
         expected = rows * comps * dtype.itemsize
         if nbytes != expected or len(data) < expected:
             raise DumpReadError(f"{path}: not a readable VTU file (truncated or corrupt?): "
                                 f"array {name or 'Points'} decodes to {len(data)} bytes, "
                                 f"expected {expected}")
-        arr = np.frombuffer(data[:expected], dtype)
+        arr = data[:expected].view(dtype)
         arr = arr.reshape(rows, comps) if comps > 1 else arr
         if where == "points":
             points = arr
@@ -256,6 +299,10 @@ def _read_vtu_fast(path: Path, wanted: frozenset[str] | None) -> _VtuData | None
             cell_data[name] = arr
         else:
             point_data[name] = arr
+        if missing is not None:
+            missing.discard(key)
+            if not missing:
+                break
     if points is None:
         points = np.zeros((n_points, 3))
     return _VtuData(points, point_data, cell_data, n_cells)
@@ -376,12 +423,8 @@ def read_contacts(path: Path, step: int | None = None, reader: str = "fast") -> 
         raise DumpReadError(f"{path}: contact ids out of range or a particle paired with itself")
     # Each unordered pair once: a pair straddling two MPI subdomains could be listed by both.
     lo, hi = np.minimum(id1, id2), np.maximum(id1, id2)
-    key = lo * (int(hi.max()) + 1) + hi
-    _, first = np.unique(key, return_index=True)
-    if len(first) != m_rows:
-        first.sort()
-        lo, hi = lo[first], hi[first]
-        data_delta = np.asarray(data["delta"], dtype=np.float64)[first]
-    else:
-        data_delta = np.asarray(data["delta"], dtype=np.float64)
+    first = first_of_each_pair(lo, hi)
+    data_delta = np.asarray(data["delta"], dtype=np.float64)
+    if first is not None:
+        lo, hi, data_delta = lo[first], hi[first], data_delta[first]
     return ContactFrame(path, int(step), lo, hi, data_delta)

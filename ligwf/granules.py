@@ -16,9 +16,11 @@ carry a bridge and count; beyond rupture the law gives 0 and the pair is not bon
 Granules are the connected components of the bonded graph (built on particle ids, never on
 geometry, since pairs across the periodic boundary span the box). Two implementations:
 :func:`label_reference` (networkx BFS, the method of the source study: slow, obviously
-right) and :func:`label_fast` (scipy.sparse.csgraph, C speed); both return the same
-canonical labels (granule 0 holds the particle with the smallest id, and so on), which the
-tests check on real dumps and on random graphs.
+right) and :func:`label_fast` (compiled union-find, :mod:`ligwf.granules_numba`); both
+return the same canonical labels (granule 0 holds the particle with the smallest id, and so
+on), which the tests check on real dumps and on random graphs. The bond test itself
+(:func:`bonded_contacts`) is one compiled pass over the contacts; the numpy evaluation of
+the same criterion, :func:`bonded_contacts_reference`, is kept as its reference.
 
 Centres of mass are computed with positions unwrapped along the bonds across the
 periodic axis (a granule straddling y = 0 / y = L has its centre inside it, not in the
@@ -121,7 +123,46 @@ def comoving(v_i: np.ndarray, v_j: np.ndarray, max_angle_deg: float) -> np.ndarr
 
 def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
                     criterion: BondCriterion = BondCriterion()):
-    """Indices (i, j) of bonded pairs into the particle arrays, and their bridge forces (N)."""
+    """Indices (i, j) of bonded pairs into the particle arrays, and their bridge forces (N).
+
+    One compiled pass over the contacts (:func:`ligwf.granules_numba.bond_kernel`): the
+    rupture distance and velocity-angle tests, then the force law of the liquid model only
+    for the pairs that pass both; pairs in contact order. The same pairs as
+    :func:`bonded_contacts_reference`, forces equal to rounding (~1e-16 relative), tested
+    on real dumps and random frames.
+    """
+    from .granules_numba import MODEL_CODES, bond_kernel
+
+    if liquid.model not in MODEL_CODES:
+        raise ValueError(f"no capillary force law for liquid model {liquid.model!r}")
+    ids = particles.ids
+    if len(ids) and ids[-1] - ids[0] == len(ids) - 1:
+        # contiguous ids (no particle deleted): the row is id - first id, found in the kernel
+        a, b, offset = contacts.id1, contacts.id2, int(ids[0])
+    else:
+        a, b, offset = particles.index_of(contacts.id1), particles.index_of(contacts.id2), 0
+    content = particles.liquid_content
+    if content is None:
+        content = np.full(len(particles), liquid.liquid_content)
+    # liquid per particle, m^3: the expression of ligwf.bridges, so bridge volumes agree bitwise
+    liquid_volume = 4.0 / 3.0 * np.pi * particles.radii**3 * content
+    count, i, j, force = bond_kernel(
+        a, b, offset, particles.velocities, particles.radii, liquid_volume,
+        np.asarray(contacts.delta, dtype=np.float64), MODEL_CODES[liquid.model],
+        float(liquid.surface_tension), float(liquid.contact_angle_rad),
+        bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
+        math.cos(math.radians(criterion.max_velocity_angle_deg)),
+        float(criterion.min_bridge_force))
+    if count < 0:       # raises DumpReadError naming the id that is not in the frame
+        k = -1 - count
+        particles.index_of(np.array([contacts.id1[k], contacts.id2[k]]))
+        raise AssertionError("bond_kernel and index_of disagree on the particle rows")
+    return i[:count], j[:count], force[:count]
+
+
+def bonded_contacts_reference(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
+                              criterion: BondCriterion = BondCriterion()):
+    """:func:`bonded_contacts` evaluated with numpy and :mod:`ligwf.bridges` (the reference)."""
     i = particles.index_of(contacts.id1)
     j = particles.index_of(contacts.id2)
     # the cheap velocity test first; the force law only for the pairs that pass it
@@ -141,15 +182,9 @@ def _is_canonical(labels: np.ndarray) -> bool:
     return labels[0] == 0 and bool(np.all(np.diff(np.maximum.accumulate(labels)) <= 1))
 
 
-def first_members(labels: np.ndarray) -> np.ndarray:
-    """Index of the first particle of each granule, for canonical labels (no sort)."""
-    running = np.maximum.accumulate(labels)
-    return np.flatnonzero(np.concatenate([[True], np.diff(running) > 0]))
-
-
 def _canonical(labels: np.ndarray) -> np.ndarray:
     """Relabel so granule k is the k-th distinct label met in particle (id) order."""
-    if _is_canonical(labels):      # scipy numbers components in this order already
+    if _is_canonical(labels):      # often numbered in this order already
         return labels.astype(np.int64, copy=False)
     _, first, inverse = np.unique(labels, return_index=True, return_inverse=True)
     rank = np.empty(len(first), dtype=np.int64)
@@ -173,18 +208,11 @@ def label_reference(n: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     return labels
 
 
-def _adjacency(n: int, i: np.ndarray, j: np.ndarray):
-    from scipy.sparse import coo_matrix
-
-    return coo_matrix((np.ones(len(i), dtype=np.int8), (i, j)), shape=(n, n)).tocsr()
-
-
 def label_fast(n: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-    """Granule label per particle by scipy.sparse.csgraph.connected_components."""
-    from scipy.sparse.csgraph import connected_components
+    """Granule label per particle by compiled union-find (canonical numbering built in)."""
+    from .granules_numba import union_find_labels
 
-    _, labels = connected_components(_adjacency(n, i, j), directed=False)
-    return _canonical(labels)
+    return union_find_labels(int(n), np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64))
 
 
 def _wrap(d: np.ndarray, length: float) -> np.ndarray:
@@ -201,7 +229,7 @@ def unwrap_reference(positions: np.ndarray, labels: np.ndarray, i: np.ndarray, j
     graph = nx.Graph()
     graph.add_nodes_from(range(len(positions)))
     # lexicographically sorted (lo, hi) edges make every node's neighbour order ascending,
-    # the order scipy's BFS uses, so both implementations build the same BFS tree
+    # the order the compiled BFS (unwrap_fast) uses, so both build the same BFS tree
     graph.add_edges_from(sorted(zip(np.minimum(i, j).tolist(), np.maximum(i, j).tolist())))
     roots = np.unique(labels, return_index=True)[1]
     for root in roots:
@@ -213,41 +241,23 @@ def unwrap_reference(positions: np.ndarray, labels: np.ndarray, i: np.ndarray, j
 
 def unwrap_fast(positions: np.ndarray, labels: np.ndarray, i: np.ndarray, j: np.ndarray,
                 axis: int, length: float) -> np.ndarray:
-    """Positions unwrapped along the bonds, vectorised (same result as the reference).
+    """Positions unwrapped along the bonds, compiled (same result as the reference).
 
-    A breadth-first forest (one tree per granule, rooted at its first member, reached from
-    a virtual super-root) gives every particle a parent. A particle's image offset is the
-    sum of the per-edge shifts on its path to the root, accumulated by pointer jumping:
-    log2(tree depth) vectorised passes instead of a Python loop over particles. Neighbours
-    are visited in ascending index order, as in :func:`unwrap_reference`, so both build
-    the same tree (which matters only for a granule that percolates through the periodic
-    axis, whose unwrapping depends on the tree).
+    The same breadth-first forest as :func:`unwrap_reference` (one tree per granule, rooted
+    at its first member, neighbours in ascending index order) and the same per-edge update,
+    so both agree to the last bit, also for a granule that percolates through the periodic
+    axis, whose unwrapping depends on the tree. The roots (each granule's first member) are
+    found during the search, so ``labels`` is not needed; it is kept for the common
+    signature with :func:`unwrap_reference`.
     """
-    from scipy.sparse.csgraph import breadth_first_order
+    from .granules_numba import bfs_unwrap
 
-    n = len(positions)
     out = positions.copy()
     if len(i) == 0 or length <= 0:
         return out
-    roots = first_members(labels)
-    super_root = n
-    rows = np.concatenate([i, j, np.full(len(roots), super_root)])
-    cols = np.concatenate([j, i, roots])
-    adj = _adjacency(n + 1, rows, cols)
-    adj.sort_indices()
-    _, pred = breadth_first_order(adj, super_root, directed=True, return_predecessors=True)
-    parent = pred[:n].astype(np.int64)
-    is_root = parent == super_root
-    parent[is_root] = np.nonzero(is_root)[0]
-    y = positions[:, axis]
-    offset = -length * np.round((y - y[parent]) / length)   # 0 at roots (parent = self)
-    while True:
-        grand = parent[parent]
-        if np.array_equal(grand, parent):
-            break
-        offset = offset + offset[parent]
-        parent = grand
-    out[:, axis] = y + offset
+    out[:, axis] = bfs_unwrap(np.asarray(positions[:, axis], dtype=np.float64),
+                              np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64),
+                              float(length))
     return out
 
 
@@ -256,16 +266,16 @@ def granule_table(particles: ParticleFrame, labels: np.ndarray, cg: float,
                   box_lo: float = 0.0, box_length: float = 0.0) -> pd.DataFrame:
     """One row per granule: members, volume (m^3), primary-equivalent volume (m^3, volume /
     cg^3), centre of mass (m, wrapped into the periodic box), smallest member id."""
+    from .granules_numba import granule_sums
+
     n_gran = int(labels.max()) + 1 if len(labels) else 0
-    vol = particles.volumes
-    members = np.bincount(labels, minlength=n_gran)
-    volume = np.bincount(labels, weights=vol, minlength=n_gran)
     pos = particles.positions if unwrapped is None else unwrapped
-    com = np.column_stack([np.bincount(labels, weights=vol * pos[:, a], minlength=n_gran)
-                           for a in range(3)]) / volume[:, None]
+    members, volume, moment, first = granule_sums(
+        np.asarray(labels, dtype=np.int64), n_gran, particles.radii, np.asarray(pos, dtype=np.float64))
+    com = moment / volume[:, None]
     if periodic_axis is not None and box_length > 0:
         com[:, periodic_axis] = box_lo + np.mod(com[:, periodic_axis] - box_lo, box_length)
-    first_id = particles.ids[first_members(labels)] if n_gran else np.zeros(0, np.int64)
+    first_id = particles.ids[first]
     return pd.DataFrame({
         "granule": np.arange(n_gran, dtype=np.int64),
         "members": members.astype(np.int64),

@@ -167,3 +167,93 @@ def test_fast_reader_equals_meshio(case):
                     other = getattr(ref, name)
                     assert value.dtype == other.dtype, name
                     np.testing.assert_array_equal(value, other, err_msg=name)
+
+
+# --- the compiled helpers and the direct decoder on files of every layout (no engine) ---
+
+import base64
+import binascii
+
+from hypothesis import given, settings, strategies as st
+
+from ligwf.dumps_numba import decode_base64, first_of_each_pair
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.binary(max_size=300), st.sampled_from([4, 8]))
+def test_decode_base64_equals_binascii(payload, header_size):
+    header = len(payload).to_bytes(header_size, "little")
+    text = base64.b64encode(header + payload)
+    out = decode_base64(text, header_size)
+    assert out is not None and out.tobytes() == binascii.a2b_base64(text)
+    if payload:     # (numpy does not offset the pointer of an empty slice)
+        assert out[header_size:].ctypes.data % 8 == 0, "data after the header is 8-byte aligned"
+
+
+@pytest.mark.parametrize("text", [
+    base64.b64encode(b"\x04\x00\x00\x00") + base64.b64encode(b"abcd"),   # header block apart
+    base64.b64encode(b"\x08\x00\x00\x00abcdefgh")[:-1],                   # truncated
+    b"AAAA\nAAAA",                                                        # line break
+    b"AAAA!!!!",                                                          # corrupt
+])
+def test_decode_base64_declines_what_it_does_not_handle(text):
+    assert decode_base64(text, 4) is None      # the reader then falls back to binascii
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.tuples(st.integers(1, 30), st.integers(1, 30)), max_size=80))
+def test_first_of_each_pair_equals_unique(pairs):
+    pairs = [(a, b) for a, b in pairs if a != b]
+    lo = np.array([min(p) for p in pairs], dtype=np.int64)
+    hi = np.array([max(p) for p in pairs], dtype=np.int64)
+    got = first_of_each_pair(lo, hi)
+    first = np.sort(np.unique(lo * 31 + hi, return_index=True)[1]) if len(lo) else np.zeros(0, int)
+    if len(first) == len(lo):
+        assert got is None
+    else:
+        np.testing.assert_array_equal(got, first)
+
+
+def _contact_mesh(n: int = 50, m: int = 120, seed: int = 3):
+    """A contact dump in LIGGGHTS' arrays, with some pairs listed twice (as by two ranks)."""
+    rng = np.random.default_rng(seed)
+    a = rng.integers(1, n + 1, m)
+    b = (a + rng.integers(0, n - 1, m)) % n + 1
+    a[-10:], b[-10:] = b[:10], a[:10]            # the first 10 pairs again, reversed
+    pts = rng.uniform(0, 0.01, (2 * m, 3)).astype(np.float32)
+    lines = np.column_stack([np.arange(m), np.arange(m) + m])
+    cell_data = {"vel1": [rng.normal(size=(m, 3))], "vel2": [rng.normal(size=(m, 3))],
+                 "id1": [a.astype(float)], "id2": [b.astype(float)],
+                 "force": [rng.normal(size=(m, 3))], "delta": [rng.uniform(-1e-4, 1e-5, m)]}
+    return meshio.Mesh(pts, [("line", lines)], cell_data=cell_data)
+
+
+@pytest.mark.parametrize("compression", [None, "zlib"])
+@pytest.mark.parametrize("header_type", ["UInt32", "UInt64"])
+def test_fast_contacts_equal_meshio_on_meshio_files(tmp_path, compression, header_type):
+    """meshio's layout (Points and Cells before the data, any header type; zlib goes to
+    meshio): the fast reader gives the reference arrays, duplicates dropped once."""
+    path = tmp_path / "contacts_10.vtu"
+    meshio.write(path, _contact_mesh(), file_format="vtu", binary=True,
+                 compression=compression, header_type=header_type)
+    fast, ref = read_contacts(path), read_contacts(path, reader="meshio")
+    assert len(fast) == len(ref) <= 110       # the 10 pairs listed twice are kept once
+    for name in ("id1", "id2", "delta"):
+        np.testing.assert_array_equal(getattr(fast, name), getattr(ref, name), err_msg=name)
+        assert getattr(fast, name).dtype == getattr(ref, name).dtype
+
+
+def test_fast_reader_header_in_its_own_block(tmp_path):
+    """VTK may encode the byte-count header as its own base64 block: still decoded."""
+    path = tmp_path / "contacts_11.vtu"
+    meshio.write(path, _contact_mesh(), file_format="vtu", binary=True, compression=None)
+    text = path.read_text()
+
+    def split(match):
+        raw = base64.b64decode(match.group(2))
+        return match.group(1) + (base64.b64encode(raw[:4]) + base64.b64encode(raw[4:])).decode()
+
+    text = re.sub(r'(<DataArray[^>]*Name="delta"[^>]*>\s*)([A-Za-z0-9+/=]+)', split, text)
+    path.write_text(text)
+    fast, ref = read_contacts(path), read_contacts(path, reader="meshio")
+    np.testing.assert_array_equal(fast.delta, ref.delta)

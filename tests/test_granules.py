@@ -1,5 +1,6 @@
-"""ligwf.granules: reference (networkx BFS) vs fast path (scipy) on real dumps and random
-graphs; bond criterion against a per-contact scalar evaluation; volumes and periodic CoM."""
+"""ligwf.granules: reference (networkx BFS, numpy bond criterion) vs compiled fast path
+(ligwf.granules_numba) on real dumps, random frames and random graphs; bond criterion
+against a per-contact scalar evaluation; volumes and periodic CoM."""
 
 from __future__ import annotations
 
@@ -13,10 +14,11 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from ligwf import bridges
-from ligwf.dumps import ParticleFrame, discover_frames, read_contacts, read_particles
-from ligwf.granules import (BondCriterion, Liquid, bonded_contacts, comoving, granule_table,
-                            label_fast, label_reference, louvain_labels, unwrap_fast,
-                            unwrap_reference)
+from ligwf.dumps import ContactFrame, ParticleFrame, discover_frames, read_contacts, read_particles
+from ligwf.errors import DumpReadError
+from ligwf.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
+                            comoving, granule_table, label_fast, label_reference, louvain_labels,
+                            unwrap_fast, unwrap_reference)
 from wetdump import wet_study
 
 
@@ -56,6 +58,74 @@ def test_reference_equals_fast_on_real_dumps(real, angle):
         counts.append(len(t_fast))
     if angle == 5.0:
         assert max(counts) > 5, "a strict angle splits the bed into several granules"
+
+
+def _same_bonds(p, c, liquid, crit):
+    """Compiled bond test == numpy reference: the same pairs in the same order, the same
+    forces (to rounding of the transcendental functions), and so the same granules."""
+    i, j, f = bonded_contacts(p, c, liquid, crit)
+    ri, rj, rf = bonded_contacts_reference(p, c, liquid, crit)
+    np.testing.assert_array_equal(i, ri)
+    np.testing.assert_array_equal(j, rj)
+    np.testing.assert_allclose(f, rf, rtol=1e-13, atol=0)
+    np.testing.assert_array_equal(label_fast(len(p), i, j), label_reference(len(p), ri, rj))
+    return i, j
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+@pytest.mark.parametrize("model", ["washino", "easo", "none"])
+@pytest.mark.parametrize("crit", [BondCriterion(), BondCriterion(1e-4, 30.0),
+                                  BondCriterion(0.0, 5.0), BondCriterion(0.0, 180.0)])
+def test_compiled_bonds_equal_numpy_on_real_dumps(real, model, crit):
+    scaled, frames = real
+    base = Liquid.from_scaled(scaled)
+    liquid = Liquid(model, base.surface_tension, base.contact_angle_rad, base.liquid_content)
+    bonded = 0
+    for p, c in frames:
+        i, _ = _same_bonds(p, c, liquid, crit)
+        bonded += len(i)
+    assert (bonded > 0) == (model != "none")
+
+
+@st.composite
+def wet_frames(draw):
+    """Random particles (radii, liquid, velocities, some at rest, ids with gaps or not) and
+    contacts whose gaps span touching, bridged and beyond-rupture pairs."""
+    n = draw(st.integers(2, 40))
+    seed = draw(st.integers(0, 2**31 - 1))
+    rng = np.random.default_rng(seed)
+    ids = np.arange(1, n + 1) if draw(st.booleans()) else np.sort(rng.choice(10 * n, n, replace=False)) + 1
+    radii = rng.uniform(2e-4, 1.5e-3, n)
+    vel = rng.normal(0, 1, (n, 3)) * (rng.uniform(size=(n, 1)) > 0.1)   # ~10 % at rest
+    vel[: n // 3] = vel[0] + rng.normal(0, 0.05, (n // 3, 3))            # a co-moving group
+    content = rng.uniform(0.0, 0.05, n) if draw(st.booleans()) else None
+    m = draw(st.integers(0, 3 * n))
+    a = rng.integers(0, n, m)
+    b = (a + rng.integers(1, n, m)) % n
+    delta = -rng.uniform(-0.05, 0.4, m) * (radii[a] + radii[b])          # overlap, m
+    p = ParticleFrame(Path("synthetic"), 0, 0.0, ids.astype(np.int64), np.ones(n, np.int32),
+                      rng.uniform(0, 0.01, (n, 3)), vel, radii, content)
+    c = ContactFrame(Path("synthetic"), 0, ids[np.minimum(a, b)], ids[np.maximum(a, b)], delta)
+    model = draw(st.sampled_from(["washino", "easo"]))
+    liquid = Liquid(model, draw(st.floats(0.0, 0.08)), math.radians(draw(st.floats(0.0, 89.0))),
+                    0.02)
+    crit = BondCriterion(draw(st.sampled_from([0.0, 1e-6, 1e-4])), draw(st.floats(0.0, 180.0)))
+    return p, c, liquid, crit
+
+
+@settings(max_examples=300, deadline=None)
+@given(wet_frames())
+def test_compiled_bonds_equal_numpy_on_random_frames(frame):
+    p, c, liquid, crit = frame
+    _same_bonds(p, c, liquid, crit)
+
+
+def test_bonded_contacts_unknown_id_names_it():
+    p = _frame([5e-4] * 3, np.zeros((3, 3)), np.ones((3, 3)))
+    c = ContactFrame(Path("synthetic"), 0, np.array([1, 2]), np.array([2, 7]), np.array([0.0, 0.0]))
+    with pytest.raises(DumpReadError, match="no particle with id 7"):
+        bonded_contacts(p, c, Liquid("washino", 0.02, 0.3, 0.02))
 
 
 @pytest.mark.engine
@@ -174,8 +244,10 @@ def test_unwrap_reference_equals_fast_on_random_graphs(g, seed):
     rng = np.random.default_rng(seed)
     pos = rng.uniform(0, L, size=(n, 3))
     labels = label_fast(n, i, j)
-    np.testing.assert_allclose(unwrap_fast(pos, labels, i, j, 1, L),
-                               unwrap_reference(pos, labels, i, j, 1, L), rtol=0, atol=1e-12)
+    # the same BFS tree and the same per-edge arithmetic: identical to the last bit, also for
+    # granules that wind around the periodic axis (random positions make many such cycles)
+    np.testing.assert_array_equal(unwrap_fast(pos, labels, i, j, 1, L),
+                                  unwrap_reference(pos, labels, i, j, 1, L))
 
 
 def test_unwrap_chain_across_boundary():
