@@ -145,7 +145,7 @@ class FrameResult:
 class GranuleAnalysis:
     """Granules of every frame of one case (MDAnalysis-style life cycle).
 
-    ``implementation`` is ``"fast"`` (scipy) or ``"reference"`` (networkx BFS).
+    ``implementation`` is ``"fast"`` (numba-compiled union-find) or ``"reference"`` (networkx BFS).
     ``vtu_dir`` set: write ``granules_<step>.vtu`` per frame there (ParaView series).
     ``louvain``: also store Louvain community ids per particle in the ``.vtu``.
     """

@@ -32,7 +32,7 @@ def register(subparsers) -> None:
     p.add_argument("--discard-frames", type=int, default=0,
                    help="leave the first N frames of each case out of the GSD (start-up)")
     p.add_argument("--reference", action="store_true",
-                   help="use the networkx reference implementation (slow) instead of scipy")
+                   help="use the networkx reference implementation (slow) instead of the compiled fast path")
     p.add_argument("--no-vtu", action="store_true", help="do not write the .pvd/.vtu series")
     p.add_argument("--louvain", action="store_true",
                    help="add Louvain communities (bridge-force weighted) to the .vtu files")
