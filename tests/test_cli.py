@@ -10,7 +10,7 @@ import pytest
 
 from ligwf.cli import main
 
-from conftest import DRUM
+from helpers import DRUM
 
 
 def test_render_writes_one_folder_per_case(tmp_path, capsys, monkeypatch):

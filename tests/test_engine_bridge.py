@@ -17,7 +17,7 @@ from ligwf.render import render_bridge_probe
 from ligwf.scaling import scale
 from ligwf.workflow import load_workflow
 
-from conftest import DRUM, run_liggghts
+from helpers import DRUM, run_liggghts
 
 pytestmark = [pytest.mark.engine]
 

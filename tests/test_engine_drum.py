@@ -9,7 +9,7 @@ import pytest
 
 from ligwf.cases import render_workflow, write_study
 
-from conftest import DRUM, WET_POLY, run_liggghts
+from helpers import DRUM, WET_POLY, run_liggghts
 from ligwf.workflow import load_workflow
 
 pytestmark = [pytest.mark.engine, pytest.mark.mpi]

@@ -16,7 +16,7 @@ from ligwf.errors import RenderError
 from ligwf.render import render
 from ligwf.workflow import load_workflow
 
-from conftest import DRUM, ROOT, WET_POLY
+from helpers import DRUM, ROOT, WET_POLY
 
 sys.path.insert(0, str(ROOT / "scripts"))
 from regen_golden import GOLDEN, golden_cases, render_golden  # noqa: E402

@@ -11,7 +11,7 @@ from ligwf.scaling import (Rule, bond_number, rayleigh_time, replica_seeds, is_p
                            weber_number)
 from ligwf.workflow import load_workflow
 
-from conftest import DRUM, WET_POLY
+from helpers import DRUM, WET_POLY
 
 GAP_RATIOS = [0.0, 0.01, 0.05, 0.1]  # surface gap / effective radius
 

@@ -11,7 +11,7 @@ from ligwf.errors import ConfigError
 from ligwf.scene import build_scene
 from ligwf.workflow import expand, load_workflow
 
-from conftest import DRUM
+from helpers import DRUM
 
 
 def demo_raw() -> dict:

@@ -12,7 +12,7 @@ import pytest
 
 from ligwf.cli import main
 
-from conftest import ROOT
+from helpers import ROOT
 
 pytestmark = [pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
 

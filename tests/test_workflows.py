@@ -8,7 +8,7 @@ from ligwf.cases import render_workflow
 from ligwf.stability import REFUSED, preflight
 from ligwf.workflow import load_workflow
 
-from conftest import ROOT
+from helpers import ROOT
 
 WORKFLOWS = sorted(p.name for p in (ROOT / "workflows").glob("*.yaml") if p.name != "stability.yaml")
 

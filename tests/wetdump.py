@@ -11,7 +11,7 @@ import json
 import shutil
 from pathlib import Path
 
-from conftest import DRUM, run_liggghts
+from helpers import DRUM, run_liggghts
 from ligwf.cases import render_workflow, write_study
 from ligwf.workflow import load_workflow
 
