@@ -138,14 +138,19 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
     }
 
 
-def render(scaled: ScaledScene, template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:
-    """LIGGGHTS input files for one case: ``{file name: text}`` (pure, no I/O)."""
+def render_template(name: str, context: dict[str, Any],
+                    template_dirs: Iterable[str | Path] = ()) -> str:
+    """Render one named template (user folders first, then ligwf's) with ``context``."""
     env = _environment(tuple(str(Path(d)) for d in template_dirs))
     try:
-        text = env.get_template("drum.in.j2").render(**template_context(scaled))
+        return env.get_template(name).render(**context)
     except jinja2.TemplateError as exc:
-        raise RenderError(f"cannot render drum.in.j2: {exc}") from exc
-    return {INPUT_NAME: text}
+        raise RenderError(f"cannot render {name}: {exc}") from exc
+
+
+def render(scaled: ScaledScene, template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:
+    """LIGGGHTS input files for one case: ``{file name: text}`` (pure, no I/O)."""
+    return {INPUT_NAME: render_template("drum.in.j2", template_context(scaled), template_dirs)}
 
 
 def render_bridge_probe(scaled: ScaledScene, gap_ratio: float, model_approach: bool,
@@ -155,13 +160,7 @@ def render_bridge_probe(scaled: ScaledScene, gap_ratio: float, model_approach: b
     particle 2 (``v_fx2``). With ``model_approach`` the pair touches first and is then
     separated, which the easo model needs to form its bridge.
     """
-    env = _environment(tuple(str(Path(d)) for d in template_dirs))
     ctx = template_context(scaled)
     radius = 0.5 * scaled.d_min
-    r_eff = 0.5 * radius
-    ctx.update(probe_radius=radius, probe_gap=gap_ratio * r_eff, approach=model_approach)
-    try:
-        text = env.get_template("bridge_probe.in.j2").render(**ctx)
-    except jinja2.TemplateError as exc:
-        raise RenderError(f"cannot render bridge_probe.in.j2: {exc}") from exc
-    return {INPUT_NAME: text}
+    ctx.update(probe_radius=radius, probe_gap=gap_ratio * 0.5 * radius, approach=model_approach)
+    return {INPUT_NAME: render_template("bridge_probe.in.j2", ctx, template_dirs)}

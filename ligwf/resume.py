@@ -29,7 +29,7 @@ from pathlib import Path
 from .health import DONE, FAILED, UNSTABLE
 from .manifest import (MANIFEST_FILE, SCREEN_FILE, THERMO_FILE, effective_status, read_manifest,
                        scene_hash_of)
-from .render import INPUT_NAME, _environment, template_context
+from .render import INPUT_NAME, render_template, template_context
 from .scaling import ScaledScene
 
 #: Input file of a resumed attempt (next to ``in.liggghts``).
@@ -177,12 +177,11 @@ def resume_phase(s: ScaledScene, step: int) -> tuple[str, int, bool]:
 
 def render_resume(s: ScaledScene, restart: RestartFile, template_dirs=()) -> dict[str, str]:
     """Input continuing case ``s`` from ``restart``: ``{RESUME_INPUT: text}`` (pure)."""
-    env = _environment(tuple(str(Path(d)) for d in template_dirs))
     phase, wave, inserted = resume_phase(s, restart.step)
     ctx = template_context(s)
     ctx.update(restart_file=restart.path, from_step=restart.step, resume_phase=phase,
                current_wave=wave, current_wave_inserted=inserted)
-    return {RESUME_INPUT: env.get_template("resume.in.j2").render(**ctx)}
+    return {RESUME_INPUT: render_template("resume.in.j2", ctx, template_dirs)}
 
 
 def input_for(plan: Plan) -> str:
