@@ -23,6 +23,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ligwf.manifest import pid_alive
+
 PACKAGES = ("slurmctld", "slurmd", "munge")
 ROOT = Path("/var/lib/ligwf-test-slurm")
 LOG_DIR = Path("/var/log/ligwf-test-slurm")
@@ -150,7 +152,7 @@ class LocalSlurm:
             d.mkdir(parents=True, exist_ok=True)
             shutil.chown(d, "munge", "munge")
         pidfile = run / "munged.pid"
-        if pidfile.is_file() and _alive(int(pidfile.read_text().split()[0])):
+        if pidfile.is_file() and pid_alive(int(pidfile.read_text().split()[0])):
             return  # someone else's munged: use it, never stop it
         _run(["runuser", "-u", "munge", "--", "munged", "--force"])
         for _ in range(50):
@@ -196,22 +198,13 @@ class LocalSlurm:
             for pidfile in (self.root / "slurmctld.pid", self.root / "slurmd.pid"):
                 _wait_pidfile_gone(pidfile)
             self.started = False
-        if self.munged_pid and _alive(self.munged_pid):
+        if self.munged_pid and pid_alive(self.munged_pid):
             os.kill(self.munged_pid, signal.SIGTERM)
         self.munged_pid = None
         if self.conf_backup is not None:
             CONF.write_text(self.conf_backup)
             self.conf_backup = None
 
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 def _wait_pidfile_gone(pidfile: Path, timeout: float = 20.0) -> None:
@@ -222,7 +215,7 @@ def _wait_pidfile_gone(pidfile: Path, timeout: float = 20.0) -> None:
     except (ValueError, IndexError):
         return
     deadline = time.monotonic() + timeout
-    while _alive(pid) and time.monotonic() < deadline:
+    while pid_alive(pid) and time.monotonic() < deadline:
         time.sleep(0.2)
-    if _alive(pid):
+    if pid_alive(pid):
         os.kill(pid, signal.SIGKILL)
