@@ -24,15 +24,11 @@ from .fsio import atomic_write_text
 from .scene import Drum
 
 #: Bump when the mesh algorithm changes, so cached meshes are rebuilt.
-MESH_VERSION = 4
-#: Largest gap between the polygon chord and the true circle, as a fraction of the radius
-#: (with the 96-segment floor: 13 um on a 50 mm drum). Every triangle costs time on every
-#: step of a rotating mesh (fix move/mesh), independent of the CG level: at CG3 a 360-facet
-#: drum took 60 % of the loop, so the mesh is kept as coarse as the geometry allows.
-SAG_TOLERANCE = 1e-3
-#: Largest axial length of a shell triangle, in units of its circumferential width. One row
-#: of long facets spanning the slice works in LIGGGHTS (verified); splitting only adds cost.
-MAX_ASPECT = 1e9
+MESH_VERSION = 3
+#: Largest gap between the polygon chord and the true circle, as a fraction of the radius.
+SAG_TOLERANCE = 2.5e-4
+#: Largest axial length of a shell triangle, in units of its circumferential width.
+MAX_ASPECT = 6.0
 
 
 def axis_frame(axis: str) -> tuple[int, int, int]:
