@@ -43,11 +43,11 @@ from . import gsd as gsdmod
 from .dumps import FrameFiles, ParticleFrame, discover_frames, read_contacts, read_particles
 from .errors import ConfigError, DumpReadError
 from .fsio import atomic_write_bytes, atomic_write_json, atomic_write_text
+from .health import DONE
+from .manifest import MANIFEST_FILE
 from .granules import (AXES, BondCriterion, Liquid, bonded_contacts, granule_table, label_fast,
                        label_reference, louvain_labels, unwrap_fast, unwrap_reference)
 
-MANIFEST_FILE = "manifest.json"
-DONE = "done"
 
 
 @dataclass(frozen=True)
