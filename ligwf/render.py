@@ -106,6 +106,11 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
     boundary = ["f", "f", "f"]
     if s.periodic:
         boundary[ia] = "p"
+    # never cut the domain along gravity: the bed lies in the lower half, so a cut there
+    # leaves one rank almost idle (measured: 96 % of a settled bed on one of 2 ranks, and
+    # 14 % slower than a cut across the drum at CG1)
+    grid = ["*", "*", "*"]
+    grid[iv] = "1"
     templates = [
         {"id": f"pts{k + 1}", "radius": 0.5 * d, "fraction": f, "seed": s.seeds[k]}
         for k, (d, f) in enumerate(zip(s.diameters, s.number_fractions))
@@ -117,6 +122,7 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
         "s": s,
         "version": __version__,
         "boundary": " ".join(boundary),
+        "processors": " ".join(grid),
         "box_lo": lo,
         "box_hi": hi,
         "axis": s.axis,

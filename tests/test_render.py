@@ -135,3 +135,14 @@ def test_installed_wheel_ships_templates(tmp_path):
     names = zipfile.ZipFile(wheel).namelist()
     shipped = {Path(n).name for n in names if n.startswith("ligwf/templates/")}
     assert {p.name for p in (ROOT / "templates").glob("*.j2")} <= shipped
+
+
+@pytest.mark.parametrize("axis, grid", [("x", "* * 1"), ("y", "* * 1"), ("z", "* 1 *")])
+def test_processor_grid_never_cuts_along_gravity(axis, grid):
+    # gravity is -z for axes x and y and -y for axis z (mesh.axis_frame); a cut along it
+    # would leave the rank above the bed nearly idle
+    src = text(overrides=[f"scene.drum.axis={axis}"])
+    lines = commands(src)
+    assert f"processors {grid}" in lines
+    assert lines.index(f"processors {grid}") < next(i for i, l in enumerate(lines)
+                                                    if l.startswith("create_box"))
