@@ -12,17 +12,18 @@ also written as particle and contact ``.vtu`` files (meshio, binary) to time the
 frame: read + identify + GSD.
 
 Per size it prints the time per frame of
-* reference: shared bond criterion + networkx BFS components + networkx BFS unwrap + table
-  (the ``implementation="reference"`` path of ligwf.analysis);
-* fast:      shared bond criterion + compiled union-find + compiled BFS unwrap + table
+* reference: compiled bond criterion + networkx BFS components + networkx BFS unwrap +
+  table (the ``implementation="reference"`` path of ligwf.analysis);
+* fast:      one compiled pass doing bond criterion + union-find + unwrap, then the table
   (the default path of ligwf.analysis);
 * floor:     one streaming pass over the contact arrays identification needs (id1, id2,
   delta: a sum over each, in memory), the least any implementation must do;
 * read contacts: reading one contact dump with the default (fast) reader;
 and the ratios reference/fast (target >= 100x at 360k) and fast/floor (target <= 25x),
 plus whole frames per second (read particles + contacts, identify, GSD; target >= 2 at
-360k). The bond criterion (force law + velocity angle) is compiled and shared by both
-paths; the split line also times its numpy evaluation (``bonded_contacts_reference``).
+360k). The split line shows where the time goes: the reference's parts (compiled bond
+criterion, networkx components, networkx unwrap; and the numpy evaluation of the bond
+criterion, ``bonded_contacts_reference``) and the fast path's fused pass and table.
 
 The compiled kernels (numba, ``cache=True``) are compiled or loaded from the cache once by
 ``warm_up()`` before anything is timed, so no row includes JIT compilation; the first
@@ -44,8 +45,7 @@ from ligwf import dumps_numba, granules_numba, gsd
 from ligwf.dumps import (ContactFrame, ParticleFrame, discover_frames, read_contacts,
                          read_particles)
 from ligwf.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
-                            granule_table, label_fast, label_reference, unwrap_fast,
-                            unwrap_reference)
+                            granule_table, identify, label_reference, unwrap_reference)
 
 R = 0.0005
 LIQUID = Liquid("washino", 0.024, math.radians(30.0), 0.02)
@@ -116,12 +116,10 @@ def timed(fn, repeat: int = 1) -> tuple[float, object]:
     return best, out
 
 
-def identify(p, c, length, liquid, fast: bool):
-    i, j, _ = bonded_contacts(p, c, liquid, BondCriterion())
-    label, unwrap = (label_fast, unwrap_fast) if fast else (label_reference, unwrap_reference)
-    labels = label(len(p), i, j)
-    unwrapped = unwrap(p.positions, labels, i, j, 1, length)
-    return granule_table(p, labels, 1.0, unwrapped, 1, 0.0, length)
+def granules_of(p, c, length, liquid, fast: bool):
+    """The granule table of one frame, as ligwf.analysis computes it."""
+    ident = identify(p, c, liquid, BondCriterion(), 1, length, "fast" if fast else "reference")
+    return granule_table(p, ident.labels, 1.0, ident.unwrapped_axis, 1, 0.0, length, ident.percolating)
 
 
 def stream_floor(c: ContactFrame) -> float:
@@ -131,7 +129,7 @@ def stream_floor(c: ContactFrame) -> float:
 def whole_frame(folder: Path, step: int, length: float, liquid) -> int:
     p = read_particles(folder / f"particles_{step}.vtu")
     c = read_contacts(folder / f"contacts_{step}.vtu")
-    table = identify(p, c, length, liquid, fast=True)
+    table = granules_of(p, c, length, liquid, fast=True)
     v = table["primary_volume"].to_numpy()
     gsd.histogram(v, gsd.log_edges(v.min(), v.max(), 5))
     gsd.percentile_diameters(v)
@@ -140,12 +138,12 @@ def whole_frame(folder: Path, step: int, length: float, liquid) -> int:
 
 def report(label: str, p, c, length, liquid, folder: Path | None, step: int,
            skip_reference: bool) -> None:
-    t_fast, table = timed(lambda: identify(p, c, length, liquid, True), 3)
+    t_fast, table = timed(lambda: granules_of(p, c, length, liquid, True), 3)
     t_floor, _ = timed(lambda: stream_floor(c), 5)
     if skip_reference:
         t_ref = math.nan
     else:
-        t_ref, ref_table = timed(lambda: identify(p, c, length, liquid, False), 1)
+        t_ref, ref_table = timed(lambda: granules_of(p, c, length, liquid, False), 1)
         assert ref_table["members"].tolist() == table["members"].tolist()
     line = (f"{label:>16}: N={len(p):>7,} contacts={len(c):>8,} granules={len(table):>7,} | "
             f"reference {t_ref:8.3f} s  fast {t_fast * 1e3:8.1f} ms  ratio {t_ref / t_fast:7.1f}x | "
@@ -156,23 +154,22 @@ def report(label: str, p, c, length, liquid, folder: Path | None, step: int,
         line += (f" | read contacts {t_read * 1e3:7.1f} ms  fast/read {t_fast / t_read:5.2f}x"
                  f" | whole frame {t_whole:6.3f} s = {1 / t_whole:5.2f} frames/s")
     print(line, flush=True)
-    # where the time goes: the bond criterion is shared by both implementations
+    # where the time goes
+    t_fused, ident = timed(lambda: identify(p, c, liquid, BondCriterion(), 1, length), 3)
+    t_tab, _ = timed(lambda: granule_table(p, ident.labels, 1.0, ident.unwrapped_axis, 1, 0.0, length,
+                                           ident.percolating), 3)
     t_bond, (i, j, _) = timed(lambda: bonded_contacts(p, c, liquid, BondCriterion()), 3)
     t_bond_np, _ = timed(lambda: bonded_contacts_reference(p, c, liquid, BondCriterion()), 1)
-    t_lf, labels = timed(lambda: label_fast(len(p), i, j), 3)
-    t_uf, _ = timed(lambda: unwrap_fast(p.positions, labels, i, j, 1, length), 3)
-    t_tab, _ = timed(lambda: granule_table(p, labels, 1.0, None, 1, 0.0, length), 3)
     if skip_reference:
         t_lr = t_ur = math.nan
     else:
-        t_lr, _ = timed(lambda: label_reference(len(p), i, j), 1)
+        t_lr, labels = timed(lambda: label_reference(len(p), i, j), 1)
         t_ur, _ = timed(lambda: unwrap_reference(p.positions, labels, i, j, 1, length), 1)
-    print(f"{'':>16}  split: bond criterion (shared) {t_bond * 1e3:7.1f} ms (numpy "
-          f"{t_bond_np * 1e3:6.1f} ms), table "
-          f"{t_tab * 1e3:6.1f} ms | components ref {t_lr:7.3f} s fast {t_lf * 1e3:6.1f} ms "
-          f"({t_lr / t_lf:6.1f}x) | unwrap ref {t_ur:7.3f} s fast {t_uf * 1e3:6.1f} ms "
-          f"({t_ur / t_uf:6.1f}x) | components+unwrap {(t_lr + t_ur) / (t_lf + t_uf):6.1f}x",
-          flush=True)
+    print(f"{'':>16}  split: fast = fused bond+components+unwrap pass {t_fused * 1e3:6.1f} ms "
+          f"(force law {'skipped, provably > 0' if ident.force is None else 'evaluated'}) + table "
+          f"{t_tab * 1e3:5.1f} ms | reference = bond criterion {t_bond * 1e3:6.1f} ms (numpy "
+          f"{t_bond_np * 1e3:6.1f} ms) + components {t_lr:6.3f} s + unwrap {t_ur:6.3f} s + table"
+          f" | percolating granules {int(ident.percolating.sum())}", flush=True)
 
 
 def main() -> None:

@@ -15,7 +15,8 @@ be read (:class:`~ligwf.errors.DumpReadError`) is skipped and listed, never anal
 Outputs (``OUT`` defaults to ``RUN_DIR/analysis``):
 
 * ``granules.parquet``: one row per granule per frame (case_id, cg, rule, replica,
-  frame, step, time, granule, members, volume, primary_volume, com_x/y/z, first_id);
+  frame, step, time, granule, members, volume, primary_volume, com_x/y/z, first_id,
+  percolating: the granule closes a cycle around the periodic axis);
 * ``frames.csv``: per frame: particles, contacts, bonds, granules, largest granule share;
 * ``gsd.csv``: per condition (group, CG level, rule; replicas pooled) and bin: number- and
   volume-weighted fractions with bootstrap bands and, for CG > 1, the CG1 reference, the
@@ -45,8 +46,7 @@ from .errors import ConfigError, DumpReadError
 from .fsio import atomic_write_bytes, atomic_write_json, atomic_write_text
 from .health import DONE
 from .manifest import MANIFEST_FILE
-from .granules import (AXES, BondCriterion, Liquid, bonded_contacts, granule_table, label_fast,
-                       label_reference, louvain_labels, unwrap_fast, unwrap_reference)
+from .granules import AXES, BondCriterion, Liquid, granule_table, identify, louvain_labels
 
 
 
@@ -180,30 +180,23 @@ class GranuleAnalysis:
                                     "(was the case rendered with analysis.granules: true?)")
             particles = read_particles(ff.particles, ff.step, c.dt)
             contacts = read_contacts(ff.contacts, ff.step)
-            i, j, force = bonded_contacts(particles, contacts, c.liquid, self.criterion)
+            ident = identify(particles, contacts, c.liquid, self.criterion, c.periodic_axis,
+                             c.box_length, self.implementation, need_force=self.louvain)
         except DumpReadError as exc:
             res.error = str(exc)
             return res
-        labels, unwrapped = self.identify(particles, i, j)
-        table = granule_table(particles, labels, c.cg, unwrapped, c.periodic_axis,
-                              c.box_lo, c.box_length)
-        res.table, res.particles, res.contacts, res.bonds = table, len(particles), len(contacts), len(i)
+        labels = ident.labels
+        table = granule_table(particles, labels, c.cg, ident.unwrapped_axis, c.periodic_axis,
+                              c.box_lo, c.box_length, ident.percolating)
+        res.table, res.particles, res.contacts = table, len(particles), len(contacts)
+        res.bonds = len(ident.i)
         if self.vtu_dir is not None:
-            extra = {"louvain": louvain_labels(len(particles), i, j, force)} if self.louvain else {}
+            extra = ({"louvain": louvain_labels(len(particles), ident.i, ident.j, ident.force)}
+                     if self.louvain else {})
             res.vtu = f"granules_{ff.step}.vtu"
             write_particle_vtu(Path(self.vtu_dir) / res.vtu, particles, labels,
                                table["members"].to_numpy()[labels], extra)
         return res
-
-    def identify(self, particles: ParticleFrame, i: np.ndarray, j: np.ndarray):
-        """Granule labels per particle and positions unwrapped along the bonds."""
-        label, unwrap = ((label_fast, unwrap_fast) if self.implementation == "fast"
-                         else (label_reference, unwrap_reference))
-        labels = label(len(particles), i, j)
-        c = self.case
-        if c.periodic_axis is None:
-            return labels, particles.positions
-        return labels, unwrap(particles.positions, labels, i, j, c.periodic_axis, c.box_length)
 
     def _conclude(self) -> None:
         self.results.sort(key=lambda r: r.step)
@@ -422,7 +415,7 @@ def _write_outputs(run_dir, out_dir, cases, skipped_cases, frames, results, opti
                            "bonds": r.bonds, "granules": len(t),
                            "largest_fraction": float(vol.max() / vol.sum())})
     cols = ["case_id", "cg", "rule", "replica", "frame", "step", "time", "granule", "members",
-            "volume", "primary_volume", "com_x", "com_y", "com_z", "first_id"]
+            "volume", "primary_volume", "com_x", "com_y", "com_z", "first_id", "percolating"]
     granules = (pd.concat(tables, ignore_index=True)[cols] if tables
                 else pd.DataFrame({c: pd.Series(dtype=float) for c in cols}))
     gsd_df, summary = gsd_tables(granules, cases, options.gsd, options.discard_frames)

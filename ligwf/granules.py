@@ -14,18 +14,22 @@ includes the Hertz repulsion. Separated pairs (delta < 0) within the rupture dis
 carry a bridge and count; beyond rupture the law gives 0 and the pair is not bonded.
 
 Granules are the connected components of the bonded graph (built on particle ids, never on
-geometry, since pairs across the periodic boundary span the box). Two implementations:
-:func:`label_reference` (networkx BFS, the method of the source study: slow, obviously
-right) and :func:`label_fast` (compiled union-find, :mod:`ligwf.granules_numba`); both
-return the same canonical labels (granule 0 holds the particle with the smallest id, and so
-on), which the tests check on real dumps and on random graphs. The bond test itself
-(:func:`bonded_contacts`) is one compiled pass over the contacts; the numpy evaluation of
-the same criterion, :func:`bonded_contacts_reference`, is kept as its reference.
+geometry, since pairs across the periodic boundary span the box). Two implementations of
+:func:`identify`: :func:`identify_reference` (compiled bond test, then networkx BFS for
+the components and for the unwrapping: the method of the source study, slow, obviously
+right) and :func:`identify_fast` (bond test, union-find and unwrapping in one compiled pass
+over the contacts, :mod:`ligwf.granules_numba`); both return the same canonical labels
+(granule 0 holds the particle with the smallest id, and so on), which the tests check on
+real dumps and on random graphs. The numpy evaluation of the bond criterion,
+:func:`bonded_contacts_reference`, is kept as the reference of the compiled one.
 
 Centres of mass are computed with positions unwrapped along the bonds across the
 periodic axis (a granule straddling y = 0 / y = L has its centre inside it, not in the
-middle of the box), then wrapped back into the box. All particles of a ligwf scene share
-one density, so centres of mass are volume-weighted.
+middle of the box), then wrapped back into the box. A granule that closes a cycle around
+the periodic axis (*percolating*, common for the big cluster of a dense wet bed) has no
+unwrapped layout; its members stay in the box and its centre along the axis is the plain
+mean of their in-box positions (flagged ``percolating`` in the table). All
+particles of a ligwf scene share one density, so centres of mass are volume-weighted.
 """
 
 from __future__ import annotations
@@ -121,17 +125,11 @@ def comoving(v_i: np.ndarray, v_j: np.ndarray, max_angle_deg: float) -> np.ndarr
     return (norms == 0.0) | (dot >= math.cos(math.radians(max_angle_deg)) * norms)
 
 
-def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
-                    criterion: BondCriterion = BondCriterion()):
-    """Indices (i, j) of bonded pairs into the particle arrays, and their bridge forces (N).
-
-    One compiled pass over the contacts (:func:`ligwf.granules_numba.bond_kernel`): the
-    rupture distance and velocity-angle tests, then the force law of the liquid model only
-    for the pairs that pass both; pairs in contact order. The same pairs as
-    :func:`bonded_contacts_reference`, forces equal to rounding (~1e-16 relative), tested
-    on real dumps and random frames.
-    """
-    from .granules_numba import MODEL_CODES, bond_kernel
+def _bond_inputs(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid):
+    """Arguments of the compiled bond kernels: contact rows (or ids with their offset when
+    the ids are contiguous, the kernel then maps them itself), liquid volume per particle
+    (m^3, the expression of :mod:`ligwf.bridges`, so bridge volumes agree bitwise), model code."""
+    from .granules_numba import MODEL_CODES
 
     if liquid.model not in MODEL_CODES:
         raise ValueError(f"no capillary force law for liquid model {liquid.model!r}")
@@ -144,19 +142,40 @@ def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Li
     content = particles.liquid_content
     if content is None:
         content = np.full(len(particles), liquid.liquid_content)
-    # liquid per particle, m^3: the expression of ligwf.bridges, so bridge volumes agree bitwise
     liquid_volume = 4.0 / 3.0 * np.pi * particles.radii**3 * content
+    return a, b, offset, liquid_volume, MODEL_CODES[liquid.model]
+
+
+def _unknown_id(particles: ParticleFrame, contacts: ContactFrame, count: int) -> None:
+    """A kernel reported contact ``-1 - count`` outside the frame: raise DumpReadError
+    naming the id (index_of does)."""
+    k = -1 - count
+    particles.index_of(np.array([contacts.id1[k], contacts.id2[k]]))
+    raise AssertionError("bond kernel and index_of disagree on the particle rows")
+
+
+def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
+                    criterion: BondCriterion = BondCriterion()):
+    """Indices (i, j) of bonded pairs into the particle arrays, and their bridge forces (N).
+
+    One compiled pass over the contacts (:func:`ligwf.granules_numba.bond_kernel`): the
+    rupture distance and velocity-angle tests, then the force law of the liquid model only
+    for the pairs that pass both; pairs in contact order. The same pairs as
+    :func:`bonded_contacts_reference`, forces equal to rounding (~1e-16 relative), tested
+    on real dumps and random frames.
+    """
+    from .granules_numba import bond_kernel
+
+    a, b, offset, liquid_volume, model = _bond_inputs(particles, contacts, liquid)
     count, i, j, force = bond_kernel(
         a, b, offset, particles.velocities, particles.radii, liquid_volume,
-        np.asarray(contacts.delta, dtype=np.float64), MODEL_CODES[liquid.model],
+        np.asarray(contacts.delta, dtype=np.float64), model,
         float(liquid.surface_tension), float(liquid.contact_angle_rad),
         bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
         math.cos(math.radians(criterion.max_velocity_angle_deg)),
         float(criterion.min_bridge_force))
-    if count < 0:       # raises DumpReadError naming the id that is not in the frame
-        k = -1 - count
-        particles.index_of(np.array([contacts.id1[k], contacts.id2[k]]))
-        raise AssertionError("bond_kernel and index_of disagree on the particle rows")
+    if count < 0:
+        _unknown_id(particles, contacts, count)
     return i[:count], j[:count], force[:count]
 
 
@@ -228,8 +247,8 @@ def unwrap_reference(positions: np.ndarray, labels: np.ndarray, i: np.ndarray, j
     out = positions.copy()
     graph = nx.Graph()
     graph.add_nodes_from(range(len(positions)))
-    # lexicographically sorted (lo, hi) edges make every node's neighbour order ascending,
-    # the order the compiled BFS (unwrap_fast) uses, so both build the same BFS tree
+    # lexicographically sorted (lo, hi) edges make every node's neighbour order ascending
+    # (a deterministic tree: the same result on every run)
     graph.add_edges_from(sorted(zip(np.minimum(i, j).tolist(), np.maximum(i, j).tolist())))
     roots = np.unique(labels, return_index=True)[1]
     for root in roots:
@@ -239,40 +258,150 @@ def unwrap_reference(positions: np.ndarray, labels: np.ndarray, i: np.ndarray, j
     return out
 
 
-def unwrap_fast(positions: np.ndarray, labels: np.ndarray, i: np.ndarray, j: np.ndarray,
-                axis: int, length: float) -> np.ndarray:
-    """Positions unwrapped along the bonds, compiled (same result as the reference).
-
-    The same breadth-first forest as :func:`unwrap_reference` (one tree per granule, rooted
-    at its first member, neighbours in ascending index order) and the same per-edge update,
-    so both agree to the last bit, also for a granule that percolates through the periodic
-    axis, whose unwrapping depends on the tree. The roots (each granule's first member) are
-    found during the search, so ``labels`` is not needed; it is kept for the common
-    signature with :func:`unwrap_reference`.
-    """
-    from .granules_numba import bfs_unwrap
-
-    out = positions.copy()
-    if len(i) == 0 or length <= 0:
-        return out
-    out[:, axis] = bfs_unwrap(np.asarray(positions[:, axis], dtype=np.float64),
-                              np.asarray(i, dtype=np.int64), np.asarray(j, dtype=np.int64),
-                              float(length))
+def percolating_reference(labels: np.ndarray, unwrapped: np.ndarray, i: np.ndarray,
+                          j: np.ndarray, axis: int, length: float) -> np.ndarray:
+    """Per granule: does it close a cycle around the periodic axis? True when one of its
+    bonds, laid out by the unwrapped positions, is not the minimum-image displacement."""
+    n_gran = int(labels.max()) + 1 if len(labels) else 0
+    out = np.zeros(n_gran, dtype=bool)
+    if len(i) and length > 0:
+        y = unwrapped[:, axis]
+        laid_out = y[j] - y[i]
+        direct = _wrap(y[j] - y[i], length)
+        out[labels[i[np.abs(laid_out - direct) > 0.5 * length]]] = True
     return out
 
 
+@dataclass(frozen=True)
+class Identification:
+    """Granules of one frame.
+
+    ``i``, ``j``: bonded pairs (rows of the particle arrays) in contact order; ``force``:
+    their bridge forces, N (None when not evaluated, see :func:`identify`); ``labels``:
+    canonical granule per particle; ``unwrapped_axis``: the coordinate along the periodic
+    axis ``axis``, laid out along the bonds (None without a periodic axis; the other two
+    coordinates never change); ``percolating``: per granule, True when it closes a cycle
+    around the periodic axis (it spans the whole box along it and has no unwrapped layout:
+    its members keep their in-box positions, see :func:`granule_table`).
+    """
+
+    i: np.ndarray
+    j: np.ndarray
+    force: np.ndarray | None
+    labels: np.ndarray
+    axis: int | None
+    unwrapped_axis: np.ndarray | None
+    percolating: np.ndarray
+
+    def unwrapped(self, positions: np.ndarray) -> np.ndarray:
+        """All three coordinates, the periodic one unwrapped (a copy; for output and tests)."""
+        out = np.array(positions, dtype=float, copy=True)
+        if self.axis is not None and self.unwrapped_axis is not None:
+            out[:, self.axis] = self.unwrapped_axis
+        return out
+
+
+def force_law_positive(particles: ParticleFrame, liquid: Liquid, liquid_volume: np.ndarray) -> bool:
+    """True when the capillary law is > 0 N for EVERY pair of this frame within rupture
+    distance, so that with ``min_bridge_force`` = 0 the bond test need not evaluate it.
+
+    Washino's law is 2 pi R gamma [cos(theta) / (1 + S / 2d) + sin(alpha) sin(alpha + theta)]
+    (both terms > 0 when gamma > 0, 0 <= theta < 90 deg and alpha <= 90 deg), and
+    alpha^2 = S p / R <= sqrt(2 V / (pi R)) / R, bounded with the largest bridge volume and
+    the smallest effective radius of the frame. Easo's fit has no such sign guarantee."""
+    if liquid.model != "washino" or len(particles) == 0:
+        return False
+    theta = liquid.contact_angle_rad
+    if not (liquid.surface_tension > 0.0 and 0.0 <= theta < 0.5 * math.pi):
+        return False
+    if not float(liquid_volume.min()) > 0.0:      # a dry partner: the law is 0 * inf at contact
+        return False
+    v_max = bridges.WASHINO_BRIDGE_VOLUME_FRACTION * 2.0 * float(liquid_volume.max())
+    r_eff = 0.5 * float(particles.radii.min())
+    return math.sqrt(2.0 * v_max / (math.pi * r_eff)) / r_eff <= (0.5 * math.pi) ** 2
+
+
+def identify_fast(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
+                  criterion: BondCriterion = BondCriterion(), periodic_axis: int | None = 1,
+                  length: float = 0.0, need_force: bool = False) -> Identification:
+    """Bonds, granules and unwrapping in one compiled pass over the contacts
+    (:func:`ligwf.granules_numba.bond_components`). The force law is evaluated only when it
+    can change the verdict (``min_bridge_force`` > 0, or a law not provably positive) or
+    when the caller asks for the forces (``need_force``, e.g. for Louvain weights)."""
+    from .granules_numba import bond_components
+
+    a, b, offset, liquid_volume, model = _bond_inputs(particles, contacts, liquid)
+    force_needed = (need_force or criterion.min_bridge_force > 0.0
+                    or not force_law_positive(particles, liquid, liquid_volume))
+    axis = 1 if periodic_axis is None else periodic_axis
+    period = float(length) if periodic_axis is not None else 0.0
+    y = np.ascontiguousarray(particles.positions[:, axis], dtype=np.float64)
+    count, i, j, force, labels, y_out, percolating, _ = bond_components(
+        a, b, offset, particles.velocities, particles.radii, liquid_volume,
+        np.asarray(contacts.delta, dtype=np.float64), model,
+        float(liquid.surface_tension), float(liquid.contact_angle_rad),
+        bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
+        math.cos(math.radians(criterion.max_velocity_angle_deg)),
+        float(criterion.min_bridge_force), force_needed, y, period)
+    if count < 0:
+        _unknown_id(particles, contacts, count)
+    return Identification(i[:count], j[:count], force[:count] if force_needed else None,
+                          labels, periodic_axis if period > 0.0 else None,
+                          y_out if period > 0.0 else None, percolating)
+
+
+def identify_reference(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
+                       criterion: BondCriterion = BondCriterion(), periodic_axis: int | None = 1,
+                       length: float = 0.0, need_force: bool = True) -> Identification:
+    """The reference: the shared bond test, networkx BFS components, networkx BFS unwrap."""
+    i, j, force = bonded_contacts(particles, contacts, liquid, criterion)
+    labels = label_reference(len(particles), i, j)
+    if periodic_axis is None or length <= 0:
+        n_gran = int(labels.max()) + 1 if len(labels) else 0
+        return Identification(i, j, force, labels, None, None, np.zeros(n_gran, bool))
+    unwrapped = unwrap_reference(particles.positions, labels, i, j, periodic_axis, length)
+    percolating = percolating_reference(labels, unwrapped, i, j, periodic_axis, length)
+    stay = percolating[labels]            # no unwrapped layout: members stay in the box
+    unwrapped[stay, periodic_axis] = particles.positions[stay, periodic_axis]
+    return Identification(i, j, force, labels, periodic_axis, unwrapped[:, periodic_axis].copy(),
+                          percolating)
+
+
+def identify(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
+             criterion: BondCriterion = BondCriterion(), periodic_axis: int | None = 1,
+             length: float = 0.0, implementation: str = "fast",
+             need_force: bool = False) -> Identification:
+    """Granules of one frame by the ``fast`` (default) or ``reference`` implementation."""
+    fn = {"fast": identify_fast, "reference": identify_reference}.get(implementation)
+    if fn is None:
+        raise ValueError(f"implementation {implementation!r}: use fast or reference")
+    return fn(particles, contacts, liquid, criterion, periodic_axis, length, need_force)
+
+
 def granule_table(particles: ParticleFrame, labels: np.ndarray, cg: float,
-                  unwrapped: np.ndarray | None = None, periodic_axis: int | None = 1,
-                  box_lo: float = 0.0, box_length: float = 0.0) -> pd.DataFrame:
+                  unwrapped_axis: np.ndarray | None = None, periodic_axis: int | None = 1,
+                  box_lo: float = 0.0, box_length: float = 0.0,
+                  percolating: np.ndarray | None = None) -> pd.DataFrame:
     """One row per granule: members, volume (m^3), primary-equivalent volume (m^3, volume /
-    cg^3), centre of mass (m, wrapped into the periodic box), smallest member id."""
+    cg^3), centre of mass (m, wrapped into the periodic box), smallest member id, and
+    whether it percolates along the periodic axis. ``unwrapped_axis``: the coordinate along
+    ``periodic_axis`` laid out along the bonds (:class:`Identification`); None: as dumped.
+
+    A percolating granule wraps around the periodic axis: unwrapping it along its bonds
+    would depend on the path taken, so both implementations leave its members in the box
+    and its centre along that axis is the plain mean of their in-box positions (about the
+    box middle for a granule spread along the whole axis; only the flag is meaningful).
+    """
     from .granules_numba import granule_sums
 
     n_gran = int(labels.max()) + 1 if len(labels) else 0
-    pos = particles.positions if unwrapped is None else unwrapped
+    replace = periodic_axis is not None and unwrapped_axis is not None
     members, volume, moment, first = granule_sums(
-        np.asarray(labels, dtype=np.int64), n_gran, particles.radii, np.asarray(pos, dtype=np.float64))
+        np.asarray(labels, dtype=np.int64), n_gran, particles.radii,
+        np.asarray(particles.positions, dtype=np.float64), periodic_axis if replace else -1,
+        np.asarray(unwrapped_axis, dtype=np.float64) if replace else np.empty(0))
     com = moment / volume[:, None]
+    perc = np.zeros(n_gran, dtype=bool) if percolating is None else np.asarray(percolating, bool)
     if periodic_axis is not None and box_length > 0:
         com[:, periodic_axis] = box_lo + np.mod(com[:, periodic_axis] - box_lo, box_length)
     first_id = particles.ids[first]
@@ -283,6 +412,7 @@ def granule_table(particles: ParticleFrame, labels: np.ndarray, cg: float,
         "primary_volume": volume / float(cg) ** 3,
         "com_x": com[:, 0], "com_y": com[:, 1], "com_z": com[:, 2],
         "first_id": first_id,
+        "percolating": perc,
     })
 
 

@@ -17,8 +17,8 @@ from ligwf import bridges
 from ligwf.dumps import ContactFrame, ParticleFrame, discover_frames, read_contacts, read_particles
 from ligwf.errors import DumpReadError
 from ligwf.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
-                            comoving, granule_table, label_fast, label_reference, louvain_labels,
-                            unwrap_fast, unwrap_reference)
+                            comoving, force_law_positive, granule_table, identify_fast,
+                            identify_reference, label_fast, label_reference, louvain_labels)
 from wetdump import wet_study
 
 
@@ -37,18 +37,19 @@ def real(engine, tmp_path_factory):
 def test_reference_equals_fast_on_real_dumps(real, angle):
     scaled, frames = real
     liquid = Liquid.from_scaled(scaled)
-    counts = []
+    counts, L = [], scaled["drum_length"]
     for p, c in frames:
-        i, j, _ = bonded_contacts(p, c, liquid, BondCriterion(0.0, angle))
-        ref, fast = label_reference(len(p), i, j), label_fast(len(p), i, j)
-        np.testing.assert_array_equal(ref, fast)
-        u_ref = unwrap_reference(p.positions, ref, i, j, 1, scaled["drum_length"])
-        u_fast = unwrap_fast(p.positions, fast, i, j, 1, scaled["drum_length"])
-        np.testing.assert_allclose(u_fast, u_ref, rtol=0, atol=1e-15)
-        t_ref = granule_table(p, ref, scaled["cg"], u_ref, 1, 0.0, scaled["drum_length"])
-        t_fast = granule_table(p, fast, scaled["cg"], u_fast, 1, 0.0, scaled["drum_length"])
+        crit = BondCriterion(0.0, angle)
+        ref = identify_reference(p, c, liquid, crit, 1, L)
+        fast = identify_fast(p, c, liquid, crit, 1, L)
+        _same_identification(p, ref, fast)
+        t_ref = granule_table(p, ref.labels, scaled["cg"], ref.unwrapped_axis, 1, 0.0, L,
+                              ref.percolating)
+        t_fast = granule_table(p, fast.labels, scaled["cg"], fast.unwrapped_axis, 1, 0.0, L,
+                               fast.percolating)
         np.testing.assert_array_equal(t_ref["members"], t_fast["members"])
         np.testing.assert_array_equal(t_ref["volume"], t_fast["volume"])
+        np.testing.assert_array_equal(t_ref["percolating"], t_fast["percolating"])
         np.testing.assert_allclose(t_ref[["com_x", "com_y", "com_z"]],
                                    t_fast[["com_x", "com_y", "com_z"]], atol=1e-15)
         # volumes sum to the total particle volume, singletons included
@@ -58,6 +59,21 @@ def test_reference_equals_fast_on_real_dumps(real, angle):
         counts.append(len(t_fast))
     if angle == 5.0:
         assert max(counts) > 5, "a strict angle splits the bed into several granules"
+
+
+def _same_identification(p, ref, fast, atol=1e-15):
+    """The fused compiled pass == the reference: same bonds in the same order, same
+    canonical labels, same percolating granules, the same unwrapped positions (to rounding:
+    the reference sums displacements along its BFS tree, the fused pass adds whole periods)."""
+    np.testing.assert_array_equal(fast.i, ref.i)
+    np.testing.assert_array_equal(fast.j, ref.j)
+    np.testing.assert_array_equal(fast.labels, ref.labels)
+    np.testing.assert_array_equal(fast.percolating, ref.percolating)
+    assert fast.axis == ref.axis
+    if ref.unwrapped_axis is None:
+        assert fast.unwrapped_axis is None
+    else:
+        np.testing.assert_allclose(fast.unwrapped_axis, ref.unwrapped_axis, rtol=0, atol=atol)
 
 
 def _same_bonds(p, c, liquid, crit):
@@ -119,6 +135,27 @@ def wet_frames(draw):
 def test_compiled_bonds_equal_numpy_on_random_frames(frame):
     p, c, liquid, crit = frame
     _same_bonds(p, c, liquid, crit)
+    for need_force in (False, True):
+        fast = identify_fast(p, c, liquid, crit, 1, 0.01, need_force)
+        _same_identification(p, identify_reference(p, c, liquid, crit, 1, 0.01), fast)
+        assert (fast.force is not None) or not need_force
+
+
+@settings(max_examples=200, deadline=None)
+@given(wet_frames(), st.floats(1e-4, 0.05))
+def test_force_law_shortcut_keeps_the_bonds(frame, content):
+    """Where the washino law is provably positive, the fused pass skips it: same bonds."""
+    p, c, liquid, crit = frame
+    r = float(p.radii[0])
+    p = ParticleFrame(p.path, 0, 0.0, p.ids, p.types, p.positions, p.velocities,
+                      np.full(len(p), r), np.full(len(p), content))
+    liquid = Liquid("washino", max(liquid.surface_tension, 1e-3), liquid.contact_angle_rad, 0.02)
+    crit = BondCriterion(0.0, crit.max_velocity_angle_deg)
+    lv = 4.0 / 3.0 * np.pi * p.radii**3 * p.liquid_content
+    assert force_law_positive(p, liquid, lv)
+    fast = identify_fast(p, c, liquid, crit, 1, 0.01)
+    assert fast.force is None
+    _same_identification(p, identify_reference(p, c, liquid, crit, 1, 0.01), fast)
 
 
 def test_bonded_contacts_unknown_id_names_it():
@@ -192,19 +229,49 @@ def test_broken_bridge_and_threshold():
     assert list(zip(i, j)) == [(0, 1)]
 
 
+def _all_bonded(pos, i, j, length):
+    """Identify with every contact (i, j) a bond (overlapping, co-moving partners), both ways."""
+    n = len(pos)
+    p = _frame([5e-4] * n, pos, np.zeros((n, 3)))
+    c = ContactFrame(Path("synthetic"), 0, np.asarray(i, np.int64) + 1, np.asarray(j, np.int64) + 1,
+                     np.full(len(i), 1e-6))
+    liquid = Liquid("washino", 0.02, math.radians(30), 0.02)
+    ref = identify_reference(p, c, liquid, BondCriterion(), 1, length)
+    fast = identify_fast(p, c, liquid, BondCriterion(), 1, length)
+    assert len(fast.i) == len(i)
+    return p, ref, fast
+
+
 def test_periodic_centre_of_mass():
     """A granule straddling y = 0 / y = L has its centre at the boundary, not mid-box."""
-    L, r = 0.009, 0.0005
+    L = 0.009
     pos = [[0, 0.0004, 0], [0, L - 0.0004, 0], [0.01, 0.0045, 0]]
-    p = _frame([r, r, r], pos, np.zeros((3, 3)))
-    i, j = np.array([0]), np.array([1])
-    labels = label_fast(3, i, j)
-    t = granule_table(p, labels, 1.0, unwrap_fast(p.positions, labels, i, j, 1, L), 1, 0.0, L)
+    p, ref, fast = _all_bonded(pos, [0], [1], L)
+    t = granule_table(p, fast.labels, 1.0, fast.unwrapped_axis, 1, 0.0, L, fast.percolating)
     assert t["members"].tolist() == [2, 1]
+    assert not t["percolating"].any()
     com_y = t.loc[0, "com_y"]
     assert min(com_y, L - com_y) < 1e-12          # at the boundary (0 or L)
-    naive = granule_table(p, labels, 1.0, None, 1, 0.0, L)
+    naive = granule_table(p, fast.labels, 1.0, None, 1, 0.0, L)
     assert naive.loc[0, "com_y"] == pytest.approx(L / 2)   # what not unwrapping gives
+
+
+def test_percolating_ring_is_flagged_and_kept_in_the_box():
+    """A chain closing on itself around the periodic axis percolates (both implementations);
+    having no unwrapped layout, its members keep their in-box positions."""
+    L = 1.0
+    y = np.array([0.05, 0.2, 0.45, 0.7, 0.5])          # ring 0-1-2-3-0 and a singleton
+    pos = np.column_stack([np.zeros(5), y, np.zeros(5)])
+    p, ref, fast = _all_bonded(pos, [0, 1, 2, 0], [1, 2, 3, 3], L)
+    assert fast.percolating.tolist() == ref.percolating.tolist() == [True, False]
+    np.testing.assert_array_equal(fast.unwrapped(p.positions), pos)
+    np.testing.assert_array_equal(ref.unwrapped(p.positions), pos)
+    t = granule_table(p, fast.labels, 1.0, fast.unwrapped_axis, 1, 0.0, L, fast.percolating)
+    assert t["percolating"].tolist() == [True, False]
+    assert t.loc[0, "com_y"] == pytest.approx(y[:4].mean())
+    # an open chain over the same positions does not percolate
+    _, ref, fast = _all_bonded(pos, [0, 1, 2], [1, 2, 3], L)
+    assert not fast.percolating.any() and not ref.percolating.any()
 
 
 @st.composite
@@ -236,29 +303,28 @@ def test_reference_equals_fast_on_random_graphs(g):
     assert np.all(np.unique(fast, return_index=True)[1] == np.sort(np.unique(fast, return_index=True)[1]))
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=150, deadline=None)
 @given(graphs(), st.integers(0, 2**31 - 1))
-def test_unwrap_reference_equals_fast_on_random_graphs(g, seed):
+def test_fused_pass_equals_reference_on_random_graphs(g, seed):
+    """Union-find with image counts == networkx BFS unwrap: labels, percolating granules
+    (random positions make many cycles around the axis) and the layout of the others."""
     n, i, j = g
-    L = 1.0
+    L = 0.02
     rng = np.random.default_rng(seed)
     pos = rng.uniform(0, L, size=(n, 3))
-    labels = label_fast(n, i, j)
-    # the same BFS tree and the same per-edge arithmetic: identical to the last bit, also for
-    # granules that wind around the periodic axis (random positions make many such cycles)
-    np.testing.assert_array_equal(unwrap_fast(pos, labels, i, j, 1, L),
-                                  unwrap_reference(pos, labels, i, j, 1, L))
+    p, ref, fast = _all_bonded(pos, i, j, L)
+    _same_identification(p, ref, fast, atol=1e-12 * L)
+    np.testing.assert_array_equal(fast.labels, label_reference(n, i, j))
 
 
 def test_unwrap_chain_across_boundary():
     """A chain of bonded particles crossing y = L is laid out continuously."""
-    L = 1.0
-    y = np.array([0.8, 0.9, 0.0, 0.1, 0.2])       # 0.8 -> 1.2 unwrapped
+    L = 0.01
+    y = np.array([0.8, 0.9, 0.0, 0.1, 0.2]) * L          # 0.8 -> 1.2 unwrapped
     pos = np.column_stack([np.zeros(5), y, np.zeros(5)])
-    i, j = np.array([3, 0, 2, 1]), np.array([4, 1, 3, 2])
-    labels = label_fast(5, i, j)
-    out = unwrap_fast(pos, labels, i, j, 1, L)
-    np.testing.assert_allclose(out[:, 1], [0.8, 0.9, 1.0, 1.1, 1.2])
+    _, ref, fast = _all_bonded(pos, [3, 0, 2, 1], [4, 1, 3, 2], L)
+    np.testing.assert_allclose(fast.unwrapped_axis, np.array([0.8, 0.9, 1.0, 1.1, 1.2]) * L)
+    np.testing.assert_allclose(ref.unwrapped_axis, fast.unwrapped_axis, atol=1e-15)
 
 
 @settings(max_examples=30, deadline=None)
