@@ -26,7 +26,7 @@ from .attempt import begin_attempt, finish_attempt, restart_unreadable
 from .engine import EngineConfig
 from .health import KILLED, atom_loss, kinetic_energy_blowup, log_errors, non_finite
 from .manifest import SCREEN_FILE, Manifest, write_manifest
-from .resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, plan_case
+from .resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, load_scaled, plan_case
 from .thermo import LogTail, ThermoParser
 
 #: Seconds a stopped engine gets to write its forced restart before it is killed.
@@ -82,10 +82,11 @@ def signal_engine(proc: subprocess.Popen, sig: int = signal.SIGTERM) -> None:
             pass
 
 
-def live_problem(parser: ThermoParser) -> str | None:
-    """A reason to stop a run now: an ERROR line, nan, atom loss or energy blow-up."""
+def live_problem(parser: ThermoParser, particle_count: int | None = None) -> str | None:
+    """A reason to stop a run now: an ERROR line, nan, atom loss (below ``particle_count``,
+    see :func:`ligwf.health.atom_loss`) or energy blow-up."""
     issues = (log_errors(parser.lines[-200:]) + non_finite(parser.rows[-50:])
-              + atom_loss(parser.rows) + kinetic_energy_blowup(parser.rows))
+              + atom_loss(parser.rows, particle_count) + kinetic_energy_blowup(parser.rows))
     issues = [i for i in issues if i.kind != "error"]  # errors end the engine by themselves
     return issues[0].message if issues else None
 
@@ -93,8 +94,9 @@ def live_problem(parser: ThermoParser) -> str | None:
 def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
            case_id: str = "", monitor: Monitor | None = None,
            stop: threading.Event | None = None, poll_seconds: float = 0.5,
-           stop_unstable: bool = True) -> LaunchResult:
-    """Run ``input_name`` in ``case_dir`` on ``nprocs`` ranks; stdout+stderr -> run.log."""
+           stop_unstable: bool = True, particle_count: int | None = None) -> LaunchResult:
+    """Run ``input_name`` in ``case_dir`` on ``nprocs`` ranks; stdout+stderr -> run.log.
+    ``particle_count``: the count the scene asks for (the live atom-loss test needs it)."""
     case_dir = Path(case_dir)
     cmd = engine.command(input_name, nprocs)
     screen = case_dir / SCREEN_FILE
@@ -117,7 +119,7 @@ def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
             if monitor is not None:
                 monitor.update(case_id, parser)
             if stop_sent_at is None:
-                problem = live_problem(parser) if stop_unstable else None
+                problem = live_problem(parser, particle_count) if stop_unstable else None
                 if problem or (stop is not None and stop.is_set()):
                     unstable = bool(problem)
                     killed = not unstable
@@ -159,7 +161,7 @@ def run_case(case_dir: Path, nprocs: int, engine: EngineConfig, monitor: Monitor
         if monitor is not None:
             monitor.start(case_id, manifest.total_steps, attempt.from_step)
         result = launch(case_dir, attempt.input, nprocs, engine, case_id, monitor, stop,
-                        poll_seconds)
+                        poll_seconds, particle_count=load_scaled(case_dir).particle_count)
         manifest = finish_attempt(case_dir, manifest, attempt, result.exit_code,
                                   result.wall_seconds, killed=result.killed)
         if restart_unreadable(manifest, attempt) and plan.restart is not None:

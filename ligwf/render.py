@@ -85,6 +85,11 @@ def _environment(user_dirs: tuple[str, ...]) -> jinja2.Environment:
     return env
 
 
+#: extra particles the last (top-up) insertion wave asks for and deletes again: covers the
+#: per-rank rounding of an insertion (std ~ sqrt(ranks)/2, so 4 sigma at 64 ranks)
+TOPUP_MARGIN = 16
+
+
 def _unit(index: int, sign: float = 1.0) -> list[float]:
     v = [0.0, 0.0, 0.0]
     v[index] = sign
@@ -134,6 +139,7 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
         "templates": templates,
         "distribution_seed": s.seeds[k0],
         "waves": waves,
+        "topup_margin": TOPUP_MARGIN,
         "rolling": s.rolling_friction > 0.0,
         "wet": s.wet,
         "cohesion_model": {"washino": "washino/capillary/viscous",
