@@ -17,7 +17,8 @@ Outputs (``OUT`` defaults to ``RUN_DIR/analysis``):
 * ``granules.parquet``: one row per granule per frame (case_id, cg, rule, replica,
   frame, step, time, granule, members, volume, primary_volume, com_x/y/z, first_id,
   percolating: the granule closes a cycle around the periodic axis);
-* ``frames.csv``: per frame: particles, contacts, bonds, granules, largest granule share;
+* ``frames.csv``: per frame: particles, contacts, bonds, granules, largest granule share
+  and whether the largest granule percolates (wraps around the periodic axis);
 * ``gsd.csv``: per condition (group, CG level, rule; replicas pooled) and bin: number- and
   volume-weighted fractions with bootstrap bands and, for CG > 1, the CG1 reference, the
   per-bin relative error (with band) and whether the bin lies below the size limit;
@@ -413,7 +414,8 @@ def _write_outputs(run_dir, out_dir, cases, skipped_cases, frames, results, opti
         frame_rows.append({"case_id": r.case_id, "step": r.step, "time": r.time, "status": "ok",
                            "reason": "", "particles": r.particles, "contacts": r.contacts,
                            "bonds": r.bonds, "granules": len(t),
-                           "largest_fraction": float(vol.max() / vol.sum())})
+                           "largest_fraction": float(vol.max() / vol.sum()),
+                           "largest_percolates": bool(t["percolating"].to_numpy()[vol.argmax()])})
     cols = ["case_id", "cg", "rule", "replica", "frame", "step", "time", "granule", "members",
             "volume", "primary_volume", "com_x", "com_y", "com_z", "first_id", "percolating"]
     granules = (pd.concat(tables, ignore_index=True)[cols] if tables

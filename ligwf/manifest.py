@@ -3,7 +3,7 @@
 ``manifest.json`` sits next to ``in.liggghts`` in every case folder and is always written
 atomically (temp file + rename, :mod:`ligwf.fsio`), so a reader sees the previous or the
 new manifest, never half of one. Later stages use only cases whose status is ``done``
-and whose scene hash matches ``scene.json`` (:func:`usable`).
+and whose scene hash matches ``scene.json`` (:func:`ligwf.analysis.manifest_problem`).
 
 Timing for the error-vs-run-time study: ``phases`` holds engine wall seconds and
 core-seconds (wall x MPI ranks) per phase (fill, settle, production), summed over all
@@ -22,7 +22,7 @@ from typing import Any
 
 from .errors import ConfigError
 from .fsio import atomic_write_json
-from .health import DONE, RUNNING, STATUSES
+from .health import RUNNING, STATUSES
 
 MANIFEST_FILE = "manifest.json"
 #: stdout+stderr of the current attempt of a case (earlier attempts: run.<n>.log)
@@ -118,12 +118,6 @@ def read_manifest(case_dir: Path) -> Manifest | None:
 def scene_hash_of(case_dir: Path) -> str:
     """The content hash the case folder was rendered with (from ``scene.json``)."""
     return json.loads((Path(case_dir) / "scene.json").read_text())["scene_hash"]
-
-
-def usable(case_dir: Path) -> bool:
-    """True when the case finished healthy and still matches its rendered scene."""
-    m = read_manifest(case_dir)
-    return m is not None and m.status == DONE and m.scene_hash == scene_hash_of(case_dir)
 
 
 def pid_alive(pid: int) -> bool:

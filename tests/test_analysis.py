@@ -104,6 +104,11 @@ def test_bad_frame_is_reported_and_skipped(study, tmp_path):
     assert frames[1].step in set(g[g.case_id == "cg3-weber-r0"]["step"])
     fr = pd.read_csv(tmp_path / "out" / "frames.csv")
     assert (fr["status"] == "skipped").sum() == 1
+    # the largest granule's percolation flag in frames.csv is the one of granules.parquet
+    ok = fr[fr["status"] == "ok"]
+    for row in ok.itertuples():
+        frame = g[(g.case_id == row.case_id) & (g.step == row.step)]
+        assert bool(frame.loc[frame["volume"].idxmax(), "percolating"]) == bool(row.largest_percolates)
 
 
 @pytest.mark.engine
