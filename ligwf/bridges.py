@@ -48,7 +48,10 @@ def engine_effective_angle_rad(theta_in_deg_i: float, theta_in_deg_j: float | No
 
 
 def _sphere_volume(r):
-    return 4.0 / 3.0 * np.pi * np.asarray(r, dtype=float) ** 3
+    """4/3 pi r^3, m^3, with r^3 as r*r*r: twice as fast as numpy's pow, and the compiled
+    granule kernels evaluate the same expression, so bridge volumes agree to the last bit."""
+    r = np.asarray(r, dtype=float)
+    return 4.0 / 3.0 * np.pi * (r * r * r)
 
 
 def washino_bridge_volume(r_i, r_j, content_i, content_j,

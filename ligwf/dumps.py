@@ -63,7 +63,7 @@ class ParticleFrame:
     @property
     def volumes(self) -> np.ndarray:
         """Sphere volumes, m^3."""
-        return 4.0 / 3.0 * np.pi * self.radii**3
+        return 4.0 / 3.0 * np.pi * (self.radii * self.radii * self.radii)
 
     def index_of(self, ids: np.ndarray) -> np.ndarray:
         """Row index of each particle id in ``ids``; DumpReadError if one is not present."""

@@ -127,8 +127,8 @@ def comoving(v_i: np.ndarray, v_j: np.ndarray, max_angle_deg: float) -> np.ndarr
 
 def _bond_inputs(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid):
     """Arguments of the compiled bond kernels: contact rows (or ids with their offset when
-    the ids are contiguous, the kernel then maps them itself), liquid volume per particle
-    (m^3, the expression of :mod:`ligwf.bridges`, so bridge volumes agree bitwise), model code."""
+    the ids are contiguous, the kernel then maps them itself), liquid content per particle
+    (the scene's when the dump lacks it), model code."""
     from .granules_numba import MODEL_CODES
 
     if liquid.model not in MODEL_CODES:
@@ -142,8 +142,7 @@ def _bond_inputs(particles: ParticleFrame, contacts: ContactFrame, liquid: Liqui
     content = particles.liquid_content
     if content is None:
         content = np.full(len(particles), liquid.liquid_content)
-    liquid_volume = 4.0 / 3.0 * np.pi * particles.radii**3 * content
-    return a, b, offset, liquid_volume, MODEL_CODES[liquid.model]
+    return a, b, offset, np.asarray(content, dtype=np.float64), MODEL_CODES[liquid.model]
 
 
 def _unknown_id(particles: ParticleFrame, contacts: ContactFrame, count: int) -> None:
@@ -166,9 +165,9 @@ def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Li
     """
     from .granules_numba import bond_kernel
 
-    a, b, offset, liquid_volume, model = _bond_inputs(particles, contacts, liquid)
+    a, b, offset, content, model = _bond_inputs(particles, contacts, liquid)
     count, i, j, force = bond_kernel(
-        a, b, offset, particles.velocities, particles.radii, liquid_volume,
+        a, b, offset, particles.velocities, particles.radii, content,
         np.asarray(contacts.delta, dtype=np.float64), model,
         float(liquid.surface_tension), float(liquid.contact_angle_rad),
         bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
@@ -301,23 +300,29 @@ class Identification:
         return out
 
 
-def force_law_positive(particles: ParticleFrame, liquid: Liquid, liquid_volume: np.ndarray) -> bool:
+def force_law_positive(particles: ParticleFrame, liquid: Liquid, content: np.ndarray) -> bool:
     """True when the capillary law is > 0 N for EVERY pair of this frame within rupture
     distance, so that with ``min_bridge_force`` = 0 the bond test need not evaluate it.
 
     Washino's law is 2 pi R gamma [cos(theta) / (1 + S / 2d) + sin(alpha) sin(alpha + theta)]
     (both terms > 0 when gamma > 0, 0 <= theta < 90 deg and alpha <= 90 deg), and
-    alpha^2 = S p / R <= sqrt(2 V / (pi R)) / R, bounded with the largest bridge volume and
-    the smallest effective radius of the frame. Easo's fit has no such sign guarantee."""
+    alpha^2 = S p / R <= sqrt(2 V / (pi R)) / R, bounded with a bridge volume above any of
+    the frame's (largest radius and content) and its smallest effective radius. Easo's fit
+    has no such sign guarantee.
+    """
     if liquid.model != "washino" or len(particles) == 0:
         return False
     theta = liquid.contact_angle_rad
-    if not (liquid.surface_tension > 0.0 and 0.0 <= theta < 0.5 * math.pi):
+    # margins keep the law far from underflow to 0 (a denormal surface tension, theta at
+    # 90 deg, or a nearly dry partner: then the law itself decides, as in the reference)
+    if not (liquid.surface_tension >= 1e-9 and 0.0 <= theta <= math.radians(89.9)):
         return False
-    if not float(liquid_volume.min()) > 0.0:      # a dry partner: the law is 0 * inf at contact
+    if not float(content.min()) >= 1e-12:         # a dry partner: the law is 0 * inf at contact
         return False
-    v_max = bridges.WASHINO_BRIDGE_VOLUME_FRACTION * 2.0 * float(liquid_volume.max())
-    r_eff = 0.5 * float(particles.radii.min())
+    r_min, r_max = float(particles.radii.min()), float(particles.radii.max())
+    v_max = (bridges.WASHINO_BRIDGE_VOLUME_FRACTION * 2.0
+             * float(bridges._sphere_volume(r_max)) * float(content.max()))
+    r_eff = 0.5 * r_min
     return math.sqrt(2.0 * v_max / (math.pi * r_eff)) / r_eff <= (0.5 * math.pi) ** 2
 
 
@@ -330,14 +335,14 @@ def identify_fast(particles: ParticleFrame, contacts: ContactFrame, liquid: Liqu
     when the caller asks for the forces (``need_force``, e.g. for Louvain weights)."""
     from .granules_numba import bond_components
 
-    a, b, offset, liquid_volume, model = _bond_inputs(particles, contacts, liquid)
+    a, b, offset, content, model = _bond_inputs(particles, contacts, liquid)
     force_needed = (need_force or criterion.min_bridge_force > 0.0
-                    or not force_law_positive(particles, liquid, liquid_volume))
+                    or not force_law_positive(particles, liquid, content))
     axis = 1 if periodic_axis is None else periodic_axis
     period = float(length) if periodic_axis is not None else 0.0
     y = np.ascontiguousarray(particles.positions[:, axis], dtype=np.float64)
     count, i, j, force, labels, y_out, percolating, _ = bond_components(
-        a, b, offset, particles.velocities, particles.radii, liquid_volume,
+        a, b, offset, particles.velocities, particles.radii, content,
         np.asarray(contacts.delta, dtype=np.float64), model,
         float(liquid.surface_tension), float(liquid.contact_angle_rad),
         bridges.WASHINO_BRIDGE_VOLUME_FRACTION,

@@ -84,7 +84,7 @@ def _easo_force(ri, rj, gap, gamma, theta, vol):
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _bond(a, b, gap, velocities, radii, liquid_volume, model, gamma, theta, cos_theta,
+def _bond(a, b, gap, velocities, radii, content, model, gamma, theta, cos_theta,
           sin_theta, fraction, cube_factor, cos_max, min_force, force_needed):
     """Bridge force of contact (a, b) if it is a liquid bond, else -1.0.
 
@@ -96,10 +96,15 @@ def _bond(a, b, gap, velocities, radii, liquid_volume, model, gamma, theta, cos_
     force NaN (the caller has proved the law positive for every pair within rupture and
     ``min_force`` is 0, so the law could not change the verdict).
     """
+    ra, rb = radii[a], radii[b]
+    # liquid per particle, m^3: the expression of ligwf.bridges._sphere_volume x content,
+    # operation for operation, so bridge volumes agree with the numpy reference bitwise
+    lva = 4.0 / 3.0 * np.pi * (ra * ra * ra) * content[a]
+    lvb = 4.0 / 3.0 * np.pi * (rb * rb * rb) * content[b]
     if model == 1:
-        vol = fraction * (liquid_volume[a] + liquid_volume[b])
+        vol = fraction * (lva + lvb)
     else:
-        vol = _easo_volume(radii[a], radii[b], liquid_volume[a], liquid_volume[b])
+        vol = _easo_volume(ra, rb, lva, lvb)
     if not _within_rupture(gap, vol, theta, cube_factor):
         return -1.0
     vax, vay, vaz = velocities[a, 0], velocities[a, 1], velocities[a, 2]
@@ -110,7 +115,6 @@ def _bond(a, b, gap, velocities, radii, liquid_volume, model, gamma, theta, cos_
         return -1.0
     if not force_needed:
         return np.nan
-    ra, rb = radii[a], radii[b]
     if model == 1:
         f = _washino_force(ra, rb, gap, gamma, cos_theta, sin_theta, vol)
     else:
@@ -119,7 +123,7 @@ def _bond(a, b, gap, velocities, radii, liquid_volume, model, gamma, theta, cos_
 
 
 @njit(cache=True, inline="always", error_model="numpy")
-def _scan(model, id1, id2, id_offset, velocities, radii, liquid_volume, delta, gamma, theta,
+def _scan(model, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
           fraction, cos_max, min_force, force_needed, out_i, out_j, out_f):
     """The loop over the contacts shared by :func:`bond_kernel` and :func:`bond_components`:
     bond test of each contact, bonded pairs to ``out_*``. Returns the bond count, or
@@ -138,7 +142,7 @@ def _scan(model, id1, id2, id_offset, velocities, radii, liquid_volume, delta, g
         b = np.int64(id2[k]) - id_offset
         if a < 0 or a >= n or b < 0 or b >= n:
             return -1 - k
-        f = _bond(a, b, -delta[k], velocities, radii, liquid_volume, model, gamma, theta,
+        f = _bond(a, b, -delta[k], velocities, radii, content, model, gamma, theta,
                   cos_theta, sin_theta, fraction, cube_factor, cos_max, min_force, force_needed)
         if f < 0.0:                               # not a bond (NaN: a bond, force not needed)
             continue
@@ -150,14 +154,13 @@ def _scan(model, id1, id2, id_offset, velocities, radii, liquid_volume, delta, g
 
 
 @njit(cache=True, error_model="numpy")
-def bond_kernel(id1, id2, id_offset, velocities, radii, liquid_volume, delta, model, gamma,
+def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, model, gamma,
                 theta, fraction, cos_max, min_force):
     """One pass over the contacts: the bond test of :func:`_bond` for each.
 
     Particle rows are ``id1 - id_offset`` and ``id2 - id_offset`` (the ids themselves when
-    the caller already mapped them, with offset 0). ``liquid_volume``: sphere volume x
-    liquid content per particle, m^3, computed by the caller with the numpy expression of
-    :mod:`ligwf.bridges` so that the bridge volumes agree to the last bit. Returns
+    the caller already mapped them, with offset 0). ``content``: liquid content per
+    particle (fraction of its volume). Returns
     (count, i, j, force) with the bonded pairs in the first ``count`` entries, or
     count = -1 - k when contact k refers to a row outside the frame.
     """
@@ -167,16 +170,16 @@ def bond_kernel(id1, id2, id_offset, velocities, radii, liquid_volume, delta, mo
     out_f = np.empty(m, np.float64)
     count = 0
     if model == 1:
-        count = _scan(1, id1, id2, id_offset, velocities, radii, liquid_volume, delta, gamma,
+        count = _scan(1, id1, id2, id_offset, velocities, radii, content, delta, gamma,
                       theta, fraction, cos_max, min_force, True, out_i, out_j, out_f)
     elif model == 2:
-        count = _scan(2, id1, id2, id_offset, velocities, radii, liquid_volume, delta, gamma,
+        count = _scan(2, id1, id2, id_offset, velocities, radii, content, delta, gamma,
                       theta, fraction, cos_max, min_force, True, out_i, out_j, out_f)
     return count, out_i, out_j, out_f
 
 
 @njit(cache=True, error_model="numpy")
-def bond_components(id1, id2, id_offset, velocities, radii, liquid_volume, delta, model, gamma,
+def bond_components(id1, id2, id_offset, velocities, radii, content, delta, model, gamma,
                     theta, fraction, cos_max, min_force, force_needed, y, length):
     """Bond test, granules and unwrapping along the periodic axis in one compiled call:
     one pass over the contacts, one over the bonds, one over the particles.
@@ -206,10 +209,10 @@ def bond_components(id1, id2, id_offset, velocities, radii, liquid_volume, delta
     winds = np.zeros(n, np.bool_)                 # per root: its tree closes a periodic cycle
     count = 0
     if model == 1:
-        count = _scan(1, id1, id2, id_offset, velocities, radii, liquid_volume, delta, gamma,
+        count = _scan(1, id1, id2, id_offset, velocities, radii, content, delta, gamma,
                       theta, fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
     elif model == 2:
-        count = _scan(2, id1, id2, id_offset, velocities, radii, liquid_volume, delta, gamma,
+        count = _scan(2, id1, id2, id_offset, velocities, radii, content, delta, gamma,
                       theta, fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
     if count < 0:
         return (count, out_i, out_j, out_f, parent, y, winds, 0)
@@ -332,10 +335,10 @@ def warm_up() -> None:
     v = np.ones((2, 3))
     r, c = np.full(2, 1e-3), np.full(2, 0.02)
     for model in (1, 2):
-        bond_kernel(np.array([1]), np.array([2]), 1, v, r, r**3, np.array([1e-6]), model,
+        bond_kernel(np.array([1]), np.array([2]), 1, v, r, c, np.array([1e-6]), model,
                     0.02, 0.1, 0.05, 0.5, 0.0)
         for needed in (True, False):
-            bond_components(np.array([1]), np.array([2]), 1, v, r, r**3, np.array([1e-6]),
+            bond_components(np.array([1]), np.array([2]), 1, v, r, c, np.array([1e-6]),
                             model, 0.02, 0.1, 0.05, 0.5, 0.0, needed, v[:, 1].copy(), 1.0)
     i, j = np.array([0]), np.array([1])
     labels = union_find_labels(2, i, j)

@@ -151,8 +151,7 @@ def test_force_law_shortcut_keeps_the_bonds(frame, content):
                       np.full(len(p), r), np.full(len(p), content))
     liquid = Liquid("washino", max(liquid.surface_tension, 1e-3), liquid.contact_angle_rad, 0.02)
     crit = BondCriterion(0.0, crit.max_velocity_angle_deg)
-    lv = 4.0 / 3.0 * np.pi * p.radii**3 * p.liquid_content
-    assert force_law_positive(p, liquid, lv)
+    assert force_law_positive(p, liquid, p.liquid_content)
     fast = identify_fast(p, c, liquid, crit, 1, 0.01)
     assert fast.force is None
     _same_identification(p, identify_reference(p, c, liquid, crit, 1, 0.01), fast)
