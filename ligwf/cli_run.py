@@ -21,7 +21,6 @@ from typing import Iterator
 
 from rich.console import Console
 
-from .cli_stability import preflight_or_refuse
 from .cases import STUDY_FILE, render_workflow, write_study
 from .cli_stability import preflight_or_refuse
 from .engine import EngineConfig
