@@ -13,6 +13,7 @@ import os
 import shlex
 import shutil
 import subprocess
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -91,10 +92,12 @@ class EngineConfig:
         cmd += list(self.mpirun_args) + ["-np", str(nprocs)]
         return cmd
 
-    def command(self, input_name: str, nprocs: int, log_name: str = "log.liggghts") -> list[str]:
-        """Full command line running ``input_name`` in the case folder on ``nprocs`` ranks."""
+    def command(self, input_name: str, nprocs: int, log_name: str = "log.liggghts",
+                extra: Sequence[str] = ()) -> list[str]:
+        """Full command line running ``input_name`` in the case folder on ``nprocs`` ranks;
+        ``extra``: further LIGGGHTS arguments (e.g. ``-var`` settings)."""
         return self.mpirun_prefix(nprocs) + [self.liggghts_path(), "-in", input_name,
-                                             "-log", log_name]
+                                             "-log", log_name, *extra]
 
     def version_line(self) -> str:
         """First output line of ``liggghts -h`` (which exits 1 by design)."""

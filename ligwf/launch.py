@@ -20,12 +20,13 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol
+from typing import Protocol, Sequence
 
 from .attempt import begin_attempt, finish_attempt, restart_unreadable
 from .engine import EngineConfig
 from .health import KILLED, atom_loss, kinetic_energy_blowup, log_errors, non_finite
 from .manifest import SCREEN_FILE, Manifest, write_manifest
+from .render import grid_vars
 from .resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, load_scaled, plan_case
 from .thermo import LogTail, ThermoParser
 
@@ -94,11 +95,13 @@ def live_problem(parser: ThermoParser, particle_count: int | None = None) -> str
 def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
            case_id: str = "", monitor: Monitor | None = None,
            stop: threading.Event | None = None, poll_seconds: float = 0.5,
-           stop_unstable: bool = True, particle_count: int | None = None) -> LaunchResult:
+           stop_unstable: bool = True, particle_count: int | None = None,
+           engine_args: Sequence[str] = ()) -> LaunchResult:
     """Run ``input_name`` in ``case_dir`` on ``nprocs`` ranks; stdout+stderr -> run.log.
-    ``particle_count``: the count the scene asks for (the live atom-loss test needs it)."""
+    ``particle_count``: the count the scene asks for (the live atom-loss test needs it);
+    ``engine_args``: further LIGGGHTS arguments (the processor grid)."""
     case_dir = Path(case_dir)
-    cmd = engine.command(input_name, nprocs)
+    cmd = engine.command(input_name, nprocs, extra=engine_args)
     screen = case_dir / SCREEN_FILE
     parser, tail = ThermoParser(), LogTail(screen)
     t0 = time.monotonic()
@@ -107,13 +110,14 @@ def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
                                 stdin=subprocess.DEVNULL, start_new_session=True)
     killed = unstable = False
     stop_sent_at: float | None = None
+    # a thread blocks in waitpid; this one sleeps on an event between polls. (Popen.wait
+    # with a timeout polls waitpid with backoff, ~30 wake-ups a second, each of which
+    # preempts one of the busy-polling MPI ranks on a fully used machine.)
+    ended = threading.Event()
+    threading.Thread(target=lambda: (proc.wait(), ended.set()), daemon=True,
+                     name=f"wait-{case_id or proc.pid}").start()
     try:
-        while True:
-            try:
-                proc.wait(timeout=poll_seconds)
-                break
-            except subprocess.TimeoutExpired:
-                pass
+        while not ended.wait(poll_seconds):
             for line in tail.read_lines():
                 parser.feed(line)
             if monitor is not None:
@@ -155,13 +159,15 @@ def run_case(case_dir: Path, nprocs: int, engine: EngineConfig, monitor: Monitor
         if monitor is not None:
             monitor.end(case_id, None, plan)
         return None
+    scaled = load_scaled(case_dir)
+    grid = grid_vars(scaled, nprocs)
     while True:
-        cmd = engine.command(input_for(plan), nprocs)
+        cmd = engine.command(input_for(plan), nprocs, extra=grid)
         manifest, attempt = begin_attempt(case_dir, plan, nprocs, "mpirun", cmd, template_dirs)
         if monitor is not None:
             monitor.start(case_id, manifest.total_steps, attempt.from_step)
         result = launch(case_dir, attempt.input, nprocs, engine, case_id, monitor, stop,
-                        poll_seconds, particle_count=load_scaled(case_dir).particle_count)
+                        poll_seconds, particle_count=scaled.particle_count, engine_args=grid)
         manifest = finish_attempt(case_dir, manifest, attempt, result.exit_code,
                                   result.wall_seconds, killed=result.killed)
         if restart_unreadable(manifest, attempt) and plan.restart is not None:

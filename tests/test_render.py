@@ -137,7 +137,9 @@ def test_installed_wheel_ships_templates(tmp_path):
     assert {p.name for p in (ROOT / "templates").glob("*.j2")} <= shipped
 
 
-@pytest.mark.parametrize("axis, grid", [("x", "* * 1"), ("y", "* * 1"), ("z", "* 1 *")])
+@pytest.mark.parametrize("axis, grid", [("x", "${ligwf_pa} ${ligwf_pu} 1"),
+                                        ("y", "${ligwf_pu} ${ligwf_pa} 1"),
+                                        ("z", "${ligwf_pu} 1 ${ligwf_pa}")])
 def test_processor_grid_never_cuts_along_gravity(axis, grid):
     # gravity is -z for axes x and y and -y for axis z (mesh.axis_frame); a cut along it
     # would leave the rank above the bed nearly idle
@@ -146,3 +148,23 @@ def test_processor_grid_never_cuts_along_gravity(axis, grid):
     assert f"processors {grid}" in lines
     assert lines.index(f"processors {grid}") < next(i for i, l in enumerate(lines)
                                                     if l.startswith("create_box"))
+    # run by hand (no -var): every rank along the axis
+    assert "variable ligwf_pu index 1" in lines and "variable ligwf_pa index *" in lines
+
+
+def test_processor_grid_puts_ranks_along_the_axis_first():
+    from ligwf.render import MIN_AXIAL_SLAB, grid_vars, processor_grid
+
+    wf = load_workflow(DRUM, ["sweep.cg_levels=[1, 3]", "sweep.rules=[weber]"])
+    cg1, cg3 = (c.scaled() for c in wf.cases)
+    slabs1 = int(cg1.drum_length / (MIN_AXIAL_SLAB * cg1.d_max))      # 9 mm / 4 mm = 2
+    assert slabs1 == 2
+    assert processor_grid(cg1, 1) == (1, 1)
+    assert processor_grid(cg1, 2) == (1, 2)
+    assert processor_grid(cg1, 4) == (2, 2)
+    assert processor_grid(cg1, 3) == (3, 1)            # 3 slabs of 3 mm would be too thin
+    assert processor_grid(cg3, 2) == (2, 1)            # 9 mm holds one 4 x 3 mm slab only
+    for n in range(1, 13):
+        across, axial = processor_grid(cg1, n)
+        assert across * axial == n and axial <= max(1, slabs1)
+    assert grid_vars(cg1, 2) == ["-var", "ligwf_pu", "1", "-var", "ligwf_pa", "2"]
