@@ -14,6 +14,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import NullFormatter  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
@@ -50,6 +51,7 @@ def pareto(conditions: pd.DataFrame, path: Path) -> Path:
             ax.annotate(_label(r["cg"], r["rule"]), (r["core_seconds"], 100 * y),
                         textcoords="offset points", xytext=(4, 4), fontsize=8)
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short spans
         ax.set_xlabel("run time [core-seconds]")
         ax.set_ylabel("error [%]")
         ax.set_title(title, fontsize=10)
