@@ -117,3 +117,27 @@ def test_resume_phase_boundaries():
     assert resume_phase(S, 200) == ("fill", 3, False)  # wave 3 not inserted yet
     assert resume_phase(S, 300) == ("settle", 0, False)
     assert resume_phase(S, 350) == ("production", 0, False)
+
+
+def test_resume_mid_fill_keeps_the_top_up_and_its_trim():
+    """Fresh and resumed inputs share the fill-wave template: a resume inside the last wave,
+    after its insertion, still trims to the exact count; one inside an earlier wave inserts
+    the later waves with the top-up margin; every wave ends at the same absolute step."""
+    from ligwf.render import TOPUP_MARGIN, render
+    from ligwf.resume import RestartFile, render_resume
+    from ligwf.workflow import load_workflow
+
+    from helpers import DRUM
+
+    s = load_workflow(DRUM, ["sweep.cg_levels=[3]", "sweep.rules=[weber]"]).cases[0].scaled()
+    n, last = s.particle_count, len(s.insertion_waves)
+    fresh = render(s)["in.liggghts"]
+    ends = [f"run {k * s.wave_steps} upto" for k in range(1, last + 1)]
+    assert all(e in fresh for e in ends)
+    late = list(render_resume(s, RestartFile("r", (last - 1) * s.wave_steps + 5)).values())[0]
+    assert f"fix ins{last} " not in late                     # inserted before the restart
+    assert f"group ligwf_extra id > {n}" in late and "delete_atoms group ligwf_extra" in late
+    assert ends[-1] in late
+    early = list(render_resume(s, RestartFile("r", 5)).values())[0]
+    assert "fix ins1 " not in early and f"fix ins{last} " in early
+    assert f"({n + TOPUP_MARGIN}-count(all))" in early and "delete_atoms group ligwf_extra" in early
