@@ -125,10 +125,13 @@ def comoving(v_i: np.ndarray, v_j: np.ndarray, max_angle_deg: float) -> np.ndarr
     return (norms == 0.0) | (dot >= math.cos(math.radians(max_angle_deg)) * norms)
 
 
-def _bond_inputs(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid):
-    """Arguments of the compiled bond kernels: contact rows (or ids with their offset when
-    the ids are contiguous, the kernel then maps them itself), liquid content per particle
-    (the scene's when the dump lacks it), model code."""
+def _kernel_args(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
+                 criterion: BondCriterion) -> tuple[tuple, np.ndarray]:
+    """The leading arguments shared by the compiled bond kernels (:func:`bond_kernel
+    <ligwf.granules_numba.bond_kernel>`, :func:`bond_components
+    <ligwf.granules_numba.bond_components>`), and the liquid content per particle (the
+    scene's when the dump lacks it). Contacts go in as rows, or as ids with their offset
+    when the ids are contiguous (the kernel then maps them itself)."""
     from .granules_numba import MODEL_CODES
 
     if liquid.model not in MODEL_CODES:
@@ -142,7 +145,14 @@ def _bond_inputs(particles: ParticleFrame, contacts: ContactFrame, liquid: Liqui
     content = particles.liquid_content
     if content is None:
         content = np.full(len(particles), liquid.liquid_content)
-    return a, b, offset, np.asarray(content, dtype=np.float64), MODEL_CODES[liquid.model]
+    content = np.asarray(content, dtype=np.float64)
+    args = (a, b, offset, particles.velocities, particles.radii, content,
+            np.asarray(contacts.delta, dtype=np.float64), MODEL_CODES[liquid.model],
+            float(liquid.surface_tension), float(liquid.contact_angle_rad),
+            bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
+            math.cos(math.radians(criterion.max_velocity_angle_deg)),
+            float(criterion.min_bridge_force))
+    return args, content
 
 
 def _unknown_id(particles: ParticleFrame, contacts: ContactFrame, count: int) -> None:
@@ -165,14 +175,8 @@ def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Li
     """
     from .granules_numba import bond_kernel
 
-    a, b, offset, content, model = _bond_inputs(particles, contacts, liquid)
-    count, i, j, force = bond_kernel(
-        a, b, offset, particles.velocities, particles.radii, content,
-        np.asarray(contacts.delta, dtype=np.float64), model,
-        float(liquid.surface_tension), float(liquid.contact_angle_rad),
-        bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
-        math.cos(math.radians(criterion.max_velocity_angle_deg)),
-        float(criterion.min_bridge_force))
+    args, _ = _kernel_args(particles, contacts, liquid, criterion)
+    count, i, j, force = bond_kernel(*args)
     if count < 0:
         _unknown_id(particles, contacts, count)
     return i[:count], j[:count], force[:count]
@@ -321,7 +325,7 @@ def force_law_positive(particles: ParticleFrame, liquid: Liquid, content: np.nda
         return False
     r_min, r_max = float(particles.radii.min()), float(particles.radii.max())
     v_max = (bridges.WASHINO_BRIDGE_VOLUME_FRACTION * 2.0
-             * float(bridges._sphere_volume(r_max)) * float(content.max()))
+             * float(bridges.sphere_volume(r_max)) * float(content.max()))
     r_eff = 0.5 * r_min
     return math.sqrt(2.0 * v_max / (math.pi * r_eff)) / r_eff <= (0.5 * math.pi) ** 2
 
@@ -335,19 +339,14 @@ def identify_fast(particles: ParticleFrame, contacts: ContactFrame, liquid: Liqu
     when the caller asks for the forces (``need_force``, e.g. for Louvain weights)."""
     from .granules_numba import bond_components
 
-    a, b, offset, content, model = _bond_inputs(particles, contacts, liquid)
+    args, content = _kernel_args(particles, contacts, liquid, criterion)
     force_needed = (need_force or criterion.min_bridge_force > 0.0
                     or not force_law_positive(particles, liquid, content))
     axis = 1 if periodic_axis is None else periodic_axis
     period = float(length) if periodic_axis is not None else 0.0
     y = np.ascontiguousarray(particles.positions[:, axis], dtype=np.float64)
     count, i, j, force, labels, y_out, percolating, _ = bond_components(
-        a, b, offset, particles.velocities, particles.radii, content,
-        np.asarray(contacts.delta, dtype=np.float64), model,
-        float(liquid.surface_tension), float(liquid.contact_angle_rad),
-        bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
-        math.cos(math.radians(criterion.max_velocity_angle_deg)),
-        float(criterion.min_bridge_force), force_needed, y, period)
+        *args, force_needed, y, period)
     if count < 0:
         _unknown_id(particles, contacts, count)
     return Identification(i[:count], j[:count], force[:count] if force_needed else None,

@@ -97,7 +97,7 @@ def _bond(a, b, gap, velocities, radii, content, model, gamma, theta, cos_theta,
     ``min_force`` is 0, so the law could not change the verdict).
     """
     ra, rb = radii[a], radii[b]
-    # liquid per particle, m^3: the expression of ligwf.bridges._sphere_volume x content,
+    # liquid per particle, m^3: the expression of ligwf.bridges.sphere_volume x content,
     # operation for operation, so bridge volumes agree with the numpy reference bitwise
     lva = 4.0 / 3.0 * np.pi * (ra * ra * ra) * content[a]
     lvb = 4.0 / 3.0 * np.pi * (rb * rb * rb) * content[b]
@@ -129,8 +129,8 @@ def _scan(model, id1, id2, id_offset, velocities, radii, content, delta, gamma, 
     bond test of each contact, bonded pairs to ``out_*``. Returns the bond count, or
     -1 - k when contact k refers to a row outside the frame.
 
-    Callers pass ``model`` as a literal (1 or 2) so the liquid model's branch is folded out
-    of the loop: with the model as a run-time value inside the loop the whole pass was
+    Called through :func:`_scan_model` with ``model`` as a literal (1 or 2), so the liquid
+    model's branch is folded out of the loop: with the model as a run-time value inside the loop the whole pass was
     measured 3.5x slower.
     """
     n = len(radii)
@@ -153,6 +153,20 @@ def _scan(model, id1, id2, id_offset, velocities, radii, content, delta, gamma, 
     return count
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _scan_model(model, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
+                fraction, cos_max, min_force, force_needed, out_i, out_j, out_f):
+    """:func:`_scan` with ``model`` turned into a literal (1 washino, 2 easo; 0, dry: no
+    bonds), so each model gets its own compiled loop."""
+    if model == 1:
+        return _scan(1, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
+                     fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
+    if model == 2:
+        return _scan(2, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
+                     fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
+    return 0
+
+
 @njit(cache=True, error_model="numpy")
 def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, model, gamma,
                 theta, fraction, cos_max, min_force):
@@ -168,13 +182,8 @@ def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, model, g
     out_i = np.empty(m, np.int64)
     out_j = np.empty(m, np.int64)
     out_f = np.empty(m, np.float64)
-    count = 0
-    if model == 1:
-        count = _scan(1, id1, id2, id_offset, velocities, radii, content, delta, gamma,
-                      theta, fraction, cos_max, min_force, True, out_i, out_j, out_f)
-    elif model == 2:
-        count = _scan(2, id1, id2, id_offset, velocities, radii, content, delta, gamma,
-                      theta, fraction, cos_max, min_force, True, out_i, out_j, out_f)
+    count = _scan_model(model, id1, id2, id_offset, velocities, radii, content, delta, gamma,
+                        theta, fraction, cos_max, min_force, True, out_i, out_j, out_f)
     return count, out_i, out_j, out_f
 
 
@@ -207,13 +216,8 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, mode
     parent = np.arange(n)
     image = np.zeros(n, np.int64)
     winds = np.zeros(n, np.bool_)                 # per root: its tree closes a periodic cycle
-    count = 0
-    if model == 1:
-        count = _scan(1, id1, id2, id_offset, velocities, radii, content, delta, gamma,
-                      theta, fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
-    elif model == 2:
-        count = _scan(2, id1, id2, id_offset, velocities, radii, content, delta, gamma,
-                      theta, fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
+    count = _scan_model(model, id1, id2, id_offset, velocities, radii, content, delta, gamma,
+                        theta, fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
     if count < 0:
         return (count, out_i, out_j, out_f, parent, y, winds, 0)
     # union-find over the bonds, written out in the loop: as helper calls taking the arrays
