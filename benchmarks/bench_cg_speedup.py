@@ -24,10 +24,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from ligwf.cases import render_workflow, write_study  # noqa: E402
-from ligwf.engine import EngineConfig  # noqa: E402
-from ligwf.launch import run_case  # noqa: E402
-from ligwf.workflow import load_workflow  # noqa: E402
+from ligwf.study.prepare import render_workflow, write_study  # noqa: E402
+from ligwf.engine.site import EngineConfig  # noqa: E402
+from ligwf.engine.launch import run_case  # noqa: E402
+from ligwf.scene.workflow import load_workflow  # noqa: E402
 
 
 def main() -> int:

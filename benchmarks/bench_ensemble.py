@@ -18,7 +18,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ligwf.engine import EngineConfig
+from ligwf.engine.site import EngineConfig
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -31,7 +31,7 @@ def main() -> None:
     args = ap.parse_args()
     sets = ["--set", "sweep.cg_levels=[2]", "--set", "sweep.rules=[weber]",
             "--set", f"sweep.replicas={args.members}"]
-    ligwf = [sys.executable, "-m", "ligwf.cli"]
+    ligwf = [sys.executable, "-m", "ligwf.cli.main"]
     site = EngineConfig.from_site()
     # separate mpiruns each bind their one rank to core 0 by default, so side-by-side
     # independent runs would share a core; unbind them for a fair baseline

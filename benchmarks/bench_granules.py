@@ -13,9 +13,9 @@ frame: read + identify + GSD.
 
 Per size it prints the time per frame of
 * reference: compiled bond criterion + networkx BFS components + networkx BFS unwrap +
-  table (the ``implementation="reference"`` path of ligwf.analysis);
+  table (the ``implementation="reference"`` path of ligwf.analysis.runner);
 * fast:      one compiled pass doing bond criterion + union-find + unwrap, then the table
-  (the default path of ligwf.analysis);
+  (the default path of ligwf.analysis.runner);
 * floor:     one streaming pass over the contact arrays identification needs (id1, id2,
   delta: a sum over each, in memory), the least any implementation must do;
 * read contacts: reading one contact dump with the default (fast) reader;
@@ -41,10 +41,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ligwf import dumps_numba, granules_numba, gsd
-from ligwf.dumps import (ContactFrame, ParticleFrame, discover_frames, read_contacts,
+from ligwf.analysis import dumps_numba
+from ligwf.analysis import granules_numba
+from ligwf.analysis import gsd
+from ligwf.analysis.dumps import (ContactFrame, ParticleFrame, discover_frames, read_contacts,
                          read_particles)
-from ligwf.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
+from ligwf.analysis.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
                             granule_table, identify, label_reference, unwrap_reference)
 
 R = 0.0005
@@ -117,7 +119,7 @@ def timed(fn, repeat: int = 1) -> tuple[float, object]:
 
 
 def granules_of(p, c, length, liquid, fast: bool):
-    """The granule table of one frame, as ligwf.analysis computes it."""
+    """The granule table of one frame, as ligwf.analysis.runner computes it."""
     ident = identify(p, c, liquid, BondCriterion(), 1, length, "fast" if fast else "reference")
     return granule_table(p, ident.labels, 1.0, ident.unwrapped_axis, 1, 0.0, length, ident.percolating)
 

@@ -25,7 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ligwf.manifest import read_manifest
+from ligwf.engine.manifest import read_manifest
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_SET = ["sweep.cg_levels=[1]"]
@@ -51,7 +51,7 @@ def main() -> None:
     try:
         out = work / "study"
         t0 = time.perf_counter()
-        proc = subprocess.Popen([sys.executable, "-m", "ligwf.cli", "run", args.workflow,
+        proc = subprocess.Popen([sys.executable, "-m", "ligwf.cli.main", "run", args.workflow,
                                  "--out", str(out), "--np", str(args.np)] + sets,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         cpu = 0.0

@@ -14,8 +14,8 @@ import yaml
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from ligwf.render import render  # noqa: E402
-from ligwf.workflow import load_workflow  # noqa: E402
+from ligwf.engine.render import render  # noqa: E402
+from ligwf.scene.workflow import load_workflow  # noqa: E402
 
 GOLDEN = ROOT / "tests" / "golden"
 

@@ -9,7 +9,7 @@ import pytest
 @pytest.fixture(scope="session")
 def engine():
     """The site's engine configuration; fails (never skips) when LIGGGHTS is missing."""
-    from ligwf.engine import EngineConfig
+    from ligwf.engine.site import EngineConfig
 
     cfg = EngineConfig.from_site()
     cfg.liggghts_path()

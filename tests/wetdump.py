@@ -12,8 +12,8 @@ import shutil
 from pathlib import Path
 
 from helpers import DRUM, run_liggghts
-from ligwf.cases import render_workflow, write_study
-from ligwf.workflow import load_workflow
+from ligwf.study.prepare import render_workflow, write_study
+from ligwf.scene.workflow import load_workflow
 
 _CACHE: dict[str, Path] = {}
 

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pytest
 
-from ligwf.manifest import MANIFEST_FILE, SCREEN_FILE
-from ligwf.slurm import read_record, study_status
-from ligwf.slurm_parse import task_records
+from ligwf.engine.manifest import MANIFEST_FILE, SCREEN_FILE
+from ligwf.slurm.jobs import read_record, study_status
+from ligwf.slurm.parse import task_records
 
 HERE = Path(__file__).resolve().parent
 WORKFLOW = HERE / "tiny_drum.yaml"

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from ligwf.errors import SubmitError
-from ligwf.slurm_parse import (QueueEntry, expand_task_ids, is_unknown_job, parse_records,
+from ligwf.slurm.parse import (QueueEntry, expand_task_ids, is_unknown_job, parse_records,
                                parse_sbatch_parsable, parse_squeue, task_records)
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "slurm"

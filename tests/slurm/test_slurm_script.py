@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from ligwf.errors import ConfigError
-from ligwf.slurm_script import (SQUEUE_FORMAT, array_spec, sbatch_command, scancel_command,
+from ligwf.slurm.script import (SQUEUE_FORMAT, array_spec, sbatch_command, scancel_command,
                                 scontrol_command, squeue_command)
 
 
@@ -22,7 +22,7 @@ def test_array_spec(indices, k, expected):
 
 
 def test_array_spec_round_trips_through_slurm_expansion():
-    from ligwf.slurm_parse import expand_task_ids
+    from ligwf.slurm.parse import expand_task_ids
     indices = [0, 1, 2, 7, 8, 11, 20, 21, 22, 23]
     assert expand_task_ids(array_spec(indices, 4)) == indices
 

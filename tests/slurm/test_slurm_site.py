@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from ligwf.errors import ConfigError
-from ligwf.slurm_site import (SlurmSite, default_ligwf_command, load_slurm_site,
+from ligwf.slurm.site import (SlurmSite, default_ligwf_command, load_slurm_site,
                               merged_settings, site_from_mapping)
 
 

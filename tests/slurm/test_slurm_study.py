@@ -10,9 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from ligwf.slurm import (CaseStatus, append_record, cases_to_resubmit, dry_run_text, job_name,
+from ligwf.slurm.jobs import (CaseStatus, append_record, cases_to_resubmit, dry_run_text, job_name,
                          next_round, plan_jobs, read_record, recorded_site)
-from ligwf.slurm_site import SlurmSite
+from ligwf.slurm.site import SlurmSite
 
 HERE = Path(__file__).resolve().parent
 WORKFLOW = HERE / "tiny_drum.yaml"

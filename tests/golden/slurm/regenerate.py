@@ -1,7 +1,7 @@
 """Golden references of ligwf's Slurm batch scripts: the cases and their regeneration.
 
 Each entry of :data:`CASES` renders one script from fixed inputs with the pure builders of
-``ligwf.slurm_script``; ``tests/slurm/test_slurm_golden.py`` diffs them against the ``.sh``
+``ligwf.slurm.script``; ``tests/slurm/test_slurm_golden.py`` diffs them against the ``.sh``
 files next to this one. After a deliberate change of the scripts, regenerate and review
 the diff::
 
@@ -13,8 +13,8 @@ from __future__ import annotations
 from pathlib import Path, PurePosixPath
 from typing import Callable
 
-from ligwf.slurm_script import ScriptContext, analysis_script, array_script
-from ligwf.slurm_site import SlurmSite
+from ligwf.slurm.script import ScriptContext, analysis_script, array_script
+from ligwf.slurm.site import SlurmSite
 
 HERE = Path(__file__).resolve().parent
 STUDY = PurePosixPath("/scratch/alice/drum-study")

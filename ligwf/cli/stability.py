@@ -1,0 +1,119 @@
+"""``ligwf stability-report STUDY_DIR`` and ``ligwf stability-suite SUITE --out DIR``.
+
+Also home of :func:`preflight_or_refuse`, the one call ``check``, ``render`` and ``run``
+make after rendering (before anything is written or launched).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+from rich.console import Console
+from rich.table import Table
+
+from ligwf.fsio import atomic_write_json
+from ligwf.scene.stability import MARGINAL, REFUSED, check_rendered
+
+err_console = Console(stderr=True, soft_wrap=True)
+console = Console(width=None if sys.stdout.isatty() else 200)
+
+_STYLE = {REFUSED: "bold red", MARGINAL: "yellow"}
+
+
+def add_allow_unstable(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="run/write cases the pre-flight stability check refuses (experts)")
+
+
+def preflight_or_refuse(rendered, allow_unstable: bool = False):
+    """Pre-flight every rendered case; print warnings; raise UnstableCase on refusal."""
+    reports, warnings = check_rendered(rendered, allow_unstable)
+    for line in warnings:
+        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
+    return reports
+
+
+def _fmt(value, spec: str = ".3g") -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float) and not math.isfinite(value):
+        return "inf"
+    return format(value, spec)
+
+
+def report_table(reports, title: str) -> Table:
+    table = Table(title=title)
+    for col in ("case", "pre-flight", "outcome", "agree", "atoms", "KE drift",
+                "overlap obs/exp [d]", "engine dt/t_H", "reason"):
+        table.add_column(col, overflow="fold")
+    for r in reports:
+        o, pf = r.observation, r.preflight
+        s_d = r.d_min
+        overlap = (f"{_fmt(o.max_overlap / s_d if o.max_overlap is not None else None, '.2%')}"
+                   f" / {_fmt(pf.expected_max_overlap / s_d, '.2%')}")
+        atoms = f"{_fmt(o.atoms_start, '.0f')}->{_fmt(o.atoms_end, '.0f')}"
+        table.add_row(r.name, f"[{_STYLE.get(pf.verdict, '')}]{pf.verdict}[/]" if pf.verdict
+                      in _STYLE else pf.verdict, o.outcome,
+                      "yes" if r.agrees else "[bold red]NO[/]", atoms,
+                      _fmt(o.energy_drift, "+.2f"), overlap, _fmt(o.max_dt_hertz, ".2g"),
+                      o.reason if o.outcome != "stable" else "; ".join(
+                          f.check for f in pf.problems))
+    return table
+
+
+def cmd_stability_report(args: argparse.Namespace) -> int:
+    from ligwf.report.stability import report_study
+
+    reports = report_study(args.study)
+    if not reports:
+        err_console.print(f"ligwf: no case folders (scene.json) under {args.study}")
+        return 2
+    console.print(report_table(reports, f"stability of {args.study}: {len(reports)} case(s)"))
+    disagree = [r for r in reports if not r.agrees]
+    if args.json:
+        atomic_write_json(args.json, [r.to_dict() for r in reports])
+    for r in disagree:
+        err_console.print(f"[bold red]disagreement:[/] {r.name}: pre-flight "
+                          f"{r.preflight.verdict}, observed {r.observation.outcome} "
+                          f"({r.observation.reason})", highlight=False)
+    return 1 if disagree else 0
+
+
+def cmd_stability_suite(args: argparse.Namespace) -> int:
+    """Render every variant of a stress suite (refused cases included: that is the point)."""
+    from ligwf.study.prepare import render_workflow, write_study
+    from ligwf.scene.stability_suite import load_suite
+
+    suite = load_suite(args.suite)
+    for variant, wf in suite.items():
+        rendered = render_workflow(wf, args.templates)
+        reports, _ = check_rendered(rendered, allow_unstable=True)
+        write_study(wf, rendered, args.out / variant, args.mesh_cache)
+        for rc, rep in zip(rendered, reports):
+            console.print(f"{variant}/{rc.case.case_id}: pre-flight {rep.verdict}",
+                          highlight=False)
+    (args.out).mkdir(parents=True, exist_ok=True)
+    atomic_write_json(args.out / "suite.json", {"suite": str(args.suite),
+                                                "variants": list(suite)})
+    return 0
+
+
+def register(sub) -> None:
+    p = sub.add_parser("stability-report",
+                       help="per case: pre-flight verdict, observed outcome, energy drift, "
+                       "max overlap observed vs expected")
+    p.add_argument("study", type=Path, help="study folder (case folders below it)")
+    p.add_argument("--json", type=Path, default=None, help="also write the table as JSON")
+    p.set_defaults(func=cmd_stability_report)
+
+    p = sub.add_parser("stability-suite",
+                       help="render the stress suite (workflows/stability.yaml) into one "
+                       "study folder per variant, refused cases included")
+    p.add_argument("suite", type=Path, help="suite YAML (base scene + variants)")
+    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR")
+    p.add_argument("--mesh-cache", type=Path, default=None)
+    p.set_defaults(func=cmd_stability_suite)

@@ -1,0 +1,171 @@
+"""Drum mesh: an STL of the drum shell with lifters, extruded from a closed 2-D outline.
+
+The outline is the shell circle with rectangular lifter bars cut in radially; it is
+star-shaped about the axis, which makes end caps (non-periodic drums) a simple fan.
+The extrusion spans exactly [0, L] along the axis, the same as the periodic box: a shorter
+mesh leaks particles silently at its ends, a longer one has its elements wrapped.
+
+STL is ASCII (LIGGGHTS' ``fix mesh/surface`` reads it; ParaView opens it). Generating the
+text is pure; :func:`cached_mesh` keeps one file per geometry under a cache folder, named
+by a hash of the geometry, so many cases of one study share one mesh.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+
+from ligwf.fsio import atomic_write_text
+from ligwf.scene.model import Drum
+
+#: Bump when the mesh algorithm changes, so cached meshes are rebuilt.
+MESH_VERSION = 3
+#: Largest gap between the polygon chord and the true circle, as a fraction of the radius.
+SAG_TOLERANCE = 2.5e-4
+#: Largest axial length of a shell triangle, in units of its circumferential width.
+MAX_ASPECT = 6.0
+
+
+def axis_frame(axis: str) -> tuple[int, int, int]:
+    """Indices (axial, u, v) of x/y/z for a drum axis; v is 'up' (gravity along -v)."""
+    return {"x": (0, 1, 2), "y": (1, 0, 2), "z": (2, 0, 1)}[axis]
+
+
+def segment_count(radius: float) -> int:
+    """Polygon segments for a full circle so the chord sag stays below SAG_TOLERANCE * R."""
+    return max(96, math.ceil(math.pi / math.acos(1.0 - SAG_TOLERANCE)))
+
+
+def drum_outline(drum: Drum) -> np.ndarray:
+    """Closed outline (counter-clockwise, no repeated end point) as (N, 2) array in (u, v), m."""
+    r = drum.radius
+    nseg = segment_count(r)
+    step = 2.0 * math.pi / nseg
+    lif = drum.lifters
+    if not lif.count:
+        ang = np.arange(nseg) * step
+        return np.column_stack([r * np.cos(ang), r * np.sin(ang)])
+
+    half = 0.5 * math.radians(lif.width_deg)
+    pitch = 2.0 * math.pi / lif.count
+    inner = r - lif.height
+    pts: list[tuple[float, float]] = []
+    for k in range(lif.count):
+        # lifter centred on -90 deg + k*pitch, so the first one starts at the bottom
+        centre = -0.5 * math.pi + k * pitch
+        a0, a1 = centre - half, centre + half
+        pts.append((a0, r))
+        n_top = max(1, math.ceil((a1 - a0) / step))
+        for j in range(n_top + 1):
+            pts.append((a0 + (a1 - a0) * j / n_top, inner))
+        pts.append((a1, r))
+        # shell arc up to the next lifter's start
+        b0, b1 = a1, centre + pitch - half
+        n_arc = max(1, math.ceil((b1 - b0) / step))
+        for j in range(1, n_arc):
+            pts.append((b0 + (b1 - b0) * j / n_arc, r))
+    arr = np.array(pts)
+    return np.column_stack([arr[:, 1] * np.cos(arr[:, 0]), arr[:, 1] * np.sin(arr[:, 0])])
+
+
+def _to_xyz(u: np.ndarray, v: np.ndarray, w: np.ndarray, axis: str) -> np.ndarray:
+    ia, iu, iv = axis_frame(axis)
+    out = np.zeros((len(u), 3))
+    out[:, ia], out[:, iu], out[:, iv] = w, u, v
+    return out
+
+
+def drum_triangles(drum: Drum) -> np.ndarray:
+    """Triangles (M, 3 vertices, xyz) of the shell, plus end caps when not periodic.
+
+    Shell normals point towards the axis (into the particle space).
+    """
+    outline = drum_outline(drum)
+    nxt = np.roll(outline, -1, axis=0)
+    edge_len = float(np.max(np.linalg.norm(nxt - outline, axis=1)))
+    rows = max(1, math.ceil(drum.length / (MAX_ASPECT * max(edge_len, 1e-12))))
+    ws = np.linspace(0.0, drum.length, rows + 1)
+    tris = []
+    for w0, w1 in zip(ws[:-1], ws[1:]):
+        a0 = _to_xyz(outline[:, 0], outline[:, 1], np.full(len(outline), w0), drum.axis)
+        b0 = _to_xyz(nxt[:, 0], nxt[:, 1], np.full(len(outline), w0), drum.axis)
+        a1 = _to_xyz(outline[:, 0], outline[:, 1], np.full(len(outline), w1), drum.axis)
+        b1 = _to_xyz(nxt[:, 0], nxt[:, 1], np.full(len(outline), w1), drum.axis)
+        tris.append(np.stack([a0, b0, b1], axis=1))
+        tris.append(np.stack([a0, b1, a1], axis=1))
+    if not drum.periodic:
+        for w in (0.0, drum.length):
+            c = _to_xyz(np.zeros(len(outline)), np.zeros(len(outline)),
+                        np.full(len(outline), w), drum.axis)
+            a = _to_xyz(outline[:, 0], outline[:, 1], np.full(len(outline), w), drum.axis)
+            b = _to_xyz(nxt[:, 0], nxt[:, 1], np.full(len(outline), w), drum.axis)
+            fan = np.stack([c, a, b], axis=1)
+            # the radial sides of a lifter are collinear with the centre: drop those slivers
+            area2 = np.linalg.norm(np.cross(fan[:, 1] - fan[:, 0], fan[:, 2] - fan[:, 0]), axis=1)
+            tris.append(fan[area2 > 1e-12 * drum.radius**2])
+    tri = np.concatenate(tris)
+    return _orient_inward(tri, drum)
+
+
+def _orient_inward(tri: np.ndarray, drum: Drum) -> np.ndarray:
+    """Flip triangles whose normal points away from the drum interior."""
+    ia, iu, iv = axis_frame(drum.axis)
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    centroid = tri.mean(axis=1)
+    inward = np.zeros_like(centroid)
+    inward[:, iu] = -centroid[:, iu]
+    inward[:, iv] = -centroid[:, iv]
+    # caps: interior is towards the mid-plane along the axis
+    is_cap = np.abs(n[:, ia]) > 0.5 * np.linalg.norm(n, axis=1)
+    inward[is_cap] = 0.0
+    inward[is_cap, ia] = 0.5 * drum.length - centroid[is_cap, ia]
+    flip = np.einsum("ij,ij->i", n, inward) < 0
+    tri = tri.copy()
+    tri[flip] = tri[flip][:, ::-1]
+    return tri
+
+
+def stl_text(triangles: np.ndarray, name: str = "drum") -> str:
+    """ASCII STL of triangles (M, 3, 3)."""
+    n = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    lines = [f"solid {name}"]
+    for t, nn in zip(triangles, n):
+        lines.append(f"  facet normal {nn[0]:.9e} {nn[1]:.9e} {nn[2]:.9e}")
+        lines.append("    outer loop")
+        for p in t:
+            lines.append(f"      vertex {p[0]:.12e} {p[1]:.12e} {p[2]:.12e}")
+        lines.append("    endloop")
+        lines.append("  endfacet")
+    lines.append(f"endsolid {name}")
+    return "\n".join(lines) + "\n"
+
+
+def geometry_key(drum: Drum) -> str:
+    """Short content hash of everything the mesh depends on."""
+    geo = {"v": MESH_VERSION, "diameter": drum.diameter, "length": drum.length,
+           "axis": drum.axis, "periodic": drum.periodic, "lifters": drum.lifters.model_dump()}
+    return hashlib.sha256(json.dumps(geo, sort_keys=True).encode()).hexdigest()[:16]
+
+
+@lru_cache(maxsize=32)
+def drum_stl(drum: Drum) -> str:
+    """The drum's STL text (pure; memoised per geometry)."""
+    return stl_text(drum_triangles(drum), name=f"ligwf_drum_{geometry_key(drum)}")
+
+
+def mesh_file_name(drum: Drum) -> str:
+    return f"drum_{geometry_key(drum)}.stl"
+
+
+def cached_mesh(drum: Drum, cache_dir: Path) -> Path:
+    """Path of the drum's STL in ``cache_dir``, generated on first use."""
+    path = Path(cache_dir) / mesh_file_name(drum)
+    if not path.exists():
+        atomic_write_text(path, drum_stl(drum))
+    return path

@@ -1,0 +1,92 @@
+"""Live progress and the end-of-run summary (rich).
+
+One progress bar per running case: steps done of total, simulated time (s), ETA, atoms and
+kinetic energy (J), all read from the thermo output while the engine runs. After the run
+a table summarises every case: status, steps, atoms, wall and core-seconds, and the reason.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Iterable
+
+from rich.console import Console
+from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn,
+                           TimeRemainingColumn)
+from rich.table import Table
+
+from ligwf.engine.manifest import Manifest, effective_status, read_manifest
+from ligwf.engine.resume import Plan
+from ligwf.engine.thermo import ThermoParser
+
+_STATUS_STYLE = {"done": "green", "failed": "red", "unstable": "yellow", "killed": "magenta",
+                 "running": "cyan"}
+
+
+class RichMonitor:
+    """A :class:`ligwf.engine.launch.Monitor` drawing rich progress bars."""
+
+    def __init__(self, console: Console | None = None) -> None:
+        self.console = console or Console()
+        self.progress = Progress(
+            TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+            TextColumn("t={task.fields[sim_time]:.3g} s"), TimeRemainingColumn(),
+            TextColumn("atoms {task.fields[atoms]}"), TextColumn("KE {task.fields[ke]:.3g} J"),
+            console=self.console, transient=False, refresh_per_second=2)
+        self.tasks: dict[str, TaskID] = {}
+        self.results: list[tuple[str, Manifest | None, Plan]] = []
+
+    def __enter__(self) -> "RichMonitor":
+        self.progress.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.progress.stop()
+
+    def start(self, case_id: str, total_steps: int, from_step: int) -> None:
+        if case_id in self.tasks:
+            self.progress.reset(self.tasks[case_id], total=total_steps, completed=from_step)
+            return
+        self.tasks[case_id] = self.progress.add_task(case_id, total=total_steps,
+                                                     completed=from_step, sim_time=0.0,
+                                                     atoms="-", ke=0.0)
+
+    def update(self, case_id: str, parser: ThermoParser) -> None:
+        row = parser.last_row
+        task = self.tasks.get(case_id)
+        if row is None or task is None:
+            return
+        self.progress.update(task, completed=row.step, sim_time=row.get("time", 0.0),
+                             atoms=f"{row.get('atoms'):.0f}", ke=row.get("ke", 0.0))
+
+    def end(self, case_id: str, manifest: Manifest | None, plan: Plan) -> None:
+        self.results.append((case_id, manifest, plan))
+        task = self.tasks.get(case_id)
+        if task is not None and manifest is not None:
+            style = _STATUS_STYLE.get(manifest.status, "")
+            self.progress.update(task, description=f"{case_id} [{style}]{manifest.status}[/]")
+
+
+def summary_table(case_dirs: Iterable[Path], title: str = "cases") -> Table:
+    """Status of every case folder from its manifest (``ligwf status`` and run summary)."""
+    table = Table(title=title)
+    for col in ("case", "status", "steps", "atoms start->end", "wall [s]", "core-s",
+                "settle [s]", "production [s]", "reason"):
+        table.add_column(col, justify="left" if col in ("case", "status", "reason") else "right")
+    for d in case_dirs:
+        m = read_manifest(d)
+        if m is None:
+            table.add_row(Path(d).name, "pending", "", "", "", "", "", "", "")
+            continue
+        status = effective_status(m)
+        style = _STATUS_STYLE.get(status, "")
+        phases = m.phases
+        table.add_row(
+            m.case_id, f"[{style}]{status}[/]", f"{m.steps_done:,}/{m.total_steps:,}",
+            f"{m.atoms_start if m.atoms_start is not None else '-'}->"
+            f"{m.atoms_end if m.atoms_end is not None else '-'}",
+            f"{m.wall_seconds:.1f}", f"{m.core_seconds:.1f}",
+            f"{phases.get('settle', {}).get('wall_seconds', 0.0):.1f}",
+            f"{phases.get('production', {}).get('wall_seconds', 0.0):.1f}",
+            m.reason[:80])
+    return table

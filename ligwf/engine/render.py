@@ -1,0 +1,200 @@
+"""Rendering: a scaled scene in, LIGGGHTS input text out. No I/O.
+
+``render(scaled)`` returns ``{file name: text}``; writing is a separate step (``cases``).
+Templates are Jinja2 with StrictUndefined (a missing value is an error, not an empty
+string) and are looked up through a ChoiceLoader: user folders first, then ligwf's own,
+so a site can override one template without copying the rest.
+
+Every value substituted into a template goes through :func:`_finalize`, which refuses
+strings carrying a newline, '&', '$', '#' or a quote: no scene value can inject a
+LIGGGHTS command (the engine has ``shell``).
+"""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+from typing import Any, Iterable
+
+import jinja2
+
+from ligwf import __version__
+from ligwf.liquids.bridges import engine_contact_angle_deg
+from ligwf.errors import RenderError
+from ligwf.engine.mesh import axis_frame
+from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.model import FORBIDDEN_INPUT_CHARS, GRAVITY
+
+#: Name of the main input file in a case folder.
+INPUT_NAME = "in.liggghts"
+#: Name of the drum mesh in a case folder (the input refers to it by this name).
+MESH_NAME = "drum.stl"
+#: Sub-folders the input writes into (the case writer creates them).
+OUTPUT_DIRS = ("post", "restart")
+
+
+def shipped_template_dir() -> Path:
+    """ligwf's own templates: inside the installed wheel, or the source tree's templates/."""
+    packaged = resources.files("ligwf") / "templates"
+    if packaged.is_dir():
+        return Path(str(packaged))
+    return Path(__file__).resolve().parents[2] / "templates"
+
+
+def fmt_float(value: float) -> str:
+    """Number as LIGGGHTS reads it: 12 significant digits (readable, far below any physical
+    tolerance), no locale, never 'nan'/'inf'."""
+    if isinstance(value, bool):
+        raise RenderError(f"boolean {value!r} where a number is expected")
+    if not math.isfinite(float(value)):
+        raise RenderError(f"non-finite number {value!r} in a LIGGGHTS input")
+    if isinstance(value, int):
+        return str(value)
+    return format(float(value), ".12g").replace("e+", "e")
+
+
+def _finalize(value: Any) -> Any:
+    if isinstance(value, str):
+        bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
+        if bad:
+            raise RenderError(f"refusing to render {value!r}: contains {bad!r}, which could "
+                              "inject a LIGGGHTS command")
+        return value
+    if isinstance(value, float):
+        return fmt_float(value)
+    return value
+
+
+@lru_cache(maxsize=16)
+def _environment(user_dirs: tuple[str, ...]) -> jinja2.Environment:
+    loaders = [jinja2.FileSystemLoader(d) for d in user_dirs]
+    loaders.append(jinja2.FileSystemLoader(str(shipped_template_dir())))
+    env = jinja2.Environment(
+        loader=jinja2.ChoiceLoader(loaders),
+        undefined=jinja2.StrictUndefined,
+        trim_blocks=True,
+        lstrip_blocks=True,
+        keep_trailing_newline=True,
+        autoescape=False,
+        finalize=_finalize,
+    )
+    env.filters["num"] = fmt_float
+    env.filters["vec"] = lambda xs: " ".join(fmt_float(x) for x in xs)
+    return env
+
+
+#: extra particles the last (top-up) insertion wave asks for and deletes again: covers the
+#: per-rank rounding of an insertion (std ~ sqrt(ranks)/2, so 4 sigma at 64 ranks)
+TOPUP_MARGIN = 16
+
+
+def _unit(index: int, sign: float = 1.0) -> list[float]:
+    v = [0.0, 0.0, 0.0]
+    v[index] = sign
+    return v
+
+
+def template_context(s: ScaledScene) -> dict[str, Any]:
+    """Everything the drum template needs, derived from the scaled scene (pure)."""
+    ia, iu, iv = axis_frame(s.axis)
+    r = 0.5 * s.drum_diameter
+    half_box = 1.05 * r + s.d_max
+    lo = [-half_box] * 3
+    hi = [half_box] * 3
+    if s.periodic:
+        lo[ia], hi[ia] = 0.0, s.drum_length
+    else:
+        pad = 0.02 * s.drum_length + s.d_max
+        lo[ia], hi[ia] = -pad, s.drum_length + pad
+    boundary = ["f", "f", "f"]
+    if s.periodic:
+        boundary[ia] = "p"
+    # processor grid: never along gravity (the bed lies in the lower half: 96 % of a settled
+    # bed on one of 2 ranks); ranks along the axis first, where the bed is uniform, then
+    # across (a turning bed shifts to one side: 82/18 % on 2 ranks cut across, 1.4x slower
+    # than cut along the axis, measured at CG1). The runner picks the numbers for its rank
+    # count (processor_grid) and passes them with -var; run by hand, all ranks go along the axis.
+    grid = ["1", "1", "1"]
+    grid[ia], grid[iu] = "axial", "across"
+    templates = [
+        {"id": f"pts{k + 1}", "radius": 0.5 * d, "fraction": f, "seed": s.seeds[k]}
+        for k, (d, f) in enumerate(zip(s.diameters, s.number_fractions))
+    ]
+    k0 = len(templates)
+    waves = [{"id": f"ins{k + 1}", "count": n, "seed": s.seeds[k0 + 1 + k]}
+             for k, n in enumerate(s.insertion_waves)]
+    return {
+        "s": s,
+        "version": __version__,
+        "boundary": " ".join(boundary),
+        "processor_grid": grid,
+        "box_lo": lo,
+        "box_hi": hi,
+        "axis": s.axis,
+        "axial_lo": 0.0 if s.periodic else 0.55 * s.d_max,
+        "axial_hi": s.drum_length if s.periodic else s.drum_length - 0.55 * s.d_max,
+        "axis_vector": _unit(ia),
+        "gravity": GRAVITY,
+        "gravity_vector": _unit(iv, -1.0),
+        "templates": templates,
+        "distribution_seed": s.seeds[k0],
+        "waves": waves,
+        "topup_margin": TOPUP_MARGIN,
+        "rolling": s.rolling_friction > 0.0,
+        "wet": s.wet,
+        "cohesion_model": {"washino": "washino/capillary/viscous",
+                           "easo": "easo/capillary/viscous"}.get(s.liquid_model),
+        "engine_contact_angle": engine_contact_angle_deg(s.contact_angle_deg,
+                                                         s.contact_angle_compensation),
+        "mesh_name": MESH_NAME,
+    }
+
+
+#: thinnest slab of the domain along the drum axis one rank gets, in largest diameters
+MIN_AXIAL_SLAB = 4.0
+
+
+def processor_grid(s: ScaledScene, nprocs: int) -> tuple[int, int]:
+    """Ranks (across the drum, along the axis) for ``nprocs``: as many along the axis as
+    divide ``nprocs`` and leave slabs of at least MIN_AXIAL_SLAB largest diameters (pure)."""
+    if nprocs < 1:
+        raise ValueError(f"nprocs = {nprocs}: need at least 1")
+    max_axial = max(1, int(s.drum_length / (MIN_AXIAL_SLAB * s.d_max)))
+    axial = max(k for k in range(1, nprocs + 1) if nprocs % k == 0 and k <= max_axial)
+    return nprocs // axial, axial
+
+
+def grid_vars(s: ScaledScene, nprocs: int) -> list[str]:
+    """LIGGGHTS command-line arguments setting the processor grid of the drum template."""
+    across, axial = processor_grid(s, nprocs)
+    return ["-var", "ligwf_pu", str(across), "-var", "ligwf_pa", str(axial)]
+
+
+def render_template(name: str, context: dict[str, Any],
+                    template_dirs: Iterable[str | Path] = ()) -> str:
+    """Render one named template (user folders first, then ligwf's) with ``context``."""
+    env = _environment(tuple(str(Path(d)) for d in template_dirs))
+    try:
+        return env.get_template(name).render(**context)
+    except jinja2.TemplateError as exc:
+        raise RenderError(f"cannot render {name}: {exc}") from exc
+
+
+def render(scaled: ScaledScene, template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:
+    """LIGGGHTS input files for one case: ``{file name: text}`` (pure, no I/O)."""
+    return {INPUT_NAME: render_template("drum.in.j2", template_context(scaled), template_dirs)}
+
+
+def render_bridge_probe(scaled: ScaledScene, gap_ratio: float, model_approach: bool,
+                        template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:
+    """Input of a two-particle probe: two smallest particles of ``scaled`` held (no
+    integrator) at surface gap ``gap_ratio * r_eff``; the thermo prints the force on
+    particle 2 (``v_fx2``). With ``model_approach`` the pair touches first and is then
+    separated, which the easo model needs to form its bridge.
+    """
+    ctx = template_context(scaled)
+    radius = 0.5 * scaled.d_min
+    ctx.update(probe_radius=radius, probe_gap=gap_ratio * 0.5 * radius, approach=model_approach)
+    return {INPUT_NAME: render_template("bridge_probe.in.j2", ctx, template_dirs)}

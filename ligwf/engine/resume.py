@@ -1,0 +1,200 @@
+"""Resume: decide what to do with a case folder, and continue killed runs from restarts.
+
+Running a study again must not redo finished work:
+
+* ``done`` with the scene hash of ``scene.json``  -> skip;
+* ``unstable`` with a matching hash               -> skip (the engine is deterministic:
+  re-running gives the same blow-up; pass ``retry_unstable`` to force it);
+* ``failed``, no manifest, or a stale hash        -> fresh run (old outputs removed);
+* ``killed`` (or ``running`` with a dead runner)  -> continue from the newest restart file,
+  else fresh.
+
+LIGGGHTS writes ``restart_forced_liggghts_<step>.data`` in the case folder (the engine's
+working directory) when a rank gets SIGTERM, and the drum input writes periodic restarts
+alternately to ``restart/restart_a.liggghts`` and ``restart/restart_b.liggghts`` during
+production, so after a SIGKILL at least one complete periodic restart survives. The step of
+each file is read from its binary header. :func:`render_resume` writes the input that
+re-issues every fix with the same ID and runs the remaining phases with ``run N upto``.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import struct
+from dataclasses import dataclass
+from pathlib import Path
+
+from ligwf.engine.health import DONE, FAILED, UNSTABLE
+from ligwf.engine.manifest import (MANIFEST_FILE, SCREEN_FILE, THERMO_FILE, effective_status, read_manifest,
+                       scene_hash_of)
+from ligwf.engine.render import INPUT_NAME, render_template, template_context
+from ligwf.scene.scaling import ScaledScene
+
+#: Input file of a resumed attempt (next to ``in.liggghts``).
+RESUME_INPUT = "resume.in.liggghts"
+_FORCED_RE = re.compile(r"^restart_forced_liggghts_(\d+)\.data$")
+_PERIODIC = ("restart/restart_a.liggghts", "restart/restart_b.liggghts")
+
+SKIP, FRESH, RESUME = "skip", "fresh", "resume"
+
+
+@dataclass(frozen=True)
+class RestartFile:
+    """A restart file of a case: path relative to the case folder and its step."""
+
+    path: str
+    step: int
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What the runner does with one case, and why."""
+
+    action: str                         # skip | fresh | resume
+    reason: str
+    restart: RestartFile | None = None
+
+
+def restart_step(path: Path) -> int | None:
+    """Time step stored in a LIGGGHTS 3.8.0 restart file header, or None if unreadable.
+
+    The header is a sequence of (int flag, value): 0 version string (int length + bytes),
+    1-3 int sizes, 4 units string, 5 the time step as a 64-bit integer.
+    """
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(512)
+        offset = 0
+        flag, n = struct.unpack_from("<ii", data, offset)
+        if flag != 0 or not 0 < n < 400:
+            return None
+        offset += 8 + n
+        for expect in (1, 2, 3):
+            flag, _ = struct.unpack_from("<ii", data, offset)
+            if flag != expect:
+                return None
+            offset += 8
+        flag, n = struct.unpack_from("<ii", data, offset)
+        if flag != 4 or not 0 < n < 64:
+            return None
+        offset += 8 + n
+        flag, step = struct.unpack_from("<iq", data, offset)
+        if flag != 5 or step < 0:
+            return None
+        return int(step)
+    except (OSError, struct.error):
+        return None
+
+
+def restart_files(case_dir: Path) -> list[RestartFile]:
+    """Readable restart files of a case, newest step first."""
+    case_dir = Path(case_dir)
+    found: list[RestartFile] = []
+    for p in case_dir.iterdir():
+        if _FORCED_RE.match(p.name):
+            step = restart_step(p)
+            if step is not None:
+                found.append(RestartFile(p.name, step))
+    for rel in _PERIODIC:
+        p = case_dir / rel
+        if p.is_file():
+            step = restart_step(p)
+            if step is not None:
+                found.append(RestartFile(rel, step))
+    return sorted(found, key=lambda r: r.step, reverse=True)
+
+
+def discard_restart(case_dir: Path, restart: RestartFile) -> None:
+    """Set a restart file aside (renamed ``*.corrupt``) after the engine could not read it."""
+    p = Path(case_dir) / restart.path
+    if p.exists():
+        p.rename(p.with_name(p.name + ".corrupt"))
+
+
+def plan_case(case_dir: Path, retry_unstable: bool = False) -> Plan:
+    """What to do with a case folder now (see the module docstring)."""
+    case_dir = Path(case_dir)
+    m = read_manifest(case_dir)
+    if m is None:
+        return Plan(FRESH, "not run yet")
+    if m.scene_hash != scene_hash_of(case_dir):
+        return Plan(FRESH, "scene changed since the last run")
+    status = effective_status(m)
+    if status == DONE:
+        return Plan(SKIP, "done")
+    if status == UNSTABLE and not retry_unstable:
+        return Plan(SKIP, f"unstable: {m.reason}")
+    if status in (FAILED, UNSTABLE):
+        return Plan(FRESH, f"re-run after {status}: {m.reason}")
+    if status == "running":
+        return Plan(SKIP, f"running in process {m.pid} on {m.host}")
+    restarts = restart_files(case_dir)
+    if restarts:
+        return Plan(RESUME, f"killed at step {m.steps_done}; resume from {restarts[0].path}",
+                    restarts[0])
+    return Plan(FRESH, f"killed at step {m.steps_done} before any restart file was written")
+
+
+def clean_outputs(case_dir: Path) -> None:
+    """Remove the outputs of earlier attempts before a fresh run (inputs stay)."""
+    case_dir = Path(case_dir)
+    for sub in ("post", "restart"):
+        d = case_dir / sub
+        if d.is_dir():
+            shutil.rmtree(d)
+        d.mkdir()
+    for p in case_dir.iterdir():
+        if (_FORCED_RE.match(p.name) or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT,
+                                                   "log.liggghts")
+                or re.fullmatch(r"run(\.\d+)?\.log", p.name)):
+            p.unlink()
+
+
+def load_scaled(case_dir: Path) -> ScaledScene:
+    """The scaled scene a case folder was rendered from (``scene.json``)."""
+    data = json.loads((Path(case_dir) / "scene.json").read_text())["scaled"]
+    for key, value in data.items():
+        if isinstance(value, list):
+            data[key] = tuple(value)
+    return ScaledScene(**data)
+
+
+def resume_phase(s: ScaledScene, step: int) -> tuple[str, int, bool]:
+    """Phase a run stopped at ``step`` is in: (phase, current fill wave, wave inserted).
+
+    Wave k (1-based) inserts at its first step and runs to ``k * wave_steps``; a restart
+    written exactly at a wave boundary has not inserted the next wave yet.
+    """
+    if step < s.insertion_steps:
+        wave = step // s.wave_steps + 1
+        return "fill", wave, step % s.wave_steps != 0
+    if step < s.insertion_steps + s.settle_steps:
+        return "settle", 0, False
+    return "production", 0, False
+
+
+def render_resume(s: ScaledScene, restart: RestartFile, template_dirs=()) -> dict[str, str]:
+    """Input continuing case ``s`` from ``restart``: ``{RESUME_INPUT: text}`` (pure)."""
+    phase, wave, inserted = resume_phase(s, restart.step)
+    ctx = template_context(s)
+    ctx.update(restart_file=restart.path, from_step=restart.step, resume_phase=phase,
+               current_wave=wave, current_wave_inserted=inserted)
+    return {RESUME_INPUT: render_template("resume.in.j2", ctx, template_dirs)}
+
+
+def input_for(plan: Plan) -> str:
+    """Input file an attempt runs."""
+    return RESUME_INPUT if plan.action == RESUME else INPUT_NAME
+
+
+def rotate_screen(case_dir: Path) -> None:
+    """Keep the screen of the previous attempt as ``run.<n>.log``."""
+    case_dir = Path(case_dir)
+    current = case_dir / SCREEN_FILE
+    if current.exists():
+        n = 1
+        while (case_dir / f"run.{n}.log").exists():
+            n += 1
+        current.rename(case_dir / f"run.{n}.log")

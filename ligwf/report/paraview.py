@@ -1,0 +1,76 @@
+"""ParaView collections: one ``.pvd`` per case with the particles and the turning drum.
+
+Part 0 is the particle series (the granule-labelled ``.vtu`` from the analysis stage when
+it exists, else the raw dumps); part 1 is the drum mesh, rotated to its position at each
+frame (omega x time since the drum started turning), so the lifters move with the bed
+when the series is played.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+
+import meshio
+import numpy as np
+
+from ligwf.analysis.dumps import discover_frames
+from ligwf.analysis.flow_run import production_start_step
+from ligwf.fsio import atomic_write_text
+from ligwf.engine.mesh import axis_frame
+
+
+def rotation_matrix(axis: str, angle: float) -> np.ndarray:
+    """Right-handed rotation by ``angle`` (rad) about +axis."""
+    ia, _, _ = axis_frame(axis)
+    k = np.zeros(3)
+    k[ia] = 1.0
+    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
+
+
+def drum_angle(case_dir: Path, step: int) -> float:
+    """Angle (rad) the drum has turned by at ``step`` (it starts turning after settling)."""
+    s = json.loads((Path(case_dir) / "scene.json").read_text())["scaled"]
+    return s["omega"] * max(0, step - production_start_step(s)) * s["dt"]
+
+
+def _pvd(entries: list[tuple[float, int, str]]) -> str:
+    lines = ['<?xml version="1.0"?>',
+             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+             "  <Collection>"]
+    for t, part, f in entries:
+        lines.append(f'    <DataSet timestep="{t:.9g}" group="" part="{part}" file="{f}"/>')
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    return "\n".join(lines)
+
+
+def case_collection(case_dir: Path, analysis_dir: Path, out_dir: Path) -> Path | None:
+    """Write ``out_dir/<case>.pvd`` (+ rotated drum files); None when there are no frames."""
+    rec = json.loads((case_dir / "scene.json").read_text())
+    s = rec["scaled"]
+    frames = discover_frames(case_dir)
+    if not frames:
+        return None
+    drum = meshio.read(case_dir / "drum.stl")
+    tri = drum.cells_dict["triangle"]
+    case_out = out_dir / rec["case_id"]
+    case_out.mkdir(parents=True, exist_ok=True)
+    entries = []
+    labelled = analysis_dir / rec["case_id"]
+    for ff in frames:
+        t = ff.step * s["dt"]
+        g = labelled / f"granules_{ff.step}.vtu"
+        particles = g if g.is_file() else ff.particles
+        entries.append((t, 0, os.path.relpath(particles, out_dir)))
+        pts = drum.points @ rotation_matrix(s["axis"], drum_angle(case_dir, ff.step)).T
+        drum_file = case_out / f"drum_{ff.step}.vtu"
+        tmp = drum_file.with_suffix(".tmp.vtu")
+        meshio.write(tmp, meshio.Mesh(pts, [("triangle", tri)]), binary=True)
+        os.replace(tmp, drum_file)
+        entries.append((t, 1, os.path.relpath(drum_file, out_dir)))
+    path = out_dir / f"{rec['case_id']}.pvd"
+    atomic_write_text(path, _pvd(entries))
+    return path

@@ -1,0 +1,151 @@
+"""Write the report folder of a study: tables, summary.md, index.html, figures, ParaView.
+
+``STUDY/report/``:
+``cases.csv`` and ``conditions.csv`` (the numbers), ``summary.md`` and ``index.html``
+(the same tables with the figures), ``figures/*.png`` (error vs run time, GSD overlay,
+velocity profiles, one snapshot per case coloured by speed and one by granule id) and
+``paraview/<case>.pvd`` (particles + turning drum, open in ParaView).
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+from pathlib import Path
+
+import pandas as pd
+
+from ligwf import __version__
+from ligwf.report import figures as figs
+from ligwf.analysis.dumps import discover_frames
+from ligwf.analysis.flow_run import flow_study
+from ligwf.fsio import atomic_write_text
+from ligwf.report.paraview import case_collection, drum_angle
+from ligwf.report.tables import build_tables
+
+CASE_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", "rep"),
+                ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
+                ("wall_seconds", "wall [s]"), ("core_seconds", "core-s"),
+                ("speedup_core", "speedup (core-s)"), ("angle_of_repose", "angle [deg]"),
+                ("angle_of_repose_std", "angle std [deg]"), ("angle_error", "angle err"),
+                ("profile_error", "profile err (L2)"), ("rigid_frame_share", "rigid frames"),
+                ("largest_cluster_fraction", "largest cluster"),
+                ("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
+
+CONDITION_METRICS = [("speedup_core", "speedup"), ("angle_of_repose", "angle [deg]"),
+                     ("angle_error", "angle err"), ("profile_error", "profile err"),
+                     ("rigid_frame_share", "rigid frames"),
+                     ("largest_cluster_fraction", "largest cluster"),
+                     ("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
+
+
+def _fmt(v) -> str:
+    if isinstance(v, str):
+        return v
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "–"
+    if isinstance(v, float):
+        return f"{v:.3g}"
+    return str(v)
+
+
+def _ci(row, col) -> str:
+    m, lo, hi = row[col], row.get(f"{col}_lo"), row.get(f"{col}_hi")
+    if isinstance(lo, float) and math.isfinite(lo):
+        return f"{_fmt(m)} [{_fmt(lo)}, {_fmt(hi)}]"
+    return _fmt(m)
+
+
+def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame) -> str:
+    head = "| " + " | ".join(t for _, t in CASE_COLUMNS) + " |"
+    sep = "|" + "---|" * len(CASE_COLUMNS)
+    lines = ["## Cases", "", head, sep]
+    for _, r in cases.sort_values(["group", "cg", "rule", "replica"]).iterrows():
+        lines.append("| " + " | ".join(_fmt(r[c]) for c, _ in CASE_COLUMNS) + " |")
+    lines += ["", "## Conditions (mean [95 % CI over replicas])", ""]
+    head = "| CG | rule | replicas | particles | core-s | " + " | ".join(t for _, t in CONDITION_METRICS) + " |"
+    lines += [head, "|" + "---|" * (5 + len(CONDITION_METRICS))]
+    for _, r in conditions.iterrows():
+        cells = [f"{r['cg']:g}", r["rule"], str(r["replicas"]), str(r["particles"]),
+                 _ci(r, "core_seconds")] + [_ci(r, c) for c, _ in CONDITION_METRICS]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def write_report(study: Path, out: Path | None = None, snapshots: bool = True,
+                 steady_after: float = 0.25) -> Path:
+    """Compute flow metrics, build the tables and write the report folder; returns it."""
+    study = Path(study)
+    out = Path(out) if out else study / "report"
+    fig_dir, pv_dir = out / "figures", out / "paraview"
+    fig_dir.mkdir(parents=True, exist_ok=True)
+    flow_study(study, steady_after=steady_after)
+    cases, conditions, skipped, profiles = build_tables(study)
+    atomic_write_text(out / "cases.csv", cases.to_csv(index=False))
+    atomic_write_text(out / "conditions.csv", conditions.to_csv(index=False))
+
+    figures: list[tuple[str, Path]] = []
+    if not conditions.empty:
+        figures.append(("Error vs run time", figs.pareto(conditions, fig_dir / "error_vs_runtime.png")))
+        figures.append(("Velocity profiles", figs.velocity_profiles(cases, profiles,
+                                                                    fig_dir / "velocity_profiles.png")))
+    gsd_path = study / "analysis" / "gsd.csv"
+    if gsd_path.is_file() and gsd_path.stat().st_size > 1:
+        gsd = pd.read_csv(gsd_path)
+        if not gsd.empty:
+            figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / "gsd_overlay.png")))
+    pvds = []
+    for case_id in cases.get("case_id", []):
+        case_dir = study / case_id
+        pvd = case_collection(case_dir, study / "analysis", pv_dir)
+        if pvd:
+            pvds.append(pvd)
+        frames = discover_frames(case_dir)
+        if snapshots and frames:
+            last = frames[-1]
+            axis = figs.scene_axis(case_dir)
+            angle = drum_angle(case_dir, last.step)
+            figures.append((f"{case_id}: speed", figs.snapshot(
+                last.particles, case_dir / "drum.stl", axis, angle, "speed",
+                fig_dir / f"{case_id}_speed.png", f"{case_id} step {last.step}: speed [m/s]")))
+            labelled = study / "analysis" / case_id / f"granules_{last.step}.vtu"
+            if labelled.is_file():
+                figures.append((f"{case_id}: granules", figs.snapshot(
+                    labelled, case_dir / "drum.stl", axis, angle, "granule",
+                    fig_dir / f"{case_id}_granules.png", f"{case_id} step {last.step}: granule id")))
+
+    name = json.loads((study / "study.json").read_text()).get("name", study.name)
+    skipped_md = "\n".join(f"- {s.get('case_id', s)}: {s.get('reason', '')}" for s in skipped) or "none"
+    md = "\n".join([
+        f"# {name}: error against run time", "",
+        f"Study folder `{study}`; report by ligwf {__version__}. Errors are relative to the "
+        "CG1 cases of the same sweep group; speedup is CG1 core-seconds per simulated second over the case's.", "",
+        markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
+        "## Skipped cases (not done or stale)", "", skipped_md, "",
+        "## Figures", "",
+        *[f"![{t}](figures/{p.name})" for t, p in figures], "",
+        "## ParaView", "",
+        *[f"- `paraview/{p.name}`" for p in pvds], ""])
+    atomic_write_text(out / "summary.md", md)
+    atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, skipped_md))
+    return out
+
+
+def _html(name, cases, conditions, figures, skipped_md) -> str:
+    def table(df: pd.DataFrame) -> str:
+        if df.empty:
+            return "<p>none</p>"
+        return df.to_html(index=False, float_format=lambda v: f"{v:.3g}", na_rep="–", border=0)
+    imgs = "\n".join(f'<figure><img src="figures/{p.name}" alt="{html.escape(t)}">'
+                     f"<figcaption>{html.escape(t)}</figcaption></figure>" for t, p in figures)
+    cols = [c for c, _ in CASE_COLUMNS]
+    return f"""<!doctype html><html><head><meta charset="utf-8"><title>{html.escape(name)}</title>
+<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse;font-size:12px}}
+td,th{{padding:2px 6px;border-bottom:1px solid #ddd}}img{{max-width:720px}}</style></head><body>
+<h1>{html.escape(name)}: error against run time</h1>
+<h2>Cases</h2>{table(cases[cols] if not cases.empty else cases)}
+<h2>Conditions (mean, 95 % CI bounds over replicas)</h2>{table(conditions)}
+<h2>Skipped cases</h2><pre>{html.escape(skipped_md)}</pre>
+<h2>Figures</h2>{imgs}</body></html>
+"""

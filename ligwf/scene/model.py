@@ -1,0 +1,365 @@
+"""Scene model: typed, validated, frozen parameters of one drum simulation, in SI units.
+
+A :class:`Scene` describes the *original* (CG1) system: the drum, the particles, the liquid,
+the process and the numerics. Coarse graining is a separate, pure stage (``scaling``) that
+turns a Scene plus a CG level and a rule into the parameters LIGGGHTS will see.
+
+Every field is checked when the scene is built, so bad input is refused with the field,
+the value and the allowed range before any file is written or any engine launched.
+"""
+
+from __future__ import annotations
+
+import math
+from enum import Enum
+from typing import Annotated, Any, Literal
+
+from pydantic import (AfterValidator, BaseModel, ConfigDict, Field, ValidationError,
+                      model_validator)
+
+from ligwf.errors import ConfigError
+
+#: Characters that must never reach a LIGGGHTS input: a newline ends the command and starts
+#: a new one, '&' continues a line, '$' expands variables, '#' starts a comment and quotes
+#: group words. LIGGGHTS has a ``shell`` command, so an injected line could run anything.
+FORBIDDEN_INPUT_CHARS = ("\n", "\r", "&", "$", "#", "'", '"')
+
+
+def check_input_safe(value: str) -> str:
+    """Refuse a string that could inject or break a line of a LIGGGHTS input."""
+    bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
+    if bad:
+        shown = ", ".join(repr(c) for c in bad)
+        raise ValueError(f"contains {shown}; strings that reach the LIGGGHTS input may not "
+                         "contain a newline, '&', '$', '#' or a quote")
+    return value
+
+
+SafeStr = Annotated[str, AfterValidator(check_input_safe)]
+
+
+class _Frozen(BaseModel):
+    """Base of all parameter objects: immutable, unknown keys are errors (typos)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
+
+
+# ---------------------------------------------------------------------------------------
+# Drum
+# ---------------------------------------------------------------------------------------
+
+class Lifters(_Frozen):
+    """Rectangular lifter bars cut radially into the drum shell, evenly spaced."""
+
+    count: int = Field(0, ge=0, le=360, description="number of lifters")
+    height: float = Field(0.0, ge=0.0, description="radial height, m")
+    width_deg: float = Field(3.0, gt=0.0, lt=180.0, description="angular width, degrees")
+
+    @model_validator(mode="after")
+    def _fit_around(self) -> "Lifters":
+        if self.count and self.count * self.width_deg >= 360.0:
+            raise ValueError(f"count x width_deg = {self.count * self.width_deg:g} deg; "
+                             "the lifters must leave gaps: count x width_deg < 360")
+        return self
+
+
+class Drum(_Frozen):
+    """The rotating drum: a cylinder shell (with lifters), axis through the origin."""
+
+    diameter: float = Field(gt=0.0, le=10.0, description="inner shell diameter, m")
+    length: float = Field(gt=0.0, le=10.0, description="axial length, m (the periodic length)")
+    axis: Literal["x", "y", "z"] = Field("y", description="rotation axis")
+    periodic: bool = Field(True, description="periodic boundary along the axis; "
+                           "otherwise the drum has end walls")
+    lifters: Lifters = Field(default_factory=Lifters)
+    wall_friction: float | None = Field(None, ge=0.0, le=10.0,
+                                        description="particle-wall friction (default: particles')")
+    wall_restitution: float | None = Field(None, gt=0.0, le=1.0,
+                                           description="particle-wall restitution "
+                                           "(default: particles')")
+
+    @property
+    def radius(self) -> float:
+        return 0.5 * self.diameter
+
+    @model_validator(mode="after")
+    def _lifters_fit(self) -> "Drum":
+        if self.lifters.count and self.lifters.height >= self.radius:
+            raise ValueError(f"lifters.height = {self.lifters.height:g} m must be < the drum "
+                             f"radius {self.radius:g} m")
+        if self.lifters.count and self.lifters.height <= 0.0:
+            raise ValueError("lifters.height must be > 0 when lifters.count > 0")
+        return self
+
+
+# ---------------------------------------------------------------------------------------
+# Particles
+# ---------------------------------------------------------------------------------------
+
+class SizeClass(_Frozen):
+    """One class of the size distribution: a diameter, or a diameter range split into bins.
+
+    ``fraction`` is a NUMBER fraction (share of particles), not a mass fraction.
+    A range is discretised into ``bins`` classes of equal width, equally populated, which
+    approximates a uniform number distribution between the two diameters.
+    """
+
+    diameter: float | None = Field(None, gt=0.0, le=1.0, description="diameter, m")
+    diameter_range: tuple[float, float] | None = Field(None, description="[min, max] diameter, m")
+    bins: int = Field(4, ge=1, le=64, description="classes a range is split into")
+    fraction: float = Field(gt=0.0, le=1.0, description="number fraction")
+
+    @model_validator(mode="after")
+    def _one_of(self) -> "SizeClass":
+        if (self.diameter is None) == (self.diameter_range is None):
+            raise ValueError("give exactly one of diameter or diameter_range")
+        if self.diameter_range is not None:
+            lo, hi = self.diameter_range
+            if not (0.0 < lo < hi <= 1.0):
+                raise ValueError(f"diameter_range = [{lo:g}, {hi:g}]: need 0 < min < max <= 1 m")
+        return self
+
+    def discrete(self) -> list[tuple[float, float]]:
+        """(diameter, number fraction) pairs this class stands for."""
+        if self.diameter is not None:
+            return [(self.diameter, self.fraction)]
+        lo, hi = self.diameter_range  # type: ignore[misc]
+        width = (hi - lo) / self.bins
+        return [(lo + (k + 0.5) * width, self.fraction / self.bins) for k in range(self.bins)]
+
+
+class Particles(_Frozen):
+    """Material and size distribution of the primary (CG1) particles."""
+
+    density: float = Field(gt=0.0, le=1e5, description="kg/m^3")
+    youngs_modulus: float = Field(gt=0.0, le=1e13, description="Pa")
+    poisson_ratio: float = Field(0.3, gt=0.0, lt=0.5)
+    restitution: float = Field(gt=0.0, le=1.0)
+    friction: float = Field(ge=0.0, le=10.0, description="sliding friction coefficient")
+    rolling_friction: float = Field(0.0, ge=0.0, le=10.0,
+                                    description="rolling friction coefficient (model cdt); "
+                                    "0 switches rolling friction off")
+    size_distribution: tuple[SizeClass, ...] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _fractions_sum(self) -> "Particles":
+        total = sum(c.fraction for c in self.size_distribution)
+        if not math.isclose(total, 1.0, abs_tol=1e-6):
+            raise ValueError(f"size_distribution fractions sum to {total:g}; they must sum to 1")
+        return self
+
+    def size_classes(self) -> list[tuple[float, float]]:
+        """All (diameter, number fraction) classes, ranges expanded, largest first."""
+        out: list[tuple[float, float]] = []
+        for c in self.size_distribution:
+            out.extend(c.discrete())
+        return sorted(out, key=lambda t: -t[0])
+
+
+# ---------------------------------------------------------------------------------------
+# Liquid
+# ---------------------------------------------------------------------------------------
+
+class LiquidModel(str, Enum):
+    """Capillary cohesion models of LIGGGHTS 3.8.0 (``none`` = dry bed)."""
+
+    NONE = "none"
+    WASHINO = "washino"
+    EASO = "easo"
+
+
+class Liquid(_Frozen):
+    """The binder liquid and its bridge model.
+
+    ``liquid_content`` is the liquid volume as a FRACTION of each particle's solid volume
+    (LIGGGHTS' ``surfaceLiquidContentInitial``; the engine source uses a fraction although
+    its docs say %).
+    """
+
+    model: LiquidModel = LiquidModel.NONE
+    surface_tension: float = Field(0.072, ge=0.0, le=1e4, description="N/m")
+    contact_angle_deg: float = Field(30.0, ge=0.0, le=180.0, description="degrees")
+    viscosity: float = Field(1e-3, ge=0.0, le=1e6, description="Pa s")
+    liquid_content: float = Field(0.02, gt=0.0, le=1.0,
+                                  description="liquid volume / solid volume")
+    min_separation_ratio: float = Field(1.01, gt=0.0, le=10.0,
+                                        description="minSeparationDistanceRatio")
+    max_separation_ratio: float = Field(1.1, gt=0.0, le=10.0,
+                                        description="maxSeparationDistanceRatio")
+
+    @property
+    def wet(self) -> bool:
+        return self.model is not LiquidModel.NONE
+
+    @model_validator(mode="after")
+    def _separation_order(self) -> "Liquid":
+        if self.wet and self.max_separation_ratio < self.min_separation_ratio:
+            raise ValueError(f"max_separation_ratio = {self.max_separation_ratio:g} must be >= "
+                             f"min_separation_ratio = {self.min_separation_ratio:g}")
+        return self
+
+
+# ---------------------------------------------------------------------------------------
+# Process and numerics
+# ---------------------------------------------------------------------------------------
+
+GRAVITY = 9.81  # m/s^2, the value written to the LIGGGHTS input
+
+
+class Rotation(_Frozen):
+    """Drum speed, as rpm or as Froude number Fr = omega^2 R / g (give exactly one)."""
+
+    rpm: float | None = Field(None, gt=0.0, le=1e4)
+    froude: float | None = Field(None, gt=0.0, le=100.0)
+
+    @model_validator(mode="after")
+    def _one_of(self) -> "Rotation":
+        if (self.rpm is None) == (self.froude is None):
+            raise ValueError("give exactly one of rpm or froude")
+        return self
+
+    def omega(self, drum_radius: float) -> float:
+        """Angular speed, rad/s."""
+        if self.rpm is not None:
+            return self.rpm * 2.0 * math.pi / 60.0
+        return math.sqrt(self.froude * GRAVITY / drum_radius)  # type: ignore[operator]
+
+
+class Process(_Frozen):
+    """How the drum is filled and turned."""
+
+    rotation: Rotation
+    fill_fraction: float = Field(gt=0.0, le=0.7,
+                                 description="bed volume (solids + voids) / drum volume")
+    particle_count: int | None = Field(None, gt=0, le=10**9,
+                                       description="CG1 particle count; overrides the count "
+                                       "derived from fill_fraction")
+    settle_time: float = Field(0.5, ge=0.0, le=1e3, description="s, drum at rest")
+    run_time: float = Field(gt=0.0, le=1e4, description="s, drum rotating")
+
+
+class Numerics(_Frozen):
+    """Integration and output settings."""
+
+    dt_rayleigh_fraction: float = Field(0.15, gt=0.0, le=2.0,
+                                        description="time step / Rayleigh time of the "
+                                        "smallest (scaled) particle")
+    dt: float | None = Field(None, gt=0.0, le=1.0,
+                             description="fixed time step, s; unset (default): "
+                             "dt_rayleigh_fraction x Rayleigh time at every CG level")
+    dump_interval: float = Field(0.05, gt=0.0, le=1e3, description="s between dumps")
+    thermo_interval: float = Field(0.005, gt=0.0, le=1e3, description="s between thermo lines")
+    restart_interval: float = Field(0.25, gt=0.0, le=1e4,
+                                    description="s between periodic restart files")
+    packing_fraction: float = Field(0.6, gt=0.0, le=0.74,
+                                    description="solid fraction of the settled bed")
+    skin_ratio: float = Field(0.5, gt=0.0, le=5.0,
+                              description="neighbor skin / smallest diameter")
+    contact_angle_compensation: bool = Field(
+        True, description="compensate LIGGGHTS 3.8.0's effective contact angle "
+        "0.5*theta_i*theta_j so the engine applies the scene's angle; switch off for "
+        "engines with the upstream fix")
+    seed: int = Field(10007, ge=10000, le=2**31 - 1,
+                      description="base random seed (ligwf derives primes > 10000 from it)")
+
+
+class Analysis(_Frozen):
+    """Which analyses the run must prepare output for."""
+
+    granules: bool = Field(False, description="write contact dumps for granule analysis")
+
+
+class Scene(_Frozen):
+    """One original-size (CG1) drum simulation."""
+
+    name: SafeStr = Field("scene", min_length=1, max_length=80)
+    drum: Drum
+    particles: Particles
+    liquid: Liquid = Field(default_factory=Liquid)
+    process: Process
+    numerics: Numerics = Field(default_factory=Numerics)
+    analysis: Analysis = Field(default_factory=Analysis)
+
+    @model_validator(mode="after")
+    def _granules_need_liquid(self) -> "Scene":
+        if self.analysis.granules and not self.liquid.wet:
+            raise ValueError("analysis.granules needs a liquid model (granules are held by "
+                             "liquid bridges); set liquid.model to washino or easo")
+        return self
+
+
+# ---------------------------------------------------------------------------------------
+# Error formatting
+# ---------------------------------------------------------------------------------------
+
+_BOUND_WORDS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
+
+
+def _allowed_range(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str | None:
+    """The full interval of a numeric field, e.g. '(0, 0.7]', from its declared bounds."""
+    field = None
+    for part in loc:
+        if isinstance(part, int):  # index into a tuple of models: same element model
+            continue
+        if model is None or part not in model.model_fields:
+            return None
+        field = model.model_fields[part]
+        ann = field.annotation
+        nxt = None
+        for cand in getattr(ann, "__args__", (ann,)):
+            if isinstance(cand, type) and issubclass(cand, BaseModel):
+                nxt = cand
+            for sub in getattr(cand, "__args__", ()):
+                if isinstance(sub, type) and issubclass(sub, BaseModel):
+                    nxt = sub
+        model = nxt
+    if field is None:
+        return None
+    bounds: dict[str, float] = {}
+    for meta in field.metadata:
+        for key in _BOUND_WORDS:
+            val = getattr(meta, key, None)
+            if val is not None:
+                bounds[key] = val
+    if not bounds:
+        return None
+    lo = f"({bounds['gt']:g}" if "gt" in bounds else (f"[{bounds['ge']:g}" if "ge" in bounds
+                                                     else "(-inf")
+    hi = f"{bounds['lt']:g})" if "lt" in bounds else (f"{bounds['le']:g}]" if "le" in bounds
+                                                     else "inf)")
+    return f"{lo}, {hi}"
+
+
+def format_validation_error(exc: ValidationError, root: type[BaseModel], prefix: str) -> str:
+    """One line per problem: ``field = value: reason (allowed: range)``."""
+    lines = []
+    errors = exc.errors()
+    deeper = {tuple(e["loc"][:-1]) for e in errors if len(e["loc"]) > 1}
+    for err in errors:
+        loc = tuple(err["loc"])
+        if err["type"] == "too_short" and any(d[:len(loc)] == loc for d in deeper):
+            continue  # a collection emptied by its own invalid items: already reported
+        path = ".".join(str(p) for p in (prefix, *loc) if p != "")
+        value = err.get("input")
+        msg = err["msg"].removeprefix("Value error, ")
+        if err["type"] == "extra_forbidden":
+            lines.append(f"{path}: unknown key (typo?)")
+            continue
+        if err["type"] == "missing":
+            lines.append(f"{path}: required field is missing")
+            continue
+        shown = value if not isinstance(value, (dict, list)) else "..."
+        line = f"{path} = {shown!r}: {msg}"
+        rng = _allowed_range(root, loc)
+        if rng:
+            line += f" (allowed range {rng})"
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def build_scene(data: dict[str, Any], prefix: str = "scene") -> Scene:
+    """Validate a plain mapping (from YAML) into a :class:`Scene` or raise ConfigError."""
+    try:
+        return Scene.model_validate(data)
+    except ValidationError as exc:
+        raise ConfigError("invalid scene:\n" + format_validation_error(exc, Scene, prefix)) from None

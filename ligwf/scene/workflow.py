@@ -1,0 +1,233 @@
+"""Workflows: a YAML file with a ``scene:`` and a ``sweep:`` block, expanded into cases.
+
+```yaml
+name: demo
+scene: {...}                  # a ligwf.scene.model.Scene, CG1 units
+sweep:
+  cg_levels: [1, 2, 3]
+  rules: [weber, bond]
+  replicas: {1: 1, 2: 3, 3: 3}   # or a single number for every CG level
+  scene.process.rotation.rpm: [20, 30]   # any scene field as a list
+  per_cg: {2: {process.run_time: 6.0}}    # scene fields for one CG level only
+```
+
+CLI overrides (``--set scene.drum.lifters.count=12``) are applied to the raw mapping before
+validation, so they are checked exactly like the file. Values are parsed as YAML.
+A CG1 case is the same under every rule, so it is run once (rule ``none``).
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import Field, TypeAdapter, ValidationError
+
+from ligwf.errors import ConfigError
+from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
+from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene, format_validation_error
+
+_TOP_KEYS = {"name", "description", "scene", "sweep"}
+
+
+class Sweep(_Frozen):
+    """What varies between the cases of a workflow (scene-field lists are kept apart)."""
+
+    cg_levels: tuple[float, ...] = Field((1.0,), min_length=1)
+    rules: tuple[Rule, ...] = Field((Rule.WEBER,), min_length=1)
+    replicas: int | dict[float, int] = Field(1, description="seeds per case, or per CG level")
+    per_cg: dict[float, dict[str, Any]] = Field(
+        default_factory=dict, description="scene fields set for one CG level only, e.g. "
+        "{2: {process.run_time: 6.0}} (more revolutions where they are cheap)")
+
+    def replicas_for(self, cg: float) -> int:
+        if isinstance(self.replicas, int):
+            return self.replicas
+        return self.replicas.get(cg, 1)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One run: a scene (with its sweep values applied), a CG level, a rule and a replica."""
+
+    index: int
+    case_id: str
+    scene: Scene
+    cg: float
+    rule: Rule
+    replica: int
+    varied: tuple[tuple[str, Any], ...] = ()
+
+    def scaled(self) -> ScaledScene:
+        return scale(self.scene, self.cg, self.rule, self.replica)
+
+
+@dataclass(frozen=True)
+class Workflow:
+    name: str
+    description: str
+    raw: dict[str, Any]
+    cases: tuple[Case, ...]
+
+
+# ---------------------------------------------------------------------------------------
+# overrides
+# ---------------------------------------------------------------------------------------
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """``a.b.c=value`` -> (path, YAML-parsed value)."""
+    if "=" not in text:
+        raise ConfigError(f"--set {text!r}: expected KEY=VALUE, e.g. scene.drum.lifters.count=12")
+    key, _, value = text.partition("=")
+    key = key.strip()
+    if not key:
+        raise ConfigError(f"--set {text!r}: empty key")
+    try:
+        parsed = yaml.safe_load(value) if value.strip() else ""
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"--set {key}: cannot parse value {value!r}: {exc}") from None
+    return key, parsed
+
+
+def apply_override(raw: dict[str, Any], key: str, value: Any) -> None:
+    """Set ``key`` (dotted) in the raw workflow mapping; sweep scene paths stay one key."""
+    parts = key.split(".")
+    if parts[0] not in _TOP_KEYS:
+        raise ConfigError(f"--set {key}: unknown top-level key {parts[0]!r} "
+                          f"(allowed: {', '.join(sorted(_TOP_KEYS))})")
+    if parts[0] == "sweep" and len(parts) > 2:
+        parts = ["sweep", ".".join(parts[1:])]
+    node = raw
+    for p in parts[:-1]:
+        child = node.get(p)
+        if child is None:
+            child = node[p] = {}
+        if not isinstance(child, dict):
+            raise ConfigError(f"--set {key}: {p!r} is not a mapping")
+        node = child
+    node[parts[-1]] = value
+
+
+# ---------------------------------------------------------------------------------------
+# loading and expansion
+# ---------------------------------------------------------------------------------------
+
+def _set_path(data: dict[str, Any], path: str, value: Any) -> None:
+    node = data
+    parts = path.split(".")
+    for p in parts[:-1]:
+        if not isinstance(node.get(p), dict):
+            node[p] = {} if node.get(p) is None else node[p]
+            if not isinstance(node[p], dict):
+                raise ConfigError(f"sweep: scene.{path}: {p!r} is not a mapping")
+        node = node[p]
+    node[parts[-1]] = value
+
+
+def _slug(value: Any) -> str:
+    text = re.sub(r"[^A-Za-z0-9.+-]+", "-", str(value)).strip("-")
+    return text or "x"
+
+
+def _fmt_cg(cg: float) -> str:
+    return f"{cg:g}"
+
+
+def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list[Any]]]]:
+    known, varied = {}, []
+    for key, value in sweep_raw.items():
+        if key.startswith("scene."):
+            if not isinstance(value, list) or not value:
+                raise ConfigError(f"sweep.{key} = {value!r}: a scene field in the sweep must "
+                                  "be a non-empty list of values")
+            varied.append((key.removeprefix("scene."), value))
+        else:
+            known[key] = value
+    if "rules" in known and isinstance(known["rules"], list):
+        for r in known["rules"]:
+            parse_rule(r)
+    try:
+        sweep = Sweep.model_validate(known)
+    except ValidationError as exc:
+        raise ConfigError("invalid sweep:\n" + format_validation_error(exc, Sweep, "sweep")) from None
+    for cg in list(sweep.cg_levels) + list(sweep.per_cg):
+        if cg < 1:
+            raise ConfigError(f"sweep.cg_levels: CG level {cg:g} is < 1 (allowed range [1, inf))")
+    reps = sweep.replicas.values() if isinstance(sweep.replicas, dict) else [sweep.replicas]
+    for n in reps:
+        if n < 1:
+            raise ConfigError(f"sweep.replicas = {n}: need at least 1 replica (allowed range [1, inf))")
+    return sweep, varied
+
+
+def expand(raw: dict[str, Any]) -> Workflow:
+    """Validate a raw workflow mapping and expand it into its cases (pure)."""
+    if not isinstance(raw, dict):
+        raise ConfigError("a workflow file must be a YAML mapping with scene: and sweep:")
+    unknown = set(raw) - _TOP_KEYS
+    if unknown:
+        raise ConfigError(f"workflow: unknown key(s) {', '.join(sorted(unknown))} "
+                          f"(allowed: {', '.join(sorted(_TOP_KEYS))})")
+    if "scene" not in raw:
+        raise ConfigError("workflow: the scene: block is missing")
+    name = raw.get("name", "study")
+    try:
+        TypeAdapter(SafeStr).validate_python(name)
+    except ValidationError as exc:
+        raise ConfigError(f"name = {name!r}: {exc.errors()[0]['msg']}") from None
+    sweep, varied = _split_sweep(raw.get("sweep") or {})
+
+    base_scene = copy.deepcopy(raw["scene"])
+    base_scene.setdefault("name", name)
+    build_scene(base_scene)  # report errors of the base scene once, plainly
+
+    cases: list[Case] = []
+    combos = itertools.product(*[vals for _, vals in varied]) if varied else [()]
+    seen: set[tuple] = set()
+    for combo in combos:
+        data = copy.deepcopy(base_scene)
+        for (path, _), value in zip(varied, combo):
+            _set_path(data, path, value)
+        base = build_scene(data)
+        tag = "".join(f"_{path.split('.')[-1]}-{_slug(v)}" for (path, _), v in zip(varied, combo))
+        for cg in sweep.cg_levels:
+            if cg in sweep.per_cg:
+                cg_data = copy.deepcopy(data)
+                for path, value in sweep.per_cg[cg].items():
+                    _set_path(cg_data, path.removeprefix("scene."), value)
+                scene = build_scene(cg_data, prefix=f"sweep.per_cg.{cg:g} -> scene")
+            else:
+                scene = base
+            rules = [Rule.NONE] if cg == 1 else list(sweep.rules)
+            for rule in rules:
+                for rep in range(sweep.replicas_for(cg)):
+                    key = (tuple(map(str, combo)), cg, rule, rep)
+                    if key in seen:
+                        continue
+                    seen.add(key)
+                    case_id = f"cg{_fmt_cg(cg)}-{rule.value}-r{rep}{tag}"
+                    cases.append(Case(len(cases), case_id, scene, float(cg), rule, rep,
+                                      tuple((p, v) for (p, _), v in zip(varied, combo))))
+    return Workflow(name=name, description=str(raw.get("description", "")), raw=raw,
+                    cases=tuple(cases))
+
+
+def load_workflow(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Workflow:
+    """Read a workflow YAML, apply ``--set`` overrides, validate and expand it."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(f"workflow file {path} does not exist")
+    try:
+        raw = yaml.safe_load(path.read_text()) or {}
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{path}: not valid YAML: {exc}") from None
+    if not isinstance(raw, dict):
+        raise ConfigError(f"{path}: a workflow must be a YAML mapping")
+    for text in overrides:
+        apply_override(raw, *parse_override(text))
+    return expand(raw)

@@ -1,0 +1,306 @@
+"""Run a rendered study on Slurm: submit its case array and the analysis job, report
+status, resubmit what did not finish.
+
+The study folder is the single source of truth. Besides the case folders and
+``study.json`` (:mod:`ligwf.study.prepare`) it gets ``slurm/``: the batch scripts exactly as
+submitted, ``slurm/logs/`` (``%A_%a`` logs) and ``slurm/jobs.json``, the list of
+submissions (kind, job id, case indices, script, command, time), rewritten atomically
+after every successful ``sbatch``. A case's outcome is its runner manifest
+(``<case>/manifest.json``); Slurm's view (squeue, then ``scontrol show job`` while the
+controller remembers the job) only says whether a task is still queued or running.
+
+Scripts and commands are built by :mod:`ligwf.slurm.script`, scheduler text is parsed by
+:mod:`ligwf.slurm.parse`; this module does the I/O between them.
+"""
+
+from __future__ import annotations
+
+import getpass
+import json
+import re
+import shutil
+import subprocess
+from dataclasses import asdict, dataclass, field
+from datetime import datetime, timezone
+from pathlib import Path, PurePosixPath
+from typing import Callable, Iterable, Sequence
+
+from ligwf import __version__
+from ligwf.study.prepare import STUDY_FILE
+from ligwf.errors import ConfigError, SubmitError
+from ligwf.fsio import atomic_write_json, atomic_write_text
+from ligwf.engine.manifest import MANIFEST_FILE
+from ligwf.slurm.parse import (FINISHED_STATES, QueueEntry, TaskRecord, is_unknown_job,
+                          parse_sbatch_parsable, parse_squeue, task_records)
+from ligwf.slurm.script import (LOG_DIR, SLURM_DIR, ScriptContext, analysis_script, array_script,
+                           sbatch_command, scontrol_command, squeue_command)
+from ligwf.slurm.site import SlurmSite
+
+RECORD_FILE = "slurm/jobs.json"
+#: Manifest states worth running again: the runner resumes killed cases from their restart.
+#: ``unstable`` is left out by default: the same input and seed would fail the same way.
+RETRY_STATES = frozenset({"failed", "killed", "running"})
+
+Runner = Callable[[Sequence[str]], subprocess.CompletedProcess]
+
+
+def require_scheduler() -> None:
+    """SubmitError unless sbatch is on the PATH (checked before anything is written)."""
+    if shutil.which("sbatch") is None:
+        raise SubmitError("sbatch not found: is this a Slurm login node? "
+                          "(use --dry-run to see the scripts without submitting)")
+
+
+def run_command(argv: Sequence[str]) -> subprocess.CompletedProcess:
+    """Run a scheduler command, capturing text; a missing command is a SubmitError."""
+    if shutil.which(argv[0]) is None:
+        raise SubmitError(f"{argv[0]} not found: is this a Slurm login node? "
+                          "(use --dry-run to see the scripts without submitting)")
+    try:
+        return subprocess.run(list(argv), capture_output=True, text=True, timeout=120,
+                              stdin=subprocess.DEVNULL)
+    except subprocess.TimeoutExpired:
+        raise SubmitError(f"{' '.join(argv)} did not answer within 120 s") from None
+
+
+# ---------------------------------------------------------------------------------------
+# the study folder
+# ---------------------------------------------------------------------------------------
+
+def read_study(study_dir: Path) -> dict:
+    """``study.json`` of a rendered study (ConfigError when it is not one)."""
+    path = Path(study_dir) / STUDY_FILE
+    if not path.is_file():
+        raise ConfigError(f"{study_dir} is not a ligwf study folder (no {STUDY_FILE}); "
+                          "submit a workflow with 'ligwf slurm submit' first")
+    return json.loads(path.read_text())
+
+
+def read_record(study_dir: Path) -> list[dict]:
+    """The submissions recorded in ``slurm/jobs.json`` (oldest first; [] when none)."""
+    path = Path(study_dir) / RECORD_FILE
+    if not path.is_file():
+        return []
+    return list(json.loads(path.read_text()).get("submissions", []))
+
+
+def append_record(study_dir: Path, entry: dict) -> None:
+    """Add one submission to ``slurm/jobs.json`` (atomic rewrite)."""
+    subs = read_record(study_dir) + [entry]
+    atomic_write_json(Path(study_dir) / RECORD_FILE, {"ligwf_version": __version__,
+                                                      "submissions": subs})
+
+
+def read_manifest(case_dir: Path) -> dict | None:
+    """The runner's manifest of a case, None when there is none (or it is unreadable)."""
+    path = Path(case_dir) / MANIFEST_FILE
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+def job_name(study_name: str, kind: str) -> str:
+    """``ligwf-<study>`` / ``ligwf-<study>-analysis``, restricted to safe characters."""
+    base = re.sub(r"[^A-Za-z0-9_.-]+", "-", study_name).strip("-") or "study"
+    return f"ligwf-{base}" if kind == "array" else f"ligwf-{base}-{kind}"
+
+
+# ---------------------------------------------------------------------------------------
+# planning and submitting
+# ---------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class PlannedJob:
+    """A script to write and submit; ``after_array`` makes it depend on the array job."""
+
+    kind: str  # "array" or "analysis"
+    script_path: Path
+    script_text: str
+    indices: tuple[int, ...] = ()
+    after_array: bool = False
+
+
+def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterable[int],
+              analysis_steps: Sequence[str], round_no: int) -> list[PlannedJob]:
+    """The array job over ``indices`` and (if steps are given) its analysis job (pure)."""
+    study = PurePosixPath(Path(study_dir).resolve())
+    idx = tuple(sorted(set(indices)))
+    array_ctx = ScriptContext(study, job_name(study_name, "array"), __version__)
+    jobs = [PlannedJob("array", Path(study) / SLURM_DIR / f"array-{round_no}.sh",
+                       array_script(array_ctx, site, idx), idx)]
+    if analysis_steps:
+        ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
+        jobs.append(PlannedJob("analysis", Path(study) / SLURM_DIR / f"analysis-{round_no}.sh",
+                               analysis_script(ctx, site, analysis_steps), idx,
+                               after_array=True))
+    return jobs
+
+
+def dry_run_text(jobs: Sequence[PlannedJob]) -> str:
+    """What ``--dry-run`` prints: each script, then the sbatch command that would submit it."""
+    out = []
+    for job in jobs:
+        cmd = sbatch_command(job.script_path, "1" if job.after_array else None)
+        if job.after_array:
+            cmd = [c.replace("afterany:1", "afterany:<array job id>") for c in cmd]
+        out += [f"# ----- {job.script_path} -----", job.script_text.rstrip("\n"),
+                f"# would run: {' '.join(cmd)}", ""]
+    return "\n".join(out)
+
+
+def submit_jobs(study_dir: Path, jobs: Sequence[PlannedJob], site: SlurmSite,
+                run: Runner = run_command) -> list[dict]:
+    """Write each script, ``sbatch --parsable`` it, record the id; returns the new entries.
+
+    The array id is recorded before the analysis job is submitted, so a failing second
+    sbatch never loses the first id.
+    """
+    (Path(study_dir) / LOG_DIR).mkdir(parents=True, exist_ok=True)
+    entries: list[dict] = []
+    array_id: str | None = None
+    for job in jobs:
+        atomic_write_text(job.script_path, job.script_text)
+        job.script_path.chmod(0o755)
+        if job.after_array and array_id is None:
+            raise SubmitError("analysis job planned without an array job")
+        cmd = sbatch_command(job.script_path, array_id if job.after_array else None)
+        out = run(cmd)
+        if out.returncode != 0:
+            raise SubmitError(f"{' '.join(cmd)} exited {out.returncode}: "
+                              f"{(out.stderr or out.stdout).strip()}")
+        job_id = parse_sbatch_parsable(out.stdout)
+        if job.kind == "array":
+            array_id = job_id
+        entry = {"kind": job.kind, "job_id": job_id, "indices": list(job.indices),
+                 "script": str(job.script_path.relative_to(Path(study_dir).resolve())),
+                 "command": cmd, "after": array_id if job.after_array else None,
+                 "site": asdict(site),
+                 "submitted": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+        append_record(study_dir, entry)
+        entries.append(entry)
+    return entries
+
+
+def recorded_site(study_dir: Path) -> dict:
+    """Site settings of the latest array submission (resubmits reuse them), {} if none."""
+    arrays = [s for s in read_record(study_dir) if s.get("kind") == "array" and s.get("site")]
+    return dict(arrays[-1]["site"]) if arrays else {}
+
+
+def next_round(study_dir: Path) -> int:
+    """1 + the number of array submissions recorded so far (names the scripts)."""
+    return 1 + sum(1 for s in read_record(study_dir) if s.get("kind") == "array")
+
+
+# ---------------------------------------------------------------------------------------
+# status
+# ---------------------------------------------------------------------------------------
+
+@dataclass
+class CaseStatus:
+    """One case: the runner's verdict and Slurm's view of its latest array task."""
+
+    index: int
+    case_id: str
+    manifest: str  # the manifest status, or "missing"
+    reason: str = ""
+    job: str | None = None  # "<array id>_<index>" of the latest submission
+    slurm_state: str | None = None  # PENDING/RUNNING/... or None when Slurm forgot it
+
+    @property
+    def queued(self) -> bool:
+        """Still pending or running in Slurm (it will write its manifest itself)."""
+        return self.slurm_state is not None and self.slurm_state.split()[0] not in FINISHED_STATES
+
+
+@dataclass
+class StudyStatus:
+    cases: list[CaseStatus]
+    jobs: list[dict] = field(default_factory=list)  # record entries + "state"
+    scheduler_error: str | None = None  # why Slurm's view is missing (tolerant mode)
+
+
+def slurm_view(job_ids: Iterable[str], run: Runner = run_command,
+               user: str | None = None) -> dict[tuple[str, int | None], str]:
+    """State per (job id, task index) from squeue, completed by ``scontrol show job``."""
+    ids = [str(j) for j in job_ids]
+    states: dict[tuple[str, int | None], str] = {}
+    if not ids:
+        return states
+    out = run(squeue_command(user or getpass.getuser()))
+    if out.returncode != 0:
+        raise SubmitError(f"squeue exited {out.returncode}: {out.stderr.strip()}")
+    for e in parse_squeue(out.stdout):
+        key = (e.array_job_id, e.array_task_id) if e.array_task_id is not None else (e.job_id, None)
+        states[key] = e.state
+    for job_id in ids:
+        sc = run(scontrol_command(job_id))
+        if sc.returncode != 0:
+            if is_unknown_job(sc.stdout + sc.stderr):
+                continue
+            raise SubmitError(f"scontrol show job {job_id} exited {sc.returncode}: "
+                              f"{sc.stderr.strip()}")
+        for rec in task_records(sc.stdout):
+            key = (rec.array_job_id, rec.array_task_id) if rec.array_job_id else (rec.job_id, None)
+            states.setdefault(key, rec.state)
+    return states
+
+
+def study_status(study_dir: Path, run: Runner = run_command, user: str | None = None,
+                 tolerant: bool = False) -> StudyStatus:
+    """Every case with its manifest state and its latest task's Slurm state.
+
+    With ``tolerant`` an unreachable scheduler leaves the Slurm states empty and says why
+    (for ``status``); without it, it is an error (``resubmit`` must not guess what is
+    still queued, or a case could run twice).
+    """
+    study_dir = Path(study_dir)
+    study = read_study(study_dir)
+    record = read_record(study_dir)
+    latest: dict[int, str] = {}
+    for sub in record:
+        if sub.get("kind") == "array":
+            for i in sub.get("indices", []):
+                latest[int(i)] = str(sub["job_id"])
+    scheduler_error = None
+    try:
+        states = slurm_view([s["job_id"] for s in record], run, user)
+    except SubmitError as exc:
+        if not tolerant:
+            raise
+        states, scheduler_error = {}, str(exc)
+    cases = []
+    for c in study["cases"]:
+        man = read_manifest(study_dir / c["case_id"])
+        job_id = latest.get(int(c["index"]))
+        cases.append(CaseStatus(
+            index=int(c["index"]), case_id=c["case_id"],
+            manifest=str(man.get("status", "unknown")) if man else "missing",
+            reason=str(man.get("reason") or "") if man else "",
+            job=f"{job_id}_{c['index']}" if job_id else None,
+            slurm_state=states.get((job_id, int(c["index"]))) if job_id else None))
+    jobs = []
+    for sub in record:
+        entry = dict(sub)
+        if sub.get("kind") != "array":
+            entry["state"] = states.get((str(sub["job_id"]), None))
+        jobs.append(entry)
+    return StudyStatus(cases, jobs, scheduler_error)
+
+
+def cases_to_resubmit(cases: Iterable[CaseStatus], include_unstable: bool = False) -> list[int]:
+    """Indices of cases that are not done and not queued: missing, failed, killed, stale.
+
+    A manifest still saying ``running`` while Slurm no longer runs the task means the task
+    died without the runner finishing its manifest (e.g. SIGKILL at the time limit).
+    """
+    retry = set(RETRY_STATES) | {"missing", "unknown"}
+    if include_unstable:
+        retry.add("unstable")
+    return sorted(c.index for c in cases if not c.queued and c.manifest in retry)
+
+
+def active_tasks(cases: Iterable[CaseStatus]) -> list[CaseStatus]:
+    """Cases whose latest task is still pending or running."""
+    return [c for c in cases if c.queued]

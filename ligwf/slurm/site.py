@@ -1,0 +1,177 @@
+"""Slurm site settings: partition, account, wall time, module loads, launcher, ligwf command.
+
+Read like the engine settings (:mod:`ligwf.engine.site`): command-line values win, then
+environment variables ``LIGWF_SLURM_*``, then the ``slurm:`` mapping of the site YAML
+(``$LIGWF_SITE`` or ``~/.config/ligwf/site.yaml``), then the defaults below::
+
+    slurm:
+      partition: compute
+      account: proj123
+      time: "02:00:00"          # per array task
+      ntasks: 4                 # MPI ranks per case
+      max_concurrent: 8         # the %K of --array=0-M%K
+      modules: [openmpi/4.1, liggghts/3.8.0]
+      setup: ["source /opt/ligwf/venv/bin/activate"]
+      launcher: srun --mpi=pmix # how the engine starts inside the allocation; unset = the
+                                # engine settings (LIGWF_MPIRUN / site 'mpirun', default mpirun)
+      ligwf: /opt/ligwf/venv/bin/ligwf
+      sbatch_args: ["--mem-per-cpu=2G"]
+      analysis_time: "00:30:00"
+
+Every value ends up in a batch script, so each is checked against a narrow pattern here:
+a newline or ``;`` in a partition name must be a clear error, not a shell command.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import sys
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Mapping
+
+from ligwf.engine.site import load_site
+from ligwf.errors import ConfigError
+
+_NAME = re.compile(r"^[A-Za-z0-9_.,+-]+$")
+_MODULE = re.compile(r"^[A-Za-z0-9_./+-]+$")
+# Slurm --time: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S
+_TIME = re.compile(r"^(\d+|\d+:\d{1,2}|\d+:\d{1,2}:\d{1,2}|\d+-\d{1,2}(:\d{1,2}){0,2})$")
+_UNSAFE = re.compile(r"[\n\r\x00]")
+
+ENV_PREFIX = "LIGWF_SLURM_"
+KEYS = ("partition", "account", "time", "ntasks", "max_concurrent", "modules", "setup",
+        "launcher", "ligwf", "sbatch_args", "analysis_time")
+
+
+def default_ligwf_command() -> str:
+    """The ``ligwf`` next to the running interpreter (the venv the user submitted from).
+
+    Batch jobs start with a login-like environment where ``ligwf`` may not be on the PATH
+    or may be another installation, so the script calls it by absolute path.
+    """
+    candidate = Path(sys.executable).parent / "ligwf"
+    return str(candidate) if candidate.is_file() else "ligwf"
+
+
+@dataclass(frozen=True)
+class SlurmSite:
+    """Resolved Slurm settings for one submission (validated, safe to put in a script)."""
+
+    partition: str | None = None
+    account: str | None = None
+    time: str | None = None
+    ntasks: int = 1
+    max_concurrent: int | None = None
+    modules: tuple[str, ...] = ()
+    setup: tuple[str, ...] = ()
+    launcher: str | None = None
+    ligwf: str = "ligwf"
+    sbatch_args: tuple[str, ...] = ()
+    analysis_time: str | None = None
+
+    def __post_init__(self) -> None:
+        for key in ("partition", "account"):
+            value = getattr(self, key)
+            if value is not None and not _NAME.match(value):
+                raise ConfigError(f"slurm {key} = {value!r}: only letters, digits and _.,+- "
+                                  "are allowed")
+        for key in ("time", "analysis_time"):
+            value = getattr(self, key)
+            if value is not None and not _TIME.match(value):
+                raise ConfigError(f"slurm {key} = {value!r}: not a Slurm time (minutes, "
+                                  "MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS)")
+        if self.ntasks < 1:
+            raise ConfigError(f"slurm ntasks = {self.ntasks}: allowed range [1, inf)")
+        if self.max_concurrent is not None and self.max_concurrent < 1:
+            raise ConfigError(f"slurm max_concurrent = {self.max_concurrent}: allowed range "
+                              "[1, inf)")
+        for mod in self.modules:
+            if not _MODULE.match(mod):
+                raise ConfigError(f"slurm module {mod!r}: only letters, digits and _./+- "
+                                  "are allowed")
+        for key in ("setup", "sbatch_args"):
+            for line in getattr(self, key):
+                if _UNSAFE.search(line):
+                    raise ConfigError(f"slurm {key} entry {line!r}: contains a line break")
+        for arg in self.sbatch_args:
+            if not arg.startswith("--"):
+                raise ConfigError(f"slurm sbatch_args entry {arg!r}: must be a long option "
+                                  "such as --mem=4G")
+        if self.launcher is not None and (not self.launcher.strip()
+                                          or _UNSAFE.search(self.launcher)):
+            raise ConfigError(f"slurm launcher = {self.launcher!r}: must be one command line")
+        if not self.ligwf.strip() or _UNSAFE.search(self.ligwf):
+            raise ConfigError(f"slurm ligwf = {self.ligwf!r}: must be one command line")
+
+    def with_overrides(self, **overrides: Any) -> "SlurmSite":
+        """A copy with the non-None overrides (the command-line values) applied."""
+        return replace(self, **{k: v for k, v in overrides.items() if v is not None})
+
+
+def _as_tuple(value: Any, key: str, split_text: bool) -> tuple[str, ...]:
+    if value is None:
+        return ()
+    if isinstance(value, str):
+        if split_text:
+            return tuple(v for v in re.split(r"[,\s]+", value) if v)
+        return (value,)
+    if isinstance(value, (list, tuple)):
+        return tuple(str(v) for v in value)
+    raise ConfigError(f"slurm {key} = {value!r}: expected a list of strings")
+
+
+def _as_int(value: Any, key: str) -> int | None:
+    if value is None or value == "":
+        return None
+    try:
+        return int(value)
+    except (TypeError, ValueError):
+        raise ConfigError(f"slurm {key} = {value!r}: expected an integer") from None
+
+
+def site_from_mapping(values: Mapping[str, Any]) -> SlurmSite:
+    """Build and validate :class:`SlurmSite` from a plain mapping (pure)."""
+    unknown = set(values) - set(KEYS)
+    if unknown:
+        raise ConfigError(f"slurm site settings: unknown key(s) {', '.join(sorted(unknown))} "
+                          f"(allowed: {', '.join(KEYS)})")
+    kwargs: dict[str, Any] = {}
+    for key in ("partition", "account", "time", "launcher", "ligwf", "analysis_time"):
+        if values.get(key) not in (None, ""):
+            kwargs[key] = str(values[key])
+    for key in ("ntasks", "max_concurrent"):
+        number = _as_int(values.get(key), key)
+        if number is not None:
+            kwargs[key] = number
+    if "modules" in values:
+        kwargs["modules"] = _as_tuple(values["modules"], "modules", split_text=True)
+    if "setup" in values:
+        kwargs["setup"] = _as_tuple(values["setup"], "setup", split_text=False)
+    if "sbatch_args" in values:
+        raw = values["sbatch_args"]
+        kwargs["sbatch_args"] = (tuple(shlex.split(raw)) if isinstance(raw, str)
+                                 else _as_tuple(raw, "sbatch_args", split_text=False))
+    kwargs.setdefault("ligwf", default_ligwf_command())
+    return SlurmSite(**kwargs)
+
+
+def merged_settings(site_yaml: Mapping[str, Any], environ: Mapping[str, str]) -> dict[str, Any]:
+    """The ``slurm:`` block of the site file, overridden by ``LIGWF_SLURM_*`` variables."""
+    block = site_yaml.get("slurm") or {}
+    if not isinstance(block, dict):
+        raise ConfigError("site file: 'slurm' must be a mapping")
+    merged: dict[str, Any] = dict(block)
+    for key in KEYS:
+        env = environ.get(ENV_PREFIX + key.upper())
+        if env is not None:
+            merged[key] = env
+    return merged
+
+
+def load_slurm_site(environ: Mapping[str, str] | None = None) -> SlurmSite:
+    """Site settings from the environment and the site YAML (no command-line values yet)."""
+    env = os.environ if environ is None else environ
+    return site_from_mapping(merged_settings(load_site(), env))

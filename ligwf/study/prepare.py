@@ -1,0 +1,118 @@
+"""Case folders: the I/O step after rendering.
+
+A study folder holds ``study.json`` (the workflow and its case list) and one folder per
+case with ``in.liggghts``, ``drum.stl`` (from the mesh cache), ``scene.json`` (the original
+and the scaled parameters plus a content hash) and the empty ``post/`` and ``restart/``
+folders the input writes into. Every file is written atomically.
+
+The content hash covers the scaled parameters, the rendered input and the mesh, so a
+runner can tell whether a finished case still matches what the workflow asks for.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterable
+
+from ligwf import __version__
+from ligwf.fsio import atomic_write_json, atomic_write_text
+from ligwf.engine.mesh import cached_mesh, drum_stl
+from ligwf.engine.render import MESH_NAME, OUTPUT_DIRS, render
+from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.workflow import Case, Workflow
+
+SCENE_FILE = "scene.json"
+STUDY_FILE = "study.json"
+
+
+def default_mesh_cache() -> Path:
+    """Mesh cache folder: $LIGWF_MESH_CACHE, else meshes/ under the current folder."""
+    return Path(os.environ.get("LIGWF_MESH_CACHE", "meshes"))
+
+
+@dataclass(frozen=True)
+class RenderedCase:
+    """A case with its scaled scene, rendered files and content hash (nothing written)."""
+
+    case: Case
+    scaled: ScaledScene
+    files: dict[str, str]
+    mesh_text: str
+    scene_hash: str
+
+    def scene_record(self) -> dict:
+        return {
+            "ligwf_version": __version__,
+            "case_id": self.case.case_id,
+            "index": self.case.index,
+            "cg": self.case.cg,
+            "rule": self.scaled.rule,
+            "replica": self.case.replica,
+            "varied": {k: v for k, v in self.case.varied},
+            "scene": self.case.scene.model_dump(mode="json"),
+            "scaled": self.scaled.to_dict(),
+            "scene_hash": self.scene_hash,
+        }
+
+
+def content_hash(scaled: ScaledScene, files: dict[str, str], mesh_text: str) -> str:
+    """sha256 over the scaled parameters, the rendered files and the mesh."""
+    h = hashlib.sha256()
+    h.update(json.dumps(scaled.to_dict(), sort_keys=True).encode())
+    for name in sorted(files):
+        h.update(name.encode() + b"\0" + files[name].encode() + b"\0")
+    h.update(hashlib.sha256(mesh_text.encode()).digest())
+    return h.hexdigest()
+
+
+def render_case(case: Case, template_dirs: Iterable[str | Path] = ()) -> RenderedCase:
+    """Scale and render one case in memory."""
+    scaled = case.scaled()
+    files = render(scaled, template_dirs)
+    mesh_text = drum_stl(case.scene.drum)
+    return RenderedCase(case, scaled, files, mesh_text, content_hash(scaled, files, mesh_text))
+
+
+def render_workflow(wf: Workflow, template_dirs: Iterable[str | Path] = ()) -> list[RenderedCase]:
+    """Render every case in memory: all errors surface before any file is written."""
+    dirs = tuple(template_dirs)
+    return [render_case(c, dirs) for c in wf.cases]
+
+
+def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) -> Path:
+    """Write one rendered case folder under ``out_dir``; returns the folder."""
+    case_dir = Path(out_dir) / rc.case.case_id
+    case_dir.mkdir(parents=True, exist_ok=True)
+    for sub in OUTPUT_DIRS:
+        (case_dir / sub).mkdir(exist_ok=True)
+    mesh_src = cached_mesh(rc.case.scene.drum, mesh_cache or default_mesh_cache())
+    tmp = case_dir / f".{MESH_NAME}.tmp"
+    shutil.copyfile(mesh_src, tmp)
+    os.replace(tmp, case_dir / MESH_NAME)
+    for name, text in rc.files.items():
+        atomic_write_text(case_dir / name, text)
+    atomic_write_json(case_dir / SCENE_FILE, rc.scene_record())
+    return case_dir
+
+
+def write_study(wf: Workflow, rendered: list[RenderedCase], out_dir: Path,
+                mesh_cache: Path | None = None) -> list[Path]:
+    """Write every case folder and ``study.json``; returns the case folders in order."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    dirs = [write_case(rc, out_dir, mesh_cache) for rc in rendered]
+    atomic_write_json(out_dir / STUDY_FILE, {
+        "ligwf_version": __version__,
+        "name": wf.name,
+        "description": wf.description,
+        "workflow": wf.raw,
+        "cases": [{"index": rc.case.index, "case_id": rc.case.case_id, "cg": rc.case.cg,
+                   "rule": rc.scaled.rule, "replica": rc.case.replica,
+                   "scene_hash": rc.scene_hash} for rc in rendered],
+    })
+    return dirs

@@ -1,0 +1,104 @@
+"""ligwf.analysis.gsd: bins, distributions, percentiles, bootstrap bands, CG comparison."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from ligwf.analysis import gsd
+from ligwf.analysis.runner import CaseInfo, gsd_tables
+from ligwf.analysis.granules import Liquid
+
+V1 = math.pi / 6 * 0.001**3      # one 1 mm primary particle, m^3
+
+
+def test_log_edges_cover_and_align():
+    e = gsd.log_edges(V1, 3e-6, 5)
+    assert e[0] <= V1 < e[1] and e[-1] > 3e-6
+    np.testing.assert_allclose(np.diff(np.log10(e)), 0.2)
+    # decade aligned: a bin centre at 1e-9
+    assert np.any(np.isclose(np.sqrt(e[:-1] * e[1:]), 1e-9))
+
+
+def test_histogram_and_percentiles():
+    v = np.array([V1] * 11 + [89 * V1])
+    edges = gsd.log_edges(v.min(), v.max(), 5)
+    num, vol = gsd.histogram(v, edges)
+    assert num.sum() == pytest.approx(1) and vol.sum() == pytest.approx(1)
+    assert num[0] == pytest.approx(11 / 12) and vol[0] == pytest.approx(0.11)
+    d10, d50, d90 = gsd.percentile_diameters(v)
+    assert d10 == pytest.approx(0.001)                     # 11% of the volume is singletons
+    assert d50 == d90 == pytest.approx(0.001 * 89 ** (1 / 3))
+
+
+def test_bootstrap_band_deterministic_and_covers_mean():
+    rng = np.random.default_rng(0)
+    rows = rng.uniform(size=(12, 4))
+    reps = np.repeat([0, 1, 2], 4)
+    a = gsd.bootstrap_means(rows, reps, 300, np.random.default_rng(7))
+    b = gsd.bootstrap_means(rows, reps, 300, np.random.default_rng(7))
+    np.testing.assert_array_equal(a, b)
+    lo, hi = gsd.band(a, 0.95)
+    assert np.all(lo <= rows.mean(0)) and np.all(rows.mean(0) <= hi) and np.all(lo < hi)
+    # a single frame has no spread
+    lo1, hi1 = gsd.band(gsd.bootstrap_means(rows[:1], reps[:1], 50, rng), 0.95)
+    np.testing.assert_array_equal(lo1, hi1)
+
+
+def test_side_errors_and_limit():
+    ref = np.array([0.5, 0.3, 0.2, 0.0])
+    cg = np.array([0.2, 0.4, 0.2, 0.2])
+    below = gsd.below_limit(np.array([1.0, 10, 100, 1000, 10000]), 50.0)
+    assert below.tolist() == [True, True, False, False]
+    eb, ea = gsd.side_errors(cg, ref, below)
+    assert eb == pytest.approx(0.4 / 0.8) and ea == pytest.approx(0.2 / 0.2)
+    rel = gsd.relative_error(cg, ref)
+    assert rel[0] == pytest.approx(-0.6) and math.isnan(rel[3])
+    assert gsd.size_limit(V1, 10) == pytest.approx(10 * V1)
+
+
+def _case(case_id, cg, rule, replica):
+    return CaseInfo(case_id, None, cg, rule, replica, "{}", 1e-5,
+                    Liquid("washino", 0.024, 0.5, 0.02), 1, 0.0, 0.009)
+
+
+def _table(case, frames, sizes_in_primaries):
+    rows = []
+    for f in range(frames):
+        for k, s in enumerate(sizes_in_primaries):
+            vol = s * V1
+            rows.append({"case_id": case.case_id, "cg": case.cg, "rule": case.rule,
+                         "replica": case.replica, "frame": f, "step": 100 * f, "time": 0.0,
+                         "granule": k, "members": max(1, round(s / case.cg**3)),
+                         "volume": vol * case.cg**3, "primary_volume": vol})
+    return pd.DataFrame(rows)
+
+
+def test_cg_comparison_identical_gsd_has_zero_error():
+    """CG2 granules with the same primary-equivalent volumes as CG1: error 0 everywhere;
+    the size limit is min_particles CG2 particles = 10 * 8 primaries."""
+    sizes = [8, 8, 8, 16, 64, 200, 800]
+    sizes2 = [16, 64, 200, 800]              # replica b lacks the small granules
+    c1, c2a, c2b = _case("cg1", 1.0, "none", 0), _case("a", 2.0, "weber", 0), _case("b", 2.0, "weber", 1)
+    table = pd.concat([_table(c1, 3, sizes), _table(c2a, 3, sizes), _table(c2b, 2, sizes2)])
+    settings = gsd.GsdSettings(n_boot=200)
+    # replica b differs: without it the comparison is exact
+    dist, summary = gsd_tables(table[table.case_id != "b"], [c1, c2a, c2b], settings)
+    row = summary.set_index("condition").loc["cg2-weber"]
+    assert row["error_below"] == 0 and row["error_above"] == 0
+    assert row["size_limit"] == pytest.approx(10 * 8 * V1)
+    assert row["reference"] == "cg1"
+    d = dist[dist.condition == "cg2-weber"]
+    assert np.nanmax(np.abs(d["rel_error"])) == 0
+    # with replica b the small sizes are missing: error below the limit grows, band opens
+    dist, summary = gsd_tables(table, [c1, c2a, c2b], settings)
+    row = summary.set_index("condition").loc["cg2-weber"]
+    assert row["error_below"] > 0.05 and row["replicas"] == 2 and row["frames"] == 5
+    assert row["error_below_lo"] <= row["error_below"] <= row["error_below_hi"]
+    assert row["error_below_hi"] > row["error_below_lo"]
+    for cond, d in dist.groupby("condition"):
+        assert d["volume_fraction"].sum() == pytest.approx(1)
+        assert d["number_fraction"].sum() == pytest.approx(1)

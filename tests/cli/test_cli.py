@@ -1,0 +1,66 @@
+"""CLI: render writes case folders, check writes nothing, bad input writes nothing."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from ligwf.cli.main import main
+
+from helpers import DRUM
+
+
+def test_render_writes_one_folder_per_case(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("LIGWF_MESH_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "study"
+    assert main(["render", str(DRUM), "--out", str(out), "--set", "sweep.cg_levels=[1,2]"]) == 0
+    table = capsys.readouterr().out
+    for col in ("CG", "rule", "particles", "dt", "steps"):
+        assert col in table
+    study = json.loads((out / "study.json").read_text())
+    ids = [c["case_id"] for c in study["cases"]]
+    assert ids == ["cg1-none-r0", "cg2-weber-r0", "cg2-bond-r0"]
+    for cid in ids:
+        case = out / cid
+        assert (case / "in.liggghts").is_file() and (case / "drum.stl").is_file()
+        assert (case / "post").is_dir() and (case / "restart").is_dir()
+        rec = json.loads((case / "scene.json").read_text())
+        assert rec["case_id"] == cid and len(rec["scene_hash"]) == 64
+        assert rec["scaled"]["particle_count"] > 0
+    assert len(list((tmp_path / "cache").glob("drum_*.stl"))) == 1
+    # rendering is deterministic: same hash again
+    out2 = tmp_path / "again"
+    main(["render", str(DRUM), "--out", str(out2), "--set", "sweep.cg_levels=[1,2]"])
+    h1 = json.loads((out / "study.json").read_text())["cases"]
+    h2 = json.loads((out2 / "study.json").read_text())["cases"]
+    assert [c["scene_hash"] for c in h1] == [c["scene_hash"] for c in h2]
+
+
+def test_check_writes_nothing(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["check", str(DRUM)]) == 0
+    assert "5 case(s), valid" in capsys.readouterr().out
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("override,field", [
+    ("scene.process.fill_fraction=0.9", "scene.process.fill_fraction"),
+    ("scene.drum.lifters.height=0.03", "lifters.height"),
+    ("sweep.rules=[weber,bnd]", "bnd"),
+    ("scene.name=a$b", "scene.name"),
+])
+def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, override, field):
+    out = tmp_path / "study"
+    assert main(["render", str(DRUM), "--out", str(out), "--set", override]) == 2
+    err = capsys.readouterr().err
+    assert "ConfigError" in err and field in err
+    assert not out.exists()
+
+
+def test_console_entry_point():
+    out = subprocess.run([sys.executable, "-m", "ligwf.cli.main", "--help"], capture_output=True, text=True)
+    assert out.returncode == 0
+    assert "render" in out.stdout and "check" in out.stdout

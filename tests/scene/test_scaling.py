@@ -1,0 +1,141 @@
+"""CG scaling rules, proved on the LIGGGHTS force laws evaluated on the scaled parameters."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from ligwf.liquids import bridges
+from ligwf.scene.scaling import (Rule, bond_number, rayleigh_time, replica_seeds, is_prime, scale,
+                           weber_number)
+from ligwf.scene.workflow import load_workflow
+
+from helpers import DRUM, WET_POLY
+
+GAP_RATIOS = [0.0, 0.01, 0.05, 0.1]  # surface gap / effective radius
+
+
+def base_scene(model: str = "washino"):
+    return load_workflow(DRUM, [f"scene.liquid.model={model}"]).cases[0].scene
+
+
+def bridge_force(s, gap_ratio: float) -> float:
+    """Capillary force between two smallest particles at a dimensionless gap."""
+    r = 0.5 * s.d_min
+    gap = gap_ratio * 0.5 * r
+    theta = math.radians(s.contact_angle_deg)
+    return bridges.capillary_force(s.liquid_model, r, r, gap, s.surface_tension, theta,
+                                   s.liquid_content)
+
+
+def viscous_force(s, gap_ratio: float, speed: float = 0.1) -> float:
+    r = 0.5 * s.d_min
+    return bridges.viscous_normal_force(r, r, gap_ratio * 0.5 * r, s.viscosity, speed,
+                                        s.min_separation_ratio)
+
+
+@pytest.mark.parametrize("model", ["washino", "easo"])
+@pytest.mark.parametrize("n", [2, 3, 4])
+@pytest.mark.parametrize("rule,power", [(Rule.WEBER, 2), (Rule.BOND, 3), (Rule.NONE, 1)])
+def test_bridge_force_scales_as_rule(model, n, rule, power):
+    scene = base_scene(model)
+    s1, sn = scale(scene, 1, "none"), scale(scene, n, rule)
+    for g in GAP_RATIOS:
+        f1, fn = bridge_force(s1, g), bridge_force(sn, g)
+        assert f1 > 0
+        assert fn / f1 == pytest.approx(n**power, rel=1e-9), (model, g)
+        v1, vn = viscous_force(s1, g), viscous_force(sn, g)
+        assert vn / v1 == pytest.approx(n**power, rel=1e-9)
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_weber_conserved_under_weber_rule(n):
+    scene = base_scene()
+    s1, sn = scale(scene, 1, "none"), scale(scene, n, "weber")
+    v = scene.drum.radius * s1.omega  # same drum, same speed
+    we1 = weber_number(s1.density, 0.5 * s1.d_min, v, s1.surface_tension, s1.contact_angle_deg)
+    wen = weber_number(sn.density, 0.5 * sn.d_min, v, sn.surface_tension, sn.contact_angle_deg)
+    assert wen == pytest.approx(we1, rel=1e-12)
+    bo1 = bond_number(s1.density, 0.5 * s1.d_min, s1.surface_tension, s1.contact_angle_deg)
+    bon = bond_number(sn.density, 0.5 * sn.d_min, sn.surface_tension, sn.contact_angle_deg)
+    assert bon == pytest.approx(bo1 / n, rel=1e-12)  # and Bo is NOT kept
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_bond_conserved_under_bond_rule(n):
+    scene = base_scene()
+    s1, sn = scale(scene, 1, "none"), scale(scene, n, "bond")
+    bo1 = bond_number(s1.density, 0.5 * s1.d_min, s1.surface_tension, s1.contact_angle_deg)
+    bon = bond_number(sn.density, 0.5 * sn.d_min, sn.surface_tension, sn.contact_angle_deg)
+    assert bon == pytest.approx(bo1, rel=1e-12)
+
+
+def test_unchanged_quantities():
+    scene = base_scene()
+    s1, s3 = scale(scene, 1, "none"), scale(scene, 3, "bond")
+    for name in ("contact_angle_deg", "liquid_content", "min_separation_ratio",
+                 "max_separation_ratio", "restitution", "friction", "density",
+                 "youngs_modulus", "poisson_ratio", "omega", "drum_diameter"):
+        assert getattr(s3, name) == getattr(s1, name), name
+    assert s3.surface_tension == pytest.approx(9 * s1.surface_tension)
+    assert s3.viscosity == pytest.approx(9 * s1.viscosity)
+
+
+def test_ssw_size_distribution_keeps_shape():
+    scene = load_workflow(WET_POLY).cases[0].scene
+    s1, s3 = scale(scene, 1, "none"), scale(scene, 3, "weber")
+    assert [d * 3 for d in s1.diameters] == pytest.approx(list(s3.diameters))
+    assert s3.number_fractions == s1.number_fractions
+    assert sum(s1.number_fractions) == pytest.approx(1.0)
+    # 80 % at 1 mm, 20 % spread over 1..4 mm in three bins, largest first
+    assert s1.diameters == pytest.approx((0.0035, 0.0025, 0.0015, 0.001))
+    assert s1.number_fractions == pytest.approx((0.2 / 3, 0.2 / 3, 0.2 / 3, 0.8))
+
+
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_count_and_time_step_scale(n):
+    scene = base_scene()
+    s1, sn = scale(scene, 1, "none"), scale(scene, n, "weber")
+    assert sn.particle_count == round(s1.particle_count / n**3)
+    assert sn.dt == pytest.approx(n * s1.dt)
+    assert sn.run_steps == pytest.approx(s1.run_steps / n, abs=1)
+
+
+def test_particle_count_from_fill_fraction():
+    scene = base_scene()
+    s = scale(scene, 1, "none")
+    r, lif = scene.drum.radius, scene.drum.lifters
+    free = (math.pi * r**2 - lif.count * math.radians(lif.width_deg) * 0.5
+            * (r**2 - (r - lif.height) ** 2)) * scene.drum.length
+    expected = scene.process.fill_fraction * scene.numerics.packing_fraction * free / (
+        math.pi * 1e-9 / 6)
+    assert s.particle_count == round(expected)
+
+
+def test_rayleigh_time_hand_value():
+    # 1 mm glass-like bead: R = 0.5 mm, rho 2500, E 5e6, nu 0.3 -> G = 1.923e6 Pa
+    t = rayleigh_time(5e-4, 2500.0, 5e6, 0.3)
+    assert t == pytest.approx(math.pi * 5e-4 * math.sqrt(2500 / 1.923076923e6) / 0.92553, rel=1e-6)
+
+
+def test_cg1_is_rule_independent():
+    scene = base_scene()
+    assert scale(scene, 1, "bond") == scale(scene, 1, "weber") == scale(scene, 1, "none")
+
+
+def test_seeds_are_distinct_primes_above_10000():
+    seeds = replica_seeds(10007, 0, 6) + replica_seeds(10007, 1, 6)
+    assert len(set(seeds)) == 12
+    assert all(s > 10000 and is_prime(s) for s in seeds)
+
+
+def test_contact_angle_compensation():
+    # the engine applies 0.5*a*a (rad) for input a: compensation must invert that
+    for theta in (0.0, 10.0, 30.0, 90.0, 180.0):
+        a = bridges.engine_contact_angle_deg(theta)
+        assert 0.0 <= a <= 180.0
+        assert math.degrees(bridges.engine_effective_angle_rad(a)) == pytest.approx(theta, abs=1e-9)
+    assert bridges.engine_contact_angle_deg(30.0, compensate=False) == 30.0
+    # uncompensated, 30 deg becomes about 7.9 deg in the engine
+    assert math.degrees(bridges.engine_effective_angle_rad(30.0)) == pytest.approx(7.85, abs=0.01)
