@@ -25,9 +25,12 @@ plus whole frames per second (read particles + contacts, identify, GSD; target >
 criterion, networkx components, networkx unwrap; and the numpy evaluation of the bond
 criterion, ``bonded_contacts_reference``) and the fast path's fused pass and table.
 
-The compiled kernels (numba, ``cache=True``) are compiled or loaded from the cache once by
-``warm_up()`` before anything is timed, so no row includes JIT compilation; the first
-``ligwf analyse`` of a fresh installation pays it once (a few seconds).
+The compiled kernels (numba) are compiled or loaded from the cache once by ``warm_up()``
+before anything is timed, so no row includes JIT compilation. The two bond kernels take
+the liquid model's law as arguments and are compiled once per process and model (a few
+seconds, paid by every ``ligwf analyse``); the others are cached per installation.
+``--model`` picks the synthetic frames' law (washino: the force law is provably positive
+and skipped; easo: it is evaluated for every bond).
 """
 
 from __future__ import annotations
@@ -48,9 +51,11 @@ from ligwf.analysis.dumps import (ContactFrame, ParticleFrame, discover_frames, 
                          read_particles)
 from ligwf.analysis.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
                             granule_table, identify, label_reference, unwrap_reference)
+from ligwf.scene.scaling import ScaledScene
 
 R = 0.0005
-LIQUID = Liquid("washino", 0.024, math.radians(30.0), 0.02)
+#: the synthetic frames' liquid (``--model`` picks the law)
+LIQUID = dict(surface_tension=0.024, contact_angle_rad=math.radians(30.0), liquid_content=0.02)
 
 
 def synthetic_frame(n: int, seed: int = 1) -> tuple[ParticleFrame, ContactFrame, float]:
@@ -179,9 +184,10 @@ def main() -> None:
     ap.add_argument("--sizes", type=int, nargs="*", default=[13000, 45000, 360000])
     ap.add_argument("--real", type=Path, default=None, help="a case folder with dumps")
     ap.add_argument("--skip-reference-above", type=int, default=10**9)
+    ap.add_argument("--model", default="washino", help="liquid model of the synthetic frames")
     args = ap.parse_args()
     t0 = time.perf_counter()
-    granules_numba.warm_up()
+    granules_numba.warm_up((args.model,))
     dumps_numba.warm_up()
     print(f"compiled kernels warmed up (JIT or cache load) in {time.perf_counter() - t0:.1f} s, "
           "outside every timed row")
@@ -190,13 +196,13 @@ def main() -> None:
         p, c, length = synthetic_frame(n)
         with tempfile.TemporaryDirectory() as tmp:
             write_frame(p, c, Path(tmp))
-            report(f"synthetic {n // 1000}k", p, c, length, LIQUID, Path(tmp), 1000,
+            report(f"synthetic {n // 1000}k", p, c, length, Liquid(args.model, **LIQUID), Path(tmp), 1000,
                    n > args.skip_reference_above)
     if args.real is not None:
-        scaled = json.loads((args.real / "scene.json").read_text())["scaled"]
+        scaled = ScaledScene.from_dict(json.loads((args.real / "scene.json").read_text())["scaled"])
         f = discover_frames(args.real)[-1]
         p, c = read_particles(f.particles), read_contacts(f.contacts)
-        report(f"real {args.real.name}", p, c, scaled["drum_length"], Liquid.from_scaled(scaled),
+        report(f"real {args.real.name}", p, c, scaled.drum_length, Liquid.from_scaled(scaled),
                f.particles.parent, f.step, False)
 
 

@@ -6,8 +6,8 @@ by the source study):
 1. its liquid-bridge (capillary, cohesive) force exceeds ``min_bridge_force`` (N), and
 2. the angle between the two partners' velocity vectors is below ``max_velocity_angle_deg``.
 
-The bridge force is evaluated from the geometry with the engine's own law
-(:func:`ligwf.liquids.bridges.capillary_force`, verified against LIGGGHTS to 1e-9) from the
+The bridge force is evaluated from the geometry with the engine's own law (the case's
+model in :mod:`ligwf.liquids`, verified against LIGGGHTS to 1e-9) from the
 dumped overlap ``delta`` (gap = -delta), the radii and the liquid content of both
 partners: the dumped total force cannot be used directly because for touching pairs it
 includes the Hertz repulsion. Separated pairs (delta < 0) within the rupture distance
@@ -40,7 +40,10 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ligwf.liquids import bridges
+# Liquid and louvain_labels live in their own modules; callers import them from here too
+from ligwf.analysis.bridge_law import (Liquid, bridge_forces, content_of,  # noqa: F401
+                                       force_law_positive, pair_forces)
+from ligwf.analysis.communities import louvain_labels  # noqa: F401
 from ligwf.analysis.dumps import ContactFrame, ParticleFrame
 
 AXES = "xyz"
@@ -73,48 +76,6 @@ class BondCriterion:
                              "allowed range [0, 180]")
 
 
-@dataclass(frozen=True)
-class Liquid:
-    """The liquid-bridge law the engine applied in a run (from ``scene.json``'s scaled part)."""
-
-    model: str                  # washino | easo | none
-    surface_tension: float      # N/m, already CG-scaled
-    contact_angle_rad: float    # the angle the engine APPLIED (see ligwf.liquids.bridges)
-    liquid_content: float       # fraction of particle volume, used if a dump lacks it
-
-    @classmethod
-    def from_scaled(cls, scaled: dict, engine_product_bug: bool = True) -> "Liquid":
-        """From ``ScaledScene.to_dict()``. ligwf writes a compensated input angle so the
-        3.8.0 engine applies the scene angle; without compensation it applied 0.5 a^2."""
-        theta_deg = float(scaled.get("contact_angle_deg", 0.0))
-        if scaled.get("contact_angle_compensation", True) or not engine_product_bug:
-            theta = math.radians(theta_deg)
-        else:
-            theta = bridges.engine_effective_angle_rad(theta_deg, product_bug=True)
-        return cls(str(scaled.get("liquid_model", "none")), float(scaled.get("surface_tension", 0.0)),
-                   theta, float(scaled.get("liquid_content", 0.0)))
-
-
-def bridge_forces(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
-                  i: np.ndarray | None = None, j: np.ndarray | None = None) -> np.ndarray:
-    """Capillary force magnitude of every contact, N (0 for a dry run or a broken bridge)."""
-    i = particles.index_of(contacts.id1) if i is None else i
-    j = particles.index_of(contacts.id2) if j is None else j
-    return _capillary(particles, i, j, -contacts.delta, liquid)
-
-
-def _capillary(particles: ParticleFrame, i: np.ndarray, j: np.ndarray, gap: np.ndarray,
-               liquid: Liquid) -> np.ndarray:
-    if liquid.model == "none" or len(i) == 0:
-        return np.zeros(len(i))
-    content = particles.liquid_content
-    if content is None:
-        content = np.full(len(particles), liquid.liquid_content)
-    return np.asarray(bridges.capillary_force(
-        liquid.model, particles.radii[i], particles.radii[j], gap,
-        liquid.surface_tension, liquid.contact_angle_rad, content[i], content[j]), dtype=float)
-
-
 def comoving(v_i: np.ndarray, v_j: np.ndarray, max_angle_deg: float) -> np.ndarray:
     """True where the angle between v_i and v_j (rows, m/s) is <= max_angle_deg.
 
@@ -132,24 +93,18 @@ def _kernel_args(particles: ParticleFrame, contacts: ContactFrame, liquid: Liqui
     <ligwf.analysis.granules_numba.bond_components>`), and the liquid content per particle (the
     scene's when the dump lacks it). Contacts go in as rows, or as ids with their offset
     when the ids are contiguous (the kernel then maps them itself)."""
-    from ligwf.analysis.granules_numba import MODEL_CODES
+    from ligwf.analysis.granules_numba import law
 
-    if liquid.model not in MODEL_CODES:
-        raise ValueError(f"no capillary force law for liquid model {liquid.model!r}")
     ids = particles.ids
     if len(ids) and ids[-1] - ids[0] == len(ids) - 1:
         # contiguous ids (no particle deleted): the row is id - first id, found in the kernel
         a, b, offset = contacts.id1, contacts.id2, int(ids[0])
     else:
         a, b, offset = particles.index_of(contacts.id1), particles.index_of(contacts.id2), 0
-    content = particles.liquid_content
-    if content is None:
-        content = np.full(len(particles), liquid.liquid_content)
-    content = np.asarray(content, dtype=np.float64)
+    content = content_of(particles, liquid)
     args = (a, b, offset, particles.velocities, particles.radii, content,
-            np.asarray(contacts.delta, dtype=np.float64), MODEL_CODES[liquid.model],
+            np.asarray(contacts.delta, dtype=np.float64), *law(liquid.law),
             float(liquid.surface_tension), float(liquid.contact_angle_rad),
-            bridges.WASHINO_BRIDGE_VOLUME_FRACTION,
             math.cos(math.radians(criterion.max_velocity_angle_deg)),
             float(criterion.min_bridge_force))
     return args, content
@@ -184,34 +139,16 @@ def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Li
 
 def bonded_contacts_reference(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
                               criterion: BondCriterion = BondCriterion()):
-    """:func:`bonded_contacts` evaluated with numpy and :mod:`ligwf.liquids.bridges` (the reference)."""
+    """:func:`bonded_contacts` evaluated with numpy and the model's numpy law (the reference)."""
     i = particles.index_of(contacts.id1)
     j = particles.index_of(contacts.id2)
     # the cheap velocity test first; the force law only for the pairs that pass it
     sel = np.flatnonzero(comoving(particles.velocities[i], particles.velocities[j],
                                   criterion.max_velocity_angle_deg))
     i, j = i[sel], j[sel]
-    force = _capillary(particles, i, j, -contacts.delta[sel], liquid)
+    force = pair_forces(particles, i, j, -contacts.delta[sel], liquid)
     keep = force > criterion.min_bridge_force
     return i[keep], j[keep], force[keep]
-
-
-def _is_canonical(labels: np.ndarray) -> bool:
-    """True when label k first appears after labels 0..k-1 (then the running maximum
-    never jumps by more than one), checked in one pass instead of a sort."""
-    if len(labels) == 0:
-        return True
-    return labels[0] == 0 and bool(np.all(np.diff(np.maximum.accumulate(labels)) <= 1))
-
-
-def _canonical(labels: np.ndarray) -> np.ndarray:
-    """Relabel so granule k is the k-th distinct label met in particle (id) order."""
-    if _is_canonical(labels):      # often numbered in this order already
-        return labels.astype(np.int64, copy=False)
-    _, first, inverse = np.unique(labels, return_index=True, return_inverse=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first, kind="stable")] = np.arange(len(first))
-    return rank[inverse.reshape(-1)]
 
 
 def label_reference(n: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -304,32 +241,6 @@ class Identification:
         return out
 
 
-def force_law_positive(particles: ParticleFrame, liquid: Liquid, content: np.ndarray) -> bool:
-    """True when the capillary law is > 0 N for EVERY pair of this frame within rupture
-    distance, so that with ``min_bridge_force`` = 0 the bond test need not evaluate it.
-
-    Washino's law is 2 pi R gamma [cos(theta) / (1 + S / 2d) + sin(alpha) sin(alpha + theta)]
-    (both terms > 0 when gamma > 0, 0 <= theta < 90 deg and alpha <= 90 deg), and
-    alpha^2 = S p / R <= sqrt(2 V / (pi R)) / R, bounded with a bridge volume above any of
-    the frame's (largest radius and content) and its smallest effective radius. Easo's fit
-    has no such sign guarantee.
-    """
-    if liquid.model != "washino" or len(particles) == 0:
-        return False
-    theta = liquid.contact_angle_rad
-    # margins keep the law far from underflow to 0 (a denormal surface tension, theta at
-    # 90 deg, or a nearly dry partner: then the law itself decides, as in the reference)
-    if not (liquid.surface_tension >= 1e-9 and 0.0 <= theta <= math.radians(89.9)):
-        return False
-    if not float(content.min()) >= 1e-12:         # a dry partner: the law is 0 * inf at contact
-        return False
-    r_min, r_max = float(particles.radii.min()), float(particles.radii.max())
-    v_max = (bridges.WASHINO_BRIDGE_VOLUME_FRACTION * 2.0
-             * float(bridges.sphere_volume(r_max)) * float(content.max()))
-    r_eff = 0.5 * r_min
-    return math.sqrt(2.0 * v_max / (math.pi * r_eff)) / r_eff <= (0.5 * math.pi) ** 2
-
-
 def identify_fast(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
                   criterion: BondCriterion = BondCriterion(), periodic_axis: int | None = 1,
                   length: float = 0.0, need_force: bool = False) -> Identification:
@@ -418,25 +329,3 @@ def granule_table(particles: ParticleFrame, labels: np.ndarray, cg: float,
         "first_id": first_id,
         "percolating": perc,
     })
-
-
-def louvain_labels(n: int, i: np.ndarray, j: np.ndarray, force: np.ndarray,
-                   seed: int = 0, resolution: float = 1.0) -> np.ndarray:
-    """Alternative granules: Louvain communities of the bridge-force-weighted bonded graph.
-
-    Connected components over-merge in a dense wet bed (one cluster holds ~ the whole bed),
-    whereas communities split it where bridges are weak relative to the rest. Weights are
-    forces normalised by their mean (N / N), so the result does not depend on the CG rule's
-    force scale. Labels are canonical like :func:`label_fast`; singletons stay singletons.
-    """
-    import networkx as nx
-
-    graph = nx.Graph()
-    graph.add_nodes_from(range(n))
-    w = force / force.mean() if len(force) else force
-    graph.add_weighted_edges_from(zip(i.tolist(), j.tolist(), w.tolist()))
-    labels = np.empty(n, dtype=np.int64)
-    for k, members in enumerate(nx.community.louvain_communities(
-            graph, weight="weight", resolution=resolution, seed=seed)):
-        labels[list(members)] = k
-    return _canonical(labels)

@@ -4,15 +4,21 @@ Why compiled: at 360k particles and ~900k contacts the numpy bond test allocates
 temporaries of the contact length and evaluates both branches of the force law for every
 pair, and scipy's components and BFS build sparse matrices first; that alone is tens of
 times the cost of streaming the contact arrays once. Each kernel here is one loop over its
-data instead, evaluating exactly the formulas of :mod:`ligwf.liquids.bridges` (same expressions, so
-the same bonds; the tests compare every kernel with the numpy / networkx reference on real
-dumps and random graphs). :func:`bond_components` goes further and decides the bonds,
-merges the granules and unwraps them across the periodic axis in one call: the unwrapping
-rides on the union-find (image counts), so no second search over the bonds is needed.
+data instead. The liquid model's law comes in as arguments: its numba functions
+(:func:`law`, from the model's own module in :mod:`ligwf.liquids`, the same expressions as
+its numpy version, so the same bonds; the tests compare every kernel with the numpy /
+networkx reference on real dumps and random graphs). numba compiles one loop per model
+with the law inlined, as fast as a loop written for one model. :func:`bond_components`
+goes further and decides the bonds, merges the granules and unwraps them across the
+periodic axis in one call: the unwrapping rides on the union-find (image counts), so no
+second search over the bonds is needed.
 
-``cache=True`` stores the machine code next to this file (``__pycache__``), so the few
-seconds of compilation are paid once per installation, not once per process; call
-:func:`warm_up` before timing anything.
+``cache=True`` stores the machine code next to this file (``__pycache__``), so the
+compilation is paid once per installation, not once per process; except for the two
+kernels taking a model's law (:func:`bond_kernel`, :func:`bond_components`): numba keys
+them by the function objects, which differ in every process, so a cache would never hit
+and would grow by a file per run. They are compiled once per process and model (about a
+second each, outside the per-frame time); call :func:`warm_up` before timing anything.
 """
 
 from __future__ import annotations
@@ -22,72 +28,22 @@ import math
 import numpy as np
 from numba import njit
 
-#: liquid model codes of :func:`bond_kernel`
-MODEL_CODES = {"none": 0, "washino": 1, "easo": 2}
+from ligwf import liquids
+from ligwf.liquids.base import LiquidModel
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _within_rupture(gap, vol, theta, rupture_cube_factor):
-    """``gap < (1 + theta/2) vol^(1/3)`` (:func:`ligwf.liquids.bridges.rupture_distance`) decided
-    without the cube root where the cubes differ by more than any rounding could (1e-10
-    relative); the few pairs closer than that get the exact comparison. Written with
-    non-short-circuit ``&``/``|`` so the compiler can avoid branches on random gaps."""
-    separated = gap > 0.0
-    g3, r3 = gap * gap * gap, rupture_cube_factor * vol
-    sure_in = (gap < 0.0) | (separated & (g3 < r3 * (1.0 - 1e-10)))
-    sure_out = separated & (g3 > r3 * (1.0 + 1e-10))
-    if sure_in | sure_out:
-        return sure_in
-    return gap < (1.0 + 0.5 * theta) * np.cbrt(vol)
+def law(model: LiquidModel) -> tuple:
+    """The kernels' law arguments for ``model``: (volume, within_rupture, force)."""
+    k = model.kernels
+    return (k.volume, k.within_rupture, k.force)
 
-
-@njit(cache=True, error_model="numpy")
-def _washino_force(ri, rj, gap, gamma, cos_theta, sin_theta, vol):
-    """:func:`ligwf.liquids.bridges.washino_capillary_force` for one pair within rupture, N;
-    ``vol``: the bridge volume, m^3 (:func:`ligwf.liquids.bridges.washino_bridge_volume`)."""
-    r_eff = ri * rj / (ri + rj)
-    if gap <= 0.0:
-        return 2 * np.pi * r_eff * gamma * cos_theta * (
-            1.0 - gap * math.sqrt(np.pi * r_eff / (2.0 * vol)))
-    p = -1.0 + math.sqrt(1.0 + 2.0 * vol / (np.pi * r_eff * gap**2))
-    d_sp = 0.5 * gap * p
-    alpha = math.sqrt(gap / r_eff * p)
-    sin_alpha = math.sin(alpha)
-    # sin(alpha + theta) by the addition theorem: one sine call instead of two (the same
-    # value to rounding, ~1e-16 relative); cos(alpha) >= 0 while alpha <= pi/2
-    cos_alpha = math.sqrt(1.0 - sin_alpha * sin_alpha) if alpha <= 0.5 * np.pi else math.cos(alpha)
-    return 2 * np.pi * r_eff * gamma * (
-        cos_theta / (1.0 + gap / (2.0 * d_sp))
-        + sin_alpha * (sin_alpha * cos_theta + cos_alpha * sin_theta))
-
-
-@njit(cache=True, error_model="numpy")
-def _easo_volume(ri, rj, wi, wj):
-    """:func:`ligwf.liquids.bridges.easo_bridge_volume` from each partner's liquid volume, m^3."""
-    s = ri + rj
-    cap_i = 0.5 * (1.0 - math.sqrt(1.0 - rj**2 / s**2))
-    cap_j = 0.5 * (1.0 - math.sqrt(1.0 - ri**2 / s**2))
-    return wi * cap_i + wj * cap_j
-
-
-@njit(cache=True, error_model="numpy")
-def _easo_force(ri, rj, gap, gamma, theta, vol):
-    """:func:`ligwf.liquids.bridges.easo_capillary_force` for one pair within rupture, N."""
-    r2 = max(ri, rj)
-    vs = vol / r2**3
-    log_vs = math.log(vs)
-    a = -1.1 * vs ** (-0.53)
-    b = (-0.148 * log_vs - 0.96) * theta**2 - 0.0082 * log_vs + 0.48
-    c = 0.0018 * log_vs + 0.078
-    expo = a * gap / r2 + b if gap > 0.0 else b
-    return np.pi * gamma * math.sqrt(ri * rj) * (math.exp(expo) + c)
-
-
-@njit(cache=True, inline="always", error_model="numpy")
-def _bond(a, b, gap, velocities, radii, content, model, gamma, theta, cos_theta,
-          sin_theta, fraction, cube_factor, cos_max, min_force, force_needed):
+@njit(inline="always", error_model="numpy")
+def _bond(a, b, gap, velocities, radii, content, volume, within_rupture, force, gamma, theta,
+          cos_theta, sin_theta, cos_max, min_force, force_needed):
     """Bridge force of contact (a, b) if it is a liquid bond, else -1.0.
 
+    ``volume``, ``within_rupture``, ``force``: the liquid model's numba functions
+    (``ligwf.liquids.base.Kernels``); each model gets its own compiled loop.
     The two cheap tests first: the rupture distance (beyond it there is no bridge: force
     0, never above ``min_force`` >= 0), then, only for pairs within it, the velocity angle
     (real branches: a pair out of range costs no velocity loads; measured 2.3x faster on a
@@ -97,15 +53,12 @@ def _bond(a, b, gap, velocities, radii, content, model, gamma, theta, cos_theta,
     ``min_force`` is 0, so the law could not change the verdict).
     """
     ra, rb = radii[a], radii[b]
-    # liquid per particle, m^3: the expression of ligwf.liquids.bridges.sphere_volume x content,
+    # liquid per particle, m^3: the expression of ligwf.liquids.base.sphere_volume x content,
     # operation for operation, so bridge volumes agree with the numpy reference bitwise
     lva = 4.0 / 3.0 * np.pi * (ra * ra * ra) * content[a]
     lvb = 4.0 / 3.0 * np.pi * (rb * rb * rb) * content[b]
-    if model == 1:
-        vol = fraction * (lva + lvb)
-    else:
-        vol = _easo_volume(ra, rb, lva, lvb)
-    if not _within_rupture(gap, vol, theta, cube_factor):
+    vol = volume(ra, rb, lva, lvb)
+    if not within_rupture(gap, vol, theta):
         return -1.0
     vax, vay, vaz = velocities[a, 0], velocities[a, 1], velocities[a, 2]
     vbx, vby, vbz = velocities[b, 0], velocities[b, 1], velocities[b, 2]
@@ -115,35 +68,31 @@ def _bond(a, b, gap, velocities, radii, content, model, gamma, theta, cos_theta,
         return -1.0
     if not force_needed:
         return np.nan
-    if model == 1:
-        f = _washino_force(ra, rb, gap, gamma, cos_theta, sin_theta, vol)
-    else:
-        f = _easo_force(ra, rb, gap, gamma, theta, vol)
+    f = force(ra, rb, gap, gamma, theta, cos_theta, sin_theta, vol)
     return f if f > min_force else -1.0
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _scan(model, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
-          fraction, cos_max, min_force, force_needed, out_i, out_j, out_f):
+@njit(inline="always", error_model="numpy")
+def _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii, content,
+          delta, gamma, theta, cos_max, min_force, force_needed, out_i, out_j, out_f):
     """The loop over the contacts shared by :func:`bond_kernel` and :func:`bond_components`:
     bond test of each contact, bonded pairs to ``out_*``. Returns the bond count, or
     -1 - k when contact k refers to a row outside the frame.
 
-    Called through :func:`_scan_model` with ``model`` as a literal (1 or 2), so the liquid
-    model's branch is folded out of the loop: with the model as a run-time value inside the loop the whole pass was
-    measured 3.5x slower.
+    The model's functions are arguments of their own numba type, so each liquid model gets
+    its own loop with its law inlined (with the model as a run-time value inside the loop
+    the whole pass was measured 3.5x slower).
     """
     n = len(radii)
     cos_theta, sin_theta = math.cos(theta), math.sin(theta)
-    cube_factor = (1.0 + 0.5 * theta) ** 3
     count = 0
     for k in range(len(id1)):
         a = np.int64(id1[k]) - id_offset
         b = np.int64(id2[k]) - id_offset
         if a < 0 or a >= n or b < 0 or b >= n:
             return -1 - k
-        f = _bond(a, b, -delta[k], velocities, radii, content, model, gamma, theta,
-                  cos_theta, sin_theta, fraction, cube_factor, cos_max, min_force, force_needed)
+        f = _bond(a, b, -delta[k], velocities, radii, content, volume, within_rupture, force,
+                  gamma, theta, cos_theta, sin_theta, cos_max, min_force, force_needed)
         if f < 0.0:                               # not a bond (NaN: a bond, force not needed)
             continue
         out_i[count] = a
@@ -153,23 +102,9 @@ def _scan(model, id1, id2, id_offset, velocities, radii, content, delta, gamma, 
     return count
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _scan_model(model, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
-                fraction, cos_max, min_force, force_needed, out_i, out_j, out_f):
-    """:func:`_scan` with ``model`` turned into a literal (1 washino, 2 easo; 0, dry: no
-    bonds), so each model gets its own compiled loop."""
-    if model == 1:
-        return _scan(1, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
-                     fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
-    if model == 2:
-        return _scan(2, id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
-                     fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
-    return 0
-
-
-@njit(cache=True, error_model="numpy")
-def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, model, gamma,
-                theta, fraction, cos_max, min_force):
+@njit(error_model="numpy")
+def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, volume,
+                within_rupture, force, gamma, theta, cos_max, min_force):
     """One pass over the contacts: the bond test of :func:`_bond` for each.
 
     Particle rows are ``id1 - id_offset`` and ``id2 - id_offset`` (the ids themselves when
@@ -182,14 +117,15 @@ def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, model, g
     out_i = np.empty(m, np.int64)
     out_j = np.empty(m, np.int64)
     out_f = np.empty(m, np.float64)
-    count = _scan_model(model, id1, id2, id_offset, velocities, radii, content, delta, gamma,
-                        theta, fraction, cos_max, min_force, True, out_i, out_j, out_f)
+    count = _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
+                  content, delta, gamma, theta, cos_max, min_force, True, out_i, out_j, out_f)
     return count, out_i, out_j, out_f
 
 
-@njit(cache=True, error_model="numpy")
-def bond_components(id1, id2, id_offset, velocities, radii, content, delta, model, gamma,
-                    theta, fraction, cos_max, min_force, force_needed, y, length):
+@njit(error_model="numpy")
+def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volume,
+                    within_rupture, force, gamma, theta, cos_max, min_force, force_needed, y,
+                    length):
     """Bond test, granules and unwrapping along the periodic axis in one compiled call:
     one pass over the contacts, one over the bonds, one over the particles.
 
@@ -216,8 +152,9 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, mode
     parent = np.arange(n)
     image = np.zeros(n, np.int64)
     winds = np.zeros(n, np.bool_)                 # per root: its tree closes a periodic cycle
-    count = _scan_model(model, id1, id2, id_offset, velocities, radii, content, delta, gamma,
-                        theta, fraction, cos_max, min_force, force_needed, out_i, out_j, out_f)
+    count = _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
+                  content, delta, gamma, theta, cos_max, min_force, force_needed, out_i, out_j,
+                  out_f)
     if count < 0:
         return (count, out_i, out_j, out_f, parent, y, winds, 0)
     # union-find over the bonds, written out in the loop: as helper calls taking the arrays
@@ -334,16 +271,18 @@ def granule_sums(labels, n_granules, radii, positions, axis, axis_values):
     return members, volume, moment, first
 
 
-def warm_up() -> None:
-    """Compile (or load from the cache) every kernel on a two-particle frame."""
+def warm_up(models: tuple[str, ...] | None = None) -> None:
+    """Compile (or load from the cache) every kernel on a two-particle frame, the bond
+    kernels for each of ``models`` (default: every registered wet model)."""
     v = np.ones((2, 3))
     r, c = np.full(2, 1e-3), np.full(2, 0.02)
-    for model in (1, 2):
-        bond_kernel(np.array([1]), np.array([2]), 1, v, r, c, np.array([1e-6]), model,
-                    0.02, 0.1, 0.05, 0.5, 0.0)
-        for needed in (True, False):
-            bond_components(np.array([1]), np.array([2]), 1, v, r, c, np.array([1e-6]),
-                            model, 0.02, 0.1, 0.05, 0.5, 0.0, needed, v[:, 1].copy(), 1.0)
+    names = models if models is not None else [n for n in liquids.names() if liquids.get(n).wet]
+    for name in names:
+        fns = law(liquids.get(name))
+        bond_kernel(np.array([1]), np.array([2]), 1, v, r, c, np.array([1e-6]), *fns,
+                    0.02, 0.1, 0.5, 0.0)
+        bond_components(np.array([1]), np.array([2]), 1, v, r, c, np.array([1e-6]),
+                        *fns, 0.02, 0.1, 0.5, 0.0, True, v[:, 1].copy(), 1.0)
     i, j = np.array([0]), np.array([1])
     labels = union_find_labels(2, i, j)
     for axis in (-1, 1):

@@ -21,8 +21,8 @@ from typing import Any, Iterable
 import jinja2
 
 from ligwf import __version__
-from ligwf.liquids.bridges import engine_contact_angle_deg
 from ligwf.errors import RenderError
+from ligwf.engine.liggghts import input_angle
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.model import FORBIDDEN_INPUT_CHARS, GRAVITY
@@ -144,10 +144,12 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
         "topup_margin": TOPUP_MARGIN,
         "rolling": s.rolling_friction > 0.0,
         "wet": s.wet,
-        "cohesion_model": {"washino": "washino/capillary/viscous",
-                           "easo": "easo/capillary/viscous"}.get(s.liquid_model),
-        "engine_contact_angle": engine_contact_angle_deg(s.contact_angle_deg,
-                                                         s.contact_angle_compensation),
+        # the liquid block comes from the case's model (ligwf.liquids): its cohesion
+        # keyword, its lines (the contact angle as LIGGGHTS 3.8.0 needs it) and dump columns
+        "cohesion": s.liquid.cohesion,
+        "liquid_lines": s.liquid.liggghts_lines(
+            s, input_angle(s.contact_angle_deg, s.contact_angle_compensation)),
+        "liquid_dump_columns": s.liquid.dump_columns,
         "mesh_name": MESH_NAME,
     }
 

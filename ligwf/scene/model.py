@@ -11,12 +11,12 @@ the value and the allowed range before any file is written or any engine launche
 from __future__ import annotations
 
 import math
-from enum import Enum
 from typing import Annotated, Any, Literal
 
 from pydantic import (AfterValidator, BaseModel, ConfigDict, Field, ValidationError,
                       model_validator)
 
+from ligwf import liquids
 from ligwf.errors import ConfigError
 
 #: Characters that must never reach a LIGGGHTS input: a newline ends the command and starts
@@ -160,23 +160,21 @@ class Particles(_Frozen):
 # Liquid
 # ---------------------------------------------------------------------------------------
 
-class LiquidModel(str, Enum):
-    """Capillary cohesion models of LIGGGHTS 3.8.0 (``none`` = dry bed)."""
-
-    NONE = "none"
-    WASHINO = "washino"
-    EASO = "easo"
+def check_liquid_model(name: str) -> str:
+    """Refuse a name no liquid model is registered under (the error lists the allowed)."""
+    liquids.get(name)
+    return name
 
 
 class Liquid(_Frozen):
-    """The binder liquid and its bridge model.
+    """The binder liquid and its bridge model (a name of :mod:`ligwf.liquids`' registry).
 
     ``liquid_content`` is the liquid volume as a FRACTION of each particle's solid volume
     (LIGGGHTS' ``surfaceLiquidContentInitial``; the engine source uses a fraction although
-    its docs say %).
+    its docs say %). Model-specific limits are the model's own (``validate``).
     """
 
-    model: LiquidModel = LiquidModel.NONE
+    model: Annotated[str, AfterValidator(check_liquid_model)] = "none"
     surface_tension: float = Field(0.072, ge=0.0, le=1e4, description="N/m")
     contact_angle_deg: float = Field(30.0, ge=0.0, le=180.0, description="degrees")
     viscosity: float = Field(1e-3, ge=0.0, le=1e6, description="Pa s")
@@ -189,13 +187,13 @@ class Liquid(_Frozen):
 
     @property
     def wet(self) -> bool:
-        return self.model is not LiquidModel.NONE
+        return liquids.get(self.model).wet
 
     @model_validator(mode="after")
-    def _separation_order(self) -> "Liquid":
-        if self.wet and self.max_separation_ratio < self.min_separation_ratio:
-            raise ValueError(f"max_separation_ratio = {self.max_separation_ratio:g} must be >= "
-                             f"min_separation_ratio = {self.min_separation_ratio:g}")
+    def _model_limits(self) -> "Liquid":
+        problems = liquids.get(self.model).validate(self)
+        if problems:
+            raise ValueError("; ".join(problems))
         return self
 
 
@@ -283,8 +281,9 @@ class Scene(_Frozen):
     @model_validator(mode="after")
     def _granules_need_liquid(self) -> "Scene":
         if self.analysis.granules and not self.liquid.wet:
+            wet = " or ".join(n for n in liquids.names() if liquids.get(n).wet)
             raise ValueError("analysis.granules needs a liquid model (granules are held by "
-                             "liquid bridges); set liquid.model to washino or easo")
+                             f"liquid bridges); set liquid.model to {wet}")
         return self
 
 

@@ -18,7 +18,7 @@ rule         keeps                    bridge F x   gamma x    viscosity x
 
 Why gamma and mu scale by n^(k-1): both LIGGGHTS capillary models (washino, easo) give a
 bridge force ~ R_eff * gamma * f(dimensionless gap, V_bridge/R^3, theta) and a viscous
-force ~ mu * R_eff * v * g(gap/R_eff) (see ``ligwf.liquids.bridges``). Under CG the liquid content
+force ~ mu * R_eff * v * g(gap/R_eff) (see ``ligwf.liquids``). Under CG the liquid content
 is a fraction of solid volume, so V_bridge/R^3 is unchanged, as are the separation ratios
 and the contact angle; at the same dimensionless gap and the same velocity the forces
 therefore grow like n * gamma' and n * mu'. Forces x n^k need gamma' = n^(k-1) gamma.
@@ -36,7 +36,9 @@ import math
 from dataclasses import asdict, dataclass
 from enum import Enum
 
+from ligwf import liquids
 from ligwf.errors import ConfigError
+from ligwf.liquids.base import LiquidModel
 from ligwf.scene.model import GRAVITY, Scene
 
 
@@ -256,7 +258,12 @@ class ScaledScene:
 
     @property
     def wet(self) -> bool:
-        return self.liquid_model != "none"
+        return self.liquid.wet
+
+    @property
+    def liquid(self) -> LiquidModel:
+        """The liquid model of this case (from :mod:`ligwf.liquids`' registry)."""
+        return liquids.get(self.liquid_model)
 
     @property
     def insertion_steps(self) -> int:
@@ -275,6 +282,12 @@ class ScaledScene:
     @property
     def d_max(self) -> float:
         return max(self.diameters)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> "ScaledScene":
+        """From :meth:`to_dict` (e.g. ``scene.json``'s ``scaled``): lists back to tuples;
+        a missing or unknown key is a TypeError, never a default."""
+        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in data.items()})
 
     def to_dict(self) -> dict:
         out = asdict(self)
@@ -326,7 +339,7 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
         wall_friction=drum.wall_friction if drum.wall_friction is not None else p.friction,
         wall_restitution=(drum.wall_restitution if drum.wall_restitution is not None
                           else p.restitution),
-        liquid_model=liq.model.value,
+        liquid_model=liq.model,
         surface_tension=liq.surface_tension * factor, viscosity=liq.viscosity * factor,
         contact_angle_deg=liq.contact_angle_deg, liquid_content=liq.liquid_content,
         min_separation_ratio=liq.min_separation_ratio,

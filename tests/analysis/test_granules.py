@@ -13,7 +13,10 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from ligwf.liquids import bridges
+from ligwf import liquids
+from ligwf.liquids import washino
+from ligwf.liquids.capillary import rupture_distance
+from ligwf.scene.scaling import ScaledScene
 from ligwf.analysis.dumps import ContactFrame, ParticleFrame, discover_frames, read_contacts, read_particles
 from ligwf.errors import DumpReadError
 from ligwf.analysis.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
@@ -25,8 +28,8 @@ from wetdump import wet_study
 @pytest.fixture(scope="module")
 def real(engine, tmp_path_factory):
     case = wet_study(engine, tmp_path_factory) / "cg3-weber-r0"
-    scaled = json.loads((case / "scene.json").read_text())["scaled"]
-    frames = [(read_particles(f.particles, dt=scaled["dt"]), read_contacts(f.contacts))
+    scaled = ScaledScene.from_dict(json.loads((case / "scene.json").read_text())["scaled"])
+    frames = [(read_particles(f.particles, dt=scaled.dt), read_contacts(f.contacts))
               for f in discover_frames(case)]
     return scaled, frames
 
@@ -37,15 +40,15 @@ def real(engine, tmp_path_factory):
 def test_reference_equals_fast_on_real_dumps(real, angle):
     scaled, frames = real
     liquid = Liquid.from_scaled(scaled)
-    counts, L = [], scaled["drum_length"]
+    counts, L = [], scaled.drum_length
     for p, c in frames:
         crit = BondCriterion(0.0, angle)
         ref = identify_reference(p, c, liquid, crit, 1, L)
         fast = identify_fast(p, c, liquid, crit, 1, L)
         _same_identification(p, ref, fast)
-        t_ref = granule_table(p, ref.labels, scaled["cg"], ref.unwrapped_axis, 1, 0.0, L,
+        t_ref = granule_table(p, ref.labels, scaled.cg, ref.unwrapped_axis, 1, 0.0, L,
                               ref.percolating)
-        t_fast = granule_table(p, fast.labels, scaled["cg"], fast.unwrapped_axis, 1, 0.0, L,
+        t_fast = granule_table(p, fast.labels, scaled.cg, fast.unwrapped_axis, 1, 0.0, L,
                                fast.percolating)
         np.testing.assert_array_equal(t_ref["members"], t_fast["members"])
         np.testing.assert_array_equal(t_ref["volume"], t_fast["volume"])
@@ -177,10 +180,10 @@ def test_bond_criterion_matches_scalar_evaluation(real):
     expected, near = set(), 0
     for a, b, delta in zip(c.id1.tolist(), c.id2.tolist(), c.delta.tolist()):
         ia, ib = int(np.searchsorted(p.ids, a)), int(np.searchsorted(p.ids, b))
-        f = bridges.washino_capillary_force(p.radii[ia], p.radii[ib], -delta,
-                                            scaled["surface_tension"],
-                                            math.radians(scaled["contact_angle_deg"]),
-                                            p.liquid_content[ia], p.liquid_content[ib])
+        f = liquids.get("washino").capillary_force(p.radii[ia], p.radii[ib], -delta,
+                                                   scaled.surface_tension,
+                                                   math.radians(scaled.contact_angle_deg),
+                                                   p.liquid_content[ia], p.liquid_content[ib])
         va, vb = p.velocities[ia], p.velocities[ib]
         cosang = float(va @ vb) / (float(np.linalg.norm(va)) * float(np.linalg.norm(vb)))
         angle = math.degrees(math.acos(max(-1.0, min(1.0, cosang))))
@@ -217,8 +220,8 @@ def test_broken_bridge_and_threshold():
     r = 0.0005
     p = _frame([r] * 4, np.zeros((4, 3)), np.tile([0.1, 0, 0], (4, 1)))
     liquid = Liquid("washino", 0.024, math.radians(30), 0.02)
-    vol = bridges.washino_bridge_volume(r, r, 0.02, 0.02)
-    rupture = bridges.rupture_distance(vol, math.radians(30))
+    vol = washino.bridge_volume(r, r, 0.02, 0.02)
+    rupture = rupture_distance(vol, math.radians(30))
     c = ContactFrame(Path("synthetic"), 0, np.array([1, 2, 3]), np.array([2, 3, 4]),
                      np.array([1e-6, -0.5 * rupture, -1.01 * rupture]))
     i, j, f = bonded_contacts(p, c, liquid)

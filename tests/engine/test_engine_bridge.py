@@ -12,7 +12,8 @@ import re
 
 import pytest
 
-from ligwf.liquids import bridges
+from ligwf import liquids
+from ligwf.engine.liggghts import engine_effective_angle_rad
 from ligwf.engine.render import render_bridge_probe
 from ligwf.scene.scaling import scale
 from ligwf.scene.workflow import load_workflow
@@ -30,7 +31,7 @@ ANGLE_GAP_RATIO = 0.3
 def measure(engine, tmp_path, scaled, name: str, gap_ratio: float = GAP_RATIO) -> float:
     case = tmp_path / name
     case.mkdir()
-    files = render_bridge_probe(scaled, gap_ratio, model_approach=scaled.liquid_model == "easo")
+    files = render_bridge_probe(scaled, gap_ratio, model_approach=scaled.liquid.bridge_needs_contact)
     (case / "in.liggghts").write_text(files["in.liggghts"])
     out = run_liggghts(engine, case, nprocs=1, timeout=120)
     assert out.returncode == 0, out.stdout[-3000:]
@@ -77,11 +78,11 @@ def test_engine_applies_the_intended_contact_angle(engine, tmp_path, model):
     measured = measure(engine, tmp_path, s, model, ANGLE_GAP_RATIO)
     r = 0.5 * s.d_min
     gap = ANGLE_GAP_RATIO * 0.5 * r
-    intended = bridges.capillary_force(model, r, r, gap, s.surface_tension,
-                                       math.radians(s.contact_angle_deg), s.liquid_content)
-    buggy = bridges.capillary_force(model, r, r, gap, s.surface_tension,
-                                    bridges.engine_effective_angle_rad(s.contact_angle_deg),
-                                    s.liquid_content)
+    law = liquids.get(model)
+    intended = law.capillary_force(r, r, gap, s.surface_tension,
+                                   math.radians(s.contact_angle_deg), s.liquid_content)
+    buggy = law.capillary_force(r, r, gap, s.surface_tension,
+                                engine_effective_angle_rad(s.contact_angle_deg), s.liquid_content)
     assert measured == pytest.approx(intended, rel=1e-4)
     assert abs(buggy - intended) > 0.05 * intended  # the test can tell the two apart
 
@@ -92,7 +93,7 @@ def test_uncompensated_engine_applies_the_product_angle(engine, tmp_path):
     s = scale(scene, 1, "none")
     measured = measure(engine, tmp_path, s, "raw", ANGLE_GAP_RATIO)
     r = 0.5 * s.d_min
-    expected = bridges.washino_capillary_force(
+    expected = liquids.get("washino").capillary_force(
         r, r, ANGLE_GAP_RATIO * 0.5 * r, s.surface_tension,
-        bridges.engine_effective_angle_rad(s.contact_angle_deg), s.liquid_content, s.liquid_content)
+        engine_effective_angle_rad(s.contact_angle_deg), s.liquid_content, s.liquid_content)
     assert measured == pytest.approx(expected, rel=1e-4)

@@ -1,0 +1,82 @@
+"""The liquid-bridge law of a run as the granule analysis applies it.
+
+:class:`Liquid` is the law the engine applied in one case (the model of
+:mod:`ligwf.liquids`, the CG-scaled surface tension, the contact angle the engine actually
+used, see :mod:`ligwf.engine.liggghts`); the functions evaluate it on the pairs of a dumped
+frame with the model's numpy law (the reference the compiled kernels are tested against).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ligwf import liquids
+from ligwf.analysis.dumps import ContactFrame, ParticleFrame
+from ligwf.engine.liggghts import applied_contact_angle_rad
+from ligwf.liquids.base import LiquidModel
+from ligwf.scene.scaling import ScaledScene
+
+
+@dataclass(frozen=True)
+class Liquid:
+    """The liquid-bridge law the engine applied in a run (from the case's scaled scene)."""
+
+    model: str                  # a name of ligwf.liquids' registry
+    surface_tension: float      # N/m, already CG-scaled
+    contact_angle_rad: float    # the angle the engine APPLIED (see ligwf.engine.liggghts)
+    liquid_content: float       # fraction of particle volume, used if a dump lacks it
+
+    @property
+    def law(self) -> LiquidModel:
+        """The liquid model (its force law, bridge volume and rupture distance)."""
+        return liquids.get(self.model)
+
+    @classmethod
+    def from_scaled(cls, scaled: ScaledScene, engine_product_bug: bool = True) -> "Liquid":
+        """The law of a scaled case. ligwf writes a compensated input angle so the 3.8.0
+        engine applies the scene angle; without compensation it applied 0.5 a^2."""
+        liquids.get(scaled.liquid_model)          # an unknown model is an error here
+        theta = applied_contact_angle_rad(scaled.contact_angle_deg,
+                                          scaled.contact_angle_compensation, engine_product_bug)
+        return cls(scaled.liquid_model, float(scaled.surface_tension), theta,
+                   float(scaled.liquid_content))
+
+
+def bridge_forces(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
+                  i: np.ndarray | None = None, j: np.ndarray | None = None) -> np.ndarray:
+    """Capillary force magnitude of every contact, N (0 for a dry run or a broken bridge)."""
+    i = particles.index_of(contacts.id1) if i is None else i
+    j = particles.index_of(contacts.id2) if j is None else j
+    return pair_forces(particles, i, j, -contacts.delta, liquid)
+
+
+def content_of(particles: ParticleFrame, liquid: Liquid) -> np.ndarray:
+    """Liquid content per particle: the dump's, or the scene's when the dump lacks it."""
+    content = particles.liquid_content
+    if content is None:
+        content = np.full(len(particles), liquid.liquid_content)
+    return np.asarray(content, dtype=np.float64)
+
+
+def pair_forces(particles: ParticleFrame, i: np.ndarray, j: np.ndarray, gap: np.ndarray,
+               liquid: Liquid) -> np.ndarray:
+    law = liquid.law
+    if not law.wet or len(i) == 0:
+        return np.zeros(len(i))
+    content = content_of(particles, liquid)
+    return np.asarray(law.capillary_force(
+        particles.radii[i], particles.radii[j], gap,
+        liquid.surface_tension, liquid.contact_angle_rad, content[i], content[j]), dtype=float)
+
+
+def force_law_positive(particles: ParticleFrame, liquid: Liquid, content: np.ndarray) -> bool:
+    """True when the capillary law is > 0 N for EVERY pair of this frame within rupture
+    distance, so that with ``min_bridge_force`` = 0 the bond test need not evaluate it
+    (the model's proof, ``force_positive``, over the frame's radii and contents)."""
+    if len(particles) == 0:
+        return False
+    return liquid.law.force_positive(
+        liquid.surface_tension, liquid.contact_angle_rad, float(particles.radii.min()),
+        float(particles.radii.max()), float(content.min()), float(content.max()))
