@@ -15,7 +15,6 @@ wall. Target for ligwf's rendered inputs: CG2 >= 14x, CG3 >= 50x.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import tempfile
 import threading
@@ -26,6 +25,7 @@ sys.path.insert(0, str(ROOT))
 
 from ligwf.study.prepare import render_workflow, write_study  # noqa: E402
 from ligwf.engine.site import EngineConfig  # noqa: E402
+from ligwf.engine.health import DONE  # noqa: E402
 from ligwf.engine.launch import run_case  # noqa: E402
 from ligwf.scene.workflow import load_workflow  # noqa: E402
 
@@ -47,20 +47,19 @@ def main() -> int:
         f"scene.process.run_time={args.run_time}",
         f"scene.analysis.granules={'true' if args.granules else 'false'}"])
     rendered = render_workflow(wf)
-    dirs = write_study(wf, rendered, out)
+    cases = write_study(wf, rendered, out).cases
     engine = EngineConfig.from_site()
     stop = threading.Event()
     rows = []
-    for rc, d in zip(rendered, dirs):
+    for rc, case in zip(rendered, cases):
         print(f"running {rc.case.case_id}: {rc.scaled.particle_count} particles, "
               f"{rc.scaled.total_steps} steps ...", flush=True)
-        run_case(d, args.np, engine, None, stop)
-        man = json.loads((d / "manifest.json").read_text())
-        if man["status"] != "done":
-            print(f"  {rc.case.case_id} ended {man['status']}: {man.get('reason')}")
+        man = run_case(case, args.np, engine, None, stop) or case.manifest()
+        if man.status != DONE:
+            print(f"  {rc.case.case_id} ended {man.status}: {man.reason}")
             return 1
         rows.append((rc.scaled.cg, rc.scaled.particle_count, rc.scaled.total_steps,
-                     man["wall_seconds"], man["core_seconds"]))
+                     man.wall_seconds, man.core_seconds))
     cg1 = rows[0]
     print(f"\nscene: we_vs_bo slice {args.length * 1000:g} mm, settle {args.settle_time:g} s, "
           f"run {args.run_time:g} s, -np {args.np}; runs in {out}")

@@ -25,7 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from ligwf.engine.manifest import read_manifest
+from ligwf.study.study import Study
 
 ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_SET = ["sweep.cg_levels=[1]"]
@@ -61,7 +61,7 @@ def main() -> None:
         t_total = time.perf_counter() - t0
         if proc.returncode:
             sys.exit(f"ligwf run failed (exit {proc.returncode})")
-        manifests = [read_manifest(d) for d in out.iterdir() if (d / "manifest.json").exists()]
+        manifests = [c.manifest() for c in Study.open(out).cases if c.manifest() is not None]
         t_engine = sum(a.wall_seconds for m in manifests for a in m.attempts)
         steps = sum(m.steps_done for m in manifests)
     finally:

@@ -33,13 +33,14 @@ import numpy as np
 
 from ligwf.analysis.dumps import ParticleFrame
 from ligwf.engine.mesh import axis_frame
+from ligwf.scene.scaling import ScaledScene
 
 RIGID_FRAME_SHARE = 0.9  # a frame is rigid when more than this share co-rotates
 
 
 @dataclass(frozen=True)
 class DrumGeometry:
-    """What the flow metrics need to know about the drum (from scene.json ``scaled``)."""
+    """What the flow metrics need to know about the drum (from the case's scaled scene)."""
 
     radius: float            # m
     axis: str                # x | y | z
@@ -47,11 +48,11 @@ class DrumGeometry:
     d_mean: float            # m, a typical particle diameter (sets bins and bands)
 
     @classmethod
-    def from_scaled(cls, scaled: dict) -> "DrumGeometry":
-        d = np.asarray(scaled["diameters"], float)
-        f = np.asarray(scaled["number_fractions"], float)
-        return cls(radius=0.5 * scaled["drum_diameter"], axis=scaled["axis"],
-                   omega=scaled["omega"], d_mean=float(np.sum(d * f)))
+    def from_scaled(cls, scaled: ScaledScene) -> "DrumGeometry":
+        d = np.asarray(scaled.diameters, float)
+        f = np.asarray(scaled.number_fractions, float)
+        return cls(radius=0.5 * scaled.drum_diameter, axis=scaled.axis,
+                   omega=scaled.omega, d_mean=float(np.sum(d * f)))
 
 
 @dataclass(frozen=True)

@@ -1,74 +1,41 @@
-"""Command line: ``ligwf render``, ``ligwf check`` (and the later stages' commands).
+"""Command line: ``ligwf render``, ``ligwf check`` and every stage's sub-commands.
 
-Every command validates the whole workflow and renders every case in memory before it
-writes anything, so a bad value is reported with its field and allowed range and nothing
-is left half-done.
+Every command validates the whole workflow, renders every case in memory and runs the
+stability pre-flight before it writes anything (:func:`ligwf.study.pipeline.prepare_workflow`),
+so a bad value is reported with its field and allowed range and nothing is left half-done.
+The CLI only parses arguments: the pipeline is :mod:`ligwf.study.pipeline`.
 """
 
 from __future__ import annotations
 
 import argparse
-import importlib
 import sys
 from pathlib import Path
 
-from rich.console import Console
-from rich.table import Table
-
 from ligwf import __version__
-from ligwf.study.prepare import render_workflow, write_study
-from ligwf.cli.stability import add_allow_unstable, preflight_or_refuse
+from ligwf.cli import analyse, report, run, slurm, stability
+from ligwf.cli.common import (add_mesh_cache, add_workflow_args, case_table, console,
+                              err_console, prepare_from_args)
 from ligwf.errors import LigwfError
-from ligwf.scene.workflow import load_workflow
+from ligwf.study.pipeline import write
 
-console = Console(width=None if sys.stdout.isatty() else 160)
-err_console = Console(stderr=True, soft_wrap=True)
-
-
-def case_table(rendered, title: str) -> Table:
-    """Table of cases: CG level, rule, replica, particle count, dt, steps."""
-    table = Table(title=title)
-    for col in ("case", "CG", "rule", "rep", "particles", "dt [s]", "dt/t_R", "steps",
-                "particle-steps"):
-        table.add_column(col, justify="right" if col not in ("case", "rule") else "left")
-    for rc in rendered:
-        s = rc.scaled
-        table.add_row(rc.case.case_id, f"{s.cg:g}", s.rule, str(s.replica),
-                      f"{s.particle_count:,}", f"{s.dt:.3g}", f"{s.dt_rayleigh_fraction:.3g}",
-                      f"{s.total_steps:,}", f"{s.particle_count * s.total_steps:.3g}")
-    return table
-
-
-def add_workflow_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("workflow", type=Path, help="workflow YAML file")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a workflow value, e.g. scene.drum.lifters.count=12 (repeatable)")
-    p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR",
-                   help="user template folder searched before ligwf's own (repeatable)")
-    add_allow_unstable(p)
+#: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
+COMMAND_MODULES = (run, slurm, analyse, stability, report)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    wf = load_workflow(args.workflow, args.overrides)
-    rendered = render_workflow(wf, args.templates)
-    preflight_or_refuse(rendered, args.allow_unstable)
-    console.print(case_table(rendered, f"{wf.name}: {len(rendered)} case(s), valid"))
+    prepared = prepare_from_args(args)
+    wf = prepared.workflow
+    console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
     return 0
 
 
 def cmd_render(args: argparse.Namespace) -> int:
-    wf = load_workflow(args.workflow, args.overrides)
-    rendered = render_workflow(wf, args.templates)
-    preflight_or_refuse(rendered, args.allow_unstable)
-    write_study(wf, rendered, args.out, args.mesh_cache)
-    console.print(case_table(rendered, f"{wf.name}: {len(rendered)} case(s) -> {args.out}"))
+    prepared = prepare_from_args(args)
+    write(prepared, args.out, args.mesh_cache)
+    wf = prepared.workflow
+    console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s) -> {args.out}"))
     return 0
-
-
-#: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
-#: (One module per stage keeps this file small and the stages independent.)
-COMMAND_MODULES: tuple[str, ...] = ("ligwf.cli.run", "ligwf.cli.slurm", "ligwf.cli.analyse",
-                                     "ligwf.cli.stability", "ligwf.cli.report")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -81,15 +48,14 @@ def build_parser() -> argparse.ArgumentParser:
     add_workflow_args(p)
     p.set_defaults(func=cmd_check)
 
-    p = sub.add_parser("render", help="write one folder per case (input, mesh, scene.json)")
+    p = sub.add_parser("render", help="write one folder per case (input, mesh, scene record)")
     add_workflow_args(p)
     p.add_argument("--out", type=Path, required=True, help="study folder to write")
-    p.add_argument("--mesh-cache", type=Path, default=None,
-                   help="mesh cache folder (default $LIGWF_MESH_CACHE or ./meshes)")
+    add_mesh_cache(p)
     p.set_defaults(func=cmd_render)
 
-    for name in COMMAND_MODULES:
-        importlib.import_module(name).register(sub)
+    for module in COMMAND_MODULES:
+        module.register(sub)
     return parser
 
 

@@ -1,79 +1,54 @@
 """``ligwf report STUDY`` and ``ligwf study WORKFLOW`` (run + analyse + report).
 
-``study`` is the one reproducible command of a CG study: it renders and runs every case
-(resuming what is already done), identifies granules and GSDs, computes the flow metrics
-and writes the report folder, even when some cases failed (they are listed, not used).
+``study`` is the one reproducible command of a CG study: it prepares (pre-flight first),
+renders and runs every case (resuming what is already done), then post-processes the
+study with its stored analysis settings (:func:`ligwf.study.pipeline.postprocess`: the
+granule analysis, then the flow metrics and the report folder), even when some cases
+failed (they are listed, not used).
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
-from rich.console import Console
+from ligwf.cli.common import add_workflow_args, console
+from ligwf.cli.run import add_run_args, prepare_and_run
+from ligwf.study.pipeline import postprocess, report_study
 
-console = Console()
+
+def _print_report(out: Path) -> None:
+    console.print(f"report: {out / 'summary.md'} and {out / 'index.html'}")
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from ligwf.report.write import write_report
-
-    out = write_report(args.study, args.out, snapshots=not args.no_snapshots,
-                       steady_after=args.steady_after)
-    console.print(f"report: {out / 'summary.md'} and {out / 'index.html'}")
+    _print_report(report_study(args.study, args.out, snapshots=not args.no_snapshots))
     return 0
 
 
-def _discard_frames(study: Path, steady_after: float) -> int:
-    """Frames of the start-up part of production, left out of the GSD like the flow stage."""
-    from ligwf.analysis.dumps import discover_frames
-    from ligwf.cli.run import study_case_dirs
-
-    counts = [len(discover_frames(d)) for d in study_case_dirs(study) if (d / "post").is_dir()]
-    counts = [c for c in counts if c]
-    return math.floor(steady_after * min(counts)) if counts else 0
-
-
 def cmd_study(args: argparse.Namespace) -> int:
-    from ligwf.analysis.runner import AnalysisOptions, analyse
-    from ligwf.cli.run import cmd_run
-    from ligwf.report.write import write_report
-
-    run_status = cmd_run(args)
-    analyse(args.out, options=AnalysisOptions(discard_frames=_discard_frames(args.out,
-                                                                             args.steady_after)))
-    out = write_report(args.out, None, snapshots=not args.no_snapshots,
-                       steady_after=args.steady_after)
-    console.print(f"report: {out / 'summary.md'} and {out / 'index.html'}")
-    return run_status
+    study, done = prepare_and_run(args)
+    _, out = postprocess(study.path, snapshots=not args.no_snapshots)
+    _print_report(out)
+    return 0 if done else 1
 
 
-def _report_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--steady-after", type=float, default=0.25, metavar="FRACTION",
-                   help="leave this fraction of the production time out as start-up "
-                   "(default 0.25)")
+def _add_snapshots(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-snapshots", action="store_true",
                    help="skip the pyvista snapshots (the slowest figures)")
 
 
 def register(subparsers) -> None:
     """Add ``report`` and ``study``."""
-    from ligwf.cli.main import add_workflow_args
-
-    p = subparsers.add_parser("report", help="tables, figures and ParaView files of a finished study")
-    p.add_argument("study", type=Path, help="study folder (study.json)")
+    p = subparsers.add_parser("report", help="flow metrics, tables, figures and ParaView files "
+                              "of a finished study (steady window from its analysis settings)")
+    p.add_argument("study", type=Path, help="study folder")
     p.add_argument("--out", type=Path, default=None, help="report folder (default STUDY/report)")
-    _report_options(p)
+    _add_snapshots(p)
     p.set_defaults(func=cmd_report)
 
     p = subparsers.add_parser("study", help="run + analyse + report a workflow in one command")
     add_workflow_args(p)
-    p.add_argument("--out", type=Path, required=True, help="study folder")
-    p.add_argument("--np", type=int, default=1, help="MPI ranks per case (default 1)")
-    p.add_argument("--ensemble", type=int, default=0, metavar="P",
-                   help="run all cases in ONE mpirun -np P (see ligwf run)")
-    p.add_argument("--retry-unstable", action="store_true")
-    p.add_argument("--mesh-cache", type=Path, default=None)
-    _report_options(p)
+    add_run_args(p)
+    _add_snapshots(p)
     p.set_defaults(func=cmd_study)

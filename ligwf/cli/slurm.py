@@ -1,9 +1,12 @@
 """``ligwf slurm submit | status | resubmit``: run a study as Slurm job arrays.
 
-``submit`` renders every case (the same folders ``ligwf render`` writes), writes one array
-script with one task per case (each runs ``ligwf run-case STUDY --index I``, the local
-runner with its manifests, health checks and resume) plus an analysis job that depends on
-the array (``afterany``), and submits both. ``--dry-run`` prints the scripts and the sbatch
+``submit`` prepares the workflow exactly as ``ligwf study`` does -- validation, rendering
+and the stability pre-flight (``--allow-unstable`` overrides it) before anything is
+written or submitted -- writes the same folders, one array script with one task per case
+(each runs ``ligwf run-case STUDY --index I``, the local runner with its manifests, health
+checks and resume) plus an analysis job that depends on the array (``afterany``) and runs
+the same post-processing as ``ligwf study`` (:data:`ligwf.study.pipeline.POSTPROCESS_COMMANDS`,
+with the analysis settings stored in the study), and submits both. ``--dry-run`` prints the scripts and the sbatch
 commands and writes nothing. ``status`` joins the runner's manifests with squeue/scontrol;
 ``resubmit`` submits a new array with exactly the cases that are missing, failed or killed.
 """
@@ -18,33 +21,15 @@ from typing import Any
 
 from rich.table import Table
 
-from ligwf.study.prepare import render_workflow, write_study
-from ligwf.cli.main import add_workflow_args, case_table, console, err_console
+from ligwf.cli.common import (add_mesh_cache, add_workflow_args, case_table, console,
+                              err_console, prepare_from_args)
 from ligwf.errors import SubmitError
-from ligwf.slurm.jobs import (active_tasks, require_scheduler, cases_to_resubmit, dry_run_text, next_round, plan_jobs,
-                    read_record, read_study, recorded_site, study_status, submit_jobs)
+from ligwf.slurm.jobs import (active_tasks, cases_to_resubmit, dry_run_text, next_round,
+                              plan_jobs, read_record, recorded_site, require_scheduler,
+                              study_status, submit_jobs)
 from ligwf.slurm.site import SlurmSite, load_slurm_site
-from ligwf.scene.workflow import load_workflow
-
-#: ligwf sub-commands the analysis job runs over the study, in order, when they exist.
-ANALYSIS_STEPS = ("analyse", "report")
-
-_subparsers: argparse._SubParsersAction | None = None
-
-
-def analysis_steps() -> list[str]:
-    """The post-processing commands this ligwf installation has (``analyse``, ``report``).
-
-    ``analyse`` is always included: it is the documented interface of the analysis stage,
-    and a job that fails for want of it is more honest than a silently missing analysis.
-    """
-    have = set(_subparsers.choices) if _subparsers is not None else set()
-    steps = [s for s in ANALYSIS_STEPS if s in have]
-    if "analyse" not in steps:
-        err_console.print("[yellow]warning:[/] this ligwf has no 'analyse' command yet; the "
-                          "analysis job will run 'ligwf analyse' and fail until it exists")
-        steps.insert(0, "analyse")
-    return steps
+from ligwf.study.pipeline import POSTPROCESS_COMMANDS, write
+from ligwf.study.study import Study
 
 
 def add_site_args(p: argparse.ArgumentParser) -> None:
@@ -78,15 +63,15 @@ def _print_submitted(entries: list[dict]) -> None:
 
 
 def cmd_submit(args: argparse.Namespace) -> int:
-    wf = load_workflow(args.workflow, args.overrides)
-    rendered = render_workflow(wf, args.templates)
+    prepared = prepare_from_args(args)      # pre-flight before anything is written
+    wf, rendered = prepared.workflow, prepared.rendered
     site = site_from_args(args, load_slurm_site())
-    steps = [] if args.no_analysis else analysis_steps()
+    steps = [] if args.no_analysis else list(POSTPROCESS_COMMANDS)
     out: Path = args.out.resolve()
     round_no = next_round(out) if (out / "slurm").is_dir() else 1
     jobs = plan_jobs(out, wf.name, site, [rc.case.index for rc in rendered], steps, round_no)
     if args.dry_run:
-        console.print(case_table(rendered, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
+        console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
         print(dry_run_text(jobs))
         return 0
     require_scheduler()
@@ -96,8 +81,8 @@ def cmd_submit(args: argparse.Namespace) -> int:
             raise SubmitError(f"{out} still has {len(busy)} queued or running case(s) "
                               f"({', '.join(c.job or '?' for c in busy[:5])}); wait, scancel "
                               "them, or use 'ligwf slurm resubmit'")
-    write_study(wf, rendered, out, args.mesh_cache)
-    console.print(case_table(rendered, f"{wf.name}: {len(rendered)} case(s) -> {out}"))
+    write(prepared, out, args.mesh_cache)
+    console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) -> {out}"))
     _print_submitted(submit_jobs(out, jobs, site))
     return 0
 
@@ -136,7 +121,7 @@ def cmd_status(args: argparse.Namespace) -> int:
 
 def cmd_resubmit(args: argparse.Namespace) -> int:
     study_dir: Path = args.study_dir.resolve()
-    study = read_study(study_dir)
+    study = Study.open(study_dir)
     recorded = recorded_site(study_dir)
     base = _site_from_record(recorded) if recorded else load_slurm_site()
     site = site_from_args(args, base)
@@ -149,8 +134,8 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
     if not indices:
         console.print("nothing to resubmit: every case is done, unstable or still queued")
         return 0
-    steps = [] if args.no_analysis else analysis_steps()
-    jobs = plan_jobs(study_dir, study.get("name", "study"), site, indices, steps,
+    steps = [] if args.no_analysis else list(POSTPROCESS_COMMANDS)
+    jobs = plan_jobs(study_dir, study.name, site, indices, steps,
                      next_round(study_dir))
     console.print(f"resubmitting {len(indices)} case(s): "
                   + ", ".join(f"{c.index} {c.case_id} ({c.manifest})"
@@ -164,8 +149,6 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``ligwf slurm submit|status|resubmit`` to the top-level parser."""
-    global _subparsers
-    _subparsers = subparsers
     slurm = subparsers.add_parser("slurm", help="run a study as Slurm job arrays")
     sub = slurm.add_subparsers(dest="slurm_command", required=True)
 
@@ -173,8 +156,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                       "plus a dependent analysis job")
     add_workflow_args(p)
     p.add_argument("--out", type=Path, required=True, help="study folder to write")
-    p.add_argument("--mesh-cache", type=Path, default=None,
-                   help="mesh cache folder (default $LIGWF_MESH_CACHE or ./meshes)")
+    add_mesh_cache(p)
     add_site_args(p)
     p.set_defaults(func=cmd_submit)
 

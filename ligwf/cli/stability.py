@@ -1,7 +1,7 @@
 """``ligwf stability-report STUDY_DIR`` and ``ligwf stability-suite SUITE --out DIR``.
 
-Also home of :func:`preflight_or_refuse`, the one call ``check``, ``render`` and ``run``
-make after rendering (before anything is written or launched).
+(The pre-flight every workflow command runs before writing is part of preparing a study,
+:func:`ligwf.study.prepare.prepare`.)
 """
 
 from __future__ import annotations
@@ -14,26 +14,13 @@ from pathlib import Path
 from rich.console import Console
 from rich.table import Table
 
+from ligwf.cli.common import add_mesh_cache, err_console
 from ligwf.fsio import atomic_write_json
-from ligwf.scene.stability import MARGINAL, REFUSED, check_rendered
+from ligwf.scene.stability import MARGINAL, REFUSED
 
-err_console = Console(stderr=True, soft_wrap=True)
 console = Console(width=None if sys.stdout.isatty() else 200)
 
 _STYLE = {REFUSED: "bold red", MARGINAL: "yellow"}
-
-
-def add_allow_unstable(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--allow-unstable", action="store_true",
-                   help="run/write cases the pre-flight stability check refuses (experts)")
-
-
-def preflight_or_refuse(rendered, allow_unstable: bool = False):
-    """Pre-flight every rendered case; print warnings; raise UnstableCase on refusal."""
-    reports, warnings = check_rendered(rendered, allow_unstable)
-    for line in warnings:
-        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
-    return reports
 
 
 def _fmt(value, spec: str = ".3g") -> str:
@@ -69,7 +56,7 @@ def cmd_stability_report(args: argparse.Namespace) -> int:
 
     reports = report_study(args.study)
     if not reports:
-        err_console.print(f"ligwf: no case folders (scene.json) under {args.study}")
+        err_console.print(f"ligwf: no study or case folder at or below {args.study}")
         return 2
     console.print(report_table(reports, f"stability of {args.study}: {len(reports)} case(s)"))
     disagree = [r for r in reports if not r.agrees]
@@ -84,15 +71,15 @@ def cmd_stability_report(args: argparse.Namespace) -> int:
 
 def cmd_stability_suite(args: argparse.Namespace) -> int:
     """Render every variant of a stress suite (refused cases included: that is the point)."""
-    from ligwf.study.prepare import render_workflow, write_study
     from ligwf.scene.stability_suite import load_suite
+    from ligwf.study.pipeline import write
+    from ligwf.study.prepare import prepare
 
     suite = load_suite(args.suite)
     for variant, wf in suite.items():
-        rendered = render_workflow(wf, args.templates)
-        reports, _ = check_rendered(rendered, allow_unstable=True)
-        write_study(wf, rendered, args.out / variant, args.mesh_cache)
-        for rc, rep in zip(rendered, reports):
+        prepared = prepare(wf, args.templates, allow_unstable=True)
+        write(prepared, args.out / variant, args.mesh_cache)
+        for rc, rep in zip(prepared.rendered, prepared.preflight):
             console.print(f"{variant}/{rc.case.case_id}: pre-flight {rep.verdict}",
                           highlight=False)
     (args.out).mkdir(parents=True, exist_ok=True)
@@ -115,5 +102,5 @@ def register(sub) -> None:
     p.add_argument("suite", type=Path, help="suite YAML (base scene + variants)")
     p.add_argument("--out", type=Path, required=True)
     p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR")
-    p.add_argument("--mesh-cache", type=Path, default=None)
+    add_mesh_cache(p)
     p.set_defaults(func=cmd_stability_suite)

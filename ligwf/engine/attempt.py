@@ -10,17 +10,17 @@ from __future__ import annotations
 import math
 import os
 import re
-from pathlib import Path
 
 from ligwf import __version__
 from ligwf.fsio import atomic_write_text
-from ligwf.engine.health import RUNNING, Expectation, assess, kinetic_energy_ceiling, verdict
-from ligwf.engine.manifest import (SCREEN_FILE, THERMO_FILE, Attempt, Manifest, now_iso, read_manifest,
-                       scene_hash_of, write_manifest)
-from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for, load_scaled, render_resume,
-                     rotate_screen)
-from ligwf.scene.scaling import ScaledScene
+from ligwf.engine.health import (FAILED, RUNNING, UNSTABLE, Expectation, assess,
+                                 kinetic_energy_ceiling, verdict)
+from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for, render_resume,
+                                 rotate_screen)
 from ligwf.engine.thermo import ThermoRow, parse_screen, phase_group, rows_from_csv, rows_to_csv
+from ligwf.scene.scaling import ScaledScene
+from ligwf.study.case import CaseFolder
+from ligwf.study.manifest import Attempt, Manifest, now_iso
 
 _VERSION_RE = re.compile(r"^LIGGGHTS \((Version .*)\)\s*$")
 
@@ -44,28 +44,20 @@ def engine_version(lines: list[str]) -> str | None:
     return None
 
 
-def case_index(case_dir: Path) -> tuple[str, int]:
-    import json
-    rec = json.loads((Path(case_dir) / "scene.json").read_text())
-    return rec["case_id"], int(rec["index"])
-
-
-def begin_attempt(case_dir: Path, plan: Plan, nprocs: int, launcher: str,
+def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
                   command: list[str] | None = None, template_dirs=()) -> tuple[Manifest, Attempt]:
     """Prepare the folder for ``plan`` (clean or write the resume input) and record the
     attempt as ``running`` in the manifest. Returns the manifest and the new attempt."""
-    case_dir = Path(case_dir)
-    previous = read_manifest(case_dir)
+    previous = case.manifest()
     if plan.action == FRESH or previous is None:
-        clean_outputs(case_dir)
-        case_id, index = case_index(case_dir)
-        manifest = Manifest(case_id=case_id, index=index, scene_hash=scene_hash_of(case_dir),
+        clean_outputs(case.path)
+        manifest = Manifest(case_id=case.case_id, index=case.index, scene_hash=case.scene_hash,
                             ligwf_version=__version__, liggghts_version="")
         from_step, restart_path = 0, None
     elif plan.action == RESUME and plan.restart is not None:
-        for name, text in render_resume(load_scaled(case_dir), plan.restart, template_dirs).items():
-            atomic_write_text(case_dir / name, text)
-        rotate_screen(case_dir)
+        for name, text in render_resume(case.scaled, plan.restart, template_dirs).items():
+            atomic_write_text(case.path / name, text)
+        rotate_screen(case.path)
         manifest = previous
         from_step, restart_path = plan.restart.step, plan.restart.path
     else:
@@ -74,13 +66,13 @@ def begin_attempt(case_dir: Path, plan: Plan, nprocs: int, launcher: str,
     manifest.host, manifest.pid = os.uname().nodename, os.getpid()
     manifest.launcher, manifest.nprocs = launcher, nprocs
     manifest.command = list(command or [])
-    manifest.total_steps = load_scaled(case_dir).total_steps
+    manifest.total_steps = case.scaled.total_steps
     manifest.ended = None
     attempt = Attempt(number=len(manifest.attempts) + 1, started=now_iso(), nprocs=nprocs,
                       command=list(command or []), input=input_for(plan),
                       from_restart=restart_path, from_step=from_step)
     manifest.attempts.append(attempt)
-    write_manifest(case_dir, manifest)
+    case.write_manifest(manifest)
     return manifest, attempt
 
 
@@ -99,18 +91,17 @@ def _merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int,
     return kept + shifted
 
 
-def finish_attempt(case_dir: Path, manifest: Manifest, attempt: Attempt, exit_code: int | None,
-                   wall_seconds: float, killed: bool = False,
+def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
+                   exit_code: int | None, wall_seconds: float, killed: bool = False,
                    engine_version_line: str | None = None) -> Manifest:
     """Judge the attempt from its screen capture and write thermo table + manifest."""
-    case_dir = Path(case_dir)
-    s = load_scaled(case_dir)
-    screen = case_dir / attempt.screen
+    s = case.scaled
+    screen = case.path / attempt.screen
     text = screen.read_text(errors="replace") if screen.exists() else ""
     parser = parse_screen(text)
     previous: list[ThermoRow] = []
-    if attempt.from_step and (case_dir / THERMO_FILE).exists():
-        previous = rows_from_csv((case_dir / THERMO_FILE).read_text())
+    if attempt.from_step and case.thermo.exists():
+        previous = rows_from_csv(case.thermo.read_text())
     rows = _merge_rows(previous, parser.rows, attempt.from_step, s.dt)
     expect = expectation(s)
     issues = assess(rows, parser.lines, expect)
@@ -146,16 +137,16 @@ def finish_attempt(case_dir: Path, manifest: Manifest, attempt: Attempt, exit_co
         settled = [r for r in rows if r.step <= expect.settle_end_step]
         if settled and settled[-1].step == expect.settle_end_step:
             manifest.atoms_after_settle = _int_or_none(settled[-1].get("atoms"))
-    atomic_write_text(case_dir / THERMO_FILE, rows_to_csv(rows))
-    write_manifest(case_dir, manifest)
+    atomic_write_text(case.thermo, rows_to_csv(rows))
+    case.write_manifest(manifest)
     return manifest
 
 
 def _cause_step(issues, status: str) -> int | None:
     """Step of the issue behind a failed / unstable verdict."""
-    if status == "failed":
+    if status == FAILED:
         cause = [i for i in issues if i.kind == "error"]
-    elif status == "unstable":
+    elif status == UNSTABLE:
         cause = [i for i in issues if not i.fatal]
     else:
         cause = []
@@ -168,9 +159,9 @@ def _int_or_none(value: float) -> int | None:
 
 def restart_unreadable(manifest: Manifest, attempt: Attempt) -> bool:
     """True when a resumed attempt failed before taking a step (bad restart file)."""
-    return (attempt.from_restart is not None and manifest.status == "failed"
+    return (attempt.from_restart is not None and manifest.status == FAILED
             and manifest.steps_done <= attempt.from_step)
 
 
 __all__ = ["begin_attempt", "finish_attempt", "expectation", "engine_version", "phase_group",
-           "restart_unreadable", "SCREEN_FILE"]
+           "restart_unreadable"]

@@ -27,19 +27,17 @@ import threading
 import time
 from pathlib import Path
 
-from rich.console import Console
-
 from ligwf.engine.attempt import finish_attempt
+from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
+from ligwf.engine.health import FAILED, KILLED, log_errors
+from ligwf.engine.launch import Monitor, NullMonitor, signal_engine
+from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig
+from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.errors import SimulationFailed
 from ligwf.fsio import atomic_write_json
-from ligwf.engine.health import FAILED, KILLED, log_errors
-from ligwf.engine.launch import signal_engine
-from ligwf.engine.manifest import SCREEN_FILE, Manifest, read_manifest, write_manifest
-from ligwf.engine.progress import RichMonitor
-from ligwf.engine.resume import SKIP, plan_case
-from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
-from ligwf.engine.thermo import LogTail, ThermoParser
+from ligwf.study.case import CaseFolder
+from ligwf.study.manifest import Manifest
 
 ENSEMBLE_DIR = ".ensemble"
 
@@ -64,27 +62,32 @@ def _done(ens_dir: Path, pos: int) -> bool:
     return (ens_dir / CLAIMS_DIR / f"{pos}.done").exists()
 
 
-def _settle_in_flight(case_dir: Path, exit_code: int | None, wall: float,
-                      launch_log: str) -> Manifest | None:
+def _settle_in_flight(case: CaseFolder, exit_code: int | None, wall: float) -> Manifest | None:
     """Record a member that was running when the job ended: culprit or victim."""
-    m = read_manifest(case_dir)
+    m = case.manifest()
     if m is None or not m.attempts:
         return None
     attempt = m.attempts[-1]
-    screen = case_dir / attempt.screen
+    screen = case.path / attempt.screen
     lines = screen.read_text(errors="replace").splitlines() if screen.exists() else []
     if log_errors(lines):
-        return finish_attempt(case_dir, m, attempt, exit_code, wall)
+        return finish_attempt(case, m, attempt, exit_code, wall)
     m.status, m.reason = KILLED, "stopped when another ensemble member aborted the job"
-    write_manifest(case_dir, m)
+    case.write_manifest(m)
     return m
 
 
-def run_ensemble(study: Path, case_dirs: list[Path], nprocs: int, group_size: int,
+def _key(case: CaseFolder) -> str:
+    """How the queue and the claims name a case: its resolved folder."""
+    return str(case.path.resolve())
+
+
+def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: int,
                  engine: EngineConfig, retry_unstable: bool = False,
-                 stop: threading.Event | None = None, console: Console | None = None,
+                 stop: threading.Event | None = None, monitor: Monitor | None = None,
                  poll_seconds: float = 0.5, max_launches: int | None = None) -> dict[str, str]:
-    """Run ``case_dirs`` in MPI ensembles of ``nprocs`` ranks, groups of ``group_size``.
+    """Run ``cases`` in MPI ensembles of ``nprocs`` ranks, groups of ``group_size``;
+    ``monitor`` gets the same live progress as for local runs.
 
     Returns ``{case folder name: status}`` for the cases worked on.
     """
@@ -92,87 +95,89 @@ def run_ensemble(study: Path, case_dirs: list[Path], nprocs: int, group_size: in
         raise SimulationFailed(f"--ensemble {nprocs} cannot be split into groups of --np "
                                f"{group_size}")
     stop = stop or threading.Event()
-    todo = [Path(d) for d in case_dirs if plan_case(d, retry_unstable).action != SKIP]
+    monitor = monitor or NullMonitor()
+    todo = [c for c in cases if plan_case(c, retry_unstable).action != SKIP]
+    by_key = {_key(c): c for c in todo}
     outcome: dict[str, str] = {}
     root = Path(study) / ENSEMBLE_DIR
     launches = 0
     limit = max_launches or (2 * len(todo) + 2)
-    with RichMonitor(console) as monitor:
-        while todo and not stop.is_set() and launches < limit:
-            launches += 1
-            ens_dir = root / f"launch-{launches}"
-            if ens_dir.exists():
-                shutil.rmtree(ens_dir)
-            (ens_dir / CLAIMS_DIR).mkdir(parents=True)
-            atomic_write_json(ens_dir / QUEUE_FILE, {"cases": [str(d.resolve()) for d in todo],
-                                                     "retry_unstable": retry_unstable})
-            cmd = worker_command(engine, nprocs, ens_dir, group_size)
-            t0 = time.monotonic()
-            tails: dict[int, tuple[LogTail, ThermoParser]] = {}
-            ended: set[int] = set()
-            with open(ens_dir / "launch.log", "wb") as out:
-                proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT,
-                                        stdin=subprocess.DEVNULL, start_new_session=True)
-            stop_sent = False
-            while True:
-                finished = proc.poll() is not None
-                for pos, claim in _claims(ens_dir).items():
-                    case = Path(claim["case"])
-                    if pos not in tails:
-                        m = read_manifest(case)
-                        if m is None or not m.attempts:
-                            continue
-                        tails[pos] = (LogTail(case / SCREEN_FILE), ThermoParser())
-                        monitor.start(case.name, m.total_steps, m.attempts[-1].from_step)
-                    tail, parser = tails[pos]
-                    for line in tail.read_lines():
-                        parser.feed(line)
-                    monitor.update(case.name, parser)
-                    if pos not in ended and _done(ens_dir, pos):
-                        ended.add(pos)
-                        m = read_manifest(case)
-                        if m is not None:
-                            outcome[case.name] = m.status
-                            monitor.end(case.name, m, plan_case(case))
-                if finished:
-                    break
-                if stop.is_set() and not stop_sent:
-                    signal_engine(proc)
-                    stop_sent = True
-                time.sleep(poll_seconds)
-            wall = time.monotonic() - t0
-            launch_log = (ens_dir / "launch.log").read_text(errors="replace")
-            claims = _claims(ens_dir)
-            progressed = bool(ended)
-            victims: list[Path] = []
-            for pos, claim in claims.items():
-                if pos in ended or _done(ens_dir, pos):
-                    continue
-                case = Path(claim["case"])
-                m = _settle_in_flight(case, proc.returncode, wall, launch_log)
-                if m is None:
-                    continue
-                outcome[case.name] = m.status
-                if m.status == KILLED:
-                    victims.append(case)
-                else:
-                    progressed = True
-                    monitor.end(case.name, m, plan_case(case))
-            if not claims and proc.returncode:
-                raise SimulationFailed(
-                    f"ensemble launch failed before any case started (exit {proc.returncode})",
-                    exit_code=proc.returncode, run_dir=str(ens_dir), log_tail=launch_log[-2000:])
-            if not progressed and victims and not stop.is_set():
-                for case in victims:
-                    m = read_manifest(case)
+    while todo and not stop.is_set() and launches < limit:
+        launches += 1
+        ens_dir = root / f"launch-{launches}"
+        if ens_dir.exists():
+            shutil.rmtree(ens_dir)
+        (ens_dir / CLAIMS_DIR).mkdir(parents=True)
+        atomic_write_json(ens_dir / QUEUE_FILE, {"cases": [_key(c) for c in todo],
+                                                 "retry_unstable": retry_unstable})
+        cmd = worker_command(engine, nprocs, ens_dir, group_size)
+        t0 = time.monotonic()
+        tails: dict[int, tuple[LogTail, ThermoParser]] = {}
+        ended: set[int] = set()
+        with open(ens_dir / "launch.log", "wb") as out:
+            proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT,
+                                    stdin=subprocess.DEVNULL, start_new_session=True)
+        stop_sent = False
+        while True:
+            finished = proc.poll() is not None
+            for pos, claim in _claims(ens_dir).items():
+                case = by_key[claim["case"]]
+                name = case.path.name
+                if pos not in tails:
+                    m = case.manifest()
+                    if m is None or not m.attempts:
+                        continue
+                    tails[pos] = (LogTail(case.screen), ThermoParser())
+                    monitor.start(name, m.total_steps, m.attempts[-1].from_step)
+                tail, parser = tails[pos]
+                for line in tail.read_lines():
+                    parser.feed(line)
+                monitor.update(name, parser)
+                if pos not in ended and _done(ens_dir, pos):
+                    ended.add(pos)
+                    m = case.manifest()
                     if m is not None:
-                        m.status = FAILED
-                        m.reason = (f"ensemble job ended (exit {proc.returncode}) with no member "
-                                    f"finished and no ERROR line; see {ens_dir / 'launch.log'}")
-                        write_manifest(case, m)
-                        outcome[case.name] = FAILED
-                        monitor.end(case.name, m, plan_case(case))
-            settled = {Path(c["case"]) for p, c in claims.items()}
-            todo = [d for d in todo if d.resolve() not in settled
-                    or (d.resolve() in {v.resolve() for v in victims} and progressed)]
+                        outcome[name] = m.status
+                        monitor.end(name, m, plan_case(case))
+            if finished:
+                break
+            if stop.is_set() and not stop_sent:
+                signal_engine(proc)
+                stop_sent = True
+            time.sleep(poll_seconds)
+        wall = time.monotonic() - t0
+        launch_log = (ens_dir / "launch.log").read_text(errors="replace")
+        claims = _claims(ens_dir)
+        progressed = bool(ended)
+        victims: list[CaseFolder] = []
+        for pos, claim in claims.items():
+            if pos in ended or _done(ens_dir, pos):
+                continue
+            case = by_key[claim["case"]]
+            m = _settle_in_flight(case, proc.returncode, wall)
+            if m is None:
+                continue
+            outcome[case.path.name] = m.status
+            if m.status == KILLED:
+                victims.append(case)
+            else:
+                progressed = True
+                monitor.end(case.path.name, m, plan_case(case))
+        if not claims and proc.returncode:
+            raise SimulationFailed(
+                f"ensemble launch failed before any case started (exit {proc.returncode})",
+                exit_code=proc.returncode, run_dir=str(ens_dir), log_tail=launch_log[-2000:])
+        if not progressed and victims and not stop.is_set():
+            for case in victims:
+                m = case.manifest()
+                if m is not None:
+                    m.status = FAILED
+                    m.reason = (f"ensemble job ended (exit {proc.returncode}) with no member "
+                                f"finished and no ERROR line; see {ens_dir / 'launch.log'}")
+                    case.write_manifest(m)
+                    outcome[case.path.name] = FAILED
+                    monitor.end(case.path.name, m, plan_case(case))
+        settled = {c["case"] for c in claims.values()}
+        retried = {_key(v) for v in victims} if progressed else set()
+        todo = [c for c in todo if _key(c) not in settled or _key(c) in retried]
     return outcome

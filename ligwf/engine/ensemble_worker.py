@@ -26,8 +26,8 @@ from pathlib import Path
 from ligwf.engine.attempt import begin_attempt, finish_attempt
 from ligwf.engine.site import load_site
 from ligwf.fsio import atomic_write_json
-from ligwf.engine.manifest import SCREEN_FILE
 from ligwf.engine.resume import SKIP, input_for, plan_case
+from ligwf.study.case import CaseFolder
 
 QUEUE_FILE = "queue.json"
 _libc = ctypes.CDLL(None)
@@ -76,10 +76,10 @@ class Liggghts:
             self.lib.lammps_command(handle, cmd.encode())
         self.lib.lammps_close(handle)
 
-    def run_file(self, comm, case_dir: Path, input_name: str) -> None:
-        """Run ``input_name`` in ``case_dir`` on the mpi4py communicator ``comm``.
+    def run_file(self, comm, case: CaseFolder, input_name: str) -> None:
+        """Run ``input_name`` in the case folder on the mpi4py communicator ``comm``.
 
-        The engine's screen is the process's stdout, pointed at ``run.log`` of the case on
+        The engine's screen is the process's stdout, pointed at the case's screen file on
         the group leader and line-buffered (:func:`line_buffered_stdout`): an Error::one
         ends in MPI_Abort, which drops whatever a fully buffered ``-screen FILE`` still
         held -- including the ERROR line that names the culprit.
@@ -95,11 +95,10 @@ class Liggghts:
         _libc.fflush(None)
         if comm.rank == 0:
             saved = os.dup(1)
-            fd = os.open(Path(case_dir) / SCREEN_FILE, os.O_WRONLY | os.O_CREAT | os.O_TRUNC,
-                         0o644)
+            fd = os.open(case.screen, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
             os.dup2(fd, 1)
             os.close(fd)
-        os.chdir(case_dir)
+        os.chdir(case.path)
         try:
             self.lib.lammps_open(len(args), argv, comm_ptr, ctypes.byref(handle))
             self.lib.lammps_file(handle, input_name.encode())
@@ -163,24 +162,26 @@ def main(argv: list[str] | None = None) -> int:
                                    {"group": group, "world_ranks": ranks, "pid": os.getpid()})
                 if claim is None:
                     break
-                pos, case = claim
-                plan = plan_case(Path(case), queue.get("retry_unstable", False))
+                pos, case_path = claim
+                case = CaseFolder.open(case_path)
+                plan = plan_case(case, queue.get("retry_unstable", False))
                 if plan.action == SKIP:
                     atomic_write_json(args.ens_dir / CLAIMS_DIR / f"{pos}.done", {"skipped": True})
                     continue
-                manifest, attempt = begin_attempt(Path(case), plan, k, "ensemble",
+                manifest, attempt = begin_attempt(case, plan, k, "ensemble",
                                                   [f"ensemble group {group}", input_for(plan)])
-                job = (pos, case, attempt.input)
+                job = (pos, case_path, attempt.input)
                 break
         job = sub.bcast(job, root=0)
         if job is None:
             break
-        pos, case, input_name = job
+        pos, case_path, input_name = job
+        case = CaseFolder.open(case_path)
         t0 = time.monotonic()
-        engine.run_file(sub, Path(case), input_name)
+        engine.run_file(sub, case, input_name)
         sub.Barrier()
         if sub.rank == 0:
-            finish_attempt(Path(case), manifest, attempt, 0, time.monotonic() - t0)
+            finish_attempt(case, manifest, attempt, 0, time.monotonic() - t0)
             atomic_write_json(args.ens_dir / CLAIMS_DIR / f"{pos}.done", {"group": group})
     sub.Free()
     return 0

@@ -23,23 +23,39 @@ from pathlib import Path
 from typing import Protocol, Sequence
 
 from ligwf.engine.attempt import begin_attempt, finish_attempt, restart_unreadable
-from ligwf.engine.site import EngineConfig
 from ligwf.engine.health import KILLED, atom_loss, kinetic_energy_blowup, log_errors, non_finite
-from ligwf.engine.manifest import SCREEN_FILE, Manifest, write_manifest
 from ligwf.engine.render import grid_vars
-from ligwf.engine.resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, load_scaled, plan_case
+from ligwf.engine.resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, plan_case
+from ligwf.engine.site import EngineConfig
 from ligwf.engine.thermo import LogTail, ThermoParser
+from ligwf.study.case import CaseFolder
+from ligwf.study.layout import SCREEN_FILE
+from ligwf.study.manifest import Manifest
 
 #: Seconds a stopped engine gets to write its forced restart before it is killed.
 STOP_GRACE_SECONDS = 60.0
 
 
 class Monitor(Protocol):
-    """Receives live progress of the cases a runner works on (see ligwf.engine.progress)."""
+    """Receives live progress of the cases a runner works on (local runs and ensembles
+    alike; :class:`ligwf.engine.progress.RichMonitor` draws it)."""
 
     def start(self, case_id: str, total_steps: int, from_step: int) -> None: ...
     def update(self, case_id: str, parser: ThermoParser) -> None: ...
     def end(self, case_id: str, manifest: Manifest | None, plan: Plan) -> None: ...
+
+
+class NullMonitor:
+    """A :class:`Monitor` that shows nothing (library use, tests, batch jobs)."""
+
+    def start(self, case_id: str, total_steps: int, from_step: int) -> None:
+        pass
+
+    def update(self, case_id: str, parser: ThermoParser) -> None:
+        pass
+
+    def end(self, case_id: str, manifest: Manifest | None, plan: Plan) -> None:
+        pass
 
 
 @dataclass(frozen=True)
@@ -147,37 +163,34 @@ def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
     return LaunchResult(proc.returncode, time.monotonic() - t0, killed, unstable)
 
 
-def run_case(case_dir: Path, nprocs: int, engine: EngineConfig, monitor: Monitor | None = None,
+def run_case(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Monitor | None = None,
              stop: threading.Event | None = None, retry_unstable: bool = False,
              template_dirs=(), poll_seconds: float = 0.5) -> Manifest | None:
     """Plan, launch and record one case (skip, fresh run or resume). Returns the manifest,
     or None when the case was skipped."""
-    case_dir = Path(case_dir)
-    plan = plan_case(case_dir, retry_unstable)
-    case_id = case_dir.name
+    monitor = monitor or NullMonitor()
+    plan = plan_case(case, retry_unstable)
+    case_id = case.path.name
     if plan.action == SKIP:
-        if monitor is not None:
-            monitor.end(case_id, None, plan)
+        monitor.end(case_id, None, plan)
         return None
-    scaled = load_scaled(case_dir)
-    grid = grid_vars(scaled, nprocs)
+    grid = grid_vars(case.scaled, nprocs)
     while True:
         cmd = engine.command(input_for(plan), nprocs, extra=grid)
-        manifest, attempt = begin_attempt(case_dir, plan, nprocs, "mpirun", cmd, template_dirs)
-        if monitor is not None:
-            monitor.start(case_id, manifest.total_steps, attempt.from_step)
-        result = launch(case_dir, attempt.input, nprocs, engine, case_id, monitor, stop,
-                        poll_seconds, particle_count=scaled.particle_count, engine_args=grid)
-        manifest = finish_attempt(case_dir, manifest, attempt, result.exit_code,
+        manifest, attempt = begin_attempt(case, plan, nprocs, "mpirun", cmd, template_dirs)
+        monitor.start(case_id, manifest.total_steps, attempt.from_step)
+        result = launch(case.path, attempt.input, nprocs, engine, case_id, monitor, stop,
+                        poll_seconds, particle_count=case.scaled.particle_count,
+                        engine_args=grid)
+        manifest = finish_attempt(case, manifest, attempt, result.exit_code,
                                   result.wall_seconds, killed=result.killed)
         if restart_unreadable(manifest, attempt) and plan.restart is not None:
             # a restart cut short by SIGKILL: set it aside and try the next one (or afresh)
-            discard_restart(case_dir, plan.restart)
+            discard_restart(case.path, plan.restart)
             manifest.status = KILLED
-            write_manifest(case_dir, manifest)
-            plan = plan_case(case_dir, retry_unstable)
+            case.write_manifest(manifest)
+            plan = plan_case(case, retry_unstable)
             if plan.action in (FRESH, RESUME):
                 continue
-        if monitor is not None:
-            monitor.end(case_id, manifest, plan)
+        monitor.end(case_id, manifest, plan)
         return manifest

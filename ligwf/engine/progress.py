@@ -7,7 +7,6 @@ a table summarises every case: status, steps, atoms, wall and core-seconds, and 
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Iterable
 
 from rich.console import Console
@@ -15,12 +14,14 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskID, Text
                            TimeRemainingColumn)
 from rich.table import Table
 
-from ligwf.engine.manifest import Manifest, effective_status, read_manifest
+from ligwf.engine.health import DONE, FAILED, KILLED, MISSING, RUNNING, UNSTABLE
 from ligwf.engine.resume import Plan
 from ligwf.engine.thermo import ThermoParser
+from ligwf.study.case import CaseFolder
+from ligwf.study.manifest import Manifest, effective_status
 
-_STATUS_STYLE = {"done": "green", "failed": "red", "unstable": "yellow", "killed": "magenta",
-                 "running": "cyan"}
+_STATUS_STYLE = {DONE: "green", FAILED: "red", UNSTABLE: "yellow", KILLED: "magenta",
+                 RUNNING: "cyan"}
 
 
 class RichMonitor:
@@ -67,16 +68,16 @@ class RichMonitor:
             self.progress.update(task, description=f"{case_id} [{style}]{manifest.status}[/]")
 
 
-def summary_table(case_dirs: Iterable[Path], title: str = "cases") -> Table:
+def summary_table(cases: Iterable[CaseFolder], title: str = "cases") -> Table:
     """Status of every case folder from its manifest (``ligwf status`` and run summary)."""
     table = Table(title=title)
     for col in ("case", "status", "steps", "atoms start->end", "wall [s]", "core-s",
                 "settle [s]", "production [s]", "reason"):
         table.add_column(col, justify="left" if col in ("case", "status", "reason") else "right")
-    for d in case_dirs:
-        m = read_manifest(d)
+    for case in cases:
+        m = case.manifest()
         if m is None:
-            table.add_row(Path(d).name, "pending", "", "", "", "", "", "", "")
+            table.add_row(case.path.name, MISSING, "", "", "", "", "", "", "")
             continue
         status = effective_status(m)
         style = _STATUS_STYLE.get(status, "")

@@ -2,7 +2,7 @@
 
 Running a study again must not redo finished work:
 
-* ``done`` with the scene hash of ``scene.json``  -> skip;
+* ``done`` with the case's scene hash             -> skip;
 * ``unstable`` with a matching hash               -> skip (the engine is deterministic:
   re-running gives the same blow-up; pass ``retry_unstable`` to force it);
 * ``failed``, no manifest, or a stale hash        -> fresh run (old outputs removed);
@@ -19,18 +19,18 @@ re-issues every fix with the same ID and runs the remaining phases with ``run N 
 
 from __future__ import annotations
 
-import json
 import re
 import shutil
 import struct
 from dataclasses import dataclass
 from pathlib import Path
 
-from ligwf.engine.health import DONE, FAILED, UNSTABLE
-from ligwf.engine.manifest import (MANIFEST_FILE, SCREEN_FILE, THERMO_FILE, effective_status, read_manifest,
-                       scene_hash_of)
-from ligwf.engine.render import INPUT_NAME, render_template, template_context
+from ligwf.engine.health import DONE, FAILED, RUNNING, UNSTABLE
+from ligwf.engine.render import INPUT_NAME, OUTPUT_DIRS, render_template, template_context
 from ligwf.scene.scaling import ScaledScene
+from ligwf.study.case import CaseFolder
+from ligwf.study.layout import MANIFEST_FILE, SCREEN_FILE, THERMO_FILE
+from ligwf.study.manifest import effective_status
 
 #: Input file of a resumed attempt (next to ``in.liggghts``).
 RESUME_INPUT = "resume.in.liggghts"
@@ -113,24 +113,23 @@ def discard_restart(case_dir: Path, restart: RestartFile) -> None:
         p.rename(p.with_name(p.name + ".corrupt"))
 
 
-def plan_case(case_dir: Path, retry_unstable: bool = False) -> Plan:
+def plan_case(case: CaseFolder, retry_unstable: bool = False) -> Plan:
     """What to do with a case folder now (see the module docstring)."""
-    case_dir = Path(case_dir)
-    m = read_manifest(case_dir)
+    m = case.manifest()
     if m is None:
         return Plan(FRESH, "not run yet")
-    if m.scene_hash != scene_hash_of(case_dir):
+    if m.scene_hash != case.scene_hash:
         return Plan(FRESH, "scene changed since the last run")
     status = effective_status(m)
     if status == DONE:
-        return Plan(SKIP, "done")
+        return Plan(SKIP, DONE)
     if status == UNSTABLE and not retry_unstable:
         return Plan(SKIP, f"unstable: {m.reason}")
     if status in (FAILED, UNSTABLE):
         return Plan(FRESH, f"re-run after {status}: {m.reason}")
-    if status == "running":
+    if status == RUNNING:
         return Plan(SKIP, f"running in process {m.pid} on {m.host}")
-    restarts = restart_files(case_dir)
+    restarts = restart_files(case.path)
     if restarts:
         return Plan(RESUME, f"killed at step {m.steps_done}; resume from {restarts[0].path}",
                     restarts[0])
@@ -140,7 +139,7 @@ def plan_case(case_dir: Path, retry_unstable: bool = False) -> Plan:
 def clean_outputs(case_dir: Path) -> None:
     """Remove the outputs of earlier attempts before a fresh run (inputs stay)."""
     case_dir = Path(case_dir)
-    for sub in ("post", "restart"):
+    for sub in OUTPUT_DIRS:
         d = case_dir / sub
         if d.is_dir():
             shutil.rmtree(d)
@@ -150,15 +149,6 @@ def clean_outputs(case_dir: Path) -> None:
                                                    "log.liggghts")
                 or re.fullmatch(r"run(\.\d+)?\.log", p.name)):
             p.unlink()
-
-
-def load_scaled(case_dir: Path) -> ScaledScene:
-    """The scaled scene a case folder was rendered from (``scene.json``)."""
-    data = json.loads((Path(case_dir) / "scene.json").read_text())["scaled"]
-    for key, value in data.items():
-        if isinstance(value, list):
-            data[key] = tuple(value)
-    return ScaledScene(**data)
 
 
 def resume_phase(s: ScaledScene, step: int) -> tuple[str, int, bool]:

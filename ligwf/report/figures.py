@@ -7,7 +7,6 @@ and writes the PNG atomically (render to memory, then rename).
 from __future__ import annotations
 
 import io
-import json
 from pathlib import Path
 
 import matplotlib
@@ -129,7 +128,3 @@ def snapshot(particles_vtu: Path, drum_stl: Path, axis: str, drum_angle: float, 
     Image.fromarray(png).save(buf, format="PNG")
     atomic_write_bytes(path, buf.getvalue())
     return path
-
-
-def scene_axis(case_dir: Path) -> str:
-    return json.loads((case_dir / "scene.json").read_text())["scaled"]["axis"]

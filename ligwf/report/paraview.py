@@ -8,7 +8,6 @@ when the series is played.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from pathlib import Path
@@ -17,9 +16,10 @@ import meshio
 import numpy as np
 
 from ligwf.analysis.dumps import discover_frames
-from ligwf.analysis.flow_run import production_start_step
-from ligwf.fsio import atomic_write_text
 from ligwf.engine.mesh import axis_frame
+from ligwf.engine.render import MESH_NAME
+from ligwf.fsio import atomic_write_text
+from ligwf.study.case import CaseFolder
 
 
 def rotation_matrix(axis: str, angle: float) -> np.ndarray:
@@ -29,12 +29,6 @@ def rotation_matrix(axis: str, angle: float) -> np.ndarray:
     k[ia] = 1.0
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
-
-
-def drum_angle(case_dir: Path, step: int) -> float:
-    """Angle (rad) the drum has turned by at ``step`` (it starts turning after settling)."""
-    s = json.loads((Path(case_dir) / "scene.json").read_text())["scaled"]
-    return s["omega"] * max(0, step - production_start_step(s)) * s["dt"]
 
 
 def _pvd(entries: list[tuple[float, int, str]]) -> str:
@@ -47,30 +41,29 @@ def _pvd(entries: list[tuple[float, int, str]]) -> str:
     return "\n".join(lines)
 
 
-def case_collection(case_dir: Path, analysis_dir: Path, out_dir: Path) -> Path | None:
+def case_collection(case: CaseFolder, analysis_dir: Path, out_dir: Path) -> Path | None:
     """Write ``out_dir/<case>.pvd`` (+ rotated drum files); None when there are no frames."""
-    rec = json.loads((case_dir / "scene.json").read_text())
-    s = rec["scaled"]
-    frames = discover_frames(case_dir)
+    s = case.scaled
+    frames = discover_frames(case.path)
     if not frames:
         return None
-    drum = meshio.read(case_dir / "drum.stl")
+    drum = meshio.read(case.path / MESH_NAME)
     tri = drum.cells_dict["triangle"]
-    case_out = out_dir / rec["case_id"]
+    case_out = out_dir / case.case_id
     case_out.mkdir(parents=True, exist_ok=True)
     entries = []
-    labelled = analysis_dir / rec["case_id"]
+    labelled = analysis_dir / case.case_id
     for ff in frames:
-        t = ff.step * s["dt"]
+        t = ff.step * s.dt
         g = labelled / f"granules_{ff.step}.vtu"
         particles = g if g.is_file() else ff.particles
         entries.append((t, 0, os.path.relpath(particles, out_dir)))
-        pts = drum.points @ rotation_matrix(s["axis"], drum_angle(case_dir, ff.step)).T
+        pts = drum.points @ rotation_matrix(s.axis, case.drum_angle(ff.step)).T
         drum_file = case_out / f"drum_{ff.step}.vtu"
         tmp = drum_file.with_suffix(".tmp.vtu")
         meshio.write(tmp, meshio.Mesh(pts, [("triangle", tri)]), binary=True)
         os.replace(tmp, drum_file)
         entries.append((t, 1, os.path.relpath(drum_file, out_dir)))
-    path = out_dir / f"{rec['case_id']}.pvd"
+    path = out_dir / f"{case.case_id}.pvd"
     atomic_write_text(path, _pvd(entries))
     return path

@@ -26,26 +26,21 @@ stable (``ok`` and ``marginal`` predict a stable run).
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ligwf.engine import health
-from ligwf.study.prepare import SCENE_FILE
 from ligwf.analysis.dumps import discover_frames, read_particles
+from ligwf.engine import health
+from ligwf.engine.attempt import expectation
+from ligwf.engine.thermo import parse_screen
 from ligwf.errors import DumpReadError
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.stability import OVERLAP_LIMIT, REFUSED, Preflight, preflight
-from ligwf.engine.thermo import parse_screen
-
-#: Screen capture of a run (stdout + stderr), the runner's file name.
-try:
-    from ligwf.engine.manifest import SCREEN_FILE
-except ImportError:  # pragma: no cover - the runner's module is part of the package
-    SCREEN_FILE = "run.log"
+from ligwf.study.case import CaseFolder
+from ligwf.study.study import studies_below
 
 STABLE = "stable"
 _OUTCOME_OF_KIND = {
@@ -72,16 +67,6 @@ class Observation:
     energy_drift: float | None   # relative, see module docstring
     max_overlap: float | None    # m, largest in the dumps (None: no dump)
     max_dt_hertz: float | None   # largest engine f_ts[2]
-
-
-def scaled_of(case_dir: Path) -> tuple[str, ScaledScene, bool]:
-    """(case id, scaled scene, explicit dt?) from a case folder's scene.json."""
-    rec = json.loads((Path(case_dir) / SCENE_FILE).read_text())
-    sc = dict(rec["scaled"])
-    for key in ("diameters", "number_fractions", "seeds", "insertion_waves"):
-        sc[key] = tuple(sc[key])
-    explicit = rec["scene"].get("numerics", {}).get("dt") is not None
-    return rec["case_id"], ScaledScene(**sc), explicit
 
 
 def energy_drift(rows) -> float | None:
@@ -137,29 +122,22 @@ def observed_max_overlap(case_dir: Path, s: ScaledScene) -> float | None:
     return best
 
 
-def observe(case_dir: Path, s: ScaledScene) -> Observation:
+def observe(case: CaseFolder) -> Observation:
     """Observed outcome of a finished case folder (screen capture + dumps)."""
-    case_dir = Path(case_dir)
-    screen = case_dir / SCREEN_FILE
-    if not screen.is_file():
-        return Observation("not run", f"no {SCREEN_FILE}", None, None, None, None, None)
-    parsed = parse_screen(screen.read_text(errors="replace"))
+    s = case.scaled
+    if not case.screen.is_file():
+        return Observation("not run", f"no screen capture {case.screen.name}", None, None,
+                           None, None, None)
+    parsed = parse_screen(case.screen.read_text(errors="replace"))
     rows = parsed.rows
-    expect = health.Expectation(
-        particle_count=s.particle_count, settle_end_step=s.insertion_steps + s.settle_steps,
-        total_steps=s.total_steps,
-        ke_ceiling=health.kinetic_energy_ceiling(
-            s.particle_count * sum(f * math.pi / 6 * d**3 for d, f in
-                                   zip(s.diameters, s.number_fractions)) * s.density,
-            s.drum_diameter, s.omega))
-    issues = health.assess(rows, parsed.lines, expect)
+    issues = health.assess(rows, parsed.lines, expectation(s))
     last = rows[-1].step if rows else 0
     if not issues and last < s.total_steps:
         issues.append(health.HealthIssue("incomplete", last,
                                          f"run ended at step {last} of {s.total_steps}"))
     atoms = [r.get("atoms") for r in rows if math.isfinite(r.get("atoms"))]
     hertz = [r.get("dt_hertz") for r in rows if math.isfinite(r.get("dt_hertz"))]
-    overlap = observed_max_overlap(case_dir, s)
+    overlap = observed_max_overlap(case.path, s)
     outcome, reason = STABLE, f"{last} steps, no health issue"
     if issues:
         first = min(issues, key=lambda i: _SEVERITY.index(_OUTCOME_OF_KIND.get(i.kind, "error")))
@@ -191,7 +169,7 @@ class CaseReport:
 
     @property
     def predicted(self) -> str:
-        return "unstable" if self.preflight.verdict == REFUSED else STABLE
+        return health.UNSTABLE if self.preflight.verdict == REFUSED else STABLE
 
     @property
     def agrees(self) -> bool:
@@ -213,15 +191,12 @@ class CaseReport:
                 "findings": [f.message for f in self.preflight.problems]}
 
 
-def case_dirs(study: Path) -> list[Path]:
-    """Every case folder (holding scene.json) below ``study``, sorted."""
-    return sorted(p.parent for p in Path(study).rglob(SCENE_FILE))
+def report_case(case: CaseFolder) -> CaseReport:
+    """Pre-flight verdict and observed outcome of one case."""
+    return CaseReport(case.path, case.scaled,
+                      preflight(case.scaled, case.case_id, case.explicit_dt), observe(case))
 
 
-def report_case(case_dir: Path) -> CaseReport:
-    case_id, s, explicit = scaled_of(case_dir)
-    return CaseReport(Path(case_dir), s, preflight(s, case_id, explicit), observe(case_dir, s))
-
-
-def report_study(study: Path) -> list[CaseReport]:
-    return [report_case(d) for d in case_dirs(study)]
+def report_study(root: Path) -> list[CaseReport]:
+    """Every case of the study at ``root``, or of every study below it (a stress suite)."""
+    return [report_case(c) for study in studies_below(root) for c in study.cases]

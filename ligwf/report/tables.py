@@ -1,9 +1,9 @@
 """Report stage: turn a finished study into the answer to "what error for what run time".
 
-Inputs (all already on disk): ``study.json``, each case's ``scene.json`` and
-``manifest.json``, and the analysis outputs in ``STUDY/analysis`` (``flow.csv``,
-``flow_profiles.json`` from the flow stage; ``frames.csv``, ``gsd_summary.csv`` from the
-granule stage when granules were analysed).
+Inputs (all already on disk): the study (its cases' scaled scenes and manifests, through
+:class:`ligwf.study.study.Study`) and the analysis outputs in its analysis folder (flow
+table and profiles from the flow stage; frame and GSD summary tables from the granule
+stage when granules were analysed; names in :mod:`ligwf.study.layout`).
 
 Per case: CG level, rule, particles, dt, steps, wall and core-seconds, speedup vs CG1
 (core-seconds per simulated second of the CG1 cases of the same sweep group over this
@@ -27,10 +27,9 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from ligwf.analysis.runner import discover_cases
-from ligwf.study.prepare import STUDY_FILE
 from ligwf.analysis.flow import profile_l2_error
-from ligwf.engine.manifest import MANIFEST_FILE
+from ligwf.study import layout
+from ligwf.study.study import Study
 
 METRICS = ["core_seconds", "wall_seconds", "speedup_core", "speedup_wall",
            "angle_of_repose", "angle_of_repose_std", "angle_error", "profile_error",
@@ -51,25 +50,23 @@ def _read_csv(path: Path) -> pd.DataFrame:
     return pd.DataFrame()
 
 
-def case_rows(study: Path) -> tuple[pd.DataFrame, list[dict]]:
+def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
     """One row per usable case with run facts; and the skipped cases with reasons."""
-    usable, skipped = discover_cases(study)
+    usable, skipped = study.usable_cases()
     rows = []
     for c in usable:
-        rec = json.loads((c.case_dir / "scene.json").read_text())
-        man = json.loads((c.case_dir / MANIFEST_FILE).read_text())
-        s = rec["scaled"]
-        phases = man.get("phases", {}) or {}
-        prod = phases.get("production", {}) if isinstance(phases, dict) else {}
+        man = c.manifest()
+        s = c.scaled
+        prod = (man.phases or {}).get("production", {})
         rows.append({
-            "case_id": c.case_id, "group": c.group, "cg": rec["cg"], "rule": rec["rule"],
-            "replica": rec["replica"], "particles": s["particle_count"], "dt": s["dt"],
-            "steps": man.get("steps_done", 0),
-            "simulated_seconds": man.get("steps_done", 0) * s["dt"],
-            "wall_seconds": man.get("wall_seconds", math.nan),
-            "core_seconds": man.get("core_seconds", math.nan),
+            "case_id": c.case_id, "group": c.group, "cg": c.cg, "rule": c.rule,
+            "replica": c.replica, "particles": s.particle_count, "dt": s.dt,
+            "steps": man.steps_done,
+            "simulated_seconds": man.steps_done * s.dt,
+            "wall_seconds": man.wall_seconds,
+            "core_seconds": man.core_seconds,
             "production_core_seconds": prod.get("core_seconds", math.nan),
-            "nprocs": man.get("nprocs", 1),
+            "nprocs": man.nprocs,
         })
     return pd.DataFrame(rows), skipped
 
@@ -77,20 +74,20 @@ def case_rows(study: Path) -> tuple[pd.DataFrame, list[dict]]:
 def merge_analysis(cases: pd.DataFrame, analysis_dir: Path) -> pd.DataFrame:
     """Add flow, cluster and GSD quantities to the case table (nan where not analysed)."""
     df = cases.copy()
-    flow = _read_csv(analysis_dir / "flow.csv")
+    flow = _read_csv(analysis_dir / layout.FLOW_TABLE)
     if not flow.empty:
         keep = flow[["case_id", "angle_of_repose_mean", "angle_of_repose_std", "rigid_frame_share",
                      "rms_speed_rel_fluctuation", "flowing_layer_thickness_mean"]]
         df = df.merge(keep.rename(columns={"angle_of_repose_mean": "angle_of_repose"}),
                       on="case_id", how="left")
-    frames = _read_csv(analysis_dir / "frames.csv")
+    frames = _read_csv(analysis_dir / layout.FRAMES_TABLE)
     if not frames.empty and "largest_fraction" in frames:
         ok = frames[frames.get("status", "ok") == "ok"] if "status" in frames else frames
         agg = ok.groupby("case_id")["largest_fraction"].agg(
             largest_cluster_fraction="mean",
             one_granule_frame_share=lambda x: float(np.mean(np.asarray(x) > 0.99)))
         df = df.merge(agg.reset_index(), on="case_id", how="left")
-    summary = _read_csv(analysis_dir / "gsd_summary.csv")
+    summary = _read_csv(analysis_dir / layout.GSD_SUMMARY_TABLE)
     if not summary.empty:
         cols = {f"error_{side}{sfx}": f"gsd_error_{side}{sfx}"
                 for side in ("below", "above") for sfx in ("", "_lo", "_hi")}
@@ -163,15 +160,11 @@ def condition_table(df: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def build_tables(study: Path) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], dict]:
+def build_tables(study: Study) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], dict]:
     """(case table, condition table, skipped cases, profiles) of a finished study."""
-    study = Path(study)
-    if not (study / STUDY_FILE).is_file():
-        from ligwf.errors import ConfigError
-        raise ConfigError(f"{study} is not a study folder (no {STUDY_FILE})")
     cases, skipped = case_rows(study)
-    analysis_dir = study / "analysis"
-    prof_path = analysis_dir / "flow_profiles.json"
+    analysis_dir = study.analysis_dir
+    prof_path = analysis_dir / layout.FLOW_PROFILES
     profiles = json.loads(prof_path.read_text())["profiles"] if prof_path.is_file() else {}
     if cases.empty:
         return cases, pd.DataFrame(), skipped, profiles

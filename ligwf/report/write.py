@@ -1,6 +1,6 @@
 """Write the report folder of a study: tables, summary.md, index.html, figures, ParaView.
 
-``STUDY/report/``:
+The study's report folder (:attr:`ligwf.study.study.Study.report_dir`):
 ``cases.csv`` and ``conditions.csv`` (the numbers), ``summary.md`` and ``index.html``
 (the same tables with the figures), ``figures/*.png`` (error vs run time, GSD overlay,
 velocity profiles, one snapshot per case coloured by speed and one by granule id) and
@@ -10,19 +10,22 @@ velocity profiles, one snapshot per case coloured by speed and one by granule id
 from __future__ import annotations
 
 import html
-import json
 import math
 from pathlib import Path
 
 import pandas as pd
 
 from ligwf import __version__
-from ligwf.report import figures as figs
 from ligwf.analysis.dumps import discover_frames
 from ligwf.analysis.flow_run import flow_study
+from ligwf.engine.render import MESH_NAME
 from ligwf.fsio import atomic_write_text
-from ligwf.report.paraview import case_collection, drum_angle
+from ligwf.report import figures as figs
+from ligwf.report.paraview import case_collection
 from ligwf.report.tables import build_tables
+from ligwf.study import layout
+from ligwf.study.case import CaseFolder
+from ligwf.study.study import Study
 
 CASE_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", "rep"),
                 ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
@@ -73,14 +76,13 @@ def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def write_report(study: Path, out: Path | None = None, snapshots: bool = True,
-                 steady_after: float = 0.25) -> Path:
-    """Compute flow metrics, build the tables and write the report folder; returns it."""
-    study = Path(study)
-    out = Path(out) if out else study / "report"
+def write_report(study: Study, out: Path | None = None, snapshots: bool = True) -> Path:
+    """Compute flow metrics (steady window from the study's analysis settings), build the
+    tables and write the report folder; returns it."""
+    out = Path(out) if out else study.report_dir
     fig_dir, pv_dir = out / "figures", out / "paraview"
     fig_dir.mkdir(parents=True, exist_ok=True)
-    flow_study(study, steady_after=steady_after)
+    flow_study(study)
     cases, conditions, skipped, profiles = build_tables(study)
     atomic_write_text(out / "cases.csv", cases.to_csv(index=False))
     atomic_write_text(out / "conditions.csv", conditions.to_csv(index=False))
@@ -90,36 +92,36 @@ def write_report(study: Path, out: Path | None = None, snapshots: bool = True,
         figures.append(("Error vs run time", figs.pareto(conditions, fig_dir / "error_vs_runtime.png")))
         figures.append(("Velocity profiles", figs.velocity_profiles(cases, profiles,
                                                                     fig_dir / "velocity_profiles.png")))
-    gsd_path = study / "analysis" / "gsd.csv"
+    gsd_path = study.analysis_dir / layout.GSD_TABLE
     if gsd_path.is_file() and gsd_path.stat().st_size > 1:
         gsd = pd.read_csv(gsd_path)
         if not gsd.empty:
             figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / "gsd_overlay.png")))
     pvds = []
+    by_id = {c.case_id: c for c in study.usable_cases()[0]}
     for case_id in cases.get("case_id", []):
-        case_dir = study / case_id
-        pvd = case_collection(case_dir, study / "analysis", pv_dir)
+        case: CaseFolder = by_id[case_id]
+        pvd = case_collection(case, study.analysis_dir, pv_dir)
         if pvd:
             pvds.append(pvd)
-        frames = discover_frames(case_dir)
+        frames = discover_frames(case.path)
         if snapshots and frames:
             last = frames[-1]
-            axis = figs.scene_axis(case_dir)
-            angle = drum_angle(case_dir, last.step)
+            axis, angle, mesh = case.scaled.axis, case.drum_angle(last.step), case.path / MESH_NAME
             figures.append((f"{case_id}: speed", figs.snapshot(
-                last.particles, case_dir / "drum.stl", axis, angle, "speed",
+                last.particles, mesh, axis, angle, "speed",
                 fig_dir / f"{case_id}_speed.png", f"{case_id} step {last.step}: speed [m/s]")))
-            labelled = study / "analysis" / case_id / f"granules_{last.step}.vtu"
+            labelled = study.analysis_dir / case_id / f"granules_{last.step}.vtu"
             if labelled.is_file():
                 figures.append((f"{case_id}: granules", figs.snapshot(
-                    labelled, case_dir / "drum.stl", axis, angle, "granule",
+                    labelled, mesh, axis, angle, "granule",
                     fig_dir / f"{case_id}_granules.png", f"{case_id} step {last.step}: granule id")))
 
-    name = json.loads((study / "study.json").read_text()).get("name", study.name)
+    name = study.name
     skipped_md = "\n".join(f"- {s.get('case_id', s)}: {s.get('reason', '')}" for s in skipped) or "none"
     md = "\n".join([
         f"# {name}: error against run time", "",
-        f"Study folder `{study}`; report by ligwf {__version__}. Errors are relative to the "
+        f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are relative to the "
         "CG1 cases of the same sweep group; speedup is CG1 core-seconds per simulated second over the case's.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
         "## Skipped cases (not done or stale)", "", skipped_md, "",

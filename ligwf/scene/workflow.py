@@ -1,4 +1,5 @@
-"""Workflows: a YAML file with a ``scene:`` and a ``sweep:`` block, expanded into cases.
+"""Workflows: a YAML file with ``scene:``, ``sweep:`` and ``analysis:`` blocks, expanded
+into cases.
 
 ```yaml
 name: demo
@@ -9,6 +10,7 @@ sweep:
   replicas: {1: 1, 2: 3, 3: 3}   # or a single number for every CG level
   scene.process.rotation.rpm: [20, 30]   # any scene field as a list
   per_cg: {2: {process.run_time: 6.0}}    # scene fields for one CG level only
+analysis: {steady_after: 0.25, max_velocity_angle: 30}   # ligwf.study.settings
 ```
 
 CLI overrides (``--set scene.drum.lifters.count=12``) are applied to the raw mapping before
@@ -31,8 +33,9 @@ from pydantic import Field, TypeAdapter, ValidationError
 from ligwf.errors import ConfigError
 from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
 from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene, format_validation_error
+from ligwf.study.settings import AnalysisSettings, build_analysis_settings
 
-_TOP_KEYS = {"name", "description", "scene", "sweep"}
+_TOP_KEYS = {"name", "description", "scene", "sweep", "analysis"}
 
 
 class Sweep(_Frozen):
@@ -73,6 +76,7 @@ class Workflow:
     description: str
     raw: dict[str, Any]
     cases: tuple[Case, ...]
+    analysis: AnalysisSettings = AnalysisSettings()
 
 
 # ---------------------------------------------------------------------------------------
@@ -181,6 +185,7 @@ def expand(raw: dict[str, Any]) -> Workflow:
     except ValidationError as exc:
         raise ConfigError(f"name = {name!r}: {exc.errors()[0]['msg']}") from None
     sweep, varied = _split_sweep(raw.get("sweep") or {})
+    analysis = build_analysis_settings(raw.get("analysis") or {})
 
     base_scene = copy.deepcopy(raw["scene"])
     base_scene.setdefault("name", name)
@@ -214,7 +219,7 @@ def expand(raw: dict[str, Any]) -> Workflow:
                     cases.append(Case(len(cases), case_id, scene, float(cg), rule, rep,
                                       tuple((p, v) for (p, _), v in zip(varied, combo))))
     return Workflow(name=name, description=str(raw.get("description", "")), raw=raw,
-                    cases=tuple(cases))
+                    cases=tuple(cases), analysis=analysis)
 
 
 def load_workflow(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Workflow:

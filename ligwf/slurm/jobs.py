@@ -1,13 +1,14 @@
 """Run a rendered study on Slurm: submit its case array and the analysis job, report
 status, resubmit what did not finish.
 
-The study folder is the single source of truth. Besides the case folders and
-``study.json`` (:mod:`ligwf.study.prepare`) it gets ``slurm/``: the batch scripts exactly as
+The study folder is the single source of truth. Besides the case folders and the study
+record (:mod:`ligwf.study`) it gets ``slurm/``: the batch scripts exactly as
 submitted, ``slurm/logs/`` (``%A_%a`` logs) and ``slurm/jobs.json``, the list of
 submissions (kind, job id, case indices, script, command, time), rewritten atomically
 after every successful ``sbatch``. A case's outcome is its runner manifest
-(``<case>/manifest.json``); Slurm's view (squeue, then ``scontrol show job`` while the
-controller remembers the job) only says whether a task is still queued or running.
+(:meth:`ligwf.study.case.CaseFolder.manifest`); Slurm's view (squeue, then ``scontrol show
+job`` while the controller remembers the job) only says whether a task is still queued or
+running.
 
 Scripts and commands are built by :mod:`ligwf.slurm.script`, scheduler text is parsed by
 :mod:`ligwf.slurm.parse`; this module does the I/O between them.
@@ -26,12 +27,13 @@ from pathlib import Path, PurePosixPath
 from typing import Callable, Iterable, Sequence
 
 from ligwf import __version__
-from ligwf.study.prepare import STUDY_FILE
-from ligwf.errors import ConfigError, SubmitError
+from ligwf.engine.health import FAILED, KILLED, MISSING, RUNNING, UNSTABLE
+from ligwf.errors import SubmitError
 from ligwf.fsio import atomic_write_json, atomic_write_text
-from ligwf.engine.manifest import MANIFEST_FILE
-from ligwf.slurm.parse import (FINISHED_STATES, QueueEntry, TaskRecord, is_unknown_job,
-                          parse_sbatch_parsable, parse_squeue, task_records)
+from ligwf.study.manifest import read_manifest
+from ligwf.study.study import Study
+from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_parsable,
+                               parse_squeue, task_records)
 from ligwf.slurm.script import (LOG_DIR, SLURM_DIR, ScriptContext, analysis_script, array_script,
                            sbatch_command, scontrol_command, squeue_command)
 from ligwf.slurm.site import SlurmSite
@@ -39,7 +41,7 @@ from ligwf.slurm.site import SlurmSite
 RECORD_FILE = "slurm/jobs.json"
 #: Manifest states worth running again: the runner resumes killed cases from their restart.
 #: ``unstable`` is left out by default: the same input and seed would fail the same way.
-RETRY_STATES = frozenset({"failed", "killed", "running"})
+RETRY_STATES = frozenset({FAILED, KILLED, RUNNING, MISSING})
 
 Runner = Callable[[Sequence[str]], subprocess.CompletedProcess]
 
@@ -67,15 +69,6 @@ def run_command(argv: Sequence[str]) -> subprocess.CompletedProcess:
 # the study folder
 # ---------------------------------------------------------------------------------------
 
-def read_study(study_dir: Path) -> dict:
-    """``study.json`` of a rendered study (ConfigError when it is not one)."""
-    path = Path(study_dir) / STUDY_FILE
-    if not path.is_file():
-        raise ConfigError(f"{study_dir} is not a ligwf study folder (no {STUDY_FILE}); "
-                          "submit a workflow with 'ligwf slurm submit' first")
-    return json.loads(path.read_text())
-
-
 def read_record(study_dir: Path) -> list[dict]:
     """The submissions recorded in ``slurm/jobs.json`` (oldest first; [] when none)."""
     path = Path(study_dir) / RECORD_FILE
@@ -89,15 +82,6 @@ def append_record(study_dir: Path, entry: dict) -> None:
     subs = read_record(study_dir) + [entry]
     atomic_write_json(Path(study_dir) / RECORD_FILE, {"ligwf_version": __version__,
                                                       "submissions": subs})
-
-
-def read_manifest(case_dir: Path) -> dict | None:
-    """The runner's manifest of a case, None when there is none (or it is unreadable)."""
-    path = Path(case_dir) / MANIFEST_FILE
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
 
 
 def job_name(study_name: str, kind: str) -> str:
@@ -203,7 +187,7 @@ class CaseStatus:
 
     index: int
     case_id: str
-    manifest: str  # the manifest status, or "missing"
+    manifest: str  # the manifest status, or MISSING
     reason: str = ""
     job: str | None = None  # "<array id>_<index>" of the latest submission
     slurm_state: str | None = None  # PENDING/RUNNING/... or None when Slurm forgot it
@@ -256,7 +240,7 @@ def study_status(study_dir: Path, run: Runner = run_command, user: str | None = 
     still queued, or a case could run twice).
     """
     study_dir = Path(study_dir)
-    study = read_study(study_dir)
+    study = Study.open(study_dir)
     record = read_record(study_dir)
     latest: dict[int, str] = {}
     for sub in record:
@@ -271,15 +255,15 @@ def study_status(study_dir: Path, run: Runner = run_command, user: str | None = 
             raise
         states, scheduler_error = {}, str(exc)
     cases = []
-    for c in study["cases"]:
-        man = read_manifest(study_dir / c["case_id"])
-        job_id = latest.get(int(c["index"]))
+    for index, (case_id, case_dir) in enumerate(zip(study.case_ids, study.case_dirs)):
+        man = read_manifest(case_dir)
+        job_id = latest.get(index)
         cases.append(CaseStatus(
-            index=int(c["index"]), case_id=c["case_id"],
-            manifest=str(man.get("status", "unknown")) if man else "missing",
-            reason=str(man.get("reason") or "") if man else "",
-            job=f"{job_id}_{c['index']}" if job_id else None,
-            slurm_state=states.get((job_id, int(c["index"]))) if job_id else None))
+            index=index, case_id=case_id,
+            manifest=man.status if man else MISSING,
+            reason=man.reason if man else "",
+            job=f"{job_id}_{index}" if job_id else None,
+            slurm_state=states.get((job_id, index)) if job_id else None))
     jobs = []
     for sub in record:
         entry = dict(sub)
@@ -295,9 +279,9 @@ def cases_to_resubmit(cases: Iterable[CaseStatus], include_unstable: bool = Fals
     A manifest still saying ``running`` while Slurm no longer runs the task means the task
     died without the runner finishing its manifest (e.g. SIGKILL at the time limit).
     """
-    retry = set(RETRY_STATES) | {"missing", "unknown"}
+    retry = set(RETRY_STATES)
     if include_unstable:
-        retry.add("unstable")
+        retry.add(UNSTABLE)
     return sorted(c.index for c in cases if not c.queued and c.manifest in retry)
 
 

@@ -1,9 +1,10 @@
 """Case manifests: what ran, how, how long, and whether its outputs may be used.
 
-``manifest.json`` sits next to ``in.liggghts`` in every case folder and is always written
-atomically (temp file + rename, :mod:`ligwf.fsio`), so a reader sees the previous or the
-new manifest, never half of one. Later stages use only cases whose status is ``done``
-and whose scene hash matches ``scene.json`` (:func:`ligwf.analysis.runner.manifest_problem`).
+The manifest sits next to the input in every case folder (file name:
+:data:`ligwf.study.layout.MANIFEST_FILE`) and is always written atomically (temp file +
+rename, :mod:`ligwf.fsio`), so a reader sees the previous or the new manifest, never half
+of one. Later stages use only cases whose status is ``done`` and whose scene hash matches
+the case's rendered scene (:meth:`ligwf.study.case.CaseFolder.why_not_usable`).
 
 Timing for the error-vs-run-time study: ``phases`` holds engine wall seconds and
 core-seconds (wall x MPI ranks) per phase (fill, settle, production), summed over all
@@ -22,13 +23,8 @@ from typing import Any
 
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json
-from ligwf.engine.health import RUNNING, STATUSES
-
-MANIFEST_FILE = "manifest.json"
-#: stdout+stderr of the current attempt of a case (earlier attempts: run.<n>.log)
-SCREEN_FILE = "run.log"
-#: Thermo table over all attempts.
-THERMO_FILE = "thermo.csv"
+from ligwf.engine.health import KILLED, RUNNING, STATUSES
+from ligwf.study.layout import MANIFEST_FILE, SCREEN_FILE
 
 
 def now_iso() -> str:
@@ -92,13 +88,16 @@ class Manifest:
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> "Manifest":
         data = dict(data)
+        # a hand-written or foreign manifest may carry only status and scene hash
+        for key, default in (("index", -1), ("ligwf_version", ""), ("liggghts_version", "")):
+            data.setdefault(key, default)
         data["attempts"] = [Attempt(**a) for a in data.get("attempts", [])]
         known = {f for f in cls.__dataclass_fields__}
         return cls(**{k: v for k, v in data.items() if k in known})
 
 
 def write_manifest(case_dir: Path, manifest: Manifest) -> None:
-    """Write ``manifest.json`` atomically."""
+    """Write the case's manifest atomically (a bad status is refused first)."""
     if manifest.status not in STATUSES:
         raise ConfigError(f"manifest status {manifest.status!r} (allowed: {', '.join(STATUSES)})")
     atomic_write_json(Path(case_dir) / MANIFEST_FILE, manifest.to_dict())
@@ -113,11 +112,6 @@ def read_manifest(case_dir: Path) -> Manifest | None:
         return None
     except (json.JSONDecodeError, TypeError, KeyError):
         return None
-
-
-def scene_hash_of(case_dir: Path) -> str:
-    """The content hash the case folder was rendered with (from ``scene.json``)."""
-    return json.loads((Path(case_dir) / "scene.json").read_text())["scene_hash"]
 
 
 def pid_alive(pid: int) -> bool:
@@ -138,5 +132,5 @@ def effective_status(m: Manifest) -> str:
     """
     if m.status == RUNNING:
         if m.host != socket.gethostname() or not pid_alive(m.pid) or m.pid == os.getpid():
-            return "killed"
+            return KILLED
     return m.status

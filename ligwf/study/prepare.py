@@ -1,9 +1,13 @@
-"""Case folders: the I/O step after rendering.
+"""Prepare a study: validate, scale, render, pre-flight (all in memory), then write.
 
-A study folder holds ``study.json`` (the workflow and its case list) and one folder per
-case with ``in.liggghts``, ``drum.stl`` (from the mesh cache), ``scene.json`` (the original
-and the scaled parameters plus a content hash) and the empty ``post/`` and ``restart/``
-folders the input writes into. Every file is written atomically.
+:func:`prepare` is the first step of every path that starts from a workflow (``check``,
+``render``, ``run``, ``study``, ``slurm submit``): every case is scaled and rendered and
+the stability pre-flight runs before anything is written, so a bad value or an unsafe case
+is refused with nothing half-done. :func:`write_study` then writes the study record (the
+workflow, its analysis settings, the case list) and one folder per case with the input,
+the drum mesh (from the mesh cache), the scene record (original and scaled parameters plus
+a content hash) and the empty output folders the input writes into (names:
+:mod:`ligwf.study.layout`). Every file is written atomically.
 
 The content hash covers the scaled parameters, the rendered input and the mesh, so a
 runner can tell whether a finished case still matches what the workflow asks for.
@@ -24,10 +28,10 @@ from ligwf.fsio import atomic_write_json, atomic_write_text
 from ligwf.engine.mesh import cached_mesh, drum_stl
 from ligwf.engine.render import MESH_NAME, OUTPUT_DIRS, render
 from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.stability import Preflight, check_rendered
 from ligwf.scene.workflow import Case, Workflow
-
-SCENE_FILE = "scene.json"
-STUDY_FILE = "study.json"
+from ligwf.study.layout import SCENE_FILE, STUDY_FILE
+from ligwf.study.study import Study
 
 
 def default_mesh_cache() -> Path:
@@ -84,6 +88,25 @@ def render_workflow(wf: Workflow, template_dirs: Iterable[str | Path] = ()) -> l
     return [render_case(c, dirs) for c in wf.cases]
 
 
+@dataclass(frozen=True)
+class Prepared:
+    """A validated workflow, every case rendered, and the pre-flight verdicts."""
+
+    workflow: Workflow
+    rendered: list[RenderedCase]
+    preflight: list[Preflight]
+    warnings: list[str]          # marginal findings (and refusals let through)
+
+
+def prepare(wf: Workflow, template_dirs: Iterable[str | Path] = (),
+            allow_unstable: bool = False) -> Prepared:
+    """Render every case and pre-flight it; raises UnstableCase on a refusal unless
+    ``allow_unstable``. Writes nothing."""
+    rendered = render_workflow(wf, template_dirs)
+    reports, warnings = check_rendered(rendered, allow_unstable)
+    return Prepared(wf, rendered, reports, warnings)
+
+
 def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) -> Path:
     """Write one rendered case folder under ``out_dir``; returns the folder."""
     case_dir = Path(out_dir) / rc.case.case_id
@@ -101,18 +124,20 @@ def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) 
 
 
 def write_study(wf: Workflow, rendered: list[RenderedCase], out_dir: Path,
-                mesh_cache: Path | None = None) -> list[Path]:
-    """Write every case folder and ``study.json``; returns the case folders in order."""
+                mesh_cache: Path | None = None) -> Study:
+    """Write every case folder, then the study record; returns the written study."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    dirs = [write_case(rc, out_dir, mesh_cache) for rc in rendered]
+    for rc in rendered:
+        write_case(rc, out_dir, mesh_cache)
     atomic_write_json(out_dir / STUDY_FILE, {
         "ligwf_version": __version__,
         "name": wf.name,
         "description": wf.description,
         "workflow": wf.raw,
+        "analysis": wf.analysis.model_dump(mode="json"),
         "cases": [{"index": rc.case.index, "case_id": rc.case.case_id, "cg": rc.case.cg,
                    "rule": rc.scaled.rule, "replica": rc.case.replica,
                    "scene_hash": rc.scene_hash} for rc in rendered],
     })
-    return dirs
+    return Study.open(out_dir)

@@ -14,25 +14,33 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, CaseInfo, analyse
-from ligwf.cli.main import main
 from ligwf.analysis.dumps import discover_frames, read_particles
-from ligwf.analysis.gsd import GsdSettings
+from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, analyse
+from ligwf.cli.main import main
+from ligwf.study.case import CaseFolder
+from ligwf.study.settings import AnalysisSettings
 from wetdump import wet_study
 
-FAST = AnalysisOptions(gsd=GsdSettings(n_boot=100))
+FAST = AnalysisOptions(settings=AnalysisSettings(bootstrap=100))
 OUTPUTS = ("granules.parquet", "frames.csv", "gsd.csv", "gsd_summary.csv", "analysis.json")
 
 
 @pytest.fixture(scope="module")
 def study(engine, tmp_path_factory) -> Path:
-    return wet_study(engine, tmp_path_factory)
+    """The shared wet study, copied, with 100 bootstrap draws in its analysis settings
+    (``ligwf analyse`` reads them from the study)."""
+    out = tmp_path_factory.mktemp("analysed") / "study"
+    shutil.copytree(wet_study(engine, tmp_path_factory), out)
+    record = json.loads((out / "study.json").read_text())
+    record["analysis"] = {"bootstrap": 100}
+    (out / "study.json").write_text(json.dumps(record))
+    return out
 
 
 @pytest.fixture(scope="module")
 def serial(study, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("serial")
-    assert main(["analyse", str(study), "--out", str(out), "--bootstrap", "100"]) == 0
+    assert main(["analyse", str(study), "--out", str(out)]) == 0
     return out
 
 
@@ -40,6 +48,7 @@ def serial(study, tmp_path_factory) -> Path:
 @pytest.mark.mpi
 def test_outputs_of_a_study(study, serial):
     record = json.loads((serial / "analysis.json").read_text())
+    assert record["settings"]["bootstrap"] == 100 and record["gsd"]["n_boot"] == 100
     assert [c["case_id"] for c in record["cases"]] == ["cg3-weber-r0", "cg3-weber-r1"]
     assert record["skipped_cases"][0]["case_id"] == "cg3-bond-r0"
     assert "failed" in record["skipped_cases"][0]["reason"]
@@ -58,14 +67,20 @@ def test_outputs_of_a_study(study, serial):
             for c in ("cg3-weber-r0", "cg3-weber-r1"))
     pd.testing.assert_frame_equal(a, b)
     # the table equals a direct run of the life-cycle class with the reference implementation
-    ref = GranuleAnalysis(CaseInfo.from_folder(study / "cg3-weber-r0"),
-                          implementation="reference").run()
+    case = CaseFolder.open(study / "cg3-weber-r0")
+    ref = GranuleAnalysis(case, implementation="reference").run()
     for r in ref.results:
         got = a[a.step == r.step].reset_index(drop=True)
         np.testing.assert_array_equal(got["members"], r.table["members"])
         np.testing.assert_allclose(got["volume"], r.table["volume"], rtol=1e-15)
+    # the GSD uses the steady window only (the last 75 % of production, as the flow stage)
+    first = case.steady_start_step(0.25)
+    steady = [f for f in frames if f.step >= first]
+    assert 0 < len(steady) < len(frames)
+    assert record["cases"][0]["steady_from_step"] == first
+    assert record["cases"][0]["steady_frames"] == len(steady)
     summary = pd.read_csv(serial / "gsd_summary.csv")
-    assert summary["condition"].tolist() == ["cg3-weber"] and summary["frames"][0] == 2 * len(frames)
+    assert summary["condition"].tolist() == ["cg3-weber"] and summary["frames"][0] == 2 * len(steady)
     gsd = pd.read_csv(serial / "gsd.csv")
     assert gsd["volume_fraction"].sum() == pytest.approx(1)
 
@@ -124,8 +139,8 @@ def test_manifest_gates_cases(study, tmp_path):
     reasons = {s["case_id"]: s["reason"] for s in record["skipped_cases"]}
     assert record["cases"] == []
     assert "unstable" in reasons["cg3-weber-r0"] and "no manifest" in reasons["cg3-weber-r1"]
-    opened = analyse(copy, tmp_path / "out2", AnalysisOptions(gsd=GsdSettings(n_boot=10),
-                                                             require_manifest=False))
+    opened = analyse(copy, tmp_path / "out2", AnalysisOptions(
+        settings=AnalysisSettings(bootstrap=10), require_manifest=False))
     analysed = {c["case_id"]: c["analysed"] for c in opened["cases"]}
     n = len(discover_frames(copy / "cg3-weber-r0"))
     # the bond case was never run: listed with no frames; the others fully analysed
@@ -137,7 +152,7 @@ def test_manifest_gates_cases(study, tmp_path):
 def test_mpi_two_ranks_identical_to_serial(study, serial, engine, tmp_path):
     out = tmp_path / "mpi"
     cmd = engine.mpirun_prefix(2) + [sys.executable, "-m", "ligwf.cli.main", "analyse", str(study),
-                                     "--out", str(out), "--bootstrap", "100"]
+                                     "--out", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300,
                           stdin=subprocess.DEVNULL)
     assert proc.returncode == 0, proc.stdout + proc.stderr

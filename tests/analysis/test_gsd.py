@@ -8,9 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from types import SimpleNamespace
+
 from ligwf.analysis import gsd
-from ligwf.analysis.runner import CaseInfo, gsd_tables
-from ligwf.analysis.granules import Liquid
+from ligwf.analysis.gsd_tables import gsd_tables
 
 V1 = math.pi / 6 * 0.001**3      # one 1 mm primary particle, m^3
 
@@ -61,8 +62,7 @@ def test_side_errors_and_limit():
 
 
 def _case(case_id, cg, rule, replica):
-    return CaseInfo(case_id, None, cg, rule, replica, "{}", 1e-5,
-                    Liquid("washino", 0.024, 0.5, 0.02), 1, 0.0, 0.009)
+    return SimpleNamespace(case_id=case_id, cg=cg, rule=rule, replica=replica, group="{}")
 
 
 def _table(case, frames, sizes_in_primaries):

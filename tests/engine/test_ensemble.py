@@ -4,15 +4,13 @@ from __future__ import annotations
 
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
-from ligwf.cli.run import study_case_dirs
-from ligwf.engine.site import EngineConfig
 from ligwf.engine.ensemble import run_ensemble
-from ligwf.engine.manifest import read_manifest
-from ligwf.engine.resume import render_resume, RestartFile, load_scaled
+from ligwf.engine.resume import render_resume, RestartFile
+from ligwf.engine.site import EngineConfig
+from ligwf.study.study import Study
 
 from helpers import ROOT  # noqa: E402
 
@@ -32,13 +30,13 @@ def test_four_members_on_ensemble_2(tmp_path):
     out = tmp_path / "study"
     r = ligwf("run", str(WORKFLOW), "--out", str(out), "--ensemble", "2", *FOUR)
     assert r.returncode == 0, r.stdout + r.stderr
-    dirs = study_case_dirs(out)
-    assert len(dirs) == 4
-    for d in dirs:
-        m = read_manifest(d)
+    cases = Study.open(out).cases
+    assert len(cases) == 4
+    for c in cases:
+        m = c.manifest()
         assert m.status == "done", m.reason
         assert m.launcher == "ensemble" and m.steps_done == m.total_steps
-        assert m.atoms_end == 84 and list((d / "post").glob("particles_*.vtu"))
+        assert m.atoms_end == 84 and list((c.path / "post").glob("particles_*.vtu"))
     # one mpirun for all four members
     assert [p.name for p in (out / ".ensemble").iterdir()] == ["launch-1"]
 
@@ -60,20 +58,20 @@ def test_broken_member_does_not_lose_the_others(tmp_path, kind):
     out = tmp_path / "study"
     r = ligwf("render", str(WORKFLOW), "--out", str(out), *FOUR)
     assert r.returncode == 0, r.stderr
-    dirs = study_case_dirs(out)
-    broken = dirs[1]
+    cases = Study.open(out).cases
+    broken = cases[1]
     old, new = BREAKAGES[kind]
-    text = (broken / "in.liggghts").read_text()
+    text = (broken.path / "in.liggghts").read_text()
     assert old in text
-    (broken / "in.liggghts").write_text(text.replace(old, new))
-    outcome = run_ensemble(out, dirs, 2, 1, EngineConfig.from_site())
-    assert outcome[broken.name] == "failed"
-    m = read_manifest(broken)
+    (broken.path / "in.liggghts").write_text(text.replace(old, new))
+    outcome = run_ensemble(out, list(cases), 2, 1, EngineConfig.from_site())
+    assert outcome[broken.path.name] == "failed"
+    m = broken.manifest()
     assert m.status == "failed" and m.reason.startswith("ERROR")
-    for d in dirs:
-        if d != broken:
-            m = read_manifest(d)
-            assert m.status == "done", (d.name, m.reason)
+    for c in cases:
+        if c != broken:
+            m = c.manifest()
+            assert m.status == "done", (c.case_id, m.reason)
             assert m.steps_done == m.total_steps
     launches = sorted(p.name for p in (out / ".ensemble").iterdir())
     if kind == "abort":  # the members killed by the abort were finished by a new mpirun
@@ -84,9 +82,9 @@ def test_resume_input_reissues_every_fix_of_the_drum_input(tmp_path):
     out = tmp_path / "study"
     r = ligwf("render", str(WORKFLOW), "--out", str(out), "--set", "sweep.rules=[weber]")
     assert r.returncode == 0, r.stderr
-    case = study_case_dirs(out)[0]
-    s = load_scaled(case)
-    drum = (case / "in.liggghts").read_text().splitlines()
+    case = Study.open(out).case(0)
+    s = case.scaled
+    drum = (case.path / "in.liggghts").read_text().splitlines()
     keep = ("fix ", "compute ", "region ", "thermo", "pair_style", "pair_coeff", "timestep",
             "neighbor", "neigh_modify", "dump", "restart ")
     wanted = [line for line in drum if line.startswith(keep)

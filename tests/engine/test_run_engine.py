@@ -13,7 +13,7 @@ from pathlib import Path
 import meshio
 import pytest
 
-from ligwf.engine.manifest import effective_status, read_manifest
+from ligwf.study.manifest import effective_status, read_manifest
 from ligwf.engine.resume import restart_files, restart_step
 
 from helpers import ROOT  # noqa: E402

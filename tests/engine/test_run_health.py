@@ -10,7 +10,7 @@ import pytest
 from ligwf.engine.health import (Expectation, assess, atom_loss, insertion_shortfall,
                           kinetic_energy_blowup, kinetic_energy_ceiling, log_errors,
                           log_warnings, non_finite, verdict)
-from ligwf.engine.manifest import Manifest, read_manifest, write_manifest
+from ligwf.study.manifest import Manifest, read_manifest, write_manifest
 from ligwf.engine.resume import resume_phase
 from ligwf.engine.thermo import ThermoRow, parse_screen, rows_from_csv, rows_to_csv
 

@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from ligwf.study.prepare import render_workflow, write_study
 from ligwf.cli.main import main
 from ligwf.engine.launch import run_case
-from ligwf.scene.stability import REFUSED, check_rendered
+from ligwf.scene.stability import REFUSED
+from ligwf.study.prepare import prepare, write_study
 from ligwf.report.stability import report_study
 from ligwf.scene.stability_suite import load_suite
 
@@ -25,18 +25,17 @@ SUITE = ROOT / "workflows" / "stability.yaml"
 @pytest.mark.slow
 def test_preflight_agrees_with_the_engine_on_every_suite_case(engine, tmp_path):
     study = tmp_path / "suite"
-    dirs = []
+    cases = []
     for variant, wf in load_suite(SUITE).items():
-        rendered = render_workflow(wf)
-        check_rendered(rendered, allow_unstable=True)
-        dirs += write_study(wf, rendered, study / variant, tmp_path / "meshes")
+        prepared = prepare(wf, allow_unstable=True)
+        cases += write_study(wf, prepared.rendered, study / variant, tmp_path / "meshes").cases
     # two single-rank cases at a time (2 cores); the runner stops a case as soon as its
     # health turns bad, so refused cases cost little
     with ThreadPoolExecutor(2) as pool:
-        list(pool.map(lambda d: run_case(d, 1, engine, poll_seconds=0.2), dirs))
+        list(pool.map(lambda c: run_case(c, 1, engine, poll_seconds=0.2), cases))
 
     reports = report_study(study)
-    assert len(reports) == len(dirs)
+    assert len(reports) == len(cases)
     table = "\n".join(f"{r.name}: pre-flight {r.preflight.verdict}, observed "
                       f"{r.observation.outcome} ({r.observation.reason})" for r in reports)
     disagree = [r for r in reports if not r.agrees]

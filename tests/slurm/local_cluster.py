@@ -23,7 +23,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ligwf.engine.manifest import pid_alive
+from ligwf.study.manifest import pid_alive
 
 PACKAGES = ("slurmctld", "slurmd", "munge")
 ROOT = Path("/var/lib/ligwf-test-slurm")

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import pytest
 
-from ligwf.engine.manifest import MANIFEST_FILE, SCREEN_FILE
 from ligwf.slurm.jobs import read_record, study_status
 from ligwf.slurm.parse import task_records
+from ligwf.study.study import Study
 
 HERE = Path(__file__).resolve().parent
 WORKFLOW = HERE / "tiny_drum.yaml"
@@ -58,12 +58,8 @@ def _logs(study: Path) -> str:
 
 
 def manifest_states(study: Path) -> dict[str, str]:
-    cases = json.loads((study / "study.json").read_text())["cases"]
-    out = {}
-    for c in cases:
-        path = study / c["case_id"] / MANIFEST_FILE
-        out[c["case_id"]] = json.loads(path.read_text())["status"] if path.is_file() else "missing"
-    return out
+    return {c.case_id: (m.status if (m := c.manifest()) else "missing")
+            for c in Study.open(study).cases}
 
 
 def jobcomp_states(cluster, job_id: str) -> dict[int | None, str]:
@@ -116,7 +112,7 @@ def test_array_analysis_cancel_and_resubmit(slurm_cluster, tmp_path, env):
           env=env)
     array_b = read_record(study_b)[0]["job_id"]
     victim = 1
-    log = study_b / "cg3-weber-r1" / SCREEN_FILE
+    log = Study.open(study_b).case(1).screen
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:  # running, and the engine has started stepping
         st = {c.index: c for c in study_status(study_b).cases}
@@ -176,6 +172,6 @@ def test_srun_launcher_inside_the_allocation(slurm_cluster, tmp_path, env):
     assert "export LIGWF_MPIRUN=srun\n" in script and "LIGWF_MPIRUN_ARGS=--mpi=pmix" in script
     wait_until_idle(study, timeout=120)
     assert manifest_states(study) == {"cg3-weber-r0": "done"}, _logs(study)
-    manifest = json.loads((study / "cg3-weber-r0" / MANIFEST_FILE).read_text())
-    assert Path(manifest["command"][0]).name == "srun", manifest["command"]
-    assert "--ntasks=1" in manifest["command"] and "--allow-run-as-root" not in manifest["command"]
+    command = Study.open(study).case(0).manifest().command
+    assert Path(command[0]).name == "srun", command
+    assert "--ntasks=1" in command and "--allow-run-as-root" not in command

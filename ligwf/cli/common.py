@@ -1,0 +1,82 @@
+"""What every ligwf sub-command shares: consoles, the workflow arguments, the pre-flight
+warnings, the case table and the stop-on-signal event. Holds no pipeline logic (that is
+:mod:`ligwf.study.pipeline`)."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Iterator
+
+from rich.console import Console
+from rich.table import Table
+
+from ligwf.study.pipeline import prepare_workflow
+from ligwf.study.prepare import Prepared
+
+console = Console(width=None if sys.stdout.isatty() else 160)
+err_console = Console(stderr=True, soft_wrap=True)
+
+
+def add_workflow_args(p: argparse.ArgumentParser) -> None:
+    """WORKFLOW, ``--set``, ``--templates`` and ``--allow-unstable``."""
+    p.add_argument("workflow", type=Path, help="workflow YAML file")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a workflow value, e.g. scene.drum.lifters.count=12 or "
+                   "analysis.max_velocity_angle=10 (repeatable)")
+    p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR",
+                   help="user template folder searched before ligwf's own (repeatable)")
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="run/write cases the pre-flight stability check refuses (experts)")
+
+
+def add_mesh_cache(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--mesh-cache", type=Path, default=None,
+                   help="mesh cache folder (default $LIGWF_MESH_CACHE or ./meshes)")
+
+
+def prepare_from_args(args: argparse.Namespace) -> Prepared:
+    """Validate, render and pre-flight the workflow of ``args``; print the warnings.
+    Raises (nothing written) on a bad value or a refused case."""
+    prepared = prepare_workflow(args.workflow, args.overrides, args.templates,
+                                args.allow_unstable)
+    for line in prepared.warnings:
+        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
+    return prepared
+
+
+def case_table(prepared: Prepared, title: str) -> Table:
+    """Table of cases: CG level, rule, replica, particle count, dt, steps."""
+    table = Table(title=title)
+    for col in ("case", "CG", "rule", "rep", "particles", "dt [s]", "dt/t_R", "steps",
+                "particle-steps"):
+        table.add_column(col, justify="right" if col not in ("case", "rule") else "left")
+    for rc in prepared.rendered:
+        s = rc.scaled
+        table.add_row(rc.case.case_id, f"{s.cg:g}", s.rule, str(s.replica),
+                      f"{s.particle_count:,}", f"{s.dt:.3g}", f"{s.dt_rayleigh_fraction:.3g}",
+                      f"{s.total_steps:,}", f"{s.particle_count * s.total_steps:.3g}")
+    return table
+
+
+@contextmanager
+def stop_on_signals() -> Iterator[threading.Event]:
+    """An event set by SIGTERM / SIGINT, so a runner stops its engines gracefully
+    (forced restart written, case marked ``killed``) instead of dying mid-write."""
+    stop = threading.Event()
+    previous = {}
+
+    def handler(signum, frame):  # noqa: ARG001 - signal handler signature
+        stop.set()
+
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        previous[sig] = signal.signal(sig, handler)
+    try:
+        yield stop
+    finally:
+        for sig, old in previous.items():
+            signal.signal(sig, old)
