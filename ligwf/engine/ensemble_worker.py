@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from ligwf.engine.attempt import begin_attempt, finish_attempt
-from ligwf.engine.site import load_site
+from ligwf.engine.liggghts import Liggghts
 from ligwf.fsio import atomic_write_json
 from ligwf.engine.resume import SKIP, input_for, plan_case
 from ligwf.study.case import CaseFolder
@@ -34,81 +34,39 @@ _libc = ctypes.CDLL(None)
 CLAIMS_DIR = "claims"
 
 
-def library_path() -> str:
-    """The LIGGGHTS shared library: $LIGWF_LIBLIGGGHTS, site key ``libliggghts``, or the
-    Debian package's ``libliggghts.so.3`` (found by the dynamic loader)."""
-    return os.environ.get("LIGWF_LIBLIGGGHTS", load_site().get("libliggghts", "libliggghts.so.3"))
+def run_file(engine: Liggghts, comm, case: CaseFolder, input_name: str) -> None:
+    """Run ``input_name`` in the case folder on the mpi4py communicator ``comm``.
 
+    The engine's screen is the process's stdout, pointed at the case's screen file on
+    the group leader and line-buffered (:func:`line_buffered_stdout`): an Error::one
+    ends in MPI_Abort, which drops whatever a fully buffered ``-screen FILE`` still
+    held -- including the ERROR line that names the culprit.
+    """
+    from mpi4py import MPI
 
-class Liggghts:
-    """The LAMMPS C API of libliggghts through ctypes (open, file, close)."""
-
-    def __init__(self, path: str | None = None) -> None:
-        self.lib = ctypes.CDLL(path or library_path(), mode=ctypes.RTLD_GLOBAL)
-        self.lib.lammps_open.argtypes = [ctypes.c_int, ctypes.POINTER(ctypes.c_char_p),
-                                         ctypes.c_void_p, ctypes.POINTER(ctypes.c_void_p)]
-        self.lib.lammps_open.restype = None
-        self.lib.lammps_file.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
-        self.lib.lammps_file.restype = None
-        self.lib.lammps_close.argtypes = [ctypes.c_void_p]
-        self.lib.lammps_close.restype = None
-        self.lib.lammps_command.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
-        self.lib.lammps_command.restype = ctypes.c_char_p
-
-    def warm_up_vtk(self) -> None:
-        """Create (never write) one VTK dump in a throw-away engine on MPI_COMM_SELF.
-
-        The first ``dump custom/vtk`` of a process runs vtkMPIController::Initialize,
-        which calls MPI_Comm_dup on MPI_COMM_WORLD -- a collective over ALL ranks of the
-        job (seen in gdb). If group A reaches its first dump while group B is still
-        filling, or has failed, A waits forever. Doing it on every rank at start-up, all
-        at once, makes later dumps local (VTK initialises only once per process).
-        """
-        from mpi4py import MPI
-
-        args = [b"liggghts", b"-screen", b"none", b"-log", b"none"]
-        argv = (ctypes.c_char_p * len(args))(*args)
-        handle = ctypes.c_void_p()
-        comm_ptr = ctypes.c_void_p.from_address(MPI._addressof(MPI.COMM_SELF))
-        self.lib.lammps_open(len(args), argv, comm_ptr, ctypes.byref(handle))
-        for cmd in ("units si", "atom_style granular", "region box block 0 1 0 1 0 1 units box",
-                    "create_box 1 box", "dump warm all custom/vtk 1000000 warm_*.vtu id"):
-            self.lib.lammps_command(handle, cmd.encode())
-        self.lib.lammps_close(handle)
-
-    def run_file(self, comm, case: CaseFolder, input_name: str) -> None:
-        """Run ``input_name`` in the case folder on the mpi4py communicator ``comm``.
-
-        The engine's screen is the process's stdout, pointed at the case's screen file on
-        the group leader and line-buffered (:func:`line_buffered_stdout`): an Error::one
-        ends in MPI_Abort, which drops whatever a fully buffered ``-screen FILE`` still
-        held -- including the ERROR line that names the culprit.
-        """
-        from mpi4py import MPI
-
-        args = [b"liggghts", b"-log", b"log.liggghts"]
-        argv = (ctypes.c_char_p * len(args))(*args)
-        handle = ctypes.c_void_p()
-        comm_ptr = ctypes.c_void_p.from_address(MPI._addressof(comm))
-        cwd = os.getcwd()
-        saved = None
+    args = [b"liggghts", b"-log", b"log.liggghts"]
+    argv = (ctypes.c_char_p * len(args))(*args)
+    handle = ctypes.c_void_p()
+    comm_ptr = ctypes.c_void_p.from_address(MPI._addressof(comm))
+    cwd = os.getcwd()
+    saved = None
+    _libc.fflush(None)
+    if comm.rank == 0:
+        saved = os.dup(1)
+        fd = os.open(case.screen, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+        os.dup2(fd, 1)
+        os.close(fd)
+    os.chdir(case.path)
+    try:
+        engine.lib.lammps_open(len(args), argv, comm_ptr, ctypes.byref(handle))
+        engine.lib.lammps_file(handle, input_name.encode())
+        engine.lib.lammps_close(handle)
+    finally:
         _libc.fflush(None)
-        if comm.rank == 0:
-            saved = os.dup(1)
-            fd = os.open(case.screen, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
-            os.dup2(fd, 1)
-            os.close(fd)
-        os.chdir(case.path)
-        try:
-            self.lib.lammps_open(len(args), argv, comm_ptr, ctypes.byref(handle))
-            self.lib.lammps_file(handle, input_name.encode())
-            self.lib.lammps_close(handle)
-        finally:
-            _libc.fflush(None)
-            os.chdir(cwd)
-            if saved is not None:
-                os.dup2(saved, 1)
-                os.close(saved)
+        os.chdir(cwd)
+        if saved is not None:
+            os.dup2(saved, 1)
+            os.close(saved)
 
 
 def line_buffered_stdout() -> None:
@@ -178,7 +136,7 @@ def main(argv: list[str] | None = None) -> int:
         pos, case_path, input_name = job
         case = CaseFolder.open(case_path)
         t0 = time.monotonic()
-        engine.run_file(sub, case, input_name)
+        run_file(engine, sub, case, input_name)
         sub.Barrier()
         if sub.rank == 0:
             finish_attempt(case, manifest, attempt, 0, time.monotonic() - t0)

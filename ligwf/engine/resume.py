@@ -21,10 +21,10 @@ from __future__ import annotations
 
 import re
 import shutil
-import struct
 from dataclasses import dataclass
 from pathlib import Path
 
+from ligwf.engine.liggghts import FORCED_RESTART_RE, PERIODIC_RESTARTS, restart_step
 from ligwf.engine.health import DONE, FAILED, RUNNING, UNSTABLE
 from ligwf.engine.render import INPUT_NAME, OUTPUT_DIRS, render_template, template_context
 from ligwf.scene.scaling import ScaledScene
@@ -34,8 +34,6 @@ from ligwf.study.manifest import effective_status
 
 #: Input file of a resumed attempt (next to ``in.liggghts``).
 RESUME_INPUT = "resume.in.liggghts"
-_FORCED_RE = re.compile(r"^restart_forced_liggghts_(\d+)\.data$")
-_PERIODIC = ("restart/restart_a.liggghts", "restart/restart_b.liggghts")
 
 SKIP, FRESH, RESUME = "skip", "fresh", "resume"
 
@@ -57,47 +55,16 @@ class Plan:
     restart: RestartFile | None = None
 
 
-def restart_step(path: Path) -> int | None:
-    """Time step stored in a LIGGGHTS 3.8.0 restart file header, or None if unreadable.
-
-    The header is a sequence of (int flag, value): 0 version string (int length + bytes),
-    1-3 int sizes, 4 units string, 5 the time step as a 64-bit integer.
-    """
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(512)
-        offset = 0
-        flag, n = struct.unpack_from("<ii", data, offset)
-        if flag != 0 or not 0 < n < 400:
-            return None
-        offset += 8 + n
-        for expect in (1, 2, 3):
-            flag, _ = struct.unpack_from("<ii", data, offset)
-            if flag != expect:
-                return None
-            offset += 8
-        flag, n = struct.unpack_from("<ii", data, offset)
-        if flag != 4 or not 0 < n < 64:
-            return None
-        offset += 8 + n
-        flag, step = struct.unpack_from("<iq", data, offset)
-        if flag != 5 or step < 0:
-            return None
-        return int(step)
-    except (OSError, struct.error):
-        return None
-
-
 def restart_files(case_dir: Path) -> list[RestartFile]:
     """Readable restart files of a case, newest step first."""
     case_dir = Path(case_dir)
     found: list[RestartFile] = []
     for p in case_dir.iterdir():
-        if _FORCED_RE.match(p.name):
+        if FORCED_RESTART_RE.match(p.name):
             step = restart_step(p)
             if step is not None:
                 found.append(RestartFile(p.name, step))
-    for rel in _PERIODIC:
+    for rel in PERIODIC_RESTARTS:
         p = case_dir / rel
         if p.is_file():
             step = restart_step(p)
@@ -145,7 +112,7 @@ def clean_outputs(case_dir: Path) -> None:
             shutil.rmtree(d)
         d.mkdir()
     for p in case_dir.iterdir():
-        if (_FORCED_RE.match(p.name) or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT,
+        if (FORCED_RESTART_RE.match(p.name) or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT,
                                                    "log.liggghts")
                 or re.fullmatch(r"run(\.\d+)?\.log", p.name)):
             p.unlink()

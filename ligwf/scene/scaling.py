@@ -285,7 +285,7 @@ class ScaledScene:
 
     @classmethod
     def from_dict(cls, data: dict) -> "ScaledScene":
-        """From :meth:`to_dict` (e.g. ``scene.json``'s ``scaled``): lists back to tuples;
+        """From :meth:`to_dict` (a case folder's stored scaled scene): lists back to tuples;
         a missing or unknown key is a TypeError, never a default."""
         return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in data.items()})
 

@@ -14,7 +14,8 @@ import meshio
 import pytest
 
 from ligwf.study.manifest import effective_status, read_manifest
-from ligwf.engine.resume import restart_files, restart_step
+from ligwf.engine.liggghts import restart_step
+from ligwf.engine.resume import restart_files
 
 from helpers import ROOT  # noqa: E402
 
