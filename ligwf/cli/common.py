@@ -5,6 +5,7 @@ warnings, the case table and the stop-on-signal event. Holds no pipeline logic (
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import threading
@@ -22,20 +23,69 @@ console = Console(width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True, soft_wrap=True)
 
 
+class Parser(argparse.ArgumentParser):
+    """argparse with its refusals in ligwf's one-line form (sub-parsers inherit it)."""
+
+    def error(self, message: str):  # noqa: D401 - argparse's hook
+        err_console.print(f"[bold red]ligwf: usage error:[/] {self.prog}: {message} "
+                          f"(see {self.prog} --help)", highlight=False)
+        raise SystemExit(2)
+
+
+def positive_int(text: str) -> int:
+    """argparse type: a whole number >= 1 (ranks, ensemble sizes)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
+    return value
+
+
+def folder_to_write(text: str) -> Path:
+    """argparse type: a folder ligwf may create or write into (refused before any work:
+    an existing file, a path below a file, a read-only or unwritable place)."""
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a file, not a folder")
+    probe = path
+    while not probe.exists():
+        if probe.parent == probe:
+            break
+        probe = probe.parent
+    if not probe.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: {probe} is a file, so no folder can be "
+                                         "made below it")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise argparse.ArgumentTypeError(f"{text}: {probe} is not writable (read-only file "
+                                         "system or permissions)")
+    return path
+
+
+def existing_folder(text: str) -> Path:
+    """argparse type: a folder that exists (user template folders)."""
+    path = Path(text)
+    if not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is not an existing folder")
+    return path
+
+
 def add_workflow_args(p: argparse.ArgumentParser) -> None:
     """WORKFLOW, ``--set``, ``--templates`` and ``--allow-unstable``."""
     p.add_argument("workflow", type=Path, help="workflow YAML file")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
                    help="override a workflow value, e.g. scene.drum.lifters.count=12 or "
                    "analysis.max_velocity_angle=10 (repeatable)")
-    p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR",
+    p.add_argument("--templates", action="append", default=[], type=existing_folder,
+                   metavar="DIR",
                    help="user template folder searched before ligwf's own (repeatable)")
     p.add_argument("--allow-unstable", action="store_true",
                    help="run/write cases the pre-flight stability check refuses (experts)")
 
 
 def add_mesh_cache(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--mesh-cache", type=Path, default=None,
+    p.add_argument("--mesh-cache", type=folder_to_write, default=None,
                    help="mesh cache folder (default $LIGWF_MESH_CACHE or ./meshes)")
 
 

@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from ligwf import __version__
 from ligwf.cli import analyse, report, run, slurm, stability
-from ligwf.cli.common import (add_mesh_cache, add_workflow_args, case_table, console,
-                              err_console, prepare_from_args)
+from ligwf.cli.common import (Parser, add_mesh_cache, add_workflow_args, case_table, console,
+                              err_console, folder_to_write, prepare_from_args)
 from ligwf.errors import LigwfError
 from ligwf.study.pipeline import write
 
@@ -39,7 +38,7 @@ def cmd_render(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="ligwf", description="Coarse-grained LIGGGHTS studies of wet rotating drums.")
     parser.add_argument("--version", action="version", version=f"ligwf {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -50,7 +49,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("render", help="write one folder per case (input, mesh, scene record)")
     add_workflow_args(p)
-    p.add_argument("--out", type=Path, required=True, help="study folder to write")
+    p.add_argument("--out", type=folder_to_write, required=True, help="study folder to write")
     add_mesh_cache(p)
     p.set_defaults(func=cmd_render)
 
@@ -61,7 +60,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:          # --help, --version, or a refused argument
+        return int(exc.code or 0)
     try:
         return int(args.func(args) or 0)
     except LigwfError as exc:

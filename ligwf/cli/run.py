@@ -14,8 +14,8 @@ import argparse
 import os
 from pathlib import Path
 
-from ligwf.cli.common import (add_mesh_cache, add_workflow_args, console, prepare_from_args,
-                              stop_on_signals)
+from ligwf.cli.common import (add_mesh_cache, add_workflow_args, console, folder_to_write,
+                              positive_int, prepare_from_args, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.engine.site import EngineConfig
 from ligwf.study.pipeline import RunSettings, run_study, write
@@ -63,9 +63,9 @@ def cmd_status(args: argparse.Namespace) -> int:
 
 def add_run_args(p: argparse.ArgumentParser) -> None:
     """The options of the run stage (``run`` and ``study``)."""
-    p.add_argument("--out", type=Path, required=True, help="study folder")
-    p.add_argument("--np", type=int, default=1, help="MPI ranks per case (default 1)")
-    p.add_argument("--ensemble", type=int, default=0, metavar="P",
+    p.add_argument("--out", type=folder_to_write, required=True, help="study folder")
+    p.add_argument("--np", type=positive_int, default=1, help="MPI ranks per case (default 1)")
+    p.add_argument("--ensemble", type=positive_int, default=0, metavar="P",
                    help="run all cases in ONE mpirun -np P, P/np cases at a time")
     p.add_argument("--retry-unstable", action="store_true",
                    help="also re-run cases found unstable before")
@@ -84,7 +84,7 @@ def register(subparsers) -> None:
                               "(Slurm array tasks call this)")
     p.add_argument("study", type=Path, help="rendered study folder")
     p.add_argument("--index", type=int, required=True, help="case index in the study")
-    p.add_argument("--np", type=int, default=0,
+    p.add_argument("--np", type=positive_int, default=0,
                    help="MPI ranks (default $SLURM_NTASKS, else 1)")
     p.add_argument("--retry-unstable", action="store_true")
     p.set_defaults(func=cmd_run_case)

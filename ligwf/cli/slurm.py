@@ -22,7 +22,7 @@ from typing import Any
 from rich.table import Table
 
 from ligwf.cli.common import (add_mesh_cache, add_workflow_args, case_table, console,
-                              err_console, prepare_from_args)
+                              err_console, folder_to_write, positive_int, prepare_from_args)
 from ligwf.errors import SubmitError
 from ligwf.slurm.jobs import (active_tasks, cases_to_resubmit, dry_run_text, next_round,
                               plan_jobs, read_record, recorded_site, require_scheduler,
@@ -36,8 +36,8 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--partition", help="Slurm partition (default: site setting)")
     p.add_argument("--account", help="Slurm account (default: site setting)")
     p.add_argument("--time", help="wall time per case, e.g. 02:00:00 (default: site setting)")
-    p.add_argument("--ntasks", type=int, help="MPI ranks per case (default: site setting or 1)")
-    p.add_argument("--max-concurrent", type=int, metavar="K",
+    p.add_argument("--ntasks", type=positive_int, help="MPI ranks per case (default: site setting or 1)")
+    p.add_argument("--max-concurrent", type=positive_int, metavar="K",
                    help="at most K cases at once (--array=...%%K)")
     p.add_argument("--no-analysis", action="store_true",
                    help="do not submit the dependent analysis job")
@@ -155,7 +155,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = sub.add_parser("submit", help="render all cases and submit them as one job array "
                                       "plus a dependent analysis job")
     add_workflow_args(p)
-    p.add_argument("--out", type=Path, required=True, help="study folder to write")
+    p.add_argument("--out", type=folder_to_write, required=True, help="study folder to write")
     add_mesh_cache(p)
     add_site_args(p)
     p.set_defaults(func=cmd_submit)

@@ -14,7 +14,7 @@ from pathlib import Path
 from rich.console import Console
 from rich.table import Table
 
-from ligwf.cli.common import add_mesh_cache, err_console
+from ligwf.cli.common import add_mesh_cache, err_console, folder_to_write
 from ligwf.fsio import atomic_write_json
 from ligwf.scene.stability import MARGINAL, REFUSED
 
@@ -100,7 +100,7 @@ def register(sub) -> None:
                        help="render the stress suite (workflows/stability.yaml) into one "
                        "study folder per variant, refused cases included")
     p.add_argument("suite", type=Path, help="suite YAML (base scene + variants)")
-    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--out", type=folder_to_write, required=True)
     p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR")
     add_mesh_cache(p)
     p.set_defaults(func=cmd_stability_suite)

@@ -17,9 +17,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import yaml
-
 from ligwf.errors import ConfigError, EngineNotFound
+from ligwf.yamlio import read_yaml_mapping
 
 
 def _site_file() -> Path:
@@ -32,15 +31,7 @@ def _site_file() -> Path:
 def load_site() -> dict:
     """The site YAML as a mapping ({} when there is none)."""
     path = _site_file()
-    if not path.is_file():
-        return {}
-    try:
-        data = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"site file {path}: not valid YAML: {exc}") from None
-    if not isinstance(data, dict):
-        raise ConfigError(f"site file {path}: must be a mapping")
-    return data
+    return read_yaml_mapping(path, "site file") if path.exists() else {}
 
 
 @dataclass(frozen=True)

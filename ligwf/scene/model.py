@@ -11,13 +11,15 @@ the value and the allowed range before any file is written or any engine launche
 from __future__ import annotations
 
 import math
+import typing
 from typing import Annotated, Any, Literal
 
 from pydantic import (AfterValidator, BaseModel, ConfigDict, Field, ValidationError,
-                      model_validator)
+                      ValidationInfo, field_validator, model_validator)
 
 from ligwf import liquids
 from ligwf.errors import ConfigError
+from ligwf.scene.messages import format_validation_error
 
 #: Characters that must never reach a LIGGGHTS input: a newline ends the command and starts
 #: a new one, '&' continues a line, '$' expands variables, '#' starts a comment and quotes
@@ -28,20 +30,43 @@ FORBIDDEN_INPUT_CHARS = ("\n", "\r", "&", "$", "#", "'", '"')
 def check_input_safe(value: str) -> str:
     """Refuse a string that could inject or break a line of a LIGGGHTS input."""
     bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
+    bad += sorted({c for c in value if (ord(c) < 32 or ord(c) == 127) and c not in bad})
     if bad:
         shown = ", ".join(repr(c) for c in bad)
         raise ValueError(f"contains {shown}; strings that reach the LIGGGHTS input may not "
-                         "contain a newline, '&', '$', '#' or a quote")
+                         "contain a newline, a control character, '&', '$', '#' or a quote")
     return value
 
 
 SafeStr = Annotated[str, AfterValidator(check_input_safe)]
 
 
-class _Frozen(BaseModel):
-    """Base of all parameter objects: immutable, unknown keys are errors (typos)."""
+def _admits_bool(annotation: Any) -> bool:
+    if annotation is bool:
+        return True
+    return any(_admits_bool(a) for a in typing.get_args(annotation))
 
-    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True)
+
+class _Frozen(BaseModel):
+    """Base of all parameter objects: immutable, unknown keys are errors (typos), numbers
+    are finite and never a YAML ``true``/``false`` (pydantic would read true as 1.0)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True,
+                              allow_inf_nan=False)
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _no_bool_for_non_bool(cls, value: Any, info: ValidationInfo) -> Any:
+        if isinstance(value, bool) and info.field_name in cls.model_fields and \
+                not _admits_bool(cls.model_fields[info.field_name].annotation):
+            raise ValueError(f"{str(value).lower()} is a yes/no value; a "
+                             f"{_kind(cls.model_fields[info.field_name].annotation)} is expected")
+        return value
+
+
+def _kind(annotation: Any) -> str:
+    names = {a.__name__ for a in (annotation, *typing.get_args(annotation)) if isinstance(a, type)}
+    return "number" if names & {"float", "int"} else "value"
 
 
 # ---------------------------------------------------------------------------------------
@@ -267,6 +292,11 @@ class Analysis(_Frozen):
     granules: bool = Field(False, description="write contact dumps for granule analysis")
 
 
+#: most particle (+ contact) dumps and thermo lines one production run may write
+MAX_DUMPS = 20_000
+MAX_THERMO_LINES = 2_000_000
+
+
 class Scene(_Frozen):
     """One original-size (CG1) drum simulation."""
 
@@ -286,74 +316,18 @@ class Scene(_Frozen):
                              f"liquid bridges); set liquid.model to {wet}")
         return self
 
-
-# ---------------------------------------------------------------------------------------
-# Error formatting
-# ---------------------------------------------------------------------------------------
-
-_BOUND_WORDS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
-
-
-def _allowed_range(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str | None:
-    """The full interval of a numeric field, e.g. '(0, 0.7]', from its declared bounds."""
-    field = None
-    for part in loc:
-        if isinstance(part, int):  # index into a tuple of models: same element model
-            continue
-        if model is None or part not in model.model_fields:
-            return None
-        field = model.model_fields[part]
-        ann = field.annotation
-        nxt = None
-        for cand in getattr(ann, "__args__", (ann,)):
-            if isinstance(cand, type) and issubclass(cand, BaseModel):
-                nxt = cand
-            for sub in getattr(cand, "__args__", ()):
-                if isinstance(sub, type) and issubclass(sub, BaseModel):
-                    nxt = sub
-        model = nxt
-    if field is None:
-        return None
-    bounds: dict[str, float] = {}
-    for meta in field.metadata:
-        for key in _BOUND_WORDS:
-            val = getattr(meta, key, None)
-            if val is not None:
-                bounds[key] = val
-    if not bounds:
-        return None
-    lo = f"({bounds['gt']:g}" if "gt" in bounds else (f"[{bounds['ge']:g}" if "ge" in bounds
-                                                     else "(-inf")
-    hi = f"{bounds['lt']:g})" if "lt" in bounds else (f"{bounds['le']:g}]" if "le" in bounds
-                                                     else "inf)")
-    return f"{lo}, {hi}"
-
-
-def format_validation_error(exc: ValidationError, root: type[BaseModel], prefix: str) -> str:
-    """One line per problem: ``field = value: reason (allowed: range)``."""
-    lines = []
-    errors = exc.errors()
-    deeper = {tuple(e["loc"][:-1]) for e in errors if len(e["loc"]) > 1}
-    for err in errors:
-        loc = tuple(err["loc"])
-        if err["type"] == "too_short" and any(d[:len(loc)] == loc for d in deeper):
-            continue  # a collection emptied by its own invalid items: already reported
-        path = ".".join(str(p) for p in (prefix, *loc) if p != "")
-        value = err.get("input")
-        msg = err["msg"].removeprefix("Value error, ")
-        if err["type"] == "extra_forbidden":
-            lines.append(f"{path}: unknown key (typo?)")
-            continue
-        if err["type"] == "missing":
-            lines.append(f"{path}: required field is missing")
-            continue
-        shown = value if not isinstance(value, (dict, list)) else "..."
-        line = f"{path} = {shown!r}: {msg}"
-        rng = _allowed_range(root, loc)
-        if rng:
-            line += f" (allowed range {rng})"
-        lines.append(line)
-    return "\n".join(lines)
+    @model_validator(mode="after")
+    def _output_counts(self) -> "Scene":
+        """A dump or thermo interval so short that the run writes millions of files/lines
+        (1e-12 s: one dump per step) is a typo, not a study."""
+        run, num = self.process.run_time, self.numerics
+        for name, interval, most in (("dump_interval", num.dump_interval, MAX_DUMPS),
+                                     ("thermo_interval", num.thermo_interval, MAX_THERMO_LINES)):
+            if run / interval > most:
+                raise ValueError(f"numerics.{name} = {interval:g}: {run:g} s of production "
+                                 f"would write {run / interval:.3g} outputs; allowed at most "
+                                 f"{most:,} (numerics.{name} >= {run / most:.3g} s)")
+        return self
 
 
 def build_scene(data: dict[str, Any], prefix: str = "scene") -> Scene:

@@ -110,6 +110,12 @@ def drum_free_volume(scene: Scene) -> float:
     return area * drum.length
 
 
+#: the largest solid volume / drum free volume a bed can have (fill 0.7 x packing 0.74)
+MAX_SOLID_SHARE = 0.7 * 0.74
+#: LIGGGHTS reads seeds as 32-bit ints
+INT_MAX = 2**31 - 1
+
+
 def mean_particle_volume(classes: list[tuple[float, float]]) -> float:
     """Number-weighted mean sphere volume of (diameter, number fraction) classes, m^3."""
     return sum(f * math.pi * d**3 / 6.0 for d, f in classes)
@@ -118,7 +124,15 @@ def mean_particle_volume(classes: list[tuple[float, float]]) -> float:
 def original_particle_count(scene: Scene) -> int:
     """CG1 particle count: given, or fill fraction x packing x drum volume / mean volume."""
     if scene.process.particle_count is not None:
-        return scene.process.particle_count
+        n = scene.process.particle_count
+        free = drum_free_volume(scene)
+        share = n * mean_particle_volume(scene.particles.size_classes()) / free
+        if share > MAX_SOLID_SHARE:
+            raise ConfigError(
+                f"scene.process.particle_count = {n}: their solid volume is {share:.3g} x the "
+                f"drum's free volume ({free:.3g} m^3); allowed at most {MAX_SOLID_SHARE:.2f} "
+                "(fill fraction 0.7 at the densest random packing 0.74)")
+        return n
     solid = scene.process.fill_fraction * scene.numerics.packing_fraction * drum_free_volume(scene)
     return max(1, round(solid / mean_particle_volume(scene.particles.size_classes())))
 
@@ -144,12 +158,17 @@ def next_prime(n: int) -> int:
 
 
 def replica_seeds(base: int, replica: int, count: int = 3) -> tuple[int, ...]:
-    """Distinct primes > 10000 (LIGGGHTS requires them) for one replica's random streams."""
+    """Distinct primes > 10000 (LIGGGHTS requires them) for one replica's random streams;
+    each must fit the engine's 32-bit int, else ConfigError naming the base seed."""
     seeds: list[int] = []
     p = max(base, 10007) + 10007 * replica
     for _ in range(count):
         p = next_prime(p + 1 if seeds else p)
         seeds.append(p)
+    if seeds and seeds[-1] > INT_MAX:
+        raise ConfigError(f"scene.numerics.seed = {base}: replica {replica}'s random streams "
+                          f"reach {seeds[-1]} > {INT_MAX} (the engine's largest int); allowed "
+                          f"range [10000, {INT_MAX - 10007 * (replica + 1)}] for this study")
     return tuple(seeds)
 
 

@@ -21,9 +21,9 @@ import copy
 from pathlib import Path
 from typing import Any
 
-import yaml
 
 from ligwf.errors import ConfigError
+from ligwf.yamlio import read_yaml_mapping
 from ligwf.scene.workflow import Workflow, expand
 
 
@@ -64,11 +64,4 @@ def expand_suite(raw: dict[str, Any]) -> dict[str, Workflow]:
 
 
 def load_suite(path: str | Path) -> dict[str, Workflow]:
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"stability suite {path} does not exist")
-    try:
-        raw = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML: {exc}") from None
-    return expand_suite(raw)
+    return expand_suite(read_yaml_mapping(path, "stability suite"))

@@ -22,20 +22,26 @@ from __future__ import annotations
 
 import copy
 import itertools
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import Field, TypeAdapter, ValidationError
 
 from ligwf.errors import ConfigError
+from ligwf.yamlio import parse_yaml, read_yaml_mapping
 from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
-from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene, format_validation_error
+from ligwf.scene.messages import format_validation_error
+from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene
 from ligwf.study.settings import AnalysisSettings, build_analysis_settings
 
 _TOP_KEYS = {"name", "description", "scene", "sweep", "analysis"}
+#: replicas per CG level and cases per study ligwf prepares (a typo such as 300000 replicas
+#: would otherwise spend minutes validating before anything is said)
+MAX_REPLICAS = 1000
+MAX_CASES = 5000
 
 
 class Sweep(_Frozen):
@@ -91,10 +97,7 @@ def parse_override(text: str) -> tuple[str, Any]:
     key = key.strip()
     if not key:
         raise ConfigError(f"--set {text!r}: empty key")
-    try:
-        parsed = yaml.safe_load(value) if value.strip() else ""
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"--set {key}: cannot parse value {value!r}: {exc}") from None
+    parsed = parse_yaml(value, f"--set {key}: value {value!r}") if value.strip() else ""
     return key, parsed
 
 
@@ -142,9 +145,26 @@ def _fmt_cg(cg: float) -> str:
     return f"{cg:g}"
 
 
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _mapping(value: Any, field: str, what: str) -> dict[str, Any]:
+    """``value`` as a mapping with string keys, or ConfigError naming ``field``."""
+    if value is None:
+        return {}
+    if not isinstance(value, dict):
+        raise ConfigError(f"{field} = {_short(value)}: must be a mapping of {what}")
+    for key in value:
+        if not isinstance(key, str):
+            raise ConfigError(f"{field}: key {key!r} is not a name")
+    return value
+
+
 def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list[Any]]]]:
     known, varied = {}, []
-    for key, value in sweep_raw.items():
+    for key, value in _mapping(sweep_raw, "sweep", "sweep settings").items():
         if key.startswith("scene."):
             if not isinstance(value, list) or not value:
                 raise ConfigError(f"sweep.{key} = {value!r}: a scene field in the sweep must "
@@ -164,8 +184,20 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
             raise ConfigError(f"sweep.cg_levels: CG level {cg:g} is < 1 (allowed range [1, inf))")
     reps = sweep.replicas.values() if isinstance(sweep.replicas, dict) else [sweep.replicas]
     for n in reps:
-        if n < 1:
-            raise ConfigError(f"sweep.replicas = {n}: need at least 1 replica (allowed range [1, inf))")
+        if not 1 <= n <= MAX_REPLICAS:
+            raise ConfigError(f"sweep.replicas = {n}: allowed range [1, {MAX_REPLICAS}] "
+                              "replicas per CG level")
+    stray = sorted(set(sweep.per_cg) - set(sweep.cg_levels))
+    if stray:
+        raise ConfigError(f"sweep.per_cg: CG level {stray[0]:g} is not in sweep.cg_levels "
+                          f"{[float(c) for c in sweep.cg_levels]} (its settings would never "
+                          "be used)")
+    count = math.prod(len(v) for _, v in varied) * sum(
+        (1 if cg == 1 else len(set(sweep.rules))) * sweep.replicas_for(cg)
+        for cg in set(sweep.cg_levels))
+    if count > MAX_CASES:
+        raise ConfigError(f"sweep expands to {count:,} cases (replicas x rules x CG levels x "
+                          f"scene lists); allowed at most {MAX_CASES:,} per study: split it")
     return sweep, varied
 
 
@@ -175,21 +207,27 @@ def expand(raw: dict[str, Any]) -> Workflow:
         raise ConfigError("a workflow file must be a YAML mapping with scene: and sweep:")
     unknown = set(raw) - _TOP_KEYS
     if unknown:
-        raise ConfigError(f"workflow: unknown key(s) {', '.join(sorted(unknown))} "
+        raise ConfigError(f"workflow: unknown key(s) {', '.join(sorted(map(str, unknown)))} "
                           f"(allowed: {', '.join(sorted(_TOP_KEYS))})")
-    if "scene" not in raw:
-        raise ConfigError("workflow: the scene: block is missing")
+    if raw.get("scene") is None:
+        raise ConfigError(f"scene = {raw.get('scene')!r}: the workflow's scene: block is "
+                          "missing or empty")
     name = raw.get("name", "study")
     try:
         TypeAdapter(SafeStr).validate_python(name)
     except ValidationError as exc:
         raise ConfigError(f"name = {name!r}: {exc.errors()[0]['msg']}") from None
-    sweep, varied = _split_sweep(raw.get("sweep") or {})
+    sweep, varied = _split_sweep(raw.get("sweep"))
     analysis = build_analysis_settings(raw.get("analysis") or {})
 
-    base_scene = copy.deepcopy(raw["scene"])
+    base_scene = copy.deepcopy(_mapping(raw["scene"], "scene", "scene fields (drum:, "
+                                        "particles:, liquid:, process:, ...)"))
     base_scene.setdefault("name", name)
-    build_scene(base_scene)  # report errors of the base scene once, plainly
+    first = build_scene(base_scene)  # report errors of the base scene once, plainly
+    if not first.liquid.wet and len(set(sweep.rules)) > 1 and any(c != 1 for c in sweep.cg_levels):
+        raise ConfigError(f"sweep.rules = {[r.value for r in sweep.rules]}: on a dry scene "
+                          f"(liquid.model {first.liquid.model}) every rule gives the same case; "
+                          "sweep one rule")
 
     cases: list[Case] = []
     combos = itertools.product(*[vals for _, vals in varied]) if varied else [()]
@@ -224,15 +262,7 @@ def expand(raw: dict[str, Any]) -> Workflow:
 
 def load_workflow(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Workflow:
     """Read a workflow YAML, apply ``--set`` overrides, validate and expand it."""
-    path = Path(path)
-    if not path.is_file():
-        raise ConfigError(f"workflow file {path} does not exist")
-    try:
-        raw = yaml.safe_load(path.read_text()) or {}
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML: {exc}") from None
-    if not isinstance(raw, dict):
-        raise ConfigError(f"{path}: a workflow must be a YAML mapping")
+    raw = read_yaml_mapping(path, "workflow file")
     for text in overrides:
         apply_override(raw, *parse_override(text))
     return expand(raw)

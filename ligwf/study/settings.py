@@ -17,7 +17,8 @@ from typing import Any
 from pydantic import Field, ValidationError
 
 from ligwf.errors import ConfigError
-from ligwf.scene.model import _Frozen, format_validation_error
+from ligwf.scene.messages import format_validation_error
+from ligwf.scene.model import _Frozen
 
 
 class AnalysisSettings(_Frozen):

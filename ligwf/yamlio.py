@@ -1,0 +1,142 @@
+"""Reading YAML that a user wrote: workflows, stability suites, site files, ``--set`` values.
+
+``yaml.safe_load`` alone lets through what a hostile or careless file holds: a duplicate key
+silently wins (the last one), bytes that are not UTF-8 end in a UnicodeDecodeError, an alias
+chain ("billion laughs") expands into gigabytes later, deep nesting overflows the recursive
+composer, and ``1e-3`` (no dot) is a string in YAML 1.1. This loader refuses the first four
+with a one-line :class:`~ligwf.errors.ConfigError` naming the file and where, and reads
+``1e-3`` as the number everybody means.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ligwf.errors import ConfigError
+
+#: a user's YAML file is small: refuse anything larger before parsing it
+MAX_BYTES = 1_000_000
+#: nodes after expanding every alias; a real workflow has a few hundred
+MAX_NODES = 100_000
+
+# YAML 1.1 floats need a dot; accept 1e-3, 5E+6 as well (as YAML 1.2 does)
+_FLOAT = re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+                    |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+                    |\.[0-9_]+(?:[eE][-+][0-9]+)?
+                    |[-+]?\.(?:inf|Inf|INF)
+                    |\.(?:nan|NaN|NAN))$""", re.X)
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """SafeLoader that refuses duplicate keys and reads 1e-3 as a float."""
+
+    def construct_mapping(self, node, deep=False):
+        seen: dict[Any, Any] = {}
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)
+            try:
+                hash(key)
+            except TypeError:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"unhashable key {key!r}", key_node.start_mark) from None
+            if key in seen:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"duplicate key {key!r} (first at line "
+                    f"{seen[key].line + 1}; the last one would silently win)",
+                    key_node.start_mark)
+            seen[key] = key_node.start_mark
+        return super().construct_mapping(node, deep=deep)
+
+
+_StrictLoader.yaml_implicit_resolvers = {
+    k: [(tag, rx) for tag, rx in v if tag != "tag:yaml.org,2002:float"]
+    for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+_StrictLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT,
+                                    list("-+0123456789."))
+
+
+def _expanded_size(node, memo: dict[int, int]) -> int:
+    """Nodes of the document with every alias expanded (aliases share node objects)."""
+    key = id(node)
+    if key not in memo:
+        memo[key] = 1   # a recursive alias counts once: it cannot grow the composition
+        if isinstance(node, yaml.SequenceNode):
+            memo[key] = 1 + sum(_expanded_size(n, memo) for n in node.value)
+        elif isinstance(node, yaml.MappingNode):
+            memo[key] = 1 + sum(_expanded_size(k, memo) + _expanded_size(v, memo)
+                                for k, v in node.value)
+        if memo[key] > MAX_NODES:
+            raise ConfigError(f"more than {MAX_NODES:,} values once its aliases are expanded "
+                              "(an alias chain?)")
+    return memo[key]
+
+
+def _one_line(exc: yaml.YAMLError) -> str:
+    mark = getattr(exc, "problem_mark", None) or getattr(exc, "context_mark", None)
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+    parts = [getattr(exc, "context", None), getattr(exc, "problem", None)]
+    what = ": ".join(p for p in parts if p) or str(exc).splitlines()[0]
+    return f"not valid YAML{where}: {what}"
+
+
+def parse_yaml(text: str, source: str) -> Any:
+    """Parse YAML text (``source`` names it in errors); ConfigError on anything refused."""
+    if "\0" in text:
+        raise ConfigError(f"{source}: holds a NUL character")
+    loader = _StrictLoader(text)
+    try:
+        node = loader.get_single_node()
+        if node is None:
+            return None
+        _expanded_size(node, {})
+        return loader.construct_document(node)
+    except ConfigError as exc:
+        raise ConfigError(f"{source}: {exc}") from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{source}: {_one_line(exc)}") from None
+    except RecursionError:
+        raise ConfigError(f"{source}: nested too deeply to read (thousands of levels of "
+                          "[ or {)") from None
+    finally:
+        loader.dispose()
+
+
+def read_yaml_file(path: str | Path, what: str) -> Any:
+    """Parse a user's YAML file; ``what`` names it in errors ("workflow file", ...)."""
+    path = Path(path)
+    if path.is_dir():
+        raise ConfigError(f"{what} {path} is a directory, not a YAML file")
+    if not path.is_file():
+        raise ConfigError(f"{what} {path} does not exist")
+    try:
+        size = path.stat().st_size
+        if size > MAX_BYTES:
+            raise ConfigError(f"{what} {path}: {size:,} bytes; a YAML file ligwf reads is at "
+                              f"most {MAX_BYTES:,}")
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ConfigError(f"{what} {path}: cannot be read ({exc.strerror})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{what} {path}: not UTF-8 text (byte 0x{raw[exc.start]:02x} at "
+                          f"offset {exc.start}); is it a binary file?") from None
+    return parse_yaml(text, f"{what} {path}")
+
+
+def read_yaml_mapping(path: str | Path, what: str) -> dict[str, Any]:
+    """:func:`read_yaml_file` that must hold a mapping with string keys (empty file: {})."""
+    data = read_yaml_file(path, what)
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{what} {path}: must be a YAML mapping (key: value), "
+                          f"not a {type(data).__name__}")
+    bad = [k for k in data if not isinstance(k, str)]
+    if bad:
+        raise ConfigError(f"{what} {path}: top-level key {bad[0]!r} is not a name")
+    return data
