@@ -23,6 +23,7 @@ and skip that frame instead of analysing garbage.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,7 +47,7 @@ class ParticleFrame:
 
     path: Path
     step: int
-    time: float                  # s, step * dt
+    time: float                  # s, step * dt (nan when dt was not given)
     ids: np.ndarray              # (N,) int64, ascending
     types: np.ndarray            # (N,) int32
     positions: np.ndarray        # (N, 3) float64 (the dump stores float32)
@@ -103,23 +104,45 @@ class FrameFiles:
     contacts: Path | None
 
 
-def discover_frames(case_dir: Path) -> list[FrameFiles]:
-    """Frames of a case folder (its ``post/`` subfolder or itself), sorted by step.
-
-    A particle dump without its contact dump is listed with ``contacts=None`` (a dry run
-    or a run without granule analysis); a contact dump without particles is ignored.
-    The ``particles_boundingBox_*`` files LIGGGHTS writes next to each dump do not match.
-    """
+def dump_files(case_dir: Path) -> tuple[dict[int, Path], dict[int, Path]]:
+    """(particle dumps, contact dumps) of a case folder (its ``post/`` subfolder or itself)
+    by step. The ``particles_boundingBox_*`` files LIGGGHTS writes next to each dump do
+    not match."""
     case_dir = Path(case_dir)
     post = case_dir / "post" if (case_dir / "post").is_dir() else case_dir
     parts: dict[int, Path] = {}
     contacts: dict[int, Path] = {}
+    if not post.is_dir():
+        return parts, contacts
     for path in post.iterdir():
         if m := _PARTICLE_RE.match(path.name):
             parts[int(m.group(1))] = path
         elif m := _CONTACT_RE.match(path.name):
             contacts[int(m.group(1))] = path
+    return parts, contacts
+
+
+def discover_frames(case_dir: Path) -> list[FrameFiles]:
+    """Frames of a case folder (its ``post/`` subfolder or itself), sorted by step.
+
+    A particle dump without its contact dump is listed with ``contacts=None`` (a dry run
+    or a run without granule analysis); a contact dump without particles is ignored here
+    (:func:`ligwf.analysis.frame_checks.plan_frames` reports it).
+    """
+    parts, contacts = dump_files(case_dir)
     return [FrameFiles(step, parts[step], contacts.get(step)) for step in sorted(parts)]
+
+
+def _step_of(path: Path, step: int | None, pattern: re.Pattern) -> int:
+    """The step given, else the number in a LIGGGHTS dump name; DumpReadError otherwise
+    (never a silent step 0: every frame would then claim the same time)."""
+    if step is not None:
+        return int(step)
+    m = pattern.match(path.name)
+    if m is None:
+        raise DumpReadError(f"{path}: no step in the file name (expected "
+                            f"{pattern.pattern.strip('^$')}); pass step=")
+    return int(m.group(1))
 
 
 def _need(path: Path, data: dict, names: tuple[str, ...], kind: str) -> None:
@@ -139,16 +162,16 @@ def _check_rows(path: Path, name: str, arr: np.ndarray, rows: int, cols: int | N
         raise DumpReadError(f"{path}: array {name} holds nan or inf values")
 
 
-def read_particles(path: Path, step: int | None = None, dt: float = 0.0,
+def read_particles(path: Path, step: int | None = None, dt: float | None = None,
                    reader: str = "fast") -> ParticleFrame:
-    """Read one particle dump; ``step`` defaults to the number in the file name.
+    """Read one particle dump; ``step`` defaults to the number in the file name (a name
+    without one is an error: pass ``step``).
 
-    ``dt`` (s) converts the step to a time (LIGGGHTS' time is step * dt with a fixed dt).
+    ``dt`` (s) converts the step to a time (LIGGGHTS' time is step * dt with a fixed dt);
+    without it the time is nan (unknown), never 0.
     """
     path = Path(path)
-    if step is None:
-        m = _PARTICLE_RE.match(path.name)
-        step = int(m.group(1)) if m else 0
+    step = _step_of(path, step, _PARTICLE_RE)
     counts = piece_counts(path)
     if counts is not None and counts[0] == 0:
         raise DumpReadError(f"{path}: particle dump holds zero particles")
@@ -181,18 +204,17 @@ def read_particles(path: Path, step: int | None = None, dt: float = 0.0,
         raise DumpReadError(f"{path}: non-positive particle radius")
     liquid = arrays["f_surfaceLiquidContent"]
     return ParticleFrame(
-        path=path, step=int(step), time=int(step) * float(dt), ids=ids,
+        path=path, step=step, time=math.nan if dt is None else step * float(dt), ids=ids,
         types=arrays["type"].astype(np.int32), positions=positions[order],
         velocities=arrays["v"].astype(np.float64), radii=arrays["radius"].astype(np.float64),
         liquid_content=None if liquid is None else liquid.astype(np.float64))
 
 
 def read_contacts(path: Path, step: int | None = None, reader: str = "fast") -> ContactFrame:
-    """Read one contact dump (zero contacts is a valid frame: a dispersed or dry bed)."""
+    """Read one contact dump (zero contacts is a valid frame: a dispersed or dry bed);
+    ``step`` defaults to the number in the file name (a name without one is an error)."""
     path = Path(path)
-    if step is None:
-        m = _CONTACT_RE.match(path.name)
-        step = int(m.group(1)) if m else 0
+    step = _step_of(path, step, _CONTACT_RE)
     counts = piece_counts(path)
     if counts is not None and counts[1] == 0:
         empty = np.zeros(0, dtype=np.int64)

@@ -4,7 +4,10 @@ Only usable cases count (manifest ``done`` for the scene the folder holds: the s
 as the granule analysis, :meth:`ligwf.study.study.Study.usable_cases`). Only the steady
 part of the production phase counts: frames from the study's ``steady_after`` (a fraction
 of the production time) on, the same window the GSD uses
-(:meth:`ligwf.study.case.CaseFolder.steady_start_step`). Outputs, written atomically
+(:meth:`ligwf.study.case.CaseFolder.steady_start_step`). Frames are checked as the
+granule analysis checks them (:mod:`ligwf.analysis.frame_checks`: expected steps, dump
+record, particle count, ids, radii, drum); refused and missing ones are listed per case
+with their reasons, never used. Outputs, written atomically
 into the study's analysis folder (names in :mod:`ligwf.study.layout`):
 
 * flow table: one row per case with the :class:`~ligwf.analysis.flow.FlowSummary` scalars;
@@ -20,9 +23,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.dumps import discover_frames, read_particles
+from ligwf.analysis.dumps import read_particles
 from ligwf.analysis.flow import DrumGeometry, frame_flow, summarise, velocity_field
-from ligwf.errors import DumpReadError
+from ligwf.analysis.frame_checks import check_particles, plan_frames
+from ligwf.errors import ConfigError, DumpReadError
 from ligwf.fsio import atomic_write_json, atomic_write_text
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -30,15 +34,21 @@ from ligwf.study.study import Study
 
 
 def case_flow(case: CaseFolder, steady_after: float) -> tuple[dict, dict, list[str]]:
-    """(summary row, profiles, skipped-frame notes) of one case folder."""
+    """(summary row, profiles, skipped-frame notes) of one case folder; DumpReadError when
+    no frame of the steady window is usable, ConfigError when its dump record is unreadable."""
     geo = DrumGeometry.from_scaled(case.scaled)
     first = case.steady_start_step(steady_after)
-    frames, skipped = [], []
-    for ff in discover_frames(case.path):
+    plan = plan_frames(case)
+    frames = []
+    skipped = [p["reason"] for p in plan.problems if p["step"] >= first]
+    for ff in plan.frames:
         if ff.step < first:
             continue
         try:
-            frames.append(read_particles(ff.particles, ff.step, case.scaled.dt))
+            plan.check_record(ff)
+            frame = read_particles(ff.particles, ff.step, case.scaled.dt)
+            check_particles(case, frame)
+            frames.append(frame)
         except DumpReadError as exc:
             skipped.append(str(exc))
     if not frames:
@@ -67,7 +77,7 @@ def flow_study(study: Study, out_dir: Path | None = None) -> pd.DataFrame:
     for c in cases:
         try:
             row, prof, skipped = case_flow(c, steady_after)
-        except DumpReadError as exc:
+        except (DumpReadError, ConfigError) as exc:
             notes[c.case_id] = [str(exc)]
             continue
         rows.append(row)

@@ -42,12 +42,26 @@ class Condition:
         return tag if self.group in ("{}", "") else f"{tag} {self.group}"
 
 
+#: Columns of ``gsd.csv`` (one row per condition and volume bin).
+GSD_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames", "bin", "v_lo", "v_hi",
+               "v_mid", "number_fraction", "number_lo", "number_hi", "volume_fraction",
+               "volume_lo", "volume_hi", "ref_volume_fraction", "rel_error", "rel_error_lo",
+               "rel_error_hi", "below_limit"]
+#: Columns of ``gsd_summary.csv`` (one row per condition).
+SUMMARY_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames",
+                   *[f"{q}{s}" for q in ("d10", "d50", "d90", "largest_fraction")
+                     for s in ("", "_lo", "_hi")],
+                   "size_limit", "min_particles", "reference",
+                   *[f"error_{side}{s}" for side in ("below", "above") for s in ("", "_lo", "_hi")]]
+
+
 def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
                settings: gsdmod.GsdSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
     """``gsd.csv`` and ``gsd_summary.csv`` contents from the granule table of the frames
-    to use (empty tables when there is none)."""
+    to use (tables with their columns and no row when there is none: a steady window
+    without frames is a result, and the files keep their header)."""
     if granules.empty:
-        return pd.DataFrame(), pd.DataFrame()
+        return pd.DataFrame(columns=GSD_COLUMNS), pd.DataFrame(columns=SUMMARY_COLUMNS)
     g = granules
     edges = gsdmod.log_edges(float(g["primary_volume"].min()), float(g["primary_volume"].max()),
                              settings.bins_per_decade)
@@ -123,4 +137,4 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
                         "largest_fraction_hi": sc_hi[3],
                         "size_limit": limit, "min_particles": settings.min_particles,
                         "reference": ref.name if ref is not None else "", **err})
-    return pd.DataFrame(rows), pd.DataFrame(summary)
+    return pd.DataFrame(rows, columns=GSD_COLUMNS), pd.DataFrame(summary, columns=SUMMARY_COLUMNS)

@@ -1,18 +1,23 @@
-"""Whole-run analysis: every usable case, every frame -> granule tables, GSD, ParaView series.
+"""Whole-study analysis: every usable case, every frame -> granule tables, GSD, ParaView series.
 
-Life cycle after MDAnalysis: :class:`GranuleAnalysis` takes its parameters in the
-constructor; :meth:`GranuleAnalysis.run` calls ``_prepare``, ``_single_frame`` for each
-frame it is given and ``_conclude``, and fills ``results``. Because a frame depends on
-nothing but its own two dump files, the MPI runner (:func:`analyse`) only deals
-(case, frame) tasks round-robin to ranks, gathers the per-frame results on rank 0 and
-lets rank 0 alone sort them and write the outputs: the files are the same whatever the
-number of ranks (each rank writes the per-frame ``.vtu`` files of its own frames).
+Because a frame depends on nothing but its own two dump files, the MPI runner
+(:func:`analyse`) only deals (case, frame) tasks round-robin to ranks
+(:class:`~ligwf.analysis.case_granules.GranuleAnalysis` per frame), gathers the per-frame
+results on rank 0 and lets rank 0 alone sort them and write the outputs: the files are the
+same whatever the number of ranks (each rank writes the per-frame ``.vtu`` files of its
+own frames into the staging folder).
 
 Cases are used only when the study says they are usable (manifest ``done`` for the scene
-the folder holds, :meth:`ligwf.study.case.CaseFolder.why_not_usable`); others are skipped
-and listed with the reason. A frame whose dump cannot be read
-(:class:`~ligwf.errors.DumpReadError`) is skipped and listed, never analysed. The science
-settings (bond criterion, GSD binning and bootstrap, steady window) come from the study
+the folder holds and a thermo table that agrees with it,
+:meth:`ligwf.study.case.CaseFolder.why_not_usable`); frames only when they are the run's
+own (:mod:`ligwf.analysis.frame_checks`: expected steps, dump record, particle count and
+ids, radii, drum, contact geometry). Everything else is listed with its reason -- skipped
+cases, and missing, unexpected or refused frames -- in the analysis record and the frame
+table, which the report shows; a case left without any analysable frame is a skipped
+case. When nothing at all could be analysed, :class:`NothingAnalysed` is raised and the
+previous outputs stay as they were; otherwise the outputs are replaced as one set
+(:class:`~ligwf.analysis.outputs.OutputSet`). The science settings (bond criterion, GSD
+binning and bootstrap, steady window) come from the study
 (:class:`~ligwf.study.settings.AnalysisSettings`), so every path that analyses a study
 computes the same numbers. Granules are identified in every frame; the GSD uses the
 frames of each case's steady window only (the flow stage uses the same window).
@@ -23,8 +28,9 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
 * granule table (parquet): one row per granule per frame (case_id, cg, rule, replica,
   frame, step, time, granule, members, volume, primary_volume, com_x/y/z, first_id,
   percolating: the granule closes a cycle around the periodic axis);
-* frame table: per frame: particles, contacts, bonds, granules, largest granule share
-  and whether the largest granule percolates (wraps around the periodic axis);
+* frame table: per frame: status (ok, missing, unexpected, skipped) and reason,
+  particles, contacts, bonds, granules, largest granule share and whether the largest
+  granule percolates (wraps around the periodic axis);
 * GSD and GSD summary tables: see :mod:`ligwf.analysis.gsd_tables`;
 * ``<case_id>/granules.pvd`` + ``granules_<step>.vtu``: particles with a ``granule`` array;
 * the analysis record (JSON): settings, analysed and skipped cases with their steady
@@ -34,149 +40,30 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
 from __future__ import annotations
 
 import io
+import json
 import os
-import tempfile
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from ligwf.analysis.dumps import FrameFiles, ParticleFrame, discover_frames, read_contacts, read_particles
-from ligwf.analysis.granules import AXES, BondCriterion, Liquid, granule_table, identify, louvain_labels
+from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts, pvd_text
+from ligwf.analysis.frame_checks import FramePlan, plan_frames
+from ligwf.analysis.granules import BondCriterion
 from ligwf.analysis.gsd import GsdSettings
 from ligwf.analysis.gsd_tables import gsd_tables
-from ligwf.errors import ConfigError, DumpReadError
-from ligwf.fsio import atomic_write_bytes, atomic_write_json, atomic_write_text
+from ligwf.analysis.outputs import OutputSet, new_token
+from ligwf.errors import ConfigError, LigwfError
 from ligwf.study import layout
-from ligwf.study.case import CaseFolder
 from ligwf.study.settings import AnalysisSettings
 from ligwf.study.study import Study
 
-
-def case_liquid(case: CaseFolder) -> Liquid:
-    """The liquid-bridge law the engine applied in the case."""
-    return Liquid.from_scaled(case.scaled)
+__all__ = ["AnalysisOptions", "GranuleAnalysis", "NothingAnalysed", "analyse"]
 
 
-def periodic_axis(case: CaseFolder) -> int | None:
-    """0, 1, 2 for a periodic drum axis x, y, z; None for a closed drum."""
-    return AXES.index(case.scaled.axis) if case.scaled.periodic else None
+class NothingAnalysed(LigwfError):
+    """No frame of any case could be analysed; the previous outputs were kept."""
 
-
-@dataclass
-class FrameResult:
-    """Outcome of one frame: its granule table, or why it was skipped."""
-
-    case_id: str
-    step: int
-    time: float
-    table: pd.DataFrame | None = None
-    particles: int = 0
-    contacts: int = 0
-    bonds: int = 0
-    error: str | None = None
-    vtu: str | None = None      # file name in the case's output folder
-
-
-@dataclass
-class GranuleAnalysis:
-    """Granules of every frame of one case (MDAnalysis-style life cycle).
-
-    ``implementation`` is ``"fast"`` (numba-compiled union-find) or ``"reference"`` (networkx BFS).
-    ``vtu_dir`` set: write ``granules_<step>.vtu`` per frame there (ParaView series).
-    ``louvain``: also store Louvain community ids per particle in the ``.vtu``.
-    """
-
-    case: CaseFolder
-    criterion: BondCriterion = BondCriterion()
-    implementation: str = "fast"
-    vtu_dir: Path | None = None
-    louvain: bool = False
-    results: list[FrameResult] = field(default_factory=list)
-
-    def run(self, frames: list[FrameFiles] | None = None) -> "GranuleAnalysis":
-        """Analyse ``frames`` (default: every frame of the case) and fill ``results``."""
-        frames = discover_frames(self.case.path) if frames is None else frames
-        self._prepare()
-        for ff in frames:
-            self.results.append(self._single_frame(ff))
-        self._conclude()
-        return self
-
-    def _prepare(self) -> None:
-        if self.implementation not in ("fast", "reference"):
-            raise ConfigError(f"implementation {self.implementation!r}: use fast or reference")
-        self.results = []
-        self._liquid = case_liquid(self.case)
-        self._axis = periodic_axis(self.case)
-
-    def _single_frame(self, ff: FrameFiles) -> FrameResult:
-        c, dt = self.case, self.case.scaled.dt
-        # the drum axis spans [0, L] (the periodic box, see templates/drum.in.j2)
-        box_lo, box_length = 0.0, c.scaled.drum_length
-        res = FrameResult(c.case_id, ff.step, ff.step * dt)
-        try:
-            if ff.contacts is None:
-                raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
-                                    "(was the case rendered with analysis.granules: true?)")
-            particles = read_particles(ff.particles, ff.step, dt)
-            contacts = read_contacts(ff.contacts, ff.step)
-            ident = identify(particles, contacts, self._liquid, self.criterion, self._axis,
-                             box_length, self.implementation, need_force=self.louvain)
-        except DumpReadError as exc:
-            res.error = str(exc)
-            return res
-        labels = ident.labels
-        table = granule_table(particles, labels, c.cg, ident.unwrapped_axis, self._axis,
-                              box_lo, box_length, ident.percolating)
-        res.table, res.particles, res.contacts = table, len(particles), len(contacts)
-        res.bonds = len(ident.i)
-        if self.vtu_dir is not None:
-            extra = ({"louvain": louvain_labels(len(particles), ident.i, ident.j, ident.force)}
-                     if self.louvain else {})
-            res.vtu = f"granules_{ff.step}.vtu"
-            write_particle_vtu(Path(self.vtu_dir) / res.vtu, particles, labels,
-                               table["members"].to_numpy()[labels], extra)
-        return res
-
-    def _conclude(self) -> None:
-        self.results.sort(key=lambda r: r.step)
-
-
-def write_particle_vtu(path: Path, particles: ParticleFrame, labels: np.ndarray,
-                       granule_members: np.ndarray, extra: dict[str, np.ndarray] | None = None) -> None:
-    """Particles as VTU vertices (meshio, binary) with ``granule`` ids, written atomically."""
-    import meshio
-
-    n = len(particles)
-    point_data = {"id": particles.ids.astype(np.int64), "type": particles.types,
-                  "v": particles.velocities, "radius": particles.radii,
-                  "granule": labels.astype(np.int64),
-                  "granule_members": granule_members.astype(np.int64)}
-    if particles.liquid_content is not None:
-        point_data["f_surfaceLiquidContent"] = particles.liquid_content
-    point_data.update(extra or {})
-    mesh = meshio.Mesh(particles.positions, [("vertex", np.arange(n).reshape(-1, 1))],
-                       point_data=point_data)
-    with tempfile.TemporaryDirectory() as tmp:
-        tmp_path = Path(tmp) / "frame.vtu"
-        meshio.write(tmp_path, mesh, file_format="vtu", binary=True, compression=None)
-        atomic_write_bytes(path, tmp_path.read_bytes())
-
-
-def pvd_text(entries: list[tuple[float, str]]) -> str:
-    """A ParaView collection (.pvd) of (time s, file name) entries."""
-    lines = ['<?xml version="1.0"?>',
-             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
-             "  <Collection>"]
-    lines += [f'    <DataSet timestep="{t!r}" group="" part="0" file="{name}"/>'
-              for t, name in entries]
-    lines += ["  </Collection>", "</VTKFile>", ""]
-    return "\n".join(lines)
-
-
-# --------------------------------------------------------------------------- runner
 
 def _mpi_comm():
     """MPI.COMM_WORLD when started under mpirun with more than one rank, else None."""
@@ -217,22 +104,35 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
             comm=None) -> dict | None:
     """Analyse a study (or one case) folder; on rank 0 write the outputs and return the
     analysis record (other ranks return None). ``comm``: an mpi4py communicator, by
-    default COMM_WORLD when running under mpirun with several ranks."""
+    default COMM_WORLD when running under mpirun with several ranks. NothingAnalysed
+    (outputs untouched) when no frame could be analysed."""
     study = Study.open(run_dir)
     out_dir = Path(out_dir) if out_dir is not None else study.analysis_dir
     settings = options.settings or study.analysis
     comm = _mpi_comm() if comm is None else comm
     rank, size = (comm.Get_rank(), comm.Get_size()) if comm is not None else (0, 1)
+    token = new_token() if comm is None else comm.bcast(new_token() if rank == 0 else None)
+    outputs = OutputSet(out_dir, token)
 
-    cases, skipped_cases = study.usable_cases(options.require_manifest)
-    frames = {c.case_id: discover_frames(c.path) for c in cases}
-    tasks = [(ci, k) for ci, c in enumerate(cases) for k in range(len(frames[c.case_id]))]
+    usable, skipped_cases = study.usable_cases(options.require_manifest)
+    facts: list[RunFacts] = []
+    for c in usable:
+        try:
+            facts.append(RunFacts.of_case(c, plan_frames(c)))
+        except ConfigError as exc:
+            skipped_cases.append({"case_id": c.case_id, "reason": str(exc)})
+    tasks = [(fi, ff) for fi, f in enumerate(facts) for ff in f.plan.frames]
     mine: list[FrameResult] = []
-    for ci, k in tasks[rank::size]:
-        c = cases[ci]
-        ana = GranuleAnalysis(c, bond_criterion(settings), options.implementation,
-                              out_dir / c.case_id if options.write_vtu else None, options.louvain)
-        mine.extend(ana.run([frames[c.case_id][k]]).results)
+    try:
+        for fi, ff in tasks[rank::size]:
+            f = facts[fi]
+            ana = GranuleAnalysis(f, bond_criterion(settings), options.implementation,
+                                  outputs.case_dir(f.case_id) if options.write_vtu else None,
+                                  options.louvain)
+            mine.extend(ana.run([ff]).results)
+    except BaseException:
+        outputs.discard()
+        raise
     if comm is not None:
         gathered = comm.gather(mine, root=0)
         if rank != 0:
@@ -242,66 +142,92 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     else:
         results = mine
     try:
-        return _write_outputs(study, out_dir, cases, skipped_cases, frames, results, settings,
-                              options)
+        record = write_outputs(study, outputs, facts, skipped_cases, results, settings, options)
+    except BaseException:
+        outputs.discard()
+        raise
     finally:
         if comm is not None:
             comm.barrier()
+    return record
 
 
-def _tables(cases: list[CaseFolder], results: list[FrameResult]):
+def frame_tables(facts: list[RunFacts], results: list[FrameResult]):
     """(granule table, frame rows, skipped frames, analysed frames per case) of results
-    in case and step order."""
-    by_case = {c.case_id: c for c in cases}
+    (and of the frames refused before reading) in case and step order."""
+    order = {f.case_id: fi for fi, f in enumerate(facts)}
+    refused = [FrameResult(p["case_id"], p["step"], p["step"] * facts[order[p["case_id"]]].dt,
+                           error=p["reason"], kind=p["kind"])
+               for f in facts if f.plan is not None for p in f.plan.problems]
+    results = sorted(results + refused, key=lambda r: (order[r.case_id], r.step))
+    by_case = {f.case_id: f for f in facts}
     tables, frame_rows, skipped_frames = [], [], []
     frame_index: dict[str, int] = {}
     for r in results:
-        c = by_case[r.case_id]
+        f = by_case[r.case_id]
         if r.error is not None:
-            skipped_frames.append({"case_id": r.case_id, "step": r.step, "reason": r.error})
+            kind = r.kind or "skipped"
+            skipped_frames.append({"case_id": r.case_id, "step": r.step, "kind": kind,
+                                   "reason": r.error})
             frame_rows.append({"case_id": r.case_id, "step": r.step, "time": r.time,
-                               "status": "skipped", "reason": r.error})
+                               "status": kind, "reason": r.error})
             continue
         k = frame_index.get(r.case_id, 0)
         frame_index[r.case_id] = k + 1
         t = r.table
-        tables.append(t.assign(case_id=r.case_id, cg=c.cg, rule=c.rule, replica=c.replica,
-                               frame=k, step=r.step, time=r.time))
+        c = f.case
+        tables.append(t.assign(case_id=r.case_id, cg=f.cg, rule=c.rule if c else "",
+                               replica=c.replica if c else 0, frame=k, step=r.step, time=r.time))
         vol = t["volume"].to_numpy()
         frame_rows.append({"case_id": r.case_id, "step": r.step, "time": r.time, "status": "ok",
                            "reason": "", "particles": r.particles, "contacts": r.contacts,
                            "bonds": r.bonds, "granules": len(t),
                            "largest_fraction": float(vol.max() / vol.sum()),
                            "largest_percolates": bool(t["percolating"].to_numpy()[vol.argmax()])})
-    cols = ["case_id", "cg", "rule", "replica", "frame", "step", "time", "granule", "members",
-            "volume", "primary_volume", "com_x", "com_y", "com_z", "first_id", "percolating"]
-    granules = (pd.concat(tables, ignore_index=True)[cols] if tables
-                else pd.DataFrame({c: pd.Series(dtype=float) for c in cols}))
-    return granules, frame_rows, skipped_frames, frame_index
+    granules = (pd.concat(tables, ignore_index=True)[GRANULE_COLUMNS] if tables
+                else pd.DataFrame({c: pd.Series(dtype=float) for c in GRANULE_COLUMNS}))
+    frames = pd.DataFrame(frame_rows, columns=FRAME_COLUMNS)
+    return granules, frames, skipped_frames, frame_index, results
 
 
-def _write_outputs(study: Study, out_dir: Path, cases, skipped_cases, frames, results,
-                   settings: AnalysisSettings, options: AnalysisOptions) -> dict:
-    order = {c.case_id: ci for ci, c in enumerate(cases)}
-    results = sorted(results, key=lambda r: (order[r.case_id], r.step))   # whatever the ranks
-    granules, frame_rows, skipped_frames, frame_index = _tables(cases, results)
+GRANULE_COLUMNS = ["case_id", "cg", "rule", "replica", "frame", "step", "time", "granule",
+                   "members", "volume", "primary_volume", "com_x", "com_y", "com_z", "first_id",
+                   "percolating"]
+FRAME_COLUMNS = ["case_id", "step", "time", "status", "reason", "particles", "contacts",
+                 "bonds", "granules", "largest_fraction", "largest_percolates"]
+
+
+def nothing_analysed(where: Path, skipped_cases: list[dict], skipped_frames: list[dict]) -> NothingAnalysed:
+    """The one-line refusal when no frame could be analysed (first reason included)."""
+    first = (skipped_frames or skipped_cases or [{"reason": "no case and no frame"}])[0]
+    return NothingAnalysed(
+        f"nothing analysed in {where}: {len(skipped_cases)} case(s) skipped, "
+        f"{len(skipped_frames)} frame(s) missing or refused; first: "
+        f"{first.get('case_id', '')} {first['reason']}; previous outputs kept")
+
+
+def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipped_cases,
+                  results, settings: AnalysisSettings, options: AnalysisOptions) -> dict:
+    """Tables, series and record of a study analysis, committed as one set."""
+    granules, frames, skipped_frames, frame_index, results = frame_tables(facts, results)
+    analysed = [f for f in facts if frame_index.get(f.case_id, 0) > 0]
+    skipped_cases = skipped_cases + [
+        {"case_id": f.case_id, "reason": f"no analysable frame ({f.plan.expected} expected; "
+         "see the skipped frames)"} for f in facts if f not in analysed]
+    if not analysed:
+        raise nothing_analysed(study.path, skipped_cases, skipped_frames)
+    cases = [f.case for f in analysed]
     steady_from = {c.case_id: c.steady_start_step(settings.steady_after) for c in cases}
     steady = granules[granules["step"] >= granules["case_id"].map(steady_from).astype(float)]
     gsd_df, summary = gsd_tables(steady, cases, gsd_settings(settings))
-
-    out_dir.mkdir(parents=True, exist_ok=True)
-    buf = io.BytesIO()
-    granules.to_parquet(buf, index=False)
-    atomic_write_bytes(out_dir / layout.GRANULES_TABLE, buf.getvalue())
-    atomic_write_text(out_dir / layout.FRAMES_TABLE, pd.DataFrame(frame_rows).to_csv(index=False))
-    atomic_write_text(out_dir / layout.GSD_TABLE, gsd_df.to_csv(index=False))
-    atomic_write_text(out_dir / layout.GSD_SUMMARY_TABLE, summary.to_csv(index=False))
+    stage_tables(outputs, granules, frames, gsd_df, summary)
     if options.write_vtu:
         for c in cases:
             entries = [(r.time, r.vtu) for r in results if r.case_id == c.case_id and r.vtu]
             if entries:
-                atomic_write_text(out_dir / c.case_id / "granules.pvd", pvd_text(entries))
+                outputs.write(f"{c.case_id}/granules.pvd", pvd_text(entries).encode())
     steady_frames = steady.groupby("case_id")["step"].nunique() if len(steady) else {}
+    plans: dict[str, FramePlan] = {f.case_id: f.plan for f in analysed}
     record = {
         "run_dir": str(study.path),
         "settings": settings.model_dump(mode="json"),
@@ -311,12 +237,31 @@ def _write_outputs(study: Study, out_dir: Path, cases, skipped_cases, frames, re
                     "write_vtu": options.write_vtu,
                     "require_manifest": options.require_manifest},
         "cases": [{"case_id": c.case_id, "cg": c.cg, "rule": c.rule, "replica": c.replica,
-                   "frames": len(frames[c.case_id]),
+                   "frames": plans[c.case_id].expected,
                    "analysed": frame_index.get(c.case_id, 0),
+                   "dump_record": plans[c.case_id].record is not None,
                    "steady_from_step": steady_from[c.case_id],
                    "steady_frames": int(steady_frames.get(c.case_id, 0))} for c in cases],
         "skipped_cases": skipped_cases,
         "skipped_frames": skipped_frames,
     }
-    atomic_write_json(out_dir / layout.ANALYSIS_RECORD, record)
+    commit(outputs, record)
     return record
+
+
+def stage_tables(outputs: OutputSet, granules: pd.DataFrame, frames: pd.DataFrame,
+                 gsd_df: pd.DataFrame, summary: pd.DataFrame) -> None:
+    """Stage the four tables of an analysis."""
+    buf = io.BytesIO()
+    granules.to_parquet(buf, index=False)
+    outputs.write(layout.GRANULES_TABLE, buf.getvalue())
+    outputs.write(layout.FRAMES_TABLE, frames.to_csv(index=False).encode())
+    outputs.write(layout.GSD_TABLE, gsd_df.to_csv(index=False).encode())
+    outputs.write(layout.GSD_SUMMARY_TABLE, summary.to_csv(index=False).encode())
+
+
+def commit(outputs: OutputSet, record: dict) -> None:
+    """Stage the analysis record and move the whole set into place (record last)."""
+    outputs.write(layout.ANALYSIS_RECORD,
+                  (json.dumps(record, indent=2, sort_keys=True) + "\n").encode())
+    outputs.commit(layout.ANALYSIS_RECORD)

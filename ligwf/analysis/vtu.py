@@ -4,7 +4,9 @@ Two readers return the same :class:`VtuData`: meshio (the reference; it reads ev
 flavour) and a direct decoder for what LIGGGHTS writes (``dump_modify binary yes``: inline
 base64 with a byte-count header per array), which maps the file, jumps over arrays nobody
 asked for by their byte count and decodes the wanted ones with a compiled base64 decoder.
-Every failure to read a file raises :class:`~ligwf.errors.DumpReadError` naming it.
+Decoded arrays are checked against the value range LIGGGHTS records in each array's
+header, so corrupt data that is still valid base64 is caught too. Every failure to read
+a file raises :class:`~ligwf.errors.DumpReadError` naming it.
 """
 
 from __future__ import annotations
@@ -195,6 +197,7 @@ def _decode_vtu(path: Path, raw, wanted: frozenset[str] | None) -> VtuData | Non
                                 f"expected {expected}")
         arr = data[:expected].view(dtype)
         arr = arr.reshape(rows, comps) if comps > 1 else arr
+        _check_range(path, name or "Points", attrs, arr)
         if where == "points":
             points = arr
         elif where == "cell":
@@ -208,6 +211,29 @@ def _decode_vtu(path: Path, raw, wanted: frozenset[str] | None) -> VtuData | Non
     if points is None:
         points = np.zeros((n_points, 3))
     return VtuData(points, point_data, cell_data, n_cells)
+
+
+def _check_range(path: Path, name: str, attrs: dict, arr: np.ndarray) -> None:
+    """DumpReadError when the decoded values leave the range the writer recorded in the
+    array's header (``RangeMin`` / ``RangeMax``, of the magnitude for vectors): flipped bits
+    in valid base64 decode without error but usually move a value out of it. Arrays with
+    nan or inf are left to the dump readers (they name the problem)."""
+    if b"RangeMin" not in attrs or b"RangeMax" not in attrs or len(arr) == 0:
+        return
+    try:
+        lo, hi = float(attrs[b"RangeMin"]), float(attrs[b"RangeMax"])
+    except ValueError:
+        return
+    values = np.asarray(arr, dtype=np.float64)
+    if values.ndim == 2:
+        values = np.linalg.norm(values, axis=1)
+    if not np.all(np.isfinite(values)):
+        return
+    tol = 1e-6 * max(abs(lo), abs(hi)) + 1e-300
+    got_lo, got_hi = float(values.min()), float(values.max())
+    if abs(got_lo - lo) > tol or abs(got_hi - hi) > tol:
+        raise DumpReadError(f"{path}: array {name} spans [{got_lo:.9g}, {got_hi:.9g}], its header "
+                            f"says [{lo:.9g}, {hi:.9g}] (corrupt data: flipped bits?)")
 
 
 def read_vtu(path: Path, wanted: frozenset[str] | None, reader: str) -> VtuData:

@@ -15,6 +15,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from ligwf.errors import LigwfError
+
 
 def register(subparsers) -> None:
     """Add the ``analyse`` sub-command."""
@@ -45,6 +47,11 @@ def cmd_analyse(args: argparse.Namespace) -> int:
     comm = _mpi_comm()
     try:
         record = analyse_study(args.run_dir, args.out, options, comm)
+    except LigwfError as exc:          # a refusal: one line (every rank got here or is done)
+        if comm is None:
+            raise
+        print(f"ligwf: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 2
     except BaseException:
         if comm is not None:            # one failing rank must not leave the others waiting
             import traceback
@@ -55,10 +62,16 @@ def cmd_analyse(args: argparse.Namespace) -> int:
     if record is None:
         return 0
     out = args.out or Study.open(args.run_dir).analysis_dir
+    print_record(record, out)
+    return 0
+
+
+def print_record(record: dict, out: Path) -> None:
+    """What was analysed (stdout) and what was skipped, with reasons (stderr)."""
     analysed = sum(c["analysed"] for c in record["cases"])
     print(f"analysed {analysed} frame(s) of {len(record['cases'])} case(s) -> {out}")
     for s in record["skipped_cases"]:
         print(f"skipped case {s['case_id']}: {s['reason']}", file=sys.stderr)
     for s in record["skipped_frames"]:
-        print(f"skipped frame {s['case_id']} step {s['step']}: {s['reason']}", file=sys.stderr)
-    return 0
+        print(f"{s.get('kind', 'skipped')} frame {s['case_id']} step {s['step']}: {s['reason']}",
+              file=sys.stderr)

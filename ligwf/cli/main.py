@@ -12,14 +12,14 @@ import argparse
 import sys
 
 from ligwf import __version__
-from ligwf.cli import analyse, report, run, slurm, stability
+from ligwf.cli import analyse, analyse_dumps, report, run, slurm, stability
 from ligwf.cli.common import (Parser, add_mesh_cache, add_workflow_args, case_table, console,
                               err_console, folder_to_write, prepare_from_args)
 from ligwf.errors import LigwfError
 from ligwf.study.pipeline import write
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
-COMMAND_MODULES = (run, slurm, analyse, stability, report)
+COMMAND_MODULES = (run, slurm, analyse, analyse_dumps, stability, report)
 
 
 def cmd_check(args: argparse.Namespace) -> int:

@@ -12,24 +12,34 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ligwf.cli.common import add_workflow_args, console
+from ligwf.cli.common import add_workflow_args, console, err_console
 from ligwf.cli.run import add_run_args, prepare_and_run
 from ligwf.study.pipeline import postprocess, report_study
+from ligwf.study.study import Study
 
 
-def _print_report(out: Path) -> None:
+def _print_report(study_dir: Path, out: Path) -> None:
+    """Where the report is, and on stderr how much it lists as not used."""
+    from ligwf.report.problems import study_problems
+
     console.print(f"report: {out / 'summary.md'} and {out / 'index.html'}")
+    p = study_problems(Study.open(study_dir))
+    if p.count:
+        err_console.print(f"[yellow]ligwf: warning:[/] the report lists {len(p.cases)} skipped "
+                          f"case(s), {len(p.frames)} skipped or missing frame(s) and "
+                          f"{len(p.outputs)} analysis output problem(s) (see summary.md)",
+                          highlight=False)
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    _print_report(report_study(args.study, args.out, snapshots=not args.no_snapshots))
+    _print_report(args.study, report_study(args.study, args.out, snapshots=not args.no_snapshots))
     return 0
 
 
 def cmd_study(args: argparse.Namespace) -> int:
     study, done = prepare_and_run(args)
     _, out = postprocess(study.path, snapshots=not args.no_snapshots)
-    _print_report(out)
+    _print_report(study.path, out)
     return 0 if done else 1
 
 

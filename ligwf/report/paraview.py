@@ -15,9 +15,10 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from ligwf.analysis.dumps import discover_frames
+from ligwf.analysis.frame_checks import plan_frames
 from ligwf.engine.mesh import axis_frame
 from ligwf.engine.render import MESH_NAME
+from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_text
 from ligwf.study.case import CaseFolder
 
@@ -44,7 +45,10 @@ def _pvd(entries: list[tuple[float, int, str]]) -> str:
 def case_collection(case: CaseFolder, analysis_dir: Path, out_dir: Path) -> Path | None:
     """Write ``out_dir/<case>.pvd`` (+ rotated drum files); None when there are no frames."""
     s = case.scaled
-    frames = discover_frames(case.path)
+    try:
+        frames = plan_frames(case).frames     # missing or unexpected dumps left out
+    except ConfigError:
+        return None
     if not frames:
         return None
     drum = meshio.read(case.path / MESH_NAME)

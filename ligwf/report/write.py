@@ -4,7 +4,9 @@ The study's report folder (:attr:`ligwf.study.study.Study.report_dir`):
 ``cases.csv`` and ``conditions.csv`` (the numbers), ``summary.md`` and ``index.html``
 (the same tables with the figures), ``figures/*.png`` (error vs run time, GSD overlay,
 velocity profiles, one snapshot per case coloured by speed and one by granule id) and
-``paraview/<case>.pvd`` (particles + turning drum, open in ParaView).
+``paraview/<case>.pvd`` (particles + turning drum, open in ParaView). Whatever was not
+used -- skipped cases, missing or refused frames, missing analysis outputs -- is listed
+with its reason in ``summary.md`` and ``index.html`` (:mod:`ligwf.report.problems`).
 """
 
 from __future__ import annotations
@@ -16,12 +18,13 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf import __version__
-from ligwf.analysis.dumps import discover_frames
+from ligwf.analysis.frame_checks import last_usable_frame
 from ligwf.analysis.flow_run import flow_study
 from ligwf.engine.render import MESH_NAME
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
 from ligwf.report.paraview import case_collection
+from ligwf.report.problems import study_problems
 from ligwf.report.tables import build_tables
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -83,7 +86,8 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     fig_dir, pv_dir = out / "figures", out / "paraview"
     fig_dir.mkdir(parents=True, exist_ok=True)
     flow_study(study)
-    cases, conditions, skipped, profiles = build_tables(study)
+    cases, conditions, _, profiles = build_tables(study)
+    problems = study_problems(study)
     atomic_write_text(out / "cases.csv", cases.to_csv(index=False))
     atomic_write_text(out / "conditions.csv", conditions.to_csv(index=False))
 
@@ -104,9 +108,8 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         pvd = case_collection(case, study.analysis_dir, pv_dir)
         if pvd:
             pvds.append(pvd)
-        frames = discover_frames(case.path)
-        if snapshots and frames:
-            last = frames[-1]
+        last = last_usable_frame(case) if snapshots else None
+        if last is not None:
             axis, angle, mesh = case.scaled.axis, case.drum_angle(last.step), case.path / MESH_NAME
             figures.append((f"{case_id}: speed", figs.snapshot(
                 last.particles, mesh, axis, angle, "speed",
@@ -118,23 +121,22 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
                     fig_dir / f"{case_id}_granules.png", f"{case_id} step {last.step}: granule id")))
 
     name = study.name
-    skipped_md = "\n".join(f"- {s.get('case_id', s)}: {s.get('reason', '')}" for s in skipped) or "none"
     md = "\n".join([
         f"# {name}: error against run time", "",
         f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are relative to the "
         "CG1 cases of the same sweep group; speedup is CG1 core-seconds per simulated second over the case's.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
-        "## Skipped cases (not done or stale)", "", skipped_md, "",
+        *problems.markdown(),
         "## Figures", "",
         *[f"![{t}](figures/{p.name})" for t, p in figures], "",
         "## ParaView", "",
         *[f"- `paraview/{p.name}`" for p in pvds], ""])
     atomic_write_text(out / "summary.md", md)
-    atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, skipped_md))
+    atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, problems))
     return out
 
 
-def _html(name, cases, conditions, figures, skipped_md) -> str:
+def _html(name, cases, conditions, figures, problems) -> str:
     def table(df: pd.DataFrame) -> str:
         if df.empty:
             return "<p>none</p>"
@@ -148,6 +150,6 @@ td,th{{padding:2px 6px;border-bottom:1px solid #ddd}}img{{max-width:720px}}</sty
 <h1>{html.escape(name)}: error against run time</h1>
 <h2>Cases</h2>{table(cases[cols] if not cases.empty else cases)}
 <h2>Conditions (mean, 95 % CI bounds over replicas)</h2>{table(conditions)}
-<h2>Skipped cases</h2><pre>{html.escape(skipped_md)}</pre>
+{problems.html()}
 <h2>Figures</h2>{imgs}</body></html>
 """

@@ -4,20 +4,62 @@
 :class:`~ligwf.scene.scaling.ScaledScene`); every stage -- runner, resume, analysis, flow,
 report, stability report -- asks the object instead of reading files. The manifest is
 read fresh on every call (the runner rewrites it while a case runs).
+
+The case also knows what its run must have left behind, so the analysis can tell a
+complete, untouched run from a damaged one: the dump steps (:meth:`CaseFolder.expected_dump_steps`,
+from the scene's dump interval and the steps the manifest says were run), and the dump
+record written with every ``done`` manifest (size and SHA-256 of each file in ``post/``,
+:meth:`CaseFolder.dump_record`), which identifies the run's own dumps: a frame deleted,
+edited, copied in from another replica or added afterwards no longer matches it.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ligwf.engine.health import DONE
+from ligwf.engine.thermo import rows_from_csv
 from ligwf.errors import ConfigError
+from ligwf.fsio import atomic_write_json
 from ligwf.scene.scaling import ScaledScene
-from ligwf.study.layout import MANIFEST_FILE, SCENE_FILE, SCREEN_FILE, THERMO_FILE
+from ligwf.study.layout import (DUMP_RECORD, MANIFEST_FILE, POST_DIR, SCENE_FILE, SCREEN_FILE,
+                                THERMO_FILE)
 from ligwf.study.manifest import Manifest, read_manifest, write_manifest
+
+
+def file_digest(path: Path) -> str:
+    """SHA-256 of a file (hex), read in 1 MiB blocks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(1 << 20):
+            h.update(block)
+    return h.hexdigest()
+
+
+@dataclass(frozen=True)
+class DumpRecord:
+    """The files a finished run left in ``post/``: name -> (size in bytes, SHA-256)."""
+
+    scene_hash: str
+    steps_done: int
+    files: dict[str, tuple[int, str]]
+
+    def mismatch(self, path: Path) -> str | None:
+        """Why ``path`` is not the file the run left (None: same size and digest)."""
+        entry = self.files.get(path.name)
+        if entry is None:
+            return f"{path}: not among the dumps the run left (dump record {DUMP_RECORD})"
+        size = path.stat().st_size
+        if size != entry[0]:
+            return f"{path}: {size} bytes, the run left {entry[0]} (truncated or replaced)"
+        if file_digest(path) != entry[1]:
+            return (f"{path}: content differs from the dump the run left (SHA-256 mismatch: "
+                    "edited, corrupted or copied from another run)")
+        return None
 
 
 def group_of(varied: dict[str, Any]) -> str:
@@ -74,7 +116,57 @@ class CaseFolder:
         return read_manifest(self.path)
 
     def write_manifest(self, manifest: Manifest) -> None:
+        """Write the manifest; a ``done`` one after the dump record of the run's ``post/``
+        (so a done case always identifies its dumps), any other removes a stale record."""
+        record = self.path / DUMP_RECORD
+        if manifest.status == DONE:
+            post = self.path / POST_DIR
+            files = ({p.name: [p.stat().st_size, file_digest(p)] for p in sorted(post.iterdir())
+                      if p.is_file()} if post.is_dir() else {})
+            atomic_write_json(record, {"scene_hash": manifest.scene_hash,
+                                       "steps_done": manifest.steps_done, "files": files})
+        else:
+            record.unlink(missing_ok=True)
         write_manifest(self.path, manifest)
+
+    def dump_record(self) -> DumpRecord | None:
+        """The dump record of the finished run (None: none was written, e.g. a case run by
+        hand); ConfigError when it is unreadable."""
+        path = self.path / DUMP_RECORD
+        if not path.is_file():
+            return None
+        try:
+            rec = json.loads(path.read_text())
+            files = {str(k): (int(v[0]), str(v[1])) for k, v in rec["files"].items()}
+            return DumpRecord(str(rec["scene_hash"]), int(rec["steps_done"]), files)
+        except (OSError, ValueError, KeyError, TypeError, IndexError, AttributeError) as exc:
+            raise ConfigError(f"{path}: unreadable dump record ({type(exc).__name__}: {exc})") from None
+
+    def expected_dump_steps(self, end_step: int) -> list[int]:
+        """Steps at which the engine writes a frame up to ``end_step``: the multiples of the
+        dump interval from the start of production on (the dumps are defined when the drum
+        starts turning; LIGGGHTS writes on multiples of the interval only)."""
+        every = self.scaled.dump_every
+        first = -(-self.production_start_step // every) * every
+        return list(range(first, min(end_step, self.scaled.total_steps) + 1, every))
+
+    def thermo_problem(self, manifest: Manifest) -> str | None:
+        """Why the thermo table disagrees with a runner's manifest (None: it ends at the
+        manifest's last step with the scene's particle count, or the manifest is a
+        hand-written one without a step count)."""
+        if manifest.steps_done <= 0:
+            return None
+        try:
+            rows = rows_from_csv(self.thermo.read_text())
+        except FileNotFoundError:
+            return f"{self.thermo.name} is missing (the runner writes it for every run)"
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            return f"{self.thermo.name} is unreadable (truncated or corrupt?): {exc}"
+        last = rows[-1].step if rows else None
+        if last != manifest.steps_done:
+            return (f"{self.thermo.name} ends at step {last}, the manifest says "
+                    f"{manifest.steps_done} steps were run (truncated or replaced)")
+        return None
 
     # ----------------------------------------------------------------- usability
     def why_not_usable(self) -> str | None:
@@ -82,14 +174,17 @@ class CaseFolder:
         written for the scene the folder holds now)."""
         if not (self.path / MANIFEST_FILE).is_file():
             return "no manifest (the case was not run by `ligwf run`)"
-        m = self.manifest()
+        try:
+            m = self.manifest()
+        except (ValueError, TypeError, AttributeError):   # valid JSON of the wrong shape
+            m = None
         if m is None:
-            return "unreadable manifest"
+            return "unreadable manifest (truncated or corrupt)"
         if m.status != DONE:
             return f"manifest status {m.status!r}" + (f": {m.reason}" if m.reason else "")
         if m.scene_hash != self.scene_hash:
             return "manifest scene hash differs from the case's scene (re-rendered since the run)"
-        return None
+        return self.thermo_problem(m)
 
     def usable(self) -> bool:
         return self.why_not_usable() is None

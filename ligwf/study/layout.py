@@ -7,6 +7,8 @@ A study folder (``ligwf render`` / ``run`` / ``study`` write it)::
     STUDY/<case_id>/manifest.json    what ran, how, and the verdict (the runner writes it)
     STUDY/<case_id>/run.log          screen of the current attempt (earlier: run.<n>.log)
     STUDY/<case_id>/thermo.csv       thermo table over all attempts
+    STUDY/<case_id>/dumps.json       size and SHA-256 of every file in post/ when the run
+                                     ended done (written with the done manifest)
     STUDY/<case_id>/post/, restart/  the engine's dumps and restarts
     STUDY/analysis/                  granule, GSD and flow tables
     STUDY/report/                    the report folder
@@ -29,6 +31,10 @@ MANIFEST_FILE = "manifest.json"
 SCREEN_FILE = "run.log"
 #: Case level: thermo table over all attempts.
 THERMO_FILE = "thermo.csv"
+#: Case level: the dumps a finished run left (size and SHA-256 per file of ``post/``).
+DUMP_RECORD = "dumps.json"
+#: Case level: the engine's dump folder.
+POST_DIR = "post"
 
 #: Study level: outputs of the analysis stage.
 ANALYSIS_DIR = "analysis"

@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 
 from ligwf.analysis.dumps import discover_frames, read_particles
-from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, analyse
+from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, NothingAnalysed, analyse
 from ligwf.cli.main import main
 from ligwf.study.case import CaseFolder
 from ligwf.study.settings import AnalysisSettings
@@ -135,16 +135,18 @@ def test_manifest_gates_cases(study, tmp_path):
     m = json.loads((copy / "cg3-weber-r0" / "manifest.json").read_text())
     m["status"] = "unstable"
     (copy / "cg3-weber-r0" / "manifest.json").write_text(json.dumps(m))
-    record = analyse(copy, tmp_path / "out", FAST)
-    reasons = {s["case_id"]: s["reason"] for s in record["skipped_cases"]}
-    assert record["cases"] == []
-    assert "unstable" in reasons["cg3-weber-r0"] and "no manifest" in reasons["cg3-weber-r1"]
+    with pytest.raises(NothingAnalysed, match="unstable"):     # no usable case: refused
+        analyse(copy, tmp_path / "out", FAST)
+    assert not (tmp_path / "out").exists()
     opened = analyse(copy, tmp_path / "out2", AnalysisOptions(
         settings=AnalysisSettings(bootstrap=10), require_manifest=False))
     analysed = {c["case_id"]: c["analysed"] for c in opened["cases"]}
     n = len(discover_frames(copy / "cg3-weber-r0"))
-    # the bond case was never run: listed with no frames; the others fully analysed
-    assert analysed == {"cg3-weber-r0": n, "cg3-bond-r0": 0, "cg3-weber-r1": n}
+    # the bond case was never run: skipped with its missing frames; the others fully analysed
+    assert analysed == {"cg3-weber-r0": n, "cg3-weber-r1": n}
+    reasons = {s["case_id"]: s["reason"] for s in opened["skipped_cases"]}
+    assert "no analysable frame" in reasons["cg3-bond-r0"]
+    assert {f["kind"] for f in opened["skipped_frames"]} == {"missing"}
 
 
 @pytest.mark.engine

@@ -1,0 +1,190 @@
+"""Granules of the frames of one run (MDAnalysis-style life cycle), and their ParaView files.
+
+:class:`GranuleAnalysis` takes its parameters in the constructor; :meth:`GranuleAnalysis.run`
+calls ``_prepare``, ``_single_frame`` for each frame it is given and ``_conclude``, and
+fills ``results``. What it needs to know about the run that wrote the frames is a
+:class:`RunFacts`: for a ligwf case it comes from the case's scaled scene
+(:meth:`RunFacts.of_case`), and the frames are also checked against the run (its dump
+record, particle count and ids, radii, drum, contact geometry:
+:mod:`ligwf.analysis.frame_checks`); for dumps ligwf did not write, the caller states
+every fact (:mod:`ligwf.analysis.foreign`): nothing defaults silently.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ligwf.analysis.dumps import FrameFiles, ParticleFrame, read_contacts, read_particles
+from ligwf.analysis.frame_checks import FramePlan, check_contacts, check_particles, plan_frames
+from ligwf.analysis.granules import AXES, BondCriterion, Liquid, granule_table, identify, louvain_labels
+from ligwf.errors import ConfigError, DumpReadError
+from ligwf.fsio import atomic_write_bytes
+from ligwf.study.case import CaseFolder
+
+
+@dataclass(frozen=True)
+class RunFacts:
+    """What the granule analysis must know about the run that wrote the frames."""
+
+    case_id: str
+    cg: float
+    liquid: Liquid
+    periodic_axis: int | None      # 0, 1, 2 for x, y, z; None: no periodic axis
+    box_length: float              # m, periodic length (the box spans [0, L] on that axis)
+    dt: float                      # s per step
+    case: CaseFolder | None = None     # a ligwf case: frames checked against its run
+    plan: FramePlan | None = None      # ... and its dump record
+
+    def __post_init__(self) -> None:
+        if self.periodic_axis is not None and not self.box_length > 0:
+            raise ConfigError(f"{self.case_id}: a periodic axis needs the box length (> 0 m), "
+                              f"got {self.box_length!r}; without it granules that wrap "
+                              "around the axis would not be detected")
+        if not self.dt > 0:
+            raise ConfigError(f"{self.case_id}: the time step must be > 0 s, got {self.dt!r}")
+
+    @classmethod
+    def of_case(cls, case: CaseFolder, plan: FramePlan | None = None) -> "RunFacts":
+        """The facts of a ligwf case (the drum axis spans [0, L], see templates/drum.in.j2)."""
+        s = case.scaled
+        return cls(case.case_id, case.cg, case_liquid(case), periodic_axis(case),
+                   s.drum_length, s.dt, case, plan)
+
+
+def case_liquid(case: CaseFolder) -> Liquid:
+    """The liquid-bridge law the engine applied in the case."""
+    return Liquid.from_scaled(case.scaled)
+
+
+def periodic_axis(case: CaseFolder) -> int | None:
+    """0, 1, 2 for a periodic drum axis x, y, z; None for a closed drum."""
+    return AXES.index(case.scaled.axis) if case.scaled.periodic else None
+
+
+@dataclass
+class FrameResult:
+    """Outcome of one frame: its granule table, or why it was skipped."""
+
+    case_id: str
+    step: int
+    time: float
+    table: pd.DataFrame | None = None
+    particles: int = 0
+    contacts: int = 0
+    bonds: int = 0
+    error: str | None = None
+    vtu: str | None = None      # file name in the case's output folder
+    kind: str | None = None     # why there is no table: missing / unexpected (None: unreadable)
+
+
+@dataclass
+class GranuleAnalysis:
+    """Granules of every frame of one case (MDAnalysis-style life cycle).
+
+    ``case``: a :class:`~ligwf.study.case.CaseFolder` or the :class:`RunFacts` of a run.
+    ``implementation`` is ``"fast"`` (numba-compiled union-find) or ``"reference"`` (networkx BFS).
+    ``vtu_dir`` set: write ``granules_<step>.vtu`` per frame there (ParaView series).
+    ``louvain``: also store Louvain community ids per particle in the ``.vtu``.
+    """
+
+    case: CaseFolder | RunFacts
+    criterion: BondCriterion = BondCriterion()
+    implementation: str = "fast"
+    vtu_dir: Path | None = None
+    louvain: bool = False
+    results: list[FrameResult] = field(default_factory=list)
+
+    def run(self, frames: list[FrameFiles] | None = None) -> "GranuleAnalysis":
+        """Analyse ``frames`` (default: every frame the case's run should have left that is
+        there, :func:`~ligwf.analysis.frame_checks.plan_frames`) and fill ``results``."""
+        self._prepare()
+        if frames is None:
+            if self._facts.case is None:
+                raise ConfigError(f"{self._facts.case_id}: pass the frames to analyse")
+            frames = list(self._facts.plan.frames)
+        for ff in frames:
+            self.results.append(self._single_frame(ff))
+        self._conclude()
+        return self
+
+    def _prepare(self) -> None:
+        if self.implementation not in ("fast", "reference"):
+            raise ConfigError(f"implementation {self.implementation!r}: use fast or reference")
+        self.results = []
+        facts = self.case
+        if isinstance(facts, CaseFolder):
+            facts = RunFacts.of_case(facts, plan_frames(facts))
+        self._facts = facts
+
+    def _single_frame(self, ff: FrameFiles) -> FrameResult:
+        f = self._facts
+        res = FrameResult(f.case_id, ff.step, ff.step * f.dt)
+        try:
+            if ff.contacts is None:
+                raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
+                                    "(was the case rendered with analysis.granules: true?)")
+            if f.plan is not None:
+                f.plan.check_record(ff)
+            particles = read_particles(ff.particles, ff.step, f.dt)
+            contacts = read_contacts(ff.contacts, ff.step)
+            if f.case is not None:
+                check_particles(f.case, particles)
+            check_contacts(particles, contacts, f.periodic_axis, f.box_length)
+            ident = identify(particles, contacts, f.liquid, self.criterion, f.periodic_axis,
+                             f.box_length, self.implementation, need_force=self.louvain)
+        except DumpReadError as exc:
+            res.error = str(exc)
+            return res
+        labels = ident.labels
+        # the periodic axis spans [0, L] (the box, see templates/drum.in.j2)
+        table = granule_table(particles, labels, f.cg, ident.unwrapped_axis, f.periodic_axis,
+                              0.0, f.box_length, ident.percolating)
+        res.table, res.particles, res.contacts = table, len(particles), len(contacts)
+        res.bonds = len(ident.i)
+        if self.vtu_dir is not None:
+            extra = ({"louvain": louvain_labels(len(particles), ident.i, ident.j, ident.force)}
+                     if self.louvain else {})
+            res.vtu = f"granules_{ff.step}.vtu"
+            write_particle_vtu(Path(self.vtu_dir) / res.vtu, particles, labels,
+                               table["members"].to_numpy()[labels], extra)
+        return res
+
+    def _conclude(self) -> None:
+        self.results.sort(key=lambda r: r.step)
+
+
+def write_particle_vtu(path: Path, particles: ParticleFrame, labels: np.ndarray,
+                       granule_members: np.ndarray, extra: dict[str, np.ndarray] | None = None) -> None:
+    """Particles as VTU vertices (meshio, binary) with ``granule`` ids, written atomically."""
+    import meshio
+
+    n = len(particles)
+    point_data = {"id": particles.ids.astype(np.int64), "type": particles.types,
+                  "v": particles.velocities, "radius": particles.radii,
+                  "granule": labels.astype(np.int64),
+                  "granule_members": granule_members.astype(np.int64)}
+    if particles.liquid_content is not None:
+        point_data["f_surfaceLiquidContent"] = particles.liquid_content
+    point_data.update(extra or {})
+    mesh = meshio.Mesh(particles.positions, [("vertex", np.arange(n).reshape(-1, 1))],
+                       point_data=point_data)
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp_path = Path(tmp) / "frame.vtu"
+        meshio.write(tmp_path, mesh, file_format="vtu", binary=True, compression=None)
+        atomic_write_bytes(path, tmp_path.read_bytes())
+
+
+def pvd_text(entries: list[tuple[float, str]]) -> str:
+    """A ParaView collection (.pvd) of (time s, file name) entries."""
+    lines = ['<?xml version="1.0"?>',
+             '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
+             "  <Collection>"]
+    lines += [f'    <DataSet timestep="{t!r}" group="" part="0" file="{name}"/>'
+              for t, name in entries]
+    lines += ["  </Collection>", "</VTKFile>", ""]
+    return "\n".join(lines)

@@ -1,0 +1,167 @@
+"""Granules of LIGGGHTS dumps ligwf did not write (``ligwf analyse-dumps``).
+
+A ligwf case carries everything the granule analysis needs in its scene record; dumps
+from a hand-written input carry none of it. :class:`ForeignRun` is what the user must
+state instead -- the liquid model and its CG-scaled surface tension, the contact angle
+and which convention it is in, the periodic axis and its length, the time step -- and
+every piece is required: a missing time step would put every frame at time 0, a missing
+box length would silently switch off the detection of granules that wrap around the
+periodic axis. Frames are found by file-name patterns (``*`` stands for the step), read
+and checked like a ligwf case's (structure, nan, duplicate ids, contact geometry against
+the particles); they cannot be checked against a scene (count, radii, drum) or a dump
+record, which the analysis record says. Outputs are those of ``ligwf analyse``
+(:mod:`ligwf.analysis.runner`), written as one set; the GSD uses the frames from
+``steady_from_step`` on.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from ligwf import liquids
+from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts, pvd_text
+from ligwf.analysis.dumps import FrameFiles, read_particles
+from ligwf.analysis.granules import AXES, Liquid
+from ligwf.analysis.gsd_tables import gsd_tables
+from ligwf.analysis.outputs import OutputSet, new_token
+from ligwf.analysis.runner import (bond_criterion, commit, frame_tables, gsd_settings,
+                                   nothing_analysed, stage_tables)
+from ligwf.engine.liggghts import applied_contact_angle_rad
+from ligwf.errors import ConfigError, DumpReadError
+from ligwf.study.settings import AnalysisSettings
+
+#: ``engine``: the angle as written into a LIGGGHTS 3.8.0 input (the engine applied
+#: 0.5 theta^2, see :mod:`ligwf.engine.liggghts`); ``scene``: the angle the engine applied
+#: (an engine with the upstream fix, or an input compensated as ligwf does).
+ANGLE_CONVENTIONS = ("engine", "scene")
+
+
+@dataclass(frozen=True)
+class ForeignCase:
+    """A foreign run seen as a case of the GSD tables (one condition, one replica)."""
+
+    case_id: str
+    cg: float
+    rule: str = "foreign"
+    replica: int = 0
+    group: str = ""
+
+
+@dataclass(frozen=True)
+class ForeignRun:
+    """Everything the granule analysis needs about a run ligwf did not write."""
+
+    liquid: str                      # a ligwf liquid model name (ligwf.liquids)
+    surface_tension: float | None    # N/m as the engine used it (CG-scaled); None: dry
+    contact_angle_deg: float | None
+    angle_convention: str            # one of ANGLE_CONVENTIONS
+    periodic_axis: str               # x, y, z, or "none"
+    box_length: float | None         # m, the periodic length (box [0, L] on that axis)
+    dt: float                        # s per step
+    liquid_content: float | None = None   # fraction of particle volume, if dumps lack it
+    cg: float = 1.0
+
+    def facts(self, name: str) -> RunFacts:
+        """The run facts; ConfigError naming the missing or invalid piece."""
+        try:
+            law = liquids.get(self.liquid)
+        except ValueError as exc:
+            raise ConfigError(f"--liquid: {exc}") from None
+        if self.angle_convention not in ANGLE_CONVENTIONS:
+            raise ConfigError(f"--angle-convention {self.angle_convention!r}: use "
+                              f"{' or '.join(ANGLE_CONVENTIONS)}")
+        gamma = theta = 0.0
+        if law.wet:
+            if self.surface_tension is None or not self.surface_tension > 0:
+                raise ConfigError(f"--surface-tension: a wet model ({self.liquid}) needs the "
+                                  "surface tension the engine used, N/m (> 0)")
+            if self.contact_angle_deg is None or not 0 <= self.contact_angle_deg < 90:
+                raise ConfigError("--contact-angle: a wet model needs the contact angle, "
+                                  "deg, in [0, 90)")
+            gamma = float(self.surface_tension)
+            theta = applied_contact_angle_rad(self.contact_angle_deg,
+                                              compensated=self.angle_convention == "scene")
+        axis = None if self.periodic_axis == "none" else self.periodic_axis
+        if axis is not None and axis not in AXES:
+            raise ConfigError(f"--periodic-axis {axis!r}: use x, y, z or none")
+        if axis is not None and (self.box_length is None or not self.box_length > 0):
+            raise ConfigError(f"--box-length: a periodic axis ({axis}) needs its length, m (> 0)")
+        if not (self.dt > 0 and math.isfinite(self.dt)):
+            raise ConfigError(f"--dt {self.dt!r}: the time step must be > 0 s")
+        content = math.nan if self.liquid_content is None else float(self.liquid_content)
+        return RunFacts(name, float(self.cg), Liquid(self.liquid, gamma, theta, content),
+                        None if axis is None else AXES.index(axis),
+                        float(self.box_length or 0.0), float(self.dt))
+
+
+def find_frames(dump_dir: Path, particles: str, contacts: str) -> list[FrameFiles]:
+    """Frames in ``dump_dir`` by file-name patterns (``*`` = the step); ConfigError when
+    there is none or a pattern has no ``*``."""
+    def regex(pattern: str) -> re.Pattern:
+        if pattern.count("*") != 1:
+            raise ConfigError(f"file pattern {pattern!r}: needs exactly one * for the step")
+        head, tail = pattern.split("*")
+        return re.compile("^" + re.escape(head) + r"(\d+)" + re.escape(tail) + "$")
+    dump_dir = Path(dump_dir)
+    if not dump_dir.is_dir():
+        raise ConfigError(f"{dump_dir}: no such folder")
+    found: dict[str, dict[int, Path]] = {"p": {}, "c": {}}
+    for key, rx in (("p", regex(particles)), ("c", regex(contacts))):
+        for path in dump_dir.iterdir():
+            if m := rx.match(path.name):
+                found[key][int(m.group(1))] = path
+    if not found["p"]:
+        raise ConfigError(f"{dump_dir}: no particle dump named {particles}")
+    return [FrameFiles(s, found["p"][s], found["c"].get(s)) for s in sorted(found["p"])]
+
+
+def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
+                  settings: AnalysisSettings = AnalysisSettings(), steady_from_step: int = 0,
+                  particles: str = "particles_*.vtu", contacts: str = "contacts_*.vtu",
+                  write_vtu: bool = True) -> dict:
+    """Analyse the frames of ``dump_dir``; write the outputs as one set into ``out_dir``
+    and return the analysis record (NothingAnalysed, outputs untouched, when no frame
+    could be analysed)."""
+    dump_dir = Path(dump_dir)
+    facts = run.facts(dump_dir.resolve().name)
+    frames = find_frames(dump_dir, particles, contacts)
+    if run.liquid_content is None and liquids.get(run.liquid).wet:
+        try:
+            lacks = read_particles(frames[0].particles, frames[0].step).liquid_content is None
+        except DumpReadError:
+            lacks = False                   # that frame is reported as unreadable below
+        if lacks:
+            raise ConfigError(f"--liquid-content: {frames[0].particles.name} has no "
+                              "f_surfaceLiquidContent array; give the liquid content (fraction "
+                              "of particle volume)")
+    outputs = OutputSet(Path(out_dir), new_token())
+    try:
+        ana = GranuleAnalysis(facts, bond_criterion(settings),
+                              vtu_dir=outputs.case_dir(facts.case_id) if write_vtu else None)
+        results = ana.run(frames).results
+        granules, table, skipped, index, results = frame_tables([facts], results)
+        if not index:
+            raise nothing_analysed(dump_dir, [], skipped)
+        case = ForeignCase(facts.case_id, facts.cg)
+        gsd_df, summary = gsd_tables(granules[granules["step"] >= steady_from_step], [case],
+                                     gsd_settings(settings))
+        stage_tables(outputs, granules, table, gsd_df, summary)
+        entries = [(r.time, r.vtu) for r in results if r.vtu]
+        if entries:
+            outputs.write(f"{facts.case_id}/granules.pvd", pvd_text(entries).encode())
+        record = {"dump_dir": str(dump_dir), "run": asdict(run),
+                  "settings": settings.model_dump(mode="json"),
+                  "criterion": asdict(bond_criterion(settings)),
+                  "gsd": asdict(gsd_settings(settings)), "steady_from_step": steady_from_step,
+                  "checked_against_scene": False,
+                  "cases": [{"case_id": facts.case_id, "cg": facts.cg, "frames": len(frames),
+                             "analysed": index.get(facts.case_id, 0)}],
+                  "skipped_cases": [], "skipped_frames": skipped}
+        commit(outputs, record)
+        return record
+    except BaseException:
+        outputs.discard()
+        raise

@@ -1,0 +1,181 @@
+"""Is this frame the run's own, complete and plausible? Checked before any frame is used.
+
+A readable dump is not yet a right one: a frame can be missing, left over from an earlier
+run, copied in from another replica, edited, or hold particles the run never had. Every
+stage that reads frames (granules, flow) asks this module first, so they use the same
+frames and report the same reasons:
+
+* :func:`plan_frames` (before reading): the frames the run must have left are the dump
+  steps of its scene up to the step the manifest says it reached
+  (:meth:`~ligwf.study.case.CaseFolder.expected_dump_steps`). A missing particle or
+  contact dump, a dump at a step the run never writes (beyond the run, or off the dump
+  interval) is a problem of that frame: listed with its reason, never analysed. When the
+  run left a dump record (:meth:`~ligwf.study.case.CaseFolder.dump_record`),
+  :meth:`FramePlan.check_record` refuses a file whose size or SHA-256 differs from what
+  the run left (done by whoever reads the frame, so MPI ranks share the hashing).
+* :func:`check_particles` / :func:`check_contacts` (after reading): the particle count
+  and ids are the scene's (1..N: the fill deletes the surplus of the top-up wave, so the
+  ids stay contiguous), radii are the scene's size classes, centres lie inside the drum,
+  speeds and liquid contents are physical, and the contact dump describes the particle
+  dump of the same step: each pair's overlap equals r_i + r_j minus the distance of the
+  two centres (nearest periodic image). Permuted ids, a contact dump of another frame or
+  flipped bits in positions fail these; flipped bits elsewhere fail the record or the
+  value range LIGGGHTS wrote into the array header (:mod:`ligwf.analysis.vtu`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ligwf.analysis.dumps import ContactFrame, FrameFiles, ParticleFrame, dump_files, read_particles
+from ligwf.analysis.granules import AXES
+from ligwf.errors import ConfigError, DumpReadError
+from ligwf.study.case import CaseFolder, DumpRecord
+
+#: Relative slack of the geometric checks (float32 positions, mesh facets vs circle).
+GEOMETRY_SLACK = 0.05
+#: A speed above this many times (tip speed + free fall across the drum) is not physical.
+SPEED_FACTOR = 20.0
+#: |distance - (r_i + r_j - delta)| allowed, as a fraction of r_i + r_j.
+OVERLAP_TOLERANCE = 1e-3
+
+
+@dataclass(frozen=True)
+class FramePlan:
+    """The frames of a case to read, and those refused before reading (with reasons)."""
+
+    case_id: str
+    frames: tuple[FrameFiles, ...]
+    problems: tuple[dict, ...]           # {case_id, step, kind: missing|unexpected, reason}
+    expected: int                        # frames the run should have left
+    record: DumpRecord | None            # the run's dump record (None: run by hand)
+
+    def check_record(self, ff: FrameFiles) -> None:
+        """DumpReadError when a file of the frame is not the one the run left (size or
+        SHA-256 differ from the dump record; nothing to check without a record)."""
+        if self.record is None:
+            return
+        for path in (ff.particles, ff.contacts):
+            if path is not None and (why := self.record.mismatch(path)):
+                raise DumpReadError(why)
+
+
+def end_step(case: CaseFolder) -> int:
+    """Last step the run reached: the manifest's (or the dump record's) step count; the
+    scene's total for a case without either (run by hand)."""
+    try:
+        m = case.manifest()
+    except (ValueError, TypeError, AttributeError):
+        m = None
+    if m is not None and m.steps_done > 0:
+        return int(m.steps_done)
+    record = case.dump_record()
+    if record is not None and record.steps_done > 0:
+        return record.steps_done
+    return case.scaled.total_steps
+
+
+def plan_frames(case: CaseFolder) -> FramePlan:
+    """The case's frames to read and the refused ones; ConfigError when its dump record is
+    unreadable or belongs to another scene (nothing of the case can be trusted)."""
+    record = case.dump_record()
+    if record is not None and record.scene_hash != case.scene_hash:
+        raise ConfigError(f"{case.path}: the dump record was written for another scene "
+                          "(dumps of an earlier run?)")
+    s = case.scaled
+    last = end_step(case)
+    expected = case.expected_dump_steps(last)
+    parts, contacts = dump_files(case.path)
+    plan = f"every {s.dump_every} steps from {case.production_start_step} to {last}"
+    frames, problems = [], []
+
+    def refuse(step: int, reason: str, kind: str = "missing") -> None:
+        problems.append({"case_id": case.case_id, "step": step, "kind": kind, "reason": reason})
+
+    for step in sorted(set(expected) | set(parts) | set(contacts)):
+        part, contact = parts.get(step), contacts.get(step)
+        if step not in expected:
+            refuse(step, f"{part or contact}: not a dump step of this run ({plan}): left "
+                   "over from another run or added by hand", "unexpected")
+        elif part is None:
+            refuse(step, f"missing frame: no particle dump for step {step}"
+                   + (f" (its contact dump {contact.name} is left)" if contact else ""))
+        elif s.granules and contact is None:
+            refuse(step, f"missing frame: no contact dump for step {step} "
+                   f"(its particle dump {part.name} is left)")
+        else:
+            frames.append(FrameFiles(step, part, contact))
+    return FramePlan(case.case_id, tuple(frames), tuple(problems), len(expected), record)
+
+
+def _fail(p: ParticleFrame | ContactFrame, what: str) -> None:
+    raise DumpReadError(f"{p.path}: {what}")
+
+
+def check_particles(case: CaseFolder, p: ParticleFrame) -> None:
+    """DumpReadError when the particle frame is not one of this run's (see module doc)."""
+    s = case.scaled
+    n = s.particle_count
+    if len(p) != n:
+        _fail(p, f"{len(p)} particles, the run has {n}")
+    if p.ids[0] != 1 or p.ids[-1] != n:
+        _fail(p, f"particle ids {p.ids[0]}..{p.ids[-1]}, the run numbers them 1..{n}")
+    if np.any(p.types < 1):
+        _fail(p, "particle type below 1")
+    radii = 0.5 * np.asarray(s.diameters, dtype=float)
+    near = np.min(np.abs(p.radii[:, None] - radii[None, :]) / radii[None, :], axis=1)
+    if np.any(near > 1e-6):
+        _fail(p, f"radius {p.radii[near.argmax()]:.6g} m is none of the scene's size classes")
+    ia = AXES.index(s.axis)
+    across = np.delete(p.positions, ia, axis=1)
+    reach = 0.5 * s.drum_diameter * (1 + GEOMETRY_SLACK)
+    if np.any(np.hypot(across[:, 0], across[:, 1]) > reach):
+        _fail(p, "a particle centre lies outside the drum")
+    along = p.positions[:, ia]
+    slack = GEOMETRY_SLACK * s.drum_length
+    if np.any(along < -slack) or np.any(along > s.drum_length + slack):
+        _fail(p, f"a particle centre lies outside the drum length [0, {s.drum_length:g}] m")
+    limit = SPEED_FACTOR * (s.omega * 0.5 * s.drum_diameter + np.sqrt(2 * 9.81 * s.drum_diameter))
+    if np.any(np.linalg.norm(p.velocities, axis=1) > limit):
+        _fail(p, f"a particle speed above {limit:.3g} m/s (not physical in this drum)")
+    if p.liquid_content is not None and np.any((p.liquid_content < 0) | (p.liquid_content > 1)):
+        _fail(p, "liquid content outside [0, 1]")
+
+
+def check_contacts(p: ParticleFrame, c: ContactFrame, periodic_axis: int | None,
+                   box_length: float) -> None:
+    """DumpReadError unless every pair's overlap matches the two particles' centres and
+    radii in ``p`` (nearest image along the periodic axis): the contact dump then belongs
+    to the same particles at the same step."""
+    if len(c) == 0:
+        return
+    i, j = p.index_of(c.id1), p.index_of(c.id2)
+    d = p.positions[i] - p.positions[j]
+    if periodic_axis is not None and box_length > 0:
+        d[:, periodic_axis] -= box_length * np.round(d[:, periodic_axis] / box_length)
+    reach = p.radii[i] + p.radii[j]
+    off = np.abs(np.linalg.norm(d, axis=1) - (reach - c.delta)) / reach
+    if np.any(off > OVERLAP_TOLERANCE):
+        k = int(off.argmax())
+        _fail(c, f"pair {c.id1[k]}-{c.id2[k]}: overlap {c.delta[k]:.3g} m does not match the "
+              f"particle dump of step {p.step} ({int(np.sum(off > OVERLAP_TOLERANCE))} pair(s) "
+              "off: ids permuted, or the dumps are of different frames or runs)")
+
+
+
+def last_usable_frame(case: CaseFolder) -> FrameFiles | None:
+    """The last frame of the case that passes every check (for a snapshot), or None."""
+    try:
+        plan = plan_frames(case)
+    except ConfigError:
+        return None
+    for ff in reversed(plan.frames):
+        try:
+            plan.check_record(ff)
+            check_particles(case, read_particles(ff.particles, ff.step, case.scaled.dt))
+        except DumpReadError:
+            continue
+        return ff
+    return None

@@ -1,0 +1,73 @@
+"""``ligwf analyse-dumps DIR``: granules and GSD of LIGGGHTS dumps ligwf did not write.
+
+Dumps from a hand-written input carry no scene record, so everything the bond criterion
+and the periodic unwrapping need is given here, and every piece is required (nothing
+defaults silently: a missing box length would switch off the detection of granules that
+wrap around the periodic axis). The dumps must be ``dump custom/vtk`` particle files
+with the arrays id, type, v, radius (and f_surfaceLiquidContent, else give
+--liquid-content) and ``dump local/gran/vtk`` contact files with id1, id2, delta (see
+README "Analysing foreign dumps"). Outputs are those of ``ligwf analyse``.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ligwf import liquids
+from ligwf.cli.analyse import print_record
+
+
+def register(subparsers) -> None:
+    """Add the ``analyse-dumps`` sub-command."""
+    p = subparsers.add_parser(
+        "analyse-dumps", help="granules and GSD of LIGGGHTS dumps ligwf did not write",
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("dump_dir", type=Path, help="folder with the particle and contact dumps")
+    p.add_argument("--out", type=Path, default=None, help="output folder (default DIR/analysis)")
+    p.add_argument("--liquid", required=True, choices=liquids.names(), help="liquid model")
+    p.add_argument("--surface-tension", type=float, help="N/m as the engine used it "
+                   "(CG-scaled); required for a wet model")
+    p.add_argument("--contact-angle", type=float, help="deg; required for a wet model")
+    p.add_argument("--angle-convention", required=True, choices=("engine", "scene"),
+                   help="engine: the value written into a LIGGGHTS 3.8.0 input (which applied "
+                   "0.5 theta^2); scene: the angle the engine applied (fixed engine)")
+    p.add_argument("--periodic-axis", required=True, choices=("x", "y", "z", "none"))
+    p.add_argument("--box-length", type=float, help="m, length of the periodic box "
+                   "(it spans [0, L]); required with a periodic axis")
+    p.add_argument("--dt", type=float, required=True, help="time step, s")
+    p.add_argument("--liquid-content", type=float, default=None,
+                   help="fraction of particle volume, when the dumps lack f_surfaceLiquidContent")
+    p.add_argument("--cg", type=float, default=1.0, help="coarse-graining factor of the run")
+    p.add_argument("--steady-from-step", type=int, default=0,
+                   help="first step of the GSD window (default: every frame)")
+    p.add_argument("--particles", default="particles_*.vtu", help="particle file pattern")
+    p.add_argument("--contacts", default="contacts_*.vtu", help="contact file pattern")
+    p.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
+                   help="an analysis setting, e.g. max_velocity_angle=10 (repeatable)")
+    p.add_argument("--no-vtu", action="store_true", help="do not write the .pvd/.vtu series")
+    p.set_defaults(func=cmd_analyse_dumps)
+
+
+def cmd_analyse_dumps(args: argparse.Namespace) -> int:
+    import yaml
+
+    from ligwf.analysis.foreign import ForeignRun, analyse_dumps
+    from ligwf.errors import ConfigError
+    from ligwf.study.settings import build_analysis_settings
+
+    values = {}
+    for item in args.settings:
+        key, sep, value = item.partition("=")
+        if not sep:
+            raise ConfigError(f"--set {item!r}: use KEY=VALUE")
+        values[key.strip()] = yaml.safe_load(value)
+    settings = build_analysis_settings(values, "--set")
+    run = ForeignRun(args.liquid, args.surface_tension, args.contact_angle,
+                     args.angle_convention, args.periodic_axis, args.box_length, args.dt,
+                     args.liquid_content, args.cg)
+    out = args.out or args.dump_dir / "analysis"
+    record = analyse_dumps(args.dump_dir, run, out, settings, args.steady_from_step,
+                           args.particles, args.contacts, not args.no_vtu)
+    print_record(record, out)
+    return 0

@@ -1,0 +1,109 @@
+"""Everything the report did not use, and why: skipped cases, missing or refused frames,
+missing or unreadable analysis outputs.
+
+A problem that sits only in a JSON file is a problem nobody sees, so the report gathers
+them from every stage -- the study (cases not done, stale or unreadable), the granule
+analysis record (cases without an analysable frame, frames missing, unexpected or
+refused, see :mod:`ligwf.analysis.frame_checks`) and the flow stage (frames of the steady
+window it could not use) -- and lists them in ``summary.md`` and ``index.html``.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+from ligwf.study import layout
+
+#: The files of a complete granule analysis (the report reads all of them).
+ANALYSIS_OUTPUTS = (layout.GRANULES_TABLE, layout.FRAMES_TABLE, layout.GSD_TABLE,
+                    layout.GSD_SUMMARY_TABLE)
+
+
+@dataclass(frozen=True)
+class Problems:
+    """What the report lists as not used, each with its reason."""
+
+    cases: tuple[tuple[str, str], ...]              # (case_id, reason)
+    frames: tuple[tuple[str, str, str, str], ...]   # (case_id, step, kind, reason)
+    outputs: tuple[str, ...]                        # analysis outputs missing or unreadable
+
+    @property
+    def count(self) -> int:
+        return len(self.cases) + len(self.frames) + len(self.outputs)
+
+    def markdown(self) -> list[str]:
+        """The report's sections on skipped cases, frames and analysis outputs."""
+        def cell(text: str) -> str:
+            return text.replace("|", "\\|").replace("\n", " ")
+        lines = ["## Skipped cases (not used anywhere in this report)", ""]
+        lines += [f"- {cid}: {cell(why)}" for cid, why in self.cases] or ["none"]
+        lines += ["", "## Skipped or missing frames", ""]
+        if self.frames:
+            lines += ["| case | step | kind | reason |", "|---|---|---|---|"]
+            lines += [f"| {c} | {s} | {k} | {cell(r)} |" for c, s, k, r in self.frames]
+        else:
+            lines.append("none")
+        lines += ["", "## Analysis outputs", ""]
+        lines += [f"- {cell(o)}" for o in self.outputs] or ["complete"]
+        return lines + [""]
+
+    def html(self) -> str:
+        """The same sections as HTML."""
+        e = html.escape
+        cases = "".join(f"<li>{e(c)}: {e(w)}</li>" for c, w in self.cases) or "<li>none</li>"
+        rows = "".join(f"<tr><td>{e(c)}</td><td>{e(s)}</td><td>{e(k)}</td><td>{e(r)}</td></tr>"
+                       for c, s, k, r in self.frames)
+        frames = (f"<table><tr><th>case</th><th>step</th><th>kind</th><th>reason</th></tr>{rows}"
+                  "</table>" if rows else "<p>none</p>")
+        outputs = "".join(f"<li>{e(o)}</li>" for o in self.outputs) or "<li>complete</li>"
+        return (f"<h2>Skipped cases</h2><ul>{cases}</ul>"
+                f"<h2>Skipped or missing frames</h2>{frames}"
+                f"<h2>Analysis outputs</h2><ul>{outputs}</ul>")
+
+
+def _read_json(path: Path, what: str, outputs: list[str]) -> dict:
+    try:
+        data = json.loads(path.read_text())
+        if not isinstance(data, dict):
+            raise ValueError("not a JSON object")
+        return data
+    except FileNotFoundError:
+        outputs.append(f"{path.name} missing: {what}")
+    except (OSError, ValueError) as exc:
+        outputs.append(f"{path.name} unreadable ({exc}): {what}")
+    return {}
+
+
+def collect(study_skipped: list[dict], analysis_dir: Path) -> Problems:
+    """The problems of a study: its own skipped cases, the analysis record's and the flow
+    stage's (read from ``analysis_dir``), and missing analysis outputs."""
+    outputs: list[str] = []
+    record = _read_json(analysis_dir / layout.ANALYSIS_RECORD,
+                        "granules were not analysed (run `ligwf analyse`)", outputs)
+    if record:
+        outputs += [f"{name} missing: rerun `ligwf analyse` (granule and GSD columns are empty)"
+                    for name in ANALYSIS_OUTPUTS if not (analysis_dir / name).is_file()]
+    flow = _read_json(analysis_dir / layout.FLOW_PROFILES, "flow metrics missing", [])
+    cases: dict[str, str] = {}
+    for s in [*study_skipped, *record.get("skipped_cases", []), *flow.get("skipped_cases", [])]:
+        if isinstance(s, dict):
+            cases.setdefault(str(s.get("case_id", "?")), str(s.get("reason", "")))
+    frames = {(str(f.get("case_id")), str(f.get("step")), str(f.get("kind", "skipped")),
+               str(f.get("reason"))) for f in record.get("skipped_frames", []) if isinstance(f, dict)}
+    notes = flow.get("skipped_frames", {})
+    for cid, reasons in (notes.items() if isinstance(notes, dict) else []):
+        for why in reasons:
+            if not any(why == r for c, _, _, r in frames if c == cid):
+                frames.add((str(cid), "-", "flow", str(why)))
+    return Problems(tuple(sorted(cases.items())),
+                    tuple(sorted(frames, key=lambda f: (f[0], f[1].zfill(12), f[3]))),
+                    tuple(outputs))
+
+
+def study_problems(study) -> Problems:
+    """:func:`collect` for a :class:`~ligwf.study.study.Study` (its skipped cases and its
+    analysis folder)."""
+    return collect(study.usable_cases()[1], study.analysis_dir)

@@ -1,0 +1,75 @@
+"""``ligwf analyse-dumps`` and the Python API on dumps ligwf did not write: every fact of the
+run is required (clear one-line errors), nothing defaults to step 0 or a box length of 0."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from ligwf.analysis.case_granules import RunFacts
+from ligwf.analysis.dumps import read_contacts, read_particles
+from ligwf.analysis.granules import Liquid
+from ligwf.cli.main import main
+from ligwf.errors import ConfigError, DumpReadError
+from wetdump import wet_study
+
+ARGS = ["--liquid", "washino", "--surface-tension", "0.216", "--contact-angle", "30",
+        "--angle-convention", "scene", "--periodic-axis", "y", "--box-length", "0.009",
+        "--dt", "2e-5"]
+
+
+@pytest.fixture(scope="module")
+def dumps(engine, tmp_path_factory) -> Path:
+    """The wet case's dumps alone, as a user would bring them (no scene, no manifest)."""
+    out = tmp_path_factory.mktemp("foreign") / "dumps"
+    shutil.copytree(wet_study(engine, tmp_path_factory) / "cg3-weber-r0" / "post", out)
+    return out
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_analyse_dumps_matches_the_case_analysis(dumps, tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["analyse-dumps", str(dumps), "--out", str(out), "--cg", "3", *ARGS]) == 0
+    g = pd.read_parquet(out / "granules.parquet")
+    frames = pd.read_csv(out / "frames.csv")
+    assert (frames["status"] == "ok").all() and (g.groupby("step")["members"].sum() == 222).all()
+    assert g["percolating"].dtype == bool and (out / "dumps" / "granules.pvd").is_file()
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+@pytest.mark.parametrize("drop,message", [
+    ("--box-length", "--box-length"), ("--surface-tension", "--surface-tension"),
+    ("--contact-angle", "--contact-angle")])
+def test_missing_facts_are_one_line_errors(dumps, tmp_path, capsys, drop, message):
+    i = ARGS.index(drop)
+    args = ARGS[:i] + ARGS[i + 2:]
+    assert main(["analyse-dumps", str(dumps), "--out", str(tmp_path / "o"), *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "o").exists()
+
+
+def test_required_options_refused_by_the_parser(tmp_path, capsys):
+    try:
+        code = main(["analyse-dumps", str(tmp_path), "--liquid", "washino"])
+    except SystemExit as exc:          # argparse's own exit, or ligwf's usage-error line
+        code = exc.code
+    assert code == 2 and "--angle-convention" in capsys.readouterr().err
+
+
+def test_no_silent_defaults_in_the_python_api(tmp_path):
+    bad = tmp_path / "frame.vtu"
+    bad.write_text("x")
+    with pytest.raises(DumpReadError, match="no step in the file name"):
+        read_particles(bad)
+    with pytest.raises(DumpReadError, match="no step in the file name"):
+        read_contacts(bad)
+    with pytest.raises(ConfigError, match="box length"):
+        RunFacts("foreign", 1.0, Liquid("washino", 0.02, 0.5, 0.02), 1, 0.0, 1e-5)
+    with pytest.raises(ConfigError, match="time step"):
+        RunFacts("foreign", 1.0, Liquid("washino", 0.02, 0.5, 0.02), None, 0.0, 0.0)
