@@ -40,7 +40,8 @@ def commands(src: str) -> list[str]:
 
 
 def test_dry_scene_has_no_liquid():
-    src = text(overrides=["scene.liquid.model=none", "scene.analysis.granules=false"])
+    src = text(overrides=["scene.liquid.model=none", "scene.analysis.granules=false",
+                          "sweep.rules=[weber]"])
     body = "\n".join(commands(src))
     for word in ("cohesion", "surfaceTension", "fluidViscosity", "contactAngle",
                  "surfaceLiquidContent", "SeparationDistanceRatio"):
