@@ -576,12 +576,14 @@ def main(argv=None):
         r["d50_1x"] = d1
         r["c"] = all(v[1] <= 1.0 for v in tiles.values())
         # (d) process response, (e) CG
-        dser = []
-        for c in series:
+
+        def summary(c, spec=spec, cut=cut):
             rr = run_spec(ev[id(c)], spec)
-            dser.append((boot_band(rr["d50"], args.boot, rng), float(np.mean(rr["largest"])),
-                         float(np.mean(rr["perc"])),
-                         boot_band([d50_of(v, cut) for v in rr["vols"]], args.boot, rng)))
+            return (boot_band(rr["d50"], args.boot, rng), float(np.mean(rr["largest"])),
+                    float(np.mean(rr["perc"])),
+                    boot_band([d50_of(v, cut) for v in rr["vols"]], args.boot, rng))
+
+        dser = [summary(c) for c in series]
         r["series"] = dser
         if len(dser) >= 3:
             m = [x[0] for x in dser]
@@ -590,12 +592,7 @@ def main(argv=None):
             r["d"] = up or down
         else:
             r["d"] = None
-        dcg = []
-        for c in cgs:
-            rr = run_spec(ev[id(c)], spec)
-            dcg.append((boot_band(rr["d50"], args.boot, rng), float(np.mean(rr["largest"])),
-                        float(np.mean(rr["perc"])),
-                        boot_band([d50_of(v, cut) for v in rr["vols"]], args.boot, rng)))
+        dcg = [summary(c) for c in cgs]
         r["cg"] = dcg
         if dcg and len(dcg) == len(dser):
             r["cg_ratio_plain"] = [c[0][0] / s[0][0] for c, s in zip(dcg, dser)]

@@ -20,6 +20,16 @@ import pandas as pd  # noqa: E402
 from ligwf.fsio import atomic_write_bytes  # noqa: E402
 
 
+def _axes(ax, xlabel: str, ylabel: str, title: str, legend: int | None = None) -> None:
+    """Axis labels, a small title, an optional legend (font size) and a light grid."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    if legend:
+        ax.legend(fontsize=legend)
+    ax.grid(alpha=0.3)
+
+
 def _save(fig, path: Path) -> Path:
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
@@ -51,10 +61,7 @@ def pareto(conditions: pd.DataFrame, path: Path) -> Path:
                         textcoords="offset points", xytext=(4, 4), fontsize=8)
         ax.set_xscale("log")
         ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short spans
-        ax.set_xlabel("run time [core-seconds]")
-        ax.set_ylabel("error [%]")
-        ax.set_title(title, fontsize=10)
-        ax.grid(alpha=0.3)
+        _axes(ax, "run time [core-seconds]", "error [%]", title)
     return _save(fig, path)
 
 
@@ -67,11 +74,8 @@ def gsd_overlay(gsd: pd.DataFrame, path: Path) -> Path:
         ax.fill_between(sub["v_mid"], sub["volume_lo"], sub["volume_hi"], alpha=0.2,
                         color=line.get_color())
     ax.set_xscale("log")
-    ax.set_xlabel("granule volume, primary-particle equivalent [m$^3$]")
-    ax.set_ylabel("volume fraction per bin")
-    ax.set_title("GSD: CG-n volumes / n$^3$ against CG1 (95 % bootstrap bands)", fontsize=10)
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
+    _axes(ax, "granule volume, primary-particle equivalent [m$^3$]", "volume fraction per bin",
+           "GSD: CG-n volumes / n$^3$ against CG1 (95 % bootstrap bands)", legend=8)
     return _save(fig, path)
 
 
@@ -86,11 +90,9 @@ def velocity_profiles(cases: pd.DataFrame, profiles: dict, path: Path) -> Path:
         ax.plot(v, 1000 * np.array(p["s"]), label=r["case_id"], lw=1.2,
                 ls="-" if r["cg"] == 1 else ("--" if r["rule"] == "weber" else ":"))
     ax.axvline(0, color="k", lw=0.5)
-    ax.set_xlabel("velocity along the free surface [m/s]")
-    ax.set_ylabel("distance from drum centre along the surface normal [mm]")
-    ax.set_title("velocity profiles (solid CG1, dashed weber, dotted bond)", fontsize=10)
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3)
+    _axes(ax, "velocity along the free surface [m/s]",
+           "distance from drum centre along the surface normal [mm]",
+           "velocity profiles (solid CG1, dashed weber, dotted bond)", legend=7)
     return _save(fig, path)
 
 
