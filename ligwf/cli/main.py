@@ -10,12 +10,14 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from ligwf import __version__
 from ligwf.cli import analyse, analyse_dumps, report, run, slurm, stability
 from ligwf.cli.common import (Parser, add_mesh_cache, add_workflow_args, case_table, console,
                               err_console, folder_to_write, prepare_from_args)
 from ligwf.errors import LigwfError
+from ligwf.fsio import NOT_WRITABLE, not_writable
 from ligwf.study.pipeline import write
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
@@ -66,6 +68,10 @@ def main(argv: list[str] | None = None) -> int:
         return int(exc.code or 0)
     try:
         return int(args.func(args) or 0)
+    except OSError as exc:  # a stage writing into a full or read-only folder: one line
+        exc = not_writable(exc, Path.cwd()) if exc.errno in NOT_WRITABLE else exc
+        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
+        return 2
     except LigwfError as exc:
         err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
         return 2

@@ -12,15 +12,17 @@ import os
 import re
 
 from ligwf import __version__
-from ligwf.fsio import atomic_write_text
-from ligwf.engine.health import (FAILED, RUNNING, UNSTABLE, Expectation, assess,
-                                 kinetic_energy_ceiling, verdict)
+from ligwf.fsio import LOW_SPACE_BYTES, FolderNotWritable, atomic_write_text, space_left
+from ligwf.engine.guard import start_time
+from ligwf.engine.health import (FAILED, KILLED, RUNNING, UNSTABLE, Expectation, assess,
+                                 engine_signal, kinetic_energy_ceiling, verdict)
 from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for, render_resume,
                                  rotate_screen)
 from ligwf.engine.thermo import ThermoRow, parse_screen, phase_group, rows_from_csv, rows_to_csv
 from ligwf.scene.scaling import ScaledScene
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import Attempt, Manifest, now_iso
+from ligwf.study.layout import SCREEN_FILE
+from ligwf.study.manifest import Attempt, Manifest, now_iso, overwrite_manifest
 
 _VERSION_RE = re.compile(r"^LIGGGHTS \((Version .*)\)\s*$")
 
@@ -57,13 +59,16 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
     elif plan.action == RESUME and plan.restart is not None:
         for name, text in render_resume(case.scaled, plan.restart, template_dirs).items():
             atomic_write_text(case.path / name, text)
-        rotate_screen(case.path)
         manifest = previous
+        kept = rotate_screen(case.path)
+        if kept and manifest.attempts and manifest.attempts[-1].screen == SCREEN_FILE:
+            manifest.attempts[-1].screen = kept   # its rows are read from there from now on
         from_step, restart_path = plan.restart.step, plan.restart.path
     else:
         raise ValueError(f"begin_attempt: nothing to run for plan {plan}")
     manifest.status, manifest.reason, manifest.reason_step = RUNNING, plan.reason, None
     manifest.host, manifest.pid = os.uname().nodename, os.getpid()
+    manifest.pid_start, manifest.engine = start_time(os.getpid()), []
     manifest.launcher, manifest.nprocs = launcher, nprocs
     manifest.command = list(command or [])
     manifest.total_steps = case.scaled.total_steps
@@ -76,8 +81,8 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
     return manifest, attempt
 
 
-def _merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int,
-                dt: float) -> list[ThermoRow]:
+def merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int,
+               dt: float) -> list[ThermoRow]:
     """Thermo of earlier attempts up to the restart step, then this attempt's rows.
 
     LIGGGHTS restarts its ``time`` thermo column at 0 after ``read_restart``; the
@@ -91,44 +96,69 @@ def _merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int,
     return kept + shifted
 
 
+def case_rows(case: CaseFolder, attempts: list[Attempt]) -> list[ThermoRow]:
+    """The case's thermo series rebuilt from the screen of every attempt (an attempt whose
+    runner was SIGKILLed never wrote ``thermo.csv``, but its screen holds its rows): no
+    gap, no duplicate step. A screen removed by hand falls back to the old table."""
+    rows: list[ThermoRow] = []
+    for a in attempts:
+        screen = case.path / a.screen
+        if screen.is_file():
+            new = parse_screen(screen.read_text(errors="replace")).rows
+            rows = merge_rows(rows, new, a.from_step, case.scaled.dt)
+        elif case.thermo.is_file():
+            table = rows_from_csv(case.thermo.read_text())
+            rows = [r for r in rows if r.step < a.from_step] + \
+                [r for r in table if r.step >= a.from_step]
+    return rows
+
+
+def history(case: CaseFolder, manifest: Manifest, attempt: Attempt) -> list[ThermoRow]:
+    """Rows of the earlier attempts before ``attempt`` starts (what the live check of a
+    resumed attempt judges its rows against)."""
+    earlier = [a for a in manifest.attempts if a.number < attempt.number]
+    return [r for r in case_rows(case, earlier) if r.step < attempt.from_step]
+
+
 def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
                    exit_code: int | None, wall_seconds: float, killed: bool = False,
-                   engine_version_line: str | None = None) -> Manifest:
-    """Judge the attempt from its screen capture and write thermo table + manifest."""
+                   engine_version_line: str | None = None,
+                   stop_problem: str | None = None) -> Manifest:
+    """Judge the attempt from its screen capture and write thermo table + manifest.
+    ``stop_problem``: why the live check stopped the run (None: it did not)."""
     s = case.scaled
     screen = case.path / attempt.screen
     text = screen.read_text(errors="replace") if screen.exists() else ""
     parser = parse_screen(text)
-    previous: list[ThermoRow] = []
-    if attempt.from_step and case.thermo.exists():
-        previous = rows_from_csv(case.thermo.read_text())
-    rows = _merge_rows(previous, parser.rows, attempt.from_step, s.dt)
+    rows = case_rows(case, manifest.attempts)
     expect = expectation(s)
     issues = assess(rows, parser.lines, expect)
     steps_done = rows[-1].step if rows else attempt.from_step
-    status, reason = verdict(issues, exit_code, steps_done, s.total_steps, killed)
+    signal = engine_signal(parser.lines, exit_code)
+    status, reason = verdict(issues, exit_code, steps_done, s.total_steps, killed, signal,
+                             stop_problem)
+    left = space_left(case.path)
+    if status in (FAILED, KILLED) and left < LOW_SPACE_BYTES:
+        # a full disk makes LIGGGHTS segfault: the case resumes once there is room
+        status, reason = KILLED, f"disk full ({left} bytes left in {case.path}): {reason}"
 
     attempt.ended = now_iso()
     attempt.wall_seconds = wall_seconds
     attempt.exit_code = exit_code
     attempt.status, attempt.reason = status, reason
+    attempt.steps = parser.rows[-1].step - attempt.from_step if parser.rows else 0
+    walls, steps = parser.phase_walls(), parser.phase_steps()
+    attempt.phases = {ph: {"wall_seconds": walls.get(ph, 0.0), "steps": steps.get(ph, 0)}
+                      for ph in walls.keys() | steps.keys()}
     manifest.status, manifest.reason = status, reason
     manifest.reason_step = _cause_step(issues, status)
     manifest.issues = [i.to_dict() for i in issues]
     manifest.liggghts_version = (engine_version(parser.lines) or engine_version_line
                                  or manifest.liggghts_version)
     manifest.ended = attempt.ended
-    manifest.wall_seconds += wall_seconds
-    manifest.core_seconds += wall_seconds * attempt.nprocs
+    manifest.engine = []
+    manifest.add_up_attempts()
     manifest.steps_done = steps_done
-    for phase, wall in parser.phase_walls().items():
-        rec = manifest.phases.setdefault(phase, {"wall_seconds": 0.0, "core_seconds": 0.0,
-                                                 "steps": 0})
-        rec["wall_seconds"] += wall
-        rec["core_seconds"] += wall * attempt.nprocs
-    for phase, steps in parser.phase_steps().items():
-        manifest.phases.setdefault(phase, {"wall_seconds": 0.0, "core_seconds": 0.0, "steps": 0})
-        manifest.phases[phase]["steps"] += steps
     if rows:
         manifest.atoms_start = int(rows[0].get("atoms")) if manifest.atoms_start is None else \
             manifest.atoms_start
@@ -137,9 +167,28 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
         settled = [r for r in rows if r.step <= expect.settle_end_step]
         if settled and settled[-1].step == expect.settle_end_step:
             manifest.atoms_after_settle = _int_or_none(settled[-1].get("atoms"))
-    atomic_write_text(case.thermo, rows_to_csv(rows))
-    case.write_manifest(manifest)
+    try:
+        atomic_write_text(case.thermo, rows_to_csv(rows))
+    except FolderNotWritable:
+        pass  # the table is rebuilt from the screens by the next attempt; the manifest counts
+    try:
+        case.write_manifest(manifest)
+    except FolderNotWritable:
+        overwrite_manifest(case.path, manifest)   # read-only: raises FolderNotWritable
     return manifest
+
+
+def close_lost_attempt(case: CaseFolder, manifest: Manifest) -> Manifest:
+    """Record the last attempt of a case whose runner died (SIGKILL, crash, lost node)
+    from its screen: rows, steps, and wall time up to the screen's last write. The
+    case becomes ``killed`` (or whatever its rows show) and resumes."""
+    attempt = manifest.attempts[-1]
+    screen = case.path / attempt.screen
+    parser = parse_screen(screen.read_text(errors="replace") if screen.exists() else "")
+    wall = sum(parser.phase_walls().values())
+    if screen.exists():
+        wall = max(wall, screen.stat().st_mtime - attempt.started_at)
+    return finish_attempt(case, manifest, attempt, None, wall, killed=True)
 
 
 def _cause_step(issues, status: str) -> int | None:
@@ -163,5 +212,5 @@ def restart_unreadable(manifest: Manifest, attempt: Attempt) -> bool:
             and manifest.steps_done <= attempt.from_step)
 
 
-__all__ = ["begin_attempt", "finish_attempt", "expectation", "engine_version", "phase_group",
-           "restart_unreadable"]
+__all__ = ["begin_attempt", "finish_attempt", "close_lost_attempt", "case_rows", "history",
+           "expectation", "engine_version", "phase_group", "restart_unreadable"]

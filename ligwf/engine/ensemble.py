@@ -30,6 +30,7 @@ from pathlib import Path
 from ligwf.engine.attempt import finish_attempt
 from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
 from ligwf.engine.health import FAILED, KILLED, log_errors
+from ligwf.engine.guard import engine_env, release, watch
 from ligwf.engine.launch import Monitor, NullMonitor, signal_engine
 from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig
@@ -116,7 +117,9 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
         ended: set[int] = set()
         with open(ens_dir / "launch.log", "wb") as out:
             proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT,
-                                    stdin=subprocess.DEVNULL, start_new_session=True)
+                                    stdin=subprocess.DEVNULL, env=engine_env(),
+                                    start_new_session=True)
+        watchdog = watch(proc)   # stops the job if this runner dies
         stop_sent = False
         while True:
             finished = proc.poll() is not None
@@ -145,6 +148,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                 signal_engine(proc)
                 stop_sent = True
             time.sleep(poll_seconds)
+        release(watchdog)
         wall = time.monotonic() - t0
         launch_log = (ens_dir / "launch.log").read_text(errors="replace")
         claims = _claims(ens_dir)

@@ -191,25 +191,54 @@ def log_warnings(lines: Sequence[str]) -> list[HealthIssue]:
     return issues
 
 
+def physics_issues(rows: Sequence[ThermoRow],
+                   expect: Expectation | None = None) -> list[HealthIssue]:
+    """nan, atom loss and kinetic-energy blow-up over a case's rows (all attempts: a
+    resumed bed at rest must be judged against the history of its case, not its own first
+    row). The live monitor and the final assessment share this rule."""
+    return (non_finite(rows)
+            + atom_loss(rows, expect.particle_count if expect else None)
+            + kinetic_energy_blowup(rows, expect.ke_ceiling if expect else None))
+
+
 def assess(rows: Sequence[ThermoRow], lines: Iterable[str],
            expect: Expectation | None = None) -> list[HealthIssue]:
     """Every failure signature in a run (rows + screen lines), earliest first."""
     lines = list(lines)
-    issues = (log_errors(lines) + log_warnings(lines) + non_finite(rows)
-              + atom_loss(rows, expect.particle_count if expect else None))
-    issues += kinetic_energy_blowup(rows, expect.ke_ceiling if expect else None)
+    issues = log_errors(lines) + log_warnings(lines) + physics_issues(rows, expect)
     if expect is not None:
         issues += insertion_shortfall(rows, expect.particle_count, expect.settle_end_step)
     return sorted(issues, key=lambda i: (i.step if i.step is not None else math.inf))
 
 
+#: signals that stop an engine from outside (user, scheduler, OOM killer, a lost runner):
+#: the case is ``killed`` and resumes from its newest restart. Other signals are crashes.
+STOP_SIGNALS = frozenset({1, 2, 9, 15, 24})
+#: mpirun's notice when a rank dies by a signal (OpenMPI 4.1), e.g. "... exited on signal 9"
+_RANK_SIGNAL_RE = re.compile(r"exited on signal (\d+)")
+
+
+def engine_signal(lines: Sequence[str], exit_code: int | None) -> int | None:
+    """Signal that ended the engine: mpirun's notice about a rank, or the launcher's own
+    (a negative exit code from ``subprocess``). None when it exited by itself."""
+    for line in reversed(lines[-100:]):
+        m = _RANK_SIGNAL_RE.search(line)
+        if m:
+            return int(m.group(1))
+    return -exit_code if exit_code is not None and exit_code < 0 else None
+
+
 def verdict(issues: Sequence[HealthIssue], exit_code: int | None, steps_done: int,
-            total_steps: int, killed: bool = False) -> tuple[str, str]:
+            total_steps: int, killed: bool = False, signal: int | None = None,
+            stop_problem: str | None = None) -> tuple[str, str]:
     """Case status and reason from the issues, the exit code and the steps reached.
 
     Order matters: an ERROR line explains a bad exit code; a physics issue (atom loss,
     nan, blow-up, time-step warning) makes the outputs unusable even when the engine
-    finished; a stop requested by the user or the scheduler is ``killed`` (resumable).
+    finished, as does the problem the live monitor stopped the run for
+    (``stop_problem``); a stop requested by the user or the scheduler, or an engine
+    killed by a stop signal (:data:`STOP_SIGNALS`), is ``killed`` (resumable); any other
+    signal is a crash.
     """
     errors = [i for i in issues if i.kind == "error"]
     physics = [i for i in issues if not i.fatal]
@@ -218,8 +247,14 @@ def verdict(issues: Sequence[HealthIssue], exit_code: int | None, steps_done: in
     if physics:
         first = physics[0]
         return UNSTABLE, f"{first.kind}: {first.message}"
-    if killed:
+    if stop_problem:
+        return UNSTABLE, f"stopped by the live check: {stop_problem}"
+    if killed and steps_done < total_steps:   # (a stop that came too late changes nothing)
         return KILLED, f"stopped at step {steps_done} of {total_steps}"
+    if signal in STOP_SIGNALS:
+        return KILLED, f"engine killed by signal {signal} at step {steps_done} of {total_steps}"
+    if signal is not None:
+        return FAILED, f"engine crashed (signal {signal}) at step {steps_done} of {total_steps}"
     if exit_code not in (0, None):
         return FAILED, f"engine exit code {exit_code} at step {steps_done} of {total_steps}"
     if steps_done < total_steps:

@@ -3,12 +3,14 @@
 The engine writes stdout+stderr straight into ``run.log`` in the case folder (no pipe for
 ligwf to drain, so monitoring cannot stall the engine); ligwf tails that file every
 ``poll_seconds`` to update the progress display and to check health while it runs. A run
-that turns unstable (nan, atom loss, energy blow-up) is stopped early: its outputs would
-never be used.
+that turns unstable (nan, atom loss, energy blow-up: the rule of the final assessment,
+over the rows of every attempt) is stopped early: its outputs would never be used.
 
-Stopping is graceful: SIGTERM goes to the engine ranks (the children of ``mpirun``), not to
-``mpirun`` itself -- ``mpirun`` would kill the ranks before LIGGGHTS writes its forced
-restart ``restart_forced_liggghts_<step>.data`` (observed with OpenMPI 4.1).
+Stopping is graceful: SIGTERM goes to the engine ranks (the children of ``mpirun``), so
+LIGGGHTS writes its forced restart ``restart_forced_liggghts_<step>.data``. The engine dies
+with its runner (a watchdog, :func:`ligwf.engine.guard.watch`), and one runner at a time
+works on a case (:func:`ligwf.study.manifest.case_lock`); engines a dead runner left
+behind are stopped and the lost attempt recorded from its screen before the case resumes.
 """
 
 from __future__ import annotations
@@ -20,21 +22,21 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol, Sequence
+from typing import Callable, Protocol, Sequence
 
-from ligwf.engine.attempt import begin_attempt, finish_attempt, restart_unreadable
-from ligwf.engine.health import KILLED, atom_loss, kinetic_energy_blowup, log_errors, non_finite
+from ligwf.engine.attempt import (begin_attempt, close_lost_attempt, expectation,
+                                  finish_attempt, history, merge_rows, restart_unreadable)
+from ligwf.engine.guard import (STOP_GRACE_SECONDS, EngineProcess, descendants, engine_env,
+                                engine_tree, live_engines, release, stop_engines, watch)
+from ligwf.engine.health import KILLED, RUNNING, Expectation, physics_issues
 from ligwf.engine.render import grid_vars
 from ligwf.engine.resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, plan_case
 from ligwf.engine.site import EngineConfig
-from ligwf.engine.thermo import LogTail, ThermoParser
+from ligwf.engine.thermo import LogTail, ThermoParser, ThermoRow
+from ligwf.fsio import NOT_WRITABLE, FolderNotWritable, not_writable
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import SCREEN_FILE
-from ligwf.study.manifest import Manifest
-
-#: Seconds a stopped engine gets to write its forced restart before it is killed.
-STOP_GRACE_SECONDS = 60.0
-
+from ligwf.study.manifest import Manifest, case_lock, runner_alive
 
 class Monitor(Protocol):
     """Receives live progress of the cases a runner works on (local runs and ensembles
@@ -60,33 +62,13 @@ class NullMonitor:
 
 @dataclass(frozen=True)
 class LaunchResult:
-    """How the engine process ended: exit code, wall seconds, whether ligwf stopped it."""
+    """How the engine process ended: exit code, wall seconds, whether ligwf stopped it
+    (``killed``: on request; ``problem``: the live check's reason, None if it did not)."""
 
     exit_code: int | None
     wall_seconds: float
     killed: bool
-    stopped_unstable: bool = False
-
-
-def descendants(pid: int) -> list[int]:
-    """Process ids below ``pid`` (children first), from /proc."""
-    out: list[int] = []
-    todo = [pid]
-    while todo:
-        p = todo.pop()
-        try:
-            tasks = os.listdir(f"/proc/{p}/task")
-        except OSError:
-            continue
-        for t in tasks:
-            try:
-                with open(f"/proc/{p}/task/{t}/children") as fh:
-                    kids = [int(x) for x in fh.read().split()]
-            except OSError:
-                continue
-            out += kids
-            todo += kids
-    return out
+    problem: str | None = None
 
 
 def signal_engine(proc: subprocess.Popen, sig: int = signal.SIGTERM) -> None:
@@ -99,32 +81,31 @@ def signal_engine(proc: subprocess.Popen, sig: int = signal.SIGTERM) -> None:
             pass
 
 
-def live_problem(parser: ThermoParser, particle_count: int | None = None) -> str | None:
-    """A reason to stop a run now: an ERROR line, nan, atom loss (below ``particle_count``,
-    see :func:`ligwf.engine.health.atom_loss`) or energy blow-up."""
-    issues = (log_errors(parser.lines[-200:]) + non_finite(parser.rows[-50:])
-              + atom_loss(parser.rows, particle_count) + kinetic_energy_blowup(parser.rows))
-    issues = [i for i in issues if i.kind != "error"]  # errors end the engine by themselves
+def live_problem(rows: Sequence[ThermoRow], expect: Expectation | None) -> str | None:
+    """A reason to stop a run now: nan, atom loss or energy blow-up in the case's rows
+    (earlier attempts included), by the rule of the final assessment."""
+    issues = physics_issues(rows, expect)
     return issues[0].message if issues else None
 
 
-def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
-           case_id: str = "", monitor: Monitor | None = None,
-           stop: threading.Event | None = None, poll_seconds: float = 0.5,
-           stop_unstable: bool = True, particle_count: int | None = None,
-           engine_args: Sequence[str] = ()) -> LaunchResult:
-    """Run ``input_name`` in ``case_dir`` on ``nprocs`` ranks; stdout+stderr -> run.log.
-    ``particle_count``: the count the scene asks for (the live atom-loss test needs it);
-    ``engine_args``: further LIGGGHTS arguments (the processor grid)."""
+def launch(case_dir: Path, command: Sequence[str], case_id: str = "",
+           monitor: Monitor | None = None, stop: threading.Event | None = None,
+           poll_seconds: float = 0.5,
+           judge: Callable[[ThermoParser], str | None] | None = None,
+           on_engine: Callable[[list[EngineProcess]], None] | None = None) -> LaunchResult:
+    """Run ``command`` in ``case_dir``; stdout+stderr -> run.log. ``judge``: the live
+    health check (a reason to stop, or None); ``on_engine``: told the engine's processes
+    once its ranks are up (the manifest records them)."""
     case_dir = Path(case_dir)
-    cmd = engine.command(input_name, nprocs, extra=engine_args)
     screen = case_dir / SCREEN_FILE
     parser, tail = ThermoParser(), LogTail(screen)
     t0 = time.monotonic()
     with open(screen, "wb") as out:
-        proc = subprocess.Popen(cmd, cwd=case_dir, stdout=out, stderr=subprocess.STDOUT,
-                                stdin=subprocess.DEVNULL, start_new_session=True)
-    killed = unstable = False
+        proc = subprocess.Popen(list(command), cwd=case_dir, stdout=out,
+                                stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                env=engine_env(), start_new_session=True)
+    watchdog = watch(proc)
+    killed, problem, recorded = False, None, False
     stop_sent_at: float | None = None
     # a thread blocks in waitpid; this one sleeps on an event between polls. (Popen.wait
     # with a timeout polls waitpid with backoff, ~30 wake-ups a second, each of which
@@ -134,15 +115,17 @@ def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
                      name=f"wait-{case_id or proc.pid}").start()
     try:
         while not ended.wait(poll_seconds):
+            if not recorded and on_engine is not None and descendants(proc.pid):
+                on_engine(engine_tree(proc.pid))
+                recorded = True
             for line in tail.read_lines():
                 parser.feed(line)
             if monitor is not None:
                 monitor.update(case_id, parser)
             if stop_sent_at is None:
-                problem = live_problem(parser, particle_count) if stop_unstable else None
+                problem = judge(parser) if judge is not None else None
                 if problem or (stop is not None and stop.is_set()):
-                    unstable = bool(problem)
-                    killed = not unstable
+                    killed = not problem
                     signal_engine(proc)
                     stop_sent_at = time.monotonic()
             elif time.monotonic() - stop_sent_at > STOP_GRACE_SECONDS:
@@ -156,34 +139,82 @@ def launch(case_dir: Path, input_name: str, nprocs: int, engine: EngineConfig,
             except subprocess.TimeoutExpired:
                 os.killpg(proc.pid, signal.SIGKILL)
         raise
+    finally:
+        release(watchdog)
     for line in tail.flush():
         parser.feed(line)
     if monitor is not None:
         monitor.update(case_id, parser)
-    return LaunchResult(proc.returncode, time.monotonic() - t0, killed, unstable)
+    return LaunchResult(proc.returncode, time.monotonic() - t0, killed, problem)
+
+
+def take_over(case: CaseFolder) -> None:
+    """Before a runner works on a case it holds the lock of: stop engines a dead runner
+    left behind (forced restart written) and record that runner's lost attempt from its
+    screen, so no rows and no wall time are lost."""
+    m = case.manifest()
+    if m is not None and runner_alive(m):
+        return  # an ensemble worker (it takes no case lock): plan_case skips the case
+    orphans = live_engines(case.path, m.engine_processes() if m else [])
+    if orphans:
+        stop_engines(orphans)
+    if m is not None and m.status == RUNNING and m.attempts:
+        close_lost_attempt(case, m)
 
 
 def run_case(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Monitor | None = None,
              stop: threading.Event | None = None, retry_unstable: bool = False,
              template_dirs=(), poll_seconds: float = 0.5) -> Manifest | None:
     """Plan, launch and record one case (skip, fresh run or resume). Returns the manifest,
-    or None when the case was skipped."""
+    or None when the case was skipped (done, unstable, or held by another runner).
+    FolderNotWritable when the case folder is full or read-only."""
     monitor = monitor or NullMonitor()
-    plan = plan_case(case, retry_unstable)
     case_id = case.path.name
+    try:
+        with case_lock(case.path) as mine:
+            if not mine:
+                monitor.end(case_id, None, Plan(SKIP, "running in another ligwf process"))
+                return None
+            take_over(case)
+            manifest = _run_locked(case, nprocs, engine, monitor, stop, retry_unstable,
+                                   template_dirs, poll_seconds)
+    except OSError as exc:
+        if exc.errno in NOT_WRITABLE:   # e.g. removing old outputs on a read-only mount
+            raise not_writable(exc, case.path) from exc
+        raise
+    if manifest is not None and manifest.reason.startswith("disk full"):
+        raise FolderNotWritable(f"{case.path}: {manifest.reason}")
+    return manifest
+
+
+def _run_locked(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Monitor,
+                stop: threading.Event | None, retry_unstable: bool, template_dirs,
+                poll_seconds: float) -> Manifest | None:
+    case_id = case.path.name
+    plan = plan_case(case, retry_unstable)
     if plan.action == SKIP:
         monitor.end(case_id, None, plan)
         return None
     grid = grid_vars(case.scaled, nprocs)
+    expect = expectation(case.scaled)
     while True:
         cmd = engine.command(input_for(plan), nprocs, extra=grid)
         manifest, attempt = begin_attempt(case, plan, nprocs, "mpirun", cmd, template_dirs)
         monitor.start(case_id, manifest.total_steps, attempt.from_step)
-        result = launch(case.path, attempt.input, nprocs, engine, case_id, monitor, stop,
-                        poll_seconds, particle_count=case.scaled.particle_count,
-                        engine_args=grid)
+        before = history(case, manifest, attempt)
+
+        def judge(parser: ThermoParser) -> str | None:
+            return live_problem(merge_rows(before, parser.rows, attempt.from_step,
+                                           case.scaled.dt), expect)
+
+        def record(procs: list[EngineProcess]) -> None:
+            manifest.engine = [p.to_dict() for p in procs]
+            case.write_manifest(manifest)
+
+        result = launch(case.path, cmd, case_id, monitor, stop, poll_seconds, judge, record)
         manifest = finish_attempt(case, manifest, attempt, result.exit_code,
-                                  result.wall_seconds, killed=result.killed)
+                                  result.wall_seconds, killed=result.killed,
+                                  stop_problem=result.problem)
         if restart_unreadable(manifest, attempt) and plan.restart is not None:
             # a restart cut short by SIGKILL: set it aside and try the next one (or afresh)
             discard_restart(case.path, plan.restart)

@@ -146,12 +146,14 @@ def input_for(plan: Plan) -> str:
     return RESUME_INPUT if plan.action == RESUME else INPUT_NAME
 
 
-def rotate_screen(case_dir: Path) -> None:
-    """Keep the screen of the previous attempt as ``run.<n>.log``."""
+def rotate_screen(case_dir: Path) -> str | None:
+    """Keep the screen of the previous attempt as ``run.<n>.log``; returns that name."""
     case_dir = Path(case_dir)
     current = case_dir / SCREEN_FILE
-    if current.exists():
-        n = 1
-        while (case_dir / f"run.{n}.log").exists():
-            n += 1
-        current.rename(case_dir / f"run.{n}.log")
+    if not current.exists():
+        return None
+    n = 1
+    while (case_dir / f"run.{n}.log").exists():
+        n += 1
+    current.rename(case_dir / f"run.{n}.log")
+    return f"run.{n}.log"

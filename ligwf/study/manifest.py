@@ -13,18 +13,27 @@ attempts of the case (a resumed case adds its continuation's time).
 
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import socket
+import time
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 from ligwf.errors import ConfigError
-from ligwf.fsio import atomic_write_json
+from ligwf.fsio import NOT_WRITABLE, atomic_write_json, not_writable, overwrite_in_place
+from ligwf.engine.guard import EngineProcess, start_time
 from ligwf.engine.health import KILLED, RUNNING, STATUSES
 from ligwf.study.layout import MANIFEST_FILE, SCREEN_FILE
+
+
+#: Case level: locked (flock) by the one runner working on the case. The kernel drops the
+#: lock when that process dies, however it dies, so a stale lock cannot block a case.
+RUNNER_LOCK = ".runner.lock"
 
 
 def now_iso() -> str:
@@ -38,8 +47,11 @@ class Attempt:
 
     number: int
     started: str
+    started_at: float = field(default_factory=time.time)   # epoch s (wall of a lost runner)
     ended: str | None = None
     wall_seconds: float = 0.0
+    steps: int = 0                      # steps this attempt ran (re-run steps count again)
+    phases: dict[str, dict[str, float]] = field(default_factory=dict)
     nprocs: int = 1
     command: list[str] = field(default_factory=list)
     input: str = "in.liggghts"
@@ -69,10 +81,12 @@ class Manifest:
     command: list[str] = field(default_factory=list)
     host: str = field(default_factory=socket.gethostname)
     pid: int = field(default_factory=os.getpid)
+    pid_start: int | None = None        # runner start time (/proc): a recycled pid is no runner
+    engine: list[dict] = field(default_factory=list)   # engine processes (pid, start, name)
     started: str = field(default_factory=now_iso)
     ended: str | None = None
-    wall_seconds: float = 0.0           # launcher wall time over all attempts, s
-    core_seconds: float = 0.0           # wall x ranks over all attempts, core-s
+    wall_seconds: float = 0.0           # launcher wall time, sum over attempts, s
+    core_seconds: float = 0.0           # wall x ranks, sum over attempts, core-s
     steps_done: int = 0
     total_steps: int = 0
     atoms_start: int | None = None
@@ -85,13 +99,32 @@ class Manifest:
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
+    def engine_processes(self) -> list[EngineProcess]:
+        """The engine processes the runner recorded for the current attempt."""
+        return [EngineProcess.from_dict(d) for d in self.engine]
+
+    def add_up_attempts(self) -> None:
+        """Wall, core-seconds and per-phase totals as the sums over the attempts."""
+        self.wall_seconds = sum(a.wall_seconds for a in self.attempts)
+        self.core_seconds = sum(a.wall_seconds * a.nprocs for a in self.attempts)
+        self.phases = {}
+        for a in self.attempts:
+            for phase, rec in a.phases.items():
+                tot = self.phases.setdefault(phase, {"wall_seconds": 0.0, "core_seconds": 0.0,
+                                                     "steps": 0})
+                tot["wall_seconds"] += rec.get("wall_seconds", 0.0)
+                tot["core_seconds"] += rec.get("wall_seconds", 0.0) * a.nprocs
+                tot["steps"] += int(rec.get("steps", 0))
+
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> "Manifest":
         data = dict(data)
         # a hand-written or foreign manifest may carry only status and scene hash
         for key, default in (("index", -1), ("ligwf_version", ""), ("liggghts_version", "")):
             data.setdefault(key, default)
-        data["attempts"] = [Attempt(**a) for a in data.get("attempts", [])]
+        fields = Attempt.__dataclass_fields__
+        data["attempts"] = [Attempt(**{k: v for k, v in a.items() if k in fields})
+                            for a in data.get("attempts", [])]
         known = {f for f in cls.__dataclass_fields__}
         return cls(**{k: v for k, v in data.items() if k in known})
 
@@ -101,6 +134,13 @@ def write_manifest(case_dir: Path, manifest: Manifest) -> None:
     if manifest.status not in STATUSES:
         raise ConfigError(f"manifest status {manifest.status!r} (allowed: {', '.join(STATUSES)})")
     atomic_write_json(Path(case_dir) / MANIFEST_FILE, manifest.to_dict())
+
+
+def overwrite_manifest(case_dir: Path, manifest: Manifest) -> None:
+    """Overwrite the manifest in place: the last resort on a full disk, where the atomic
+    write finds no room for its temporary copy (truncating frees the old blocks first)."""
+    overwrite_in_place(Path(case_dir) / MANIFEST_FILE,
+                       json.dumps(manifest.to_dict(), indent=2, sort_keys=True) + "\n")
 
 
 def read_manifest(case_dir: Path) -> Manifest | None:
@@ -114,15 +154,17 @@ def read_manifest(case_dir: Path) -> Manifest | None:
         return None
 
 
-def pid_alive(pid: int) -> bool:
-    """Whether a process with this id exists on this host."""
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
+def pid_alive(pid: int, start: int | None = None) -> bool:
+    """Whether a process with this id (and, when given, this start time) exists here."""
+    now = start_time(pid)
+    return now is not None and (start is None or now == start)
+
+
+def runner_alive(m: Manifest) -> bool:
+    """Whether the process that wrote ``running`` into ``m`` is still running (this host,
+    same pid and start time, not this process)."""
+    return (m.host == socket.gethostname() and m.pid != os.getpid()
+            and pid_alive(m.pid, m.pid_start))
 
 
 def effective_status(m: Manifest) -> str:
@@ -130,7 +172,34 @@ def effective_status(m: Manifest) -> str:
 
     (SIGKILL, a node crash or a scheduler timeout leave ``running`` behind.)
     """
-    if m.status == RUNNING:
-        if m.host != socket.gethostname() or not pid_alive(m.pid) or m.pid == os.getpid():
-            return KILLED
+    if m.status == RUNNING and not runner_alive(m):
+        return KILLED
     return m.status
+
+
+@contextmanager
+def case_lock(case_dir: Path) -> Iterator[bool]:
+    """Try to become the one runner of a case: yields whether the lock was taken (no
+    waiting). Two ``ligwf run`` on one study split its cases this way."""
+    path = Path(case_dir) / RUNNER_LOCK
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+    except OSError as exc:
+        if exc.errno in NOT_WRITABLE:
+            raise not_writable(exc, path.parent) from exc
+        raise
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            yield False
+            return
+        yield True
+    finally:
+        os.close(fd)
+
+
+def case_busy(case_dir: Path) -> bool:
+    """Whether another runner holds the case's lock right now."""
+    with case_lock(case_dir) as mine:
+        return not mine

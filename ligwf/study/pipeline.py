@@ -29,11 +29,15 @@ from ligwf.engine.launch import Monitor, run_case
 from ligwf.engine.site import EngineConfig
 from ligwf.scene.workflow import load_workflow
 from ligwf.study.case import CaseFolder
+from ligwf.study.manifest import case_busy
 from ligwf.study.prepare import Prepared, prepare, write_study
 from ligwf.study.study import Study
 
 if TYPE_CHECKING:  # the analysis and report stages load numba / matplotlib: imported on use
     from ligwf.analysis.runner import AnalysisOptions
+
+#: Seconds between looks at cases another runner holds (see :func:`run_study`).
+WAIT_SECONDS = 1.0
 
 #: The ligwf sub-commands the Slurm analysis job runs over the study, in order: the CLI
 #: faces of :func:`analyse_study` and :func:`report_study`, i.e. :func:`postprocess`.
@@ -73,17 +77,31 @@ def run_study(study: Study, cases: Sequence[CaseFolder], engine: EngineConfig,
               settings: RunSettings = RunSettings(), monitor: Monitor | None = None,
               stop: threading.Event | None = None) -> bool:
     """Run ``cases`` of ``study`` (skipping finished ones, resuming killed ones): one after
-    the other, or as one MPI ensemble. Returns whether all of them are done."""
+    the other, or as one MPI ensemble. Returns whether all of them are done.
+
+    Several runners may work on one study: each case runs in one of them (a per-case
+    lock, :func:`ligwf.study.manifest.case_lock`); a runner that has finished its share
+    waits for the cases the others hold, so every runner returns once the study is done."""
     stop = stop or threading.Event()
     if settings.ensemble:
         run_ensemble(study.path, list(cases), settings.ensemble, settings.nprocs, engine,
                      retry_unstable=settings.retry_unstable, stop=stop, monitor=monitor)
     else:
+        def one(case: CaseFolder) -> None:
+            run_case(case, settings.nprocs, engine, monitor, stop, settings.retry_unstable,
+                     settings.template_dirs)
+
         for case in cases:
             if stop.is_set():
                 break
-            run_case(case, settings.nprocs, engine, monitor, stop, settings.retry_unstable,
-                     settings.template_dirs)
+            one(case)
+        # cases another `ligwf run` holds: wait for them, and take over any whose runner
+        # stops before it is done (its lock goes with it)
+        busy = [c for c in cases if case_busy(c.path)]
+        while busy and not stop.wait(WAIT_SECONDS):
+            for case in [c for c in busy if not case_busy(c.path)]:
+                one(case)
+            busy = [c for c in cases if case_busy(c.path)]
     return all_done(cases)
 
 

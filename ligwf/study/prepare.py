@@ -18,13 +18,13 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import shutil
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterable
 
 from ligwf import __version__
-from ligwf.fsio import atomic_write_json, atomic_write_text
+from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, atomic_write_text,
+                        not_writable)
 from ligwf.engine.mesh import cached_mesh, drum_stl
 from ligwf.engine.render import MESH_NAME, OUTPUT_DIRS, render
 from ligwf.scene.scaling import ScaledScene
@@ -114,9 +114,8 @@ def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) 
     for sub in OUTPUT_DIRS:
         (case_dir / sub).mkdir(exist_ok=True)
     mesh_src = cached_mesh(rc.case.scene.drum, mesh_cache or default_mesh_cache())
-    tmp = case_dir / f".{MESH_NAME}.tmp"
-    shutil.copyfile(mesh_src, tmp)
-    os.replace(tmp, case_dir / MESH_NAME)
+    # a per-process temporary name: two `ligwf run` may write one study at once
+    atomic_write_bytes(case_dir / MESH_NAME, Path(mesh_src).read_bytes())
     for name, text in rc.files.items():
         atomic_write_text(case_dir / name, text)
     atomic_write_json(case_dir / SCENE_FILE, rc.scene_record())
@@ -125,11 +124,17 @@ def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) 
 
 def write_study(wf: Workflow, rendered: list[RenderedCase], out_dir: Path,
                 mesh_cache: Path | None = None) -> Study:
-    """Write every case folder, then the study record; returns the written study."""
+    """Write every case folder, then the study record; returns the written study.
+    FolderNotWritable (one line naming the folder) on a full or read-only file system."""
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    for rc in rendered:
-        write_case(rc, out_dir, mesh_cache)
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        for rc in rendered:
+            write_case(rc, out_dir, mesh_cache)
+    except OSError as exc:
+        if exc.errno in NOT_WRITABLE:
+            raise not_writable(exc, out_dir) from exc
+        raise
     atomic_write_json(out_dir / STUDY_FILE, {
         "ligwf_version": __version__,
         "name": wf.name,

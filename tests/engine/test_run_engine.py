@@ -15,6 +15,7 @@ import pytest
 
 from ligwf.study.manifest import effective_status, read_manifest
 from ligwf.engine.liggghts import restart_step
+from ligwf.engine.guard import live_engines
 from ligwf.engine.resume import restart_files
 
 from helpers import ROOT  # noqa: E402
@@ -102,9 +103,11 @@ def test_sigkill_then_resume_from_periodic_restart(tmp_path):
     case = out / "cg3-weber-r0"
     proc = start_run(out)
     wait_for(lambda: (case / "restart" / "restart_b.liggghts").exists())
-    os.killpg(proc.pid, signal.SIGKILL)        # ligwf, mpirun and the engine, no warning
+    engines = live_engines(case)               # ligwf, mpirun and the engine, no warning
+    os.killpg(proc.pid, signal.SIGKILL)
+    for p in engines:
+        os.kill(p.pid, signal.SIGKILL)
     proc.wait(timeout=30)
-    time.sleep(0.5)
     m = read_manifest(case)                    # complete JSON although killed mid-run
     assert m.status == "running" and effective_status(m) == "killed"
     assert not list(case.glob("restart_forced_*"))

@@ -105,49 +105,60 @@ def test_array_analysis_cancel_and_resubmit(slurm_cluster, tmp_path, env):
     assert (study / "report" / "summary.md").is_file(), _logs(study)
     t1 = time.monotonic()
 
-    # -- 2. a second array; cancel one task mid-run; resubmit exactly that case ----------
+    # -- 2. a second array; cancel three tasks on purpose, one in each phase (fill,
+    #       settle, production); resubmit exactly those cases; all end done ------------
     study_b = tmp_path / "study-b"
     ligwf("slurm", "submit", str(WORKFLOW), "--out", str(study_b), "--ntasks", "1",
           "--max-concurrent", "2", "--no-analysis", "--set", "scene.process.run_time=0.2",
-          env=env)
+          "--set", "scene.process.settle_time=0.2", env=env)
     array_b = read_record(study_b)[0]["job_id"]
-    victim = 1
-    log = Study.open(study_b).case(1).screen
-    deadline = time.monotonic() + 60
-    while time.monotonic() < deadline:  # running, and the engine has started stepping
-        st = {c.index: c for c in study_status(study_b).cases}
-        if st[victim].slurm_state == "RUNNING" and log.is_file() and "Step" in log.read_text():
-            break
-        time.sleep(0.5)
-    else:
-        raise AssertionError(f"task {array_b}_{victim} never ran:\n{_logs(study_b)}")
-    time.sleep(2.0)
-    subprocess.run(["scancel", f"{array_b}_{victim}"], check=True)
+    victims = {1: "fill", 2: "settle", 3: "production"}
+    for victim, phase in victims.items():
+        cancel_in_phase(study_b, array_b, victim, phase)
     wait_until_idle(study_b, timeout=150)
     states = manifest_states(study_b)
-    assert states["cg3-weber-r1"] != "done", states
-    assert {k: v for k, v in states.items() if k != "cg3-weber-r1"} == {
-        f"cg3-weber-r{i}": "done" for i in (0, 2, 3)}
-    assert jobcomp_states(slurm_cluster, array_b)[victim] == "CANCELLED"
+    assert states["cg3-weber-r0"] == "done", states
+    for victim, phase in victims.items():
+        # a cancelled task is killed (resumable), never failed
+        assert states[f"cg3-weber-r{victim}"] == "killed", (phase, states, _logs(study_b))
+        assert jobcomp_states(slurm_cluster, array_b)[victim] == "CANCELLED"
 
     status = ligwf("slurm", "status", str(study_b), "--json", env=env)
     by_index = {c["index"]: c for c in json.loads(status.stdout)["cases"]}
-    assert by_index[victim]["job"] == f"{array_b}_{victim}"
-    assert by_index[victim]["slurm_state"] == "CANCELLED"
+    assert by_index[1]["job"] == f"{array_b}_1"
+    assert by_index[1]["slurm_state"] == "CANCELLED"
 
     ligwf("slurm", "resubmit", str(study_b), "--no-analysis", env=env)
     record_b = read_record(study_b)
     assert [s["kind"] for s in record_b] == ["array", "array"]
-    assert record_b[1]["indices"] == [victim]
-    assert f"#SBATCH --array={victim}%2" in (study_b / "slurm" / "array-2.sh").read_text()
-    wait_until_idle(study_b, timeout=120)
+    assert record_b[1]["indices"] == sorted(victims)
+    wait_until_idle(study_b, timeout=150)
     assert manifest_states(study_b) == {f"cg3-weber-r{i}": "done" for i in range(4)}, \
         _logs(study_b)
+    for victim in victims:  # the resubmitted task resumed from a restart, not from step 0
+        m = Study.open(study_b).case(victim).manifest()
+        assert len(m.attempts) == 2 and m.attempts[1].from_step > 0, m.attempts
     # nothing left to resubmit
     again = ligwf("slurm", "resubmit", str(study_b), env=env)
     assert "nothing to resubmit" in again.stdout
     t2 = time.monotonic()
     print(f"\nslurm integration: first study {t1 - t0:.1f} s, cancel+resubmit {t2 - t1:.1f} s")
+
+
+def cancel_in_phase(study: Path, array_id: str, index: int, phase: str) -> None:
+    """scancel task ``index`` once its engine has printed a thermo row in ``phase``."""
+    log = Study.open(study).case(index).screen
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        text = log.read_text(errors="replace") if log.is_file() else ""
+        after = text.split(f"ligwf-phase {phase}", 1)
+        if len(after) == 2 and any(line.split()[:1] and line.split()[0].isdigit()
+                                   for line in after[1].splitlines()):
+            break
+        time.sleep(0.05)
+    else:
+        raise AssertionError(f"task {array_id}_{index} never reached {phase}:\n{_logs(study)}")
+    subprocess.run(["scancel", f"{array_id}_{index}"], check=True)
 
 
 def check_analysis_output(study: Path) -> None:

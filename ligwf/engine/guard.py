@@ -1,0 +1,199 @@
+"""Engine processes: they die with their runner, are recorded, and are found again later.
+
+A runner that is SIGKILLed (or crashes) cannot stop its engine, and ``mpirun`` runs in a
+session of its own (a Ctrl-C in the terminal must not reach the ranks before ligwf asks
+them to write a restart). Two guards make sure no engine keeps writing a case folder
+nobody watches:
+
+* :func:`watch` starts a watchdog process next to every launch. It blocks reading a pipe
+  whose only writer is the runner; when the runner dies, however it dies, the pipe closes
+  and the watchdog stops the engine like ligwf would (:func:`stop_engines`: SIGTERM to the
+  ranks, so LIGGGHTS writes its forced restart in ~0.1 s). Relying on ``mpirun`` instead
+  (``prctl(PR_SET_PDEATHSIG)``) was measured unreliable with OpenMPI 4.1.4: on SIGTERM it
+  sometimes exits at once and its ranks die ~1 s later without a restart, sometimes it
+  sends SIGCONT, waits ``odls_base_sigkill_timeout``, then SIGTERM, then SIGKILL.
+* :func:`live_engines` finds engine processes still running in a case folder (the ones the
+  manifest recorded, told apart from a recycled pid by their start time from
+  ``/proc/<pid>/stat``, plus any ``liggghts`` / ``mpirun`` / ``orted`` whose working folder
+  is the case), and :func:`stop_engines` stops them before a later run resumes the case.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+#: process names of an engine run (``orted`` only appears on multi-node launches)
+ENGINE_NAMES = ("liggghts", "mpirun", "orterun", "orted", "prterun")
+#: seconds a stopped engine gets to write its forced restart before it is killed
+STOP_GRACE_SECONDS = 60.0
+
+#: seconds OpenMPI's mpirun waits between SIGCONT, SIGTERM and SIGKILL to its ranks
+MPI_KILL_DELAY = 3
+
+
+def engine_env() -> dict[str, str]:
+    """Environment of an engine launch: the caller's, with OpenMPI's kill delay raised to
+    :data:`MPI_KILL_DELAY` unless the site set it (other MPIs ignore the variable)."""
+    env = dict(os.environ)
+    env.setdefault("OMPI_MCA_odls_base_sigkill_timeout", str(MPI_KILL_DELAY))
+    return env
+
+
+@dataclass(frozen=True)
+class EngineProcess:
+    """A process by pid and kernel start time (clock ticks since boot), so a pid the kernel
+    has since given to another process is not mistaken for the engine."""
+
+    pid: int
+    start: int
+    name: str = ""
+
+    def alive(self) -> bool:
+        return start_time(self.pid) == self.start
+
+    def to_dict(self) -> dict:
+        return {"pid": self.pid, "start": self.start, "name": self.name}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "EngineProcess":
+        return cls(int(d["pid"]), int(d["start"]), str(d.get("name", "")))
+
+
+def start_time(pid: int) -> int | None:
+    """Start time of ``pid`` (field 22 of /proc/<pid>/stat), None when it does not exist."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            stat = fh.read().decode(errors="replace")
+    except OSError:
+        return None
+    # the command name (field 2) may hold spaces and parentheses: split after the last ')'
+    fields = stat[stat.rfind(")") + 2:].split()
+    try:
+        return int(fields[19])
+    except (IndexError, ValueError):
+        return None
+
+
+def process(pid: int) -> EngineProcess | None:
+    """``pid`` with its start time and name, None when it is gone."""
+    start = start_time(pid)
+    if start is None:
+        return None
+    try:
+        name = Path(f"/proc/{pid}/comm").read_text().strip()
+    except OSError:
+        name = ""
+    return EngineProcess(pid, start, name)
+
+
+def descendants(pid: int) -> list[int]:
+    """Process ids below ``pid`` (children first), from /proc."""
+    out: list[int] = []
+    todo = [pid]
+    while todo:
+        p = todo.pop()
+        try:
+            tasks = os.listdir(f"/proc/{p}/task")
+        except OSError:
+            continue
+        for t in tasks:
+            try:
+                with open(f"/proc/{p}/task/{t}/children") as fh:
+                    kids = [int(x) for x in fh.read().split()]
+            except OSError:
+                continue
+            out += kids
+            todo += kids
+    return out
+
+
+def engine_tree(pid: int) -> list[EngineProcess]:
+    """The launcher ``pid`` and every process below it, with start times."""
+    found = (process(p) for p in [pid, *descendants(pid)])
+    return [p for p in found if p is not None]
+
+
+def watch(launcher: subprocess.Popen) -> subprocess.Popen:
+    """Start the watchdog of an engine launch (see the module docstring); the runner
+    calls :func:`release` when the engine has ended."""
+    root = process(launcher.pid)
+    return subprocess.Popen([sys.executable, "-m", "ligwf.engine.guard", str(launcher.pid),
+                             str(root.start if root else 0)],
+                            stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.DEVNULL, start_new_session=True)
+
+
+def release(watchdog: subprocess.Popen) -> None:
+    """Tell a watchdog its engine ended under the runner's eyes (it then exits)."""
+    if watchdog.stdin is not None:
+        watchdog.stdin.close()
+    try:
+        watchdog.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        watchdog.kill()
+
+
+def _cwd_matches(pid: int, folder: Path) -> bool:
+    try:
+        return Path(os.readlink(f"/proc/{pid}/cwd")) == folder
+    except OSError:
+        return False
+
+
+def live_engines(case_dir: Path, recorded: list[EngineProcess] = ()) -> list[EngineProcess]:
+    """Engine processes running now for a case folder: ``recorded`` ones still alive, and
+    any engine-named process whose working folder is the case (ranks first)."""
+    folder = Path(case_dir).resolve()
+    found = {p.pid: p for p in recorded if p.alive()}
+    for entry in os.listdir("/proc"):
+        if entry.isdigit() and int(entry) not in found and int(entry) != os.getpid():
+            p = process(int(entry))
+            if p is not None and p.name in ENGINE_NAMES and _cwd_matches(p.pid, folder):
+                found[p.pid] = p
+    return sorted(found.values(), key=lambda p: p.name != "liggghts")
+
+
+def _signal(procs: list[EngineProcess], sig: int) -> None:
+    for p in procs:
+        if p.alive():
+            try:
+                os.kill(p.pid, sig)
+            except ProcessLookupError:
+                pass
+
+
+def stop_engines(procs: list[EngineProcess], grace: float = STOP_GRACE_SECONDS) -> bool:
+    """Stop engine processes of a case: SIGTERM to the ranks (LIGGGHTS writes a forced
+    restart), then to the launchers, SIGKILL after ``grace`` seconds. Returns whether a
+    SIGKILL was needed."""
+    ranks = [p for p in procs if p.name == "liggghts"]
+    _signal(ranks or procs, signal.SIGTERM)
+    deadline = time.monotonic() + grace
+    while any(p.alive() for p in ranks) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    _signal(procs, signal.SIGTERM)
+    while any(p.alive() for p in procs) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    left = [p for p in procs if p.alive()]
+    _signal(left, signal.SIGKILL)
+    return bool(left)
+
+
+def main(argv: list[str]) -> int:
+    """The watchdog: ``python -m ligwf.engine.guard LAUNCHER_PID START``. Waits for the end
+    of stdin, then stops the launcher's engine if it still runs."""
+    root = EngineProcess(int(argv[0]), int(argv[1]), "launcher")
+    sys.stdin.buffer.read()    # returns when the runner closes the pipe or dies
+    if root.alive():
+        stop_engines(engine_tree(root.pid))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
