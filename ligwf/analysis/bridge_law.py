@@ -80,3 +80,13 @@ def force_law_positive(particles: ParticleFrame, liquid: Liquid, content: np.nda
     return liquid.law.force_positive(
         liquid.surface_tension, liquid.contact_angle_rad, float(particles.radii.min()),
         float(particles.radii.max()), float(content.min()), float(content.max()))
+
+
+def relative_force(force: np.ndarray, r_i: np.ndarray, r_j: np.ndarray, liquid: Liquid) -> np.ndarray:
+    """f_rel = F / (2 pi R* gamma cos theta): a bridge force (N) over the force of a
+    touching bridge of the same pair (R* = r_i r_j / (r_i + r_j), m; gamma the case's
+    scaled surface tension, theta the applied contact angle). Dimensionless, so one
+    threshold or weight means the same at every CG level and under every rule."""
+    r_eff = r_i * r_j / (r_i + r_j)
+    return force / (2.0 * np.pi * r_eff * liquid.surface_tension
+                    * np.cos(liquid.contact_angle_rad))

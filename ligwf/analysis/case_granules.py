@@ -21,7 +21,8 @@ import pandas as pd
 
 from ligwf.analysis.dumps import FrameFiles, ParticleFrame, read_contacts, read_particles
 from ligwf.analysis.frame_checks import FramePlan, check_contacts, check_particles, plan_frames
-from ligwf.analysis.granules import AXES, BondCriterion, Liquid, granule_table, identify, louvain_labels
+from ligwf.analysis.definitions import GranuleDefinition, Motion, identify_granules
+from ligwf.analysis.granules import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.fsio import atomic_write_bytes
 from ligwf.study.case import CaseFolder
@@ -39,6 +40,8 @@ class RunFacts:
     dt: float                      # s per step
     case: CaseFolder | None = None     # a ligwf case: frames checked against its run
     plan: FramePlan | None = None      # ... and its dump record
+    omega: float | None = None         # rad/s about +rotation_axis (None: unknown)
+    rotation_axis: int = 1             # the drum axis through the origin (0, 1, 2)
 
     def __post_init__(self) -> None:
         if self.periodic_axis is not None and not self.box_length > 0:
@@ -53,7 +56,12 @@ class RunFacts:
         """The facts of a ligwf case (the drum axis spans [0, L], see templates/drum.in.j2)."""
         s = case.scaled
         return cls(case.case_id, case.cg, case_liquid(case), periodic_axis(case),
-                   s.drum_length, s.dt, case, plan)
+                   s.drum_length, s.dt, case, plan, float(s.omega), AXES.index(s.axis))
+
+    @property
+    def motion(self) -> Motion:
+        """The drum rotation and periodic axis the velocity frames need."""
+        return Motion(self.rotation_axis, self.omega, self.periodic_axis, self.box_length)
 
 
 def case_liquid(case: CaseFolder) -> Liquid:
@@ -87,13 +95,15 @@ class GranuleAnalysis:
     """Granules of every frame of one case (MDAnalysis-style life cycle).
 
     ``case``: a :class:`~ligwf.study.case.CaseFolder` or the :class:`RunFacts` of a run.
-    ``implementation`` is ``"fast"`` (numba-compiled union-find) or ``"reference"`` (networkx BFS).
+    ``definition``: the granule definition (:mod:`ligwf.analysis.definitions`).
+    ``implementation`` is ``"fast"`` (compiled) or ``"reference"`` (numpy, networkx,
+    leidenalg).
     ``vtu_dir`` set: write ``granules_<step>.vtu`` per frame there (ParaView series).
     ``louvain``: also store Louvain community ids per particle in the ``.vtu``.
     """
 
     case: CaseFolder | RunFacts
-    criterion: BondCriterion = BondCriterion()
+    definition: GranuleDefinition = GranuleDefinition()
     implementation: str = "fast"
     vtu_dir: Path | None = None
     louvain: bool = False
@@ -135,9 +145,9 @@ class GranuleAnalysis:
             if f.case is not None:
                 check_particles(f.case, particles)
             check_contacts(particles, contacts, f.periodic_axis, f.box_length)
-            ident = identify(particles, contacts, f.liquid, self.criterion, f.periodic_axis,
-                             f.box_length, self.implementation, need_force=self.louvain)
-        except DumpReadError as exc:
+            ident = identify_granules(particles, contacts, f.liquid, self.definition, f.cg,
+                                      f.motion, self.implementation)
+        except (DumpReadError, ValueError) as exc:
             res.error = str(exc)
             return res
         labels = ident.labels
@@ -147,8 +157,11 @@ class GranuleAnalysis:
         res.table, res.particles, res.contacts = table, len(particles), len(contacts)
         res.bonds = len(ident.i)
         if self.vtu_dir is not None:
-            extra = ({"louvain": louvain_labels(len(particles), ident.i, ident.j, ident.force)}
-                     if self.louvain else {})
+            extra = {}
+            if self.louvain:
+                bi, bj, bf = bonded_contacts(particles, contacts, f.liquid,
+                                             self.definition.criterion)
+                extra["louvain"] = louvain_labels(len(particles), bi, bj, bf)
             res.vtu = f"granules_{ff.step}.vtu"
             write_particle_vtu(Path(self.vtu_dir) / res.vtu, particles, labels,
                                table["members"].to_numpy()[labels], extra)

@@ -270,14 +270,35 @@ def identify_reference(particles: ParticleFrame, contacts: ContactFrame, liquid:
                        length: float = 0.0, need_force: bool = True) -> Identification:
     """The reference: the shared bond test, networkx BFS components, networkx BFS unwrap."""
     i, j, force = bonded_contacts(particles, contacts, liquid, criterion)
-    labels = label_reference(len(particles), i, j)
-    if periodic_axis is None or length <= 0:
+    return components(particles.positions, i, j, force, periodic_axis, length, "reference")
+
+
+def components(positions: np.ndarray, i: np.ndarray, j: np.ndarray, force: np.ndarray | None,
+               periodic_axis: int | None, length: float,
+               implementation: str = "fast") -> Identification:
+    """Granules = connected components of the given bonds (rows i, j; ``force`` N is only
+    carried along), unwrapped along the periodic axis, percolation per granule: compiled
+    union-find (``fast``, :func:`ligwf.analysis.granules_numba.components_images`) or
+    networkx BFS (``reference``); the same canonical labels."""
+    n = len(positions)
+    periodic = periodic_axis is not None and length > 0
+    if implementation == "fast":
+        from ligwf.analysis.granules_numba import components_images
+
+        y = np.ascontiguousarray(positions[:, periodic_axis if periodic else 1], np.float64)
+        labels, y_out, percolating, _ = components_images(
+            n, np.asarray(i, np.int64), np.asarray(j, np.int64), len(i), y,
+            float(length) if periodic else 0.0)
+        return Identification(i, j, force, labels, periodic_axis if periodic else None,
+                              y_out if periodic else None, percolating)
+    labels = label_reference(n, i, j)
+    if not periodic:
         n_gran = int(labels.max()) + 1 if len(labels) else 0
         return Identification(i, j, force, labels, None, None, np.zeros(n_gran, bool))
-    unwrapped = unwrap_reference(particles.positions, labels, i, j, periodic_axis, length)
+    unwrapped = unwrap_reference(positions, labels, i, j, periodic_axis, length)
     percolating = percolating_reference(labels, unwrapped, i, j, periodic_axis, length)
     stay = percolating[labels]            # no unwrapped layout: members stay in the box
-    unwrapped[stay, periodic_axis] = particles.positions[stay, periodic_axis]
+    unwrapped[stay, periodic_axis] = positions[stay, periodic_axis]
     return Identification(i, j, force, labels, periodic_axis, unwrapped[:, periodic_axis].copy(),
                           percolating)
 

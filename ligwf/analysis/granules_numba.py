@@ -149,14 +149,33 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volu
     out_i = np.empty(m, np.int64)
     out_j = np.empty(m, np.int64)
     out_f = np.empty(m, np.float64)
-    parent = np.arange(n)
-    image = np.zeros(n, np.int64)
-    winds = np.zeros(n, np.bool_)                 # per root: its tree closes a periodic cycle
     count = _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
                   content, delta, gamma, theta, cos_max, min_force, force_needed, out_i, out_j,
                   out_f)
     if count < 0:
-        return (count, out_i, out_j, out_f, parent, y, winds, 0)
+        return (count, out_i, out_j, out_f, np.arange(n), y, np.zeros(n, np.bool_), 0)
+    labels, unwrapped, percolating, n_granules = components_images(n, out_i, out_j, count, y,
+                                                                    length)
+    return count, out_i, out_j, out_f, labels, unwrapped, percolating, n_granules
+
+
+@njit(cache=True, error_model="numpy")
+def components_images(n, i, j, count, y, length):
+    """Connected components of the first ``count`` pairs (i, j) of n particles with their
+    unwrapping along the periodic axis and percolation test (the union-find pass of
+    :func:`bond_components`, also used on the intra-community bonds of
+    :mod:`ligwf.analysis.definitions`). Returns (labels, y unwrapped, percolating per
+    granule, granule count); labels canonical (numbered in order of first member).
+
+    Each pair is merged into a union-find forest whose nodes also carry their periodic
+    image count relative to their parent (``u = y + length * image`` unwrapped); a pair
+    between two particles of one tree whose image counts disagree with the minimum-image
+    displacement closes a cycle around the periodic axis: that granule *percolates*.
+    """
+    out_i, out_j = i, j
+    parent = np.arange(n)
+    image = np.zeros(n, np.int64)
+    winds = np.zeros(n, np.bool_)                 # per root: its tree closes a periodic cycle
     # union-find over the bonds, written out in the loop: as helper calls taking the arrays
     # the same loop was measured 3.3x slower. Finds use path halving (each node on the
     # way is re-pointed at its grandparent, its image count updated to match).
@@ -215,7 +234,7 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volu
         labels[x] = labels[r]
         # a percolating granule has no unwrapped layout: its members stay in the box
         unwrapped[x] = y[x] if (image[x] == 0 or winds[r]) else y[x] + length * image[x]
-    return count, out_i, out_j, out_f, labels, unwrapped, percolating[:n_granules], n_granules
+    return labels, unwrapped, percolating[:n_granules], n_granules
 
 
 @njit(cache=True, inline="always")
@@ -285,5 +304,6 @@ def warm_up(models: tuple[str, ...] | None = None) -> None:
                         *fns, 0.02, 0.1, 0.5, 0.0, True, v[:, 1].copy(), 1.0)
     i, j = np.array([0]), np.array([1])
     labels = union_find_labels(2, i, j)
+    components_images(2, i, j, 1, v[:, 1].copy(), 1.0)
     for axis in (-1, 1):
         granule_sums(labels, 1, r, v, axis, v[:, 1].copy())

@@ -1,12 +1,18 @@
 """Granule size distributions (GSD) and their comparison across CG levels.
 
-Sizes are *primary-particle-equivalent volumes* (m^3): a CG-n granule's volume / n^3, the
-volume of original particles it stands for, so CG-n and CG1 distributions share one axis.
-Distributions are histograms on logarithmic bins of that volume, per frame:
+Sizes are granule volumes (m^3) -- physical, NOT divided by n^3: a CG-n bed holds the
+same solid volume as the CG1 bed, and a CG-neutral granule definition (the default CPM
+communities, :mod:`ligwf.analysis.definitions`) gives the same granule volumes at every
+level (measured CG2/CG1 d50 = 1.00), so CG-n and CG1 share one axis. (The granule table
+keeps ``primary_volume`` = volume / n^3 for whoever wants that convention; under it the
+same physical granule looks n^3 smaller at CG-n.) Only granules of at least
+``min_particles`` particles that do not percolate (close a cycle around the periodic
+axis: a bed-spanning cluster, reported on its own) enter the GSD. Distributions are
+histograms on logarithmic bins, per frame:
 
 * number-weighted: share of granules in each bin;
-* volume-weighted: share of the bed volume held by granules in each bin (what sieving
-  measures, and what d10/d50/d90 refer to).
+* volume-weighted: share of the granule volume held by granules in each bin (what
+  sieving measures, and what d10/d50/d90 refer to).
 
 Time averages are means of the per-frame distributions. Confidence bands come from a
 hierarchical bootstrap: resample replicas, then frames within each drawn replica (frames
@@ -15,10 +21,11 @@ are resampled). Every random draw comes from one seeded generator, so results ar
 reproducible and identical in serial and MPI runs.
 
 CG comparison: the volume-weighted GSD of CG-n against CG1, per-bin relative error, and
-the error summed below and above a *size limit*: the primary-equivalent volume of
-``min_particles`` CG-n particles. A CG-n granule smaller than that is made of fewer than
-``min_particles`` particles, so its size is resolved in steps of one whole CG particle
-(n^3 primary particles) and CG cannot reproduce the fine end of the GSD; above it, it can.
+the error summed below and above a *size limit located from the data*
+(:func:`located_limit`): the smallest granule volume from which on every populated bin of
+CG-n stays within ``error_band`` (default 15 %) of CG1. Below it CG-n leaves the band
+(its granules are resolved in steps of whole CG particles, n^3 primaries each); the limit
+gets its own bootstrap interval from the same draws as the bands.
 """
 
 from __future__ import annotations
@@ -29,10 +36,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-#: Default particle count below which a CG granule is too coarse to resolve its size:
-#: with 10 members, one particle more or less changes the volume by 10% (the width of a
-#: bin at 5 bins per decade is ~58%, so below ~10 members bins are sampled in holes).
-DEFAULT_MIN_PARTICLES = 10
+#: Default smallest granule (particles) in the GSD: a single particle is not a granule.
+DEFAULT_MIN_PARTICLES = 2
+#: Default relative per-bin error of CG-n against CG1 that locates the size limit.
+DEFAULT_ERROR_BAND = 0.15
+#: Bins holding less than this share of the CG1 granule volume are too sparsely sampled
+#: for a relative error (a handful of granules): they do not move the located limit.
+MIN_BIN_SHARE = 0.01
 
 
 @dataclass(frozen=True)
@@ -44,6 +54,7 @@ class GsdSettings:
     n_boot: int = 1000
     confidence: float = 0.95
     seed: int = 12345
+    error_band: float = DEFAULT_ERROR_BAND
 
     def __post_init__(self) -> None:
         if self.bins_per_decade < 1:
@@ -52,6 +63,8 @@ class GsdSettings:
             raise ValueError(f"min_particles = {self.min_particles}: must be >= 1")
         if self.n_boot < 1:
             raise ValueError(f"n_boot = {self.n_boot}: must be >= 1")
+        if not self.error_band > 0.0:
+            raise ValueError(f"error_band = {self.error_band}: must be > 0")
         if not 0.0 < self.confidence < 1.0:
             raise ValueError(f"confidence = {self.confidence}: allowed range (0, 1)")
 
@@ -88,14 +101,31 @@ def percentile_diameters(volumes: np.ndarray, fractions=(0.1, 0.5, 0.9)) -> np.n
     the fraction q of the total volume (no interpolation: well defined for any frame).
     """
     v = np.sort(np.asarray(volumes, dtype=float))
+    if len(v) == 0 or v.sum() <= 0:
+        return np.full(len(fractions), np.nan)
     cum = np.cumsum(v) / v.sum()
     k = np.searchsorted(cum, np.asarray(fractions) - 1e-12, side="left")
     return np.cbrt(6.0 * v[np.minimum(k, len(v) - 1)] / math.pi)
 
 
-def size_limit(particle_primary_volume: float, min_particles: int) -> float:
-    """Primary-equivalent volume (m^3) of a granule of ``min_particles`` CG particles."""
-    return float(min_particles) * float(particle_primary_volume)
+def located_limit(edges: np.ndarray, cg: np.ndarray, ref: np.ndarray, error_band: float,
+                  min_share: float = MIN_BIN_SHARE) -> np.ndarray:
+    """Size limit (m^3) located from the data, per row of ``cg`` / ``ref`` (volume-weighted
+    GSDs, (..., bins)): the lower edge of the smallest bin from which on every bin holding
+    at least ``min_share`` of the CG1 volume has |cg - ref| / ref <= ``error_band``; nan
+    when the largest such bin is outside the band (CG-n never enters it)."""
+    cg2, ref2 = np.atleast_2d(cg), np.atleast_2d(ref)
+    out = np.full(len(cg2), np.nan)
+    for r, (c, f) in enumerate(zip(cg2, ref2)):
+        used = np.flatnonzero(f >= min_share)
+        if len(used) == 0:
+            continue
+        bad = np.abs(c[used] - f[used]) > error_band * f[used]
+        if bad[-1]:
+            continue
+        first_ok = used[np.flatnonzero(bad)[-1] + 1] if bad.any() else used[0]
+        out[r] = edges[first_ok]
+    return out if np.ndim(cg) > 1 else out[0]
 
 
 def _resample_indices(replicas: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -110,8 +140,10 @@ def bootstrap_means(per_frame: np.ndarray, replicas: np.ndarray, n_boot: int,
                     rng: np.random.Generator) -> np.ndarray:
     """(n_boot, bins) means of hierarchically resampled per-frame rows."""
     per_frame = np.asarray(per_frame, dtype=float)
-    return np.stack([per_frame[_resample_indices(replicas, rng)].mean(axis=0)
-                     for _ in range(n_boot)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)   # frames without a granule: nan
+        return np.stack([np.nanmean(per_frame[_resample_indices(replicas, rng)], axis=0)
+                         for _ in range(n_boot)])
 
 
 def band(draws: np.ndarray, confidence: float) -> tuple[np.ndarray, np.ndarray]:
@@ -141,5 +173,30 @@ def side_errors(cg: np.ndarray, ref: np.ndarray, below: np.ndarray) -> tuple[flo
 
 
 def below_limit(edges: np.ndarray, limit: float) -> np.ndarray:
-    """Bins whose geometric centre lies below the size limit."""
+    """Bins whose geometric centre lies below the size limit (every bin when the limit is
+    nan: CG-n never enters the error band)."""
+    if not np.isfinite(limit):
+        return np.ones(len(edges) - 1, dtype=bool)
     return np.sqrt(edges[:-1] * edges[1:]) < limit
+
+
+def counted(members: np.ndarray, percolating: np.ndarray, min_particles: int) -> np.ndarray:
+    """Granules that enter the GSD: >= ``min_particles`` members and not percolating."""
+    return (np.asarray(members) >= min_particles) & ~np.asarray(percolating, dtype=bool)
+
+
+def frame_stats(volume: np.ndarray, members: np.ndarray, percolating: np.ndarray,
+                min_particles: int) -> dict[str, float]:
+    """One frame's granule numbers: count, d10/d50/d90 (m, volume-equivalent, of the
+    counted granules), largest counted granule, bed share in counted granules and bed
+    share in percolating granules (shares of the whole bed's solid volume)."""
+    volume = np.asarray(volume, dtype=float)
+    keep = counted(members, percolating, min_particles)
+    bed = volume.sum()
+    v = volume[keep]
+    d10, d50, d90 = percentile_diameters(v)
+    return {"granules": float(keep.sum()), "d10": d10, "d50": d50, "d90": d90,
+            "largest_granule": float(v.max() / bed) if len(v) else 0.0,
+            "granule_share": float(v.sum() / bed) if bed > 0 else 0.0,
+            "percolating_share": float(volume[np.asarray(percolating, bool)].sum() / bed)
+            if bed > 0 else 0.0}

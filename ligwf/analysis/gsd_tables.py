@@ -1,6 +1,9 @@
 """GSD tables of a study: per condition (sweep group, CG level, rule; replicas pooled)
-the binned number- and volume-weighted GSD with bootstrap bands, and for CG > 1 the
-comparison with the CG1 reference of the same group (see :mod:`ligwf.analysis.gsd`).
+the binned number- and volume-weighted GSD of the counted granules (>= ``min_particles``
+members, not percolating) with bootstrap bands, the percolating (bed-spanning) clusters on
+their own (share of the bed, share of frames), and for CG > 1 the comparison with the CG1
+reference of the same group with the size limit located from the data and its bootstrap
+interval (see :mod:`ligwf.analysis.gsd`).
 
 Input is the granule table of the frames to use (the runner passes the steady window of
 every case); output is what ``gsd.csv`` and ``gsd_summary.csv`` hold.
@@ -9,6 +12,7 @@ every case); output is what ``gsd.csv`` and ``gsd_summary.csv`` hold.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any, Protocol, Sequence
 
@@ -47,12 +51,41 @@ GSD_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames", "bin", 
                "v_mid", "number_fraction", "number_lo", "number_hi", "volume_fraction",
                "volume_lo", "volume_hi", "ref_volume_fraction", "rel_error", "rel_error_lo",
                "rel_error_hi", "below_limit"]
-#: Columns of ``gsd_summary.csv`` (one row per condition).
+#: Columns of ``gsd_summary.csv`` (one row per condition). ``size_limit`` (m^3) is located
+#: from the data (nan: CG-n never enters the error band, or no CG1 reference);
+#: ``percolating_share``: mean share of the bed in percolating granules, left out of the
+#: GSD; ``percolating_frames``: share of frames holding one; ``granule_share``: mean share
+#: of the bed in counted granules.
 SUMMARY_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames",
                    *[f"{q}{s}" for q in ("d10", "d50", "d90", "largest_fraction")
                      for s in ("", "_lo", "_hi")],
-                   "size_limit", "min_particles", "reference",
+                   "granule_share", "percolating_share", "percolating_frames",
+                   "size_limit", "size_limit_lo", "size_limit_hi", "error_band",
+                   "min_particles", "reference",
                    *[f"error_{side}{s}" for side in ("below", "above") for s in ("", "_lo", "_hi")]]
+SCALARS = ("d10", "d50", "d90", "largest_granule")
+
+
+def _per_condition(g: pd.DataFrame, cases: Sequence[CaseLike], edges: np.ndarray,
+                   min_particles: int) -> dict[Condition, dict[str, Any]]:
+    """Per condition the per-frame histograms, scalars, shares and replica of each frame."""
+    replica_of = {c.case_id: c.replica for c in cases}
+    cond_of = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
+    per_cond: dict[Condition, dict[str, Any]] = {}
+    for (case_id, step), fr in g.groupby(["case_id", "step"], sort=True):
+        vol, mem, perc = (fr["volume"].to_numpy(), fr["members"].to_numpy(),
+                          fr["percolating"].to_numpy(bool))
+        stats = gsdmod.frame_stats(vol, mem, perc, min_particles)
+        num, vhist = gsdmod.histogram(vol[gsdmod.counted(mem, perc, min_particles)], edges)
+        d = per_cond.setdefault(cond_of[case_id], {k: [] for k in ("num", "vol", "rep", "sc",
+                                                                   "share", "perc")})
+        d["num"].append(num)
+        d["vol"].append(vhist)
+        d["rep"].append(replica_of[case_id])
+        d["sc"].append([stats[k] for k in SCALARS])
+        d["share"].append(stats["granule_share"])
+        d["perc"].append(stats["percolating_share"])
+    return per_cond
 
 
 def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
@@ -63,63 +96,52 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
     if granules.empty:
         return pd.DataFrame(columns=GSD_COLUMNS), pd.DataFrame(columns=SUMMARY_COLUMNS)
     g = granules
-    edges = gsdmod.log_edges(float(g["primary_volume"].min()), float(g["primary_volume"].max()),
-                             settings.bins_per_decade)
+    use = gsdmod.counted(g["members"], g["percolating"].to_numpy(bool), settings.min_particles)
+    v_all = g["volume"][use] if use.any() else g["volume"]
+    edges = gsdmod.log_edges(float(v_all.min()), float(v_all.max()), settings.bins_per_decade)
     rng = np.random.default_rng(settings.seed)
-    replica_of = {c.case_id: c.replica for c in cases}
-    cond_of = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
-    per_cond: dict[Condition, dict[str, Any]] = {}
-    for (case_id, step), fr in g.groupby(["case_id", "step"], sort=True):
-        cond = cond_of[case_id]
-        v = fr["primary_volume"].to_numpy()
-        num, vol = gsdmod.histogram(v, edges)
-        d = per_cond.setdefault(cond, {"num": [], "vol": [], "rep": [], "pct": [], "largest": [],
-                                       "ppv": []})
-        d["num"].append(num)
-        d["vol"].append(vol)
-        d["rep"].append(replica_of[case_id])
-        d["pct"].append(gsdmod.percentile_diameters(v))
-        d["largest"].append(v.max() / v.sum())
-        d["ppv"].append(v.sum() / fr["members"].sum())   # mean particle primary volume
+    per_cond = _per_condition(g, cases, edges, settings.min_particles)
     rows, summary = [], []
     conds = sorted(per_cond, key=lambda c: (c.group, c.cg, c.rule))
     ref_of = {c.group: c for c in conds if c.cg == 1}
-    lo_hi = settings.confidence
+    conf, nb = settings.confidence, len(edges) - 1
     for cond in conds:
         d = per_cond[cond]
         rep = np.asarray(d["rep"])
-        num, vol = np.asarray(d["num"]), np.asarray(d["vol"])
-        scalars = np.column_stack([np.asarray(d["pct"]), np.asarray(d["largest"])])
-        num_lo, num_hi = gsdmod.band(gsdmod.bootstrap_means(num, rep, settings.n_boot, rng), lo_hi)
+        num, vol, scalars = np.asarray(d["num"]), np.asarray(d["vol"]), np.asarray(d["sc"])
+        num_lo, num_hi = gsdmod.band(gsdmod.bootstrap_means(num, rep, settings.n_boot, rng), conf)
         vol_draws = gsdmod.bootstrap_means(vol, rep, settings.n_boot, rng)
-        vol_lo, vol_hi = gsdmod.band(vol_draws, lo_hi)
-        sc_lo, sc_hi = gsdmod.band(gsdmod.bootstrap_means(scalars, rep, settings.n_boot, rng), lo_hi)
+        vol_lo, vol_hi = gsdmod.band(vol_draws, conf)
+        sc_lo, sc_hi = gsdmod.band(gsdmod.bootstrap_means(scalars, rep, settings.n_boot, rng), conf)
         mean_vol = vol.mean(axis=0)
-        limit = gsdmod.size_limit(float(np.mean(d["ppv"])), settings.min_particles)
-        below = gsdmod.below_limit(edges, limit)
         ref = ref_of.get(cond.group) if cond.cg != 1 else None
-        nan = np.full(len(edges) - 1, np.nan)
-        rel = rel_lo = rel_hi = ref_vol = nan
-        err = {"error_below": math.nan, "error_below_lo": math.nan, "error_below_hi": math.nan,
-               "error_above": math.nan, "error_above_lo": math.nan, "error_above_hi": math.nan}
+        rel = rel_lo = rel_hi = ref_vol = np.full(nb, np.nan)
+        err = dict.fromkeys([f"error_{side}{s}" for side in ("below", "above")
+                             for s in ("", "_lo", "_hi")], math.nan)
+        limit = limit_lo = limit_hi = math.nan
+        below = np.zeros(nb, dtype=bool)
         if ref is not None:
             r = per_cond[ref]
             ref_vol = np.asarray(r["vol"]).mean(axis=0)
             ref_draws = gsdmod.bootstrap_means(np.asarray(r["vol"]), np.asarray(r["rep"]),
                                                settings.n_boot, rng)
             rel = gsdmod.relative_error(mean_vol, ref_vol)
-            rel_lo, rel_hi = gsdmod.band(gsdmod.relative_error(vol_draws, ref_draws), lo_hi)
+            rel_lo, rel_hi = gsdmod.band(gsdmod.relative_error(vol_draws, ref_draws), conf)
+            limit = float(gsdmod.located_limit(edges, mean_vol, ref_vol, settings.error_band))
+            limit_lo, limit_hi = gsdmod.band(
+                gsdmod.located_limit(edges, vol_draws, ref_draws, settings.error_band), conf)
+            below = gsdmod.below_limit(edges, limit)
             eb, ea = gsdmod.side_errors(mean_vol, ref_vol, below)
             eb_d, ea_d = gsdmod.side_errors(vol_draws, ref_draws, below)
-            (eb_lo, ea_lo), (eb_hi, ea_hi) = (gsdmod.band(np.column_stack([eb_d, ea_d]), lo_hi))
+            (eb_lo, ea_lo), (eb_hi, ea_hi) = gsdmod.band(np.column_stack([eb_d, ea_d]), conf)
             err = {"error_below": float(eb), "error_below_lo": float(eb_lo),
                    "error_below_hi": float(eb_hi), "error_above": float(ea),
                    "error_above_lo": float(ea_lo), "error_above_hi": float(ea_hi)}
         n_reps = len(np.unique(rep))
-        for b in range(len(edges) - 1):
-            rows.append({"condition": cond.name, "group": cond.group, "cg": cond.cg,
-                         "rule": cond.rule, "replicas": n_reps, "frames": len(rep), "bin": b,
-                         "v_lo": edges[b], "v_hi": edges[b + 1],
+        head = {"condition": cond.name, "group": cond.group, "cg": cond.cg, "rule": cond.rule,
+                "replicas": n_reps, "frames": len(rep)}
+        for b in range(nb):
+            rows.append({**head, "bin": b, "v_lo": edges[b], "v_hi": edges[b + 1],
                          "v_mid": math.sqrt(edges[b] * edges[b + 1]),
                          "number_fraction": num.mean(axis=0)[b], "number_lo": num_lo[b],
                          "number_hi": num_hi[b], "volume_fraction": mean_vol[b],
@@ -127,14 +149,18 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
                          "ref_volume_fraction": ref_vol[b], "rel_error": rel[b],
                          "rel_error_lo": rel_lo[b], "rel_error_hi": rel_hi[b],
                          "below_limit": bool(below[b])})
-        means = scalars.mean(axis=0)
-        summary.append({"condition": cond.name, "group": cond.group, "cg": cond.cg,
-                        "rule": cond.rule, "replicas": n_reps, "frames": len(rep),
-                        "d10": means[0], "d10_lo": sc_lo[0], "d10_hi": sc_hi[0],
-                        "d50": means[1], "d50_lo": sc_lo[1], "d50_hi": sc_hi[1],
-                        "d90": means[2], "d90_lo": sc_lo[2], "d90_hi": sc_hi[2],
-                        "largest_fraction": means[3], "largest_fraction_lo": sc_lo[3],
-                        "largest_fraction_hi": sc_hi[3],
-                        "size_limit": limit, "min_particles": settings.min_particles,
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)     # no granule in any frame
+            means = np.nanmean(scalars, axis=0)
+        perc = np.asarray(d["perc"])
+        summary.append({**head, **{f"{q}{s}": a[k] for k, q in enumerate(
+                            ("d10", "d50", "d90", "largest_fraction"))
+                            for s, a in (("", means), ("_lo", sc_lo), ("_hi", sc_hi))},
+                        "granule_share": float(np.mean(d["share"])),
+                        "percolating_share": float(perc.mean()),
+                        "percolating_frames": float(np.mean(perc > 0)),
+                        "size_limit": limit, "size_limit_lo": float(limit_lo),
+                        "size_limit_hi": float(limit_hi), "error_band": settings.error_band,
+                        "min_particles": settings.min_particles,
                         "reference": ref.name if ref is not None else "", **err})
     return pd.DataFrame(rows, columns=GSD_COLUMNS), pd.DataFrame(summary, columns=SUMMARY_COLUMNS)

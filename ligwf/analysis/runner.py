@@ -32,6 +32,8 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
   particles, contacts, bonds, granules, largest granule share and whether the largest
   granule percolates (wraps around the periodic axis);
 * GSD and GSD summary tables: see :mod:`ligwf.analysis.gsd_tables`;
+* kinetics (per case and frame, and per condition with bands and CG-n/CG1 ratios) and
+  sensitivity tables: see :mod:`ligwf.analysis.kinetics`;
 * ``<case_id>/granules.pvd`` + ``granules_<step>.vtu``: particles with a ``granule`` array;
 * the analysis record (JSON): settings, analysed and skipped cases with their steady
   window, skipped frames with reasons.
@@ -45,13 +47,16 @@ import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts, pvd_text
 from ligwf.analysis.frame_checks import FramePlan, plan_frames
-from ligwf.analysis.granules import BondCriterion
+from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.gsd import GsdSettings
 from ligwf.analysis.gsd_tables import gsd_tables
+from ligwf.analysis.kinetics import (KINETICS_SUMMARY_TABLE, KINETICS_TABLE, SENSITIVITY_TABLE,
+                                     kinetics_summary, kinetics_table, sensitivity_table)
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.study import layout
@@ -89,15 +94,15 @@ class AnalysisOptions:
     require_manifest: bool = True
 
 
-def bond_criterion(s: AnalysisSettings) -> BondCriterion:
-    """The bond criterion of the settings."""
-    return BondCriterion(s.min_bridge_force, s.max_velocity_angle)
+def granule_definition(s: AnalysisSettings) -> GranuleDefinition:
+    """The granule definition of the settings."""
+    return GranuleDefinition.of_settings(s)
 
 
 def gsd_settings(s: AnalysisSettings) -> GsdSettings:
     """The GSD settings of the settings."""
     return GsdSettings(bins_per_decade=s.bins_per_decade, min_particles=s.min_particles,
-                       n_boot=s.bootstrap, seed=s.seed)
+                       n_boot=s.bootstrap, seed=s.seed, error_band=s.error_band)
 
 
 def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions = AnalysisOptions(),
@@ -126,7 +131,7 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     try:
         for fi, ff in tasks[rank::size]:
             f = facts[fi]
-            ana = GranuleAnalysis(f, bond_criterion(settings), options.implementation,
+            ana = GranuleAnalysis(f, granule_definition(settings), options.implementation,
                                   outputs.case_dir(f.case_id) if options.write_vtu else None,
                                   options.louvain)
             mine.extend(ana.run([ff]).results)
@@ -221,6 +226,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     steady = granules[granules["step"] >= granules["case_id"].map(steady_from).astype(float)]
     gsd_df, summary = gsd_tables(steady, cases, gsd_settings(settings))
     stage_tables(outputs, granules, frames, gsd_df, summary)
+    stage_kinetics(outputs, granules, analysed, steady_from, settings, options.implementation)
     if options.write_vtu:
         for c in cases:
             entries = [(r.time, r.vtu) for r in results if r.case_id == c.case_id and r.vtu]
@@ -231,7 +237,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     record = {
         "run_dir": str(study.path),
         "settings": settings.model_dump(mode="json"),
-        "criterion": asdict(bond_criterion(settings)),
+        "definition": asdict(granule_definition(settings)),
         "gsd": asdict(gsd_settings(settings)),
         "options": {"implementation": options.implementation, "louvain": options.louvain,
                     "write_vtu": options.write_vtu,
@@ -258,6 +264,30 @@ def stage_tables(outputs: OutputSet, granules: pd.DataFrame, frames: pd.DataFram
     outputs.write(layout.FRAMES_TABLE, frames.to_csv(index=False).encode())
     outputs.write(layout.GSD_TABLE, gsd_df.to_csv(index=False).encode())
     outputs.write(layout.GSD_SUMMARY_TABLE, summary.to_csv(index=False).encode())
+
+
+def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[RunFacts],
+                   steady_from: dict[str, int], settings: AnalysisSettings,
+                   implementation: str) -> None:
+    """Stage the kinetics tables (every frame) and the sensitivity table: up to
+    ``settings.sensitivity_frames`` steady frames, evenly spread, of the first CG1 case
+    (else the first case), analysed again under each variant of the definition."""
+    cases = [f.case for f in analysed]
+    kin = kinetics_table(granules, cases, settings.min_particles)
+    outputs.write(KINETICS_TABLE, kin.to_csv(index=False).encode())
+    summary = kinetics_summary(kin, settings.bootstrap, settings.seed)
+    outputs.write(KINETICS_SUMMARY_TABLE, summary.to_csv(index=False).encode())
+    if settings.sensitivity_frames == 0:
+        return
+    facts = next((f for f in analysed if f.cg == 1), analysed[0])
+    steady = [ff for ff in facts.plan.frames if ff.step >= steady_from[facts.case_id]]
+    if not steady:
+        return
+    pick = np.unique(np.linspace(0, len(steady) - 1, settings.sensitivity_frames).round())
+    table = sensitivity_table(facts, [steady[int(k)] for k in pick],
+                              granule_definition(settings), settings.min_particles,
+                              implementation)
+    outputs.write(SENSITIVITY_TABLE, table.to_csv(index=False).encode())
 
 
 def commit(outputs: OutputSet, record: dict) -> None:

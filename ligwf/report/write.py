@@ -23,6 +23,7 @@ from ligwf.analysis.flow_run import flow_study
 from ligwf.engine.render import MESH_NAME
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
+from ligwf.report.granule_figures import granule_figures
 from ligwf.report.paraview import case_collection
 from ligwf.report.problems import study_problems
 from ligwf.report.tables import build_tables
@@ -101,6 +102,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         gsd = pd.read_csv(gsd_path)
         if not gsd.empty:
             figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / "gsd_overlay.png")))
+    figures += granule_figures(study.analysis_dir, fig_dir)
     pvds = []
     by_id = {c.case_id: c for c in study.usable_cases()[0]}
     for case_id in cases.get("case_id", []):

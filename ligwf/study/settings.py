@@ -12,9 +12,9 @@ on in the LIGGGHTS input, so it is part of the scene and of its hash.)
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, Literal
 
-from pydantic import Field, ValidationError
+from pydantic import Field, ValidationError, field_validator
 
 from ligwf.errors import ConfigError
 from ligwf.scene.messages import format_validation_error
@@ -22,24 +22,71 @@ from ligwf.scene.model import _Frozen
 
 
 class AnalysisSettings(_Frozen):
-    """What the analysis of a study uses (defaults: the values ligwf always used)."""
+    """What the analysis of a study uses.
 
-    steady_after: float = Field(
-        0.25, ge=0.0, lt=1.0, description="fraction of the production time left out as "
-        "start-up, for the flow metrics and the GSD alike")
+    The granule definition (``granules`` and the fields after it) defaults to Leiden CPM
+    communities of the bridge network, the one definition that met all five criteria of
+    docs/results/granule_definitions.md on real runs (no percolating granule, not on a
+    knife edge, box-size invariant, responds to the liquid content, CG-neutral);
+    ``granules: components`` with ``max_velocity_angle: 30`` reproduces the source study
+    (one bed-spanning cluster in a dense wet bed).
+    """
+
+    steady_after: float | Literal["auto"] = Field(
+        0.25, description="fraction of the production time left out as start-up, for the "
+        "flow metrics and the GSD alike, or auto: from the measured spin-up (ligwf.analysis.steady)")
+    granules: Literal["communities", "components"] = Field(
+        "communities", description="granules are Leiden CPM communities of the bond graph "
+        "(default) or its connected components (the source study)")
     min_bridge_force: float = Field(
         0.0, ge=0.0, allow_inf_nan=False, description="a liquid bond needs a bridge force "
-        "above this, N (0: any unbroken bridge; CG-neutral)")
+        "above this, N (0: any unbroken bridge; NOT CG-neutral when > 0)")
+    min_relative_force: float = Field(
+        0.0, ge=0.0, allow_inf_nan=False, description="a liquid bond needs F / (2 pi R* "
+        "gamma cos theta) above this (the force over that of a touching bridge of the same "
+        "pair: dimensionless, CG-neutral under every rule)")
     max_velocity_angle: float = Field(
-        30.0, ge=0.0, le=180.0, description="a liquid bond needs the partners' velocities "
-        "within this angle, deg")
+        180.0, ge=0.0, le=180.0, description="a liquid bond needs the partners' velocities "
+        "within this angle, deg (180: no angle test)")
+    velocity_frame: Literal["lab", "drum", "flow"] = Field(
+        "lab", description="velocities of the angle test: as dumped (lab), relative to the "
+        "drum's rigid rotation (drum), or minus the local mean flow (flow)")
+    flow_radius: float = Field(
+        3.0, gt=0.0, le=50.0, description="radius of the local mean flow of velocity_frame "
+        "flow, in mean particle diameters of the case")
+    resolution: float = Field(
+        0.02, gt=0.0, le=100.0, allow_inf_nan=False, description="CPM resolution gamma of "
+        "the communities (edge weight f_rel n^2, node weight n^3 at CG level n)")
+    community_seed: int = Field(0, ge=0, description="seed of the Leiden runs")
     bins_per_decade: int = Field(5, ge=1, le=100, description="GSD bins per decade of volume")
     min_particles: int = Field(
-        10, ge=1, description="CG granules with fewer particles are below the size limit")
+        2, ge=1, description="granules with fewer particles are left out of the GSD and "
+        "the kinetics (single particles are not granules)")
+    error_band: float = Field(
+        0.15, gt=0.0, le=10.0, description="relative per-bin GSD error of CG-n against CG1 "
+        "that locates the size limit")
     bootstrap: int = Field(1000, ge=1, le=1_000_000, description="bootstrap draws of the "
                            "GSD confidence bands")
     seed: int = Field(12345, ge=0, description="seed of the bootstrap draws")
+    sensitivity_frames: int = Field(
+        4, ge=0, le=1000, description="steady frames of one case re-analysed with each "
+        "threshold moved x0.8 / x1.25 (0: no sensitivity table)")
 
+
+    @field_validator("steady_after", mode="before")
+    @classmethod
+    def _steady_after(cls, value):
+        """``auto`` or a fraction in [0, 1) (one message with the allowed range)."""
+        if value == "auto":
+            return value
+        try:
+            fraction = float(value)
+        except (TypeError, ValueError):
+            fraction = float("nan")
+        if isinstance(value, bool) or not 0.0 <= fraction < 1.0:
+            raise ValueError("must be auto or a fraction of the production time in the "
+                             "allowed range [0, 1)")
+        return fraction
 
 def build_analysis_settings(data: Any, prefix: str = "analysis") -> AnalysisSettings:
     """Validate a mapping (workflow block or stored record) or raise ConfigError with the

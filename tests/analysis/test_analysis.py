@@ -14,6 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.dumps import discover_frames, read_particles
 from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, NothingAnalysed, analyse
 from ligwf.cli.main import main
@@ -21,7 +22,7 @@ from ligwf.study.case import CaseFolder
 from ligwf.study.settings import AnalysisSettings
 from wetdump import wet_study
 
-FAST = AnalysisOptions(settings=AnalysisSettings(bootstrap=100))
+FAST = AnalysisOptions(settings=AnalysisSettings(bootstrap=100, resolution=0.01))
 OUTPUTS = ("granules.parquet", "frames.csv", "gsd.csv", "gsd_summary.csv", "analysis.json")
 
 
@@ -32,7 +33,7 @@ def study(engine, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("analysed") / "study"
     shutil.copytree(wet_study(engine, tmp_path_factory), out)
     record = json.loads((out / "study.json").read_text())
-    record["analysis"] = {"bootstrap": 100}
+    record["analysis"] = {"bootstrap": 100, "resolution": 0.01}   # CG3 at 0.02: all single
     (out / "study.json").write_text(json.dumps(record))
     return out
 
@@ -66,9 +67,9 @@ def test_outputs_of_a_study(study, serial):
     a, b = (g[g.case_id == c].drop(columns=["case_id", "replica"]).reset_index(drop=True)
             for c in ("cg3-weber-r0", "cg3-weber-r1"))
     pd.testing.assert_frame_equal(a, b)
-    # the table equals a direct run of the life-cycle class with the reference implementation
+    # the table equals a direct run of the life-cycle class
     case = CaseFolder.open(study / "cg3-weber-r0")
-    ref = GranuleAnalysis(case, implementation="reference").run()
+    ref = GranuleAnalysis(case, GranuleDefinition(resolution=0.01)).run()   # vs reference: test_definitions
     for r in ref.results:
         got = a[a.step == r.step].reset_index(drop=True)
         np.testing.assert_array_equal(got["members"], r.table["members"])

@@ -58,47 +58,72 @@ def test_side_errors_and_limit():
     assert eb == pytest.approx(0.4 / 0.8) and ea == pytest.approx(0.2 / 0.2)
     rel = gsd.relative_error(cg, ref)
     assert rel[0] == pytest.approx(-0.6) and math.isnan(rel[3])
-    assert gsd.size_limit(V1, 10) == pytest.approx(10 * V1)
 
 
 def _case(case_id, cg, rule, replica):
     return SimpleNamespace(case_id=case_id, cg=cg, rule=rule, replica=replica, group="{}")
 
 
-def _table(case, frames, sizes_in_primaries):
+def _table(case, frames, sizes_in_primaries, percolating=()):
+    """Granules of physical volume s * V1 (the same at every CG level: CG-neutral)."""
     rows = []
     for f in range(frames):
-        for k, s in enumerate(sizes_in_primaries):
+        for k, s in enumerate(list(sizes_in_primaries) + list(percolating)):
             vol = s * V1
             rows.append({"case_id": case.case_id, "cg": case.cg, "rule": case.rule,
                          "replica": case.replica, "frame": f, "step": 100 * f, "time": 0.0,
                          "granule": k, "members": max(1, round(s / case.cg**3)),
-                         "volume": vol * case.cg**3, "primary_volume": vol})
+                         "volume": vol, "primary_volume": vol / case.cg**3,
+                         "percolating": k >= len(sizes_in_primaries)})
     return pd.DataFrame(rows)
 
 
+def test_located_limit():
+    edges = np.array([1.0, 10, 100, 1000, 10000])
+    ref = np.array([0.2, 0.3, 0.3, 0.2])
+    # CG-n off by 50 % in the two smallest bins, within 10 % above: limit at the third bin
+    cg = np.array([0.1, 0.45, 0.28, 0.19])
+    assert gsd.located_limit(edges, cg, ref, 0.15) == 100.0
+    assert gsd.located_limit(edges, ref, ref, 0.15) == 1.0            # all within: first bin
+    assert math.isnan(gsd.located_limit(edges, ref * [1, 1, 1, 2], ref, 0.15))  # top bin off
+    # a bin with < 1 % of the reference volume does not move the limit
+    ref2 = np.array([0.005, 0.395, 0.4, 0.2])
+    assert gsd.located_limit(edges, ref2 * [5, 1, 1, 1], ref2, 0.15) == 10.0
+    rows = gsd.located_limit(edges, np.stack([cg, ref]), np.stack([ref, ref]), 0.15)
+    assert rows.tolist() == [100.0, 1.0]
+
+
 def test_cg_comparison_identical_gsd_has_zero_error():
-    """CG2 granules with the same primary-equivalent volumes as CG1: error 0 everywhere;
-    the size limit is min_particles CG2 particles = 10 * 8 primaries."""
-    sizes = [8, 8, 8, 16, 64, 200, 800]
-    sizes2 = [16, 64, 200, 800]              # replica b lacks the small granules
+    """CG2 granules with the same physical volumes as CG1: error 0 everywhere, the limit
+    at the smallest bin; single particles and percolating granules stay out of the GSD
+    and the percolating ones are reported on their own."""
+    sizes = [1, 1, 16, 16, 16, 32, 64, 200, 800]
+    sizes2 = [64, 200, 800]                  # replica b lacks the small granules
     c1, c2a, c2b = _case("cg1", 1.0, "none", 0), _case("a", 2.0, "weber", 0), _case("b", 2.0, "weber", 1)
-    table = pd.concat([_table(c1, 3, sizes), _table(c2a, 3, sizes), _table(c2b, 2, sizes2)])
+    table = pd.concat([_table(c1, 3, sizes, percolating=[5000]), _table(c2a, 3, sizes[2:]),
+                       _table(c2b, 2, sizes2)])
     settings = gsd.GsdSettings(n_boot=200)
     # replica b differs: without it the comparison is exact
     dist, summary = gsd_tables(table[table.case_id != "b"], [c1, c2a, c2b], settings)
-    row = summary.set_index("condition").loc["cg2-weber"]
-    assert row["error_below"] == 0 and row["error_above"] == 0
-    assert row["size_limit"] == pytest.approx(10 * 8 * V1)
+    s = summary.set_index("condition")
+    row = s.loc["cg2-weber"]
+    assert row["error_above"] == 0 and row["error_band"] == 0.15
+    assert row["size_limit"] == pytest.approx(dist["v_lo"].min())
     assert row["reference"] == "cg1"
+    assert s.loc["cg1", "percolating_frames"] == 1 and row["percolating_frames"] == 0
+    total = sum(sizes) + 5000
+    assert s.loc["cg1", "percolating_share"] == pytest.approx(5000 / total)
+    assert s.loc["cg1", "granule_share"] == pytest.approx((total - 5000 - 2) / total)
     d = dist[dist.condition == "cg2-weber"]
     assert np.nanmax(np.abs(d["rel_error"])) == 0
-    # with replica b the small sizes are missing: error below the limit grows, band opens
+    assert dist["v_hi"].max() < 5000 * V1 and dist["v_lo"].min() > V1     # left out
+    # with replica b the small sizes are missing: the limit moves up, the error below grows
     dist, summary = gsd_tables(table, [c1, c2a, c2b], settings)
     row = summary.set_index("condition").loc["cg2-weber"]
     assert row["error_below"] > 0.05 and row["replicas"] == 2 and row["frames"] == 5
+    assert row["size_limit"] > 32 * V1
+    assert row["size_limit_lo"] <= row["size_limit"] <= row["size_limit_hi"]
     assert row["error_below_lo"] <= row["error_below"] <= row["error_below_hi"]
-    assert row["error_below_hi"] > row["error_below_lo"]
     for cond, d in dist.groupby("condition"):
         assert d["volume_fraction"].sum() == pytest.approx(1)
         assert d["number_fraction"].sum() == pytest.approx(1)

@@ -27,13 +27,17 @@ HERE = Path(__file__).resolve().parent
 WORKFLOW = HERE / "tiny_drum.yaml"
 LIGWF = str(Path(sys.executable).parent / "ligwf")
 #: analysis settings, every one away from its default
-ANALYSIS = {"steady_after": 0.5, "min_bridge_force": 1.0e-9, "max_velocity_angle": 20.0,
-            "bins_per_decade": 4, "min_particles": 5, "bootstrap": 50, "seed": 7}
+ANALYSIS = {"steady_after": 0.5, "granules": "communities", "min_bridge_force": 1.0e-9,
+            "min_relative_force": 0.1, "max_velocity_angle": 60.0, "velocity_frame": "drum",
+            "flow_radius": 2.5, "resolution": 0.01, "community_seed": 3, "bins_per_decade": 4,
+            "min_particles": 3, "error_band": 0.2, "bootstrap": 50, "seed": 7,
+            "sensitivity_frames": 2}
 SETS = ["--set", "sweep.replicas=2", *[x for k, v in ANALYSIS.items()
                                        for x in ("--set", f"analysis.{k}={v}")]]
 #: a periodic slice shorter than one CG3 particle: the pre-flight refuses it
 UNSAFE = ["--set", "scene.drum.length=0.002"]
-TABLES = ("frames.csv", "gsd.csv", "gsd_summary.csv")
+TABLES = ("frames.csv", "gsd.csv", "gsd_summary.csv", "kinetics.csv", "kinetics_summary.csv",
+          "sensitivity.csv")
 
 pytestmark = [pytest.mark.slurm, pytest.mark.engine, pytest.mark.slow]
 
@@ -89,8 +93,12 @@ def test_local_and_slurm_give_identical_analysis(slurm_cluster, tmp_path, env):
         assert all(c.manifest().status == "done" for c in s.cases)
     rec_local, rec_slurm = _record(local), _record(slurm)
     assert rec_local["settings"] == ANALYSIS
-    assert rec_local["criterion"] == {"min_bridge_force": 1.0e-9, "max_velocity_angle_deg": 20.0}
+    assert rec_local["definition"] == {
+        "method": "communities", "velocity_frame": "drum", "max_velocity_angle_deg": 60.0,
+        "min_bridge_force": 1.0e-9, "min_relative_force": 0.1, "resolution": 0.01, "seed": 3,
+        "flow_radius": 2.5}
     assert rec_local["gsd"]["n_boot"] == 50 and rec_local["gsd"]["bins_per_decade"] == 4
+    assert rec_local["gsd"]["error_band"] == 0.2
     cases = Study.open(local).cases
     assert [c["steady_from_step"] for c in rec_local["cases"]] == \
         [c.steady_start_step(0.5) for c in cases]

@@ -1,0 +1,122 @@
+"""Granulation kinetics and the sensitivity of the granule definition.
+
+Kinetics: per case and frame (every analysed frame, start-up included: growth is what is
+watched) the granule count, d10/d50/d90 (m, volume-equivalent diameters of the counted
+granules: >= ``min_particles`` members, not percolating), the largest counted granule and
+the bed shares in counted and in percolating granules (:func:`ligwf.analysis.gsd.frame_stats`);
+per condition the mean over replicas with a bootstrap band over replicas (zero width with
+one replica: the band is the replica spread, not frame noise) and the ratio of CG-n to the
+CG1 condition of its group at the nearest time. Volumes are physical, as in the GSD
+(:mod:`ligwf.analysis.gsd`: a CG-neutral definition gives CG-n granules of CG1 volume).
+
+Sensitivity: one set of steady frames analysed again under each variant of the definition
+(:meth:`ligwf.analysis.definitions.GranuleDefinition.variants`: every threshold x0.8 and
+x1.25), so a user sees how much granule count, d50 and the largest granule depend on them.
+"""
+
+from __future__ import annotations
+
+import warnings
+from typing import Sequence
+
+import numpy as np
+import pandas as pd
+
+from ligwf.analysis import gsd as gsdmod
+from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts
+from ligwf.analysis.definitions import GranuleDefinition
+from ligwf.analysis.dumps import FrameFiles
+from ligwf.analysis.gsd_tables import CaseLike, Condition
+
+#: File names of the kinetics and sensitivity tables in the analysis folder
+KINETICS_TABLE = "kinetics.csv"
+KINETICS_SUMMARY_TABLE = "kinetics_summary.csv"
+SENSITIVITY_TABLE = "sensitivity.csv"
+#: Per-frame quantities (see :func:`ligwf.analysis.gsd.frame_stats`)
+QUANTITIES = ("granules", "d10", "d50", "d90", "largest_granule", "granule_share",
+              "percolating_share")
+
+
+def kinetics_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
+                   min_particles: int) -> pd.DataFrame:
+    """One row per case and frame: condition, cg, rule, replica, step, time (s) and
+    :data:`QUANTITIES`."""
+    cond = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
+    replica = {c.case_id: c.replica for c in cases}
+    rows = []
+    for (case_id, step), fr in granules.groupby(["case_id", "step"], sort=True):
+        stats = gsdmod.frame_stats(fr["volume"].to_numpy(), fr["members"].to_numpy(),
+                                   fr["percolating"].to_numpy(bool), min_particles)
+        c = cond[case_id]
+        rows.append({"case_id": case_id, "condition": c.name, "group": c.group, "cg": c.cg,
+                     "rule": c.rule, "replica": replica[case_id], "step": int(step),
+                     "time": float(fr["time"].iloc[0]), **stats})
+    return pd.DataFrame(rows, columns=["case_id", "condition", "group", "cg", "rule",
+                                       "replica", "step", "time", *QUANTITIES])
+
+
+def kinetics_summary(kin: pd.DataFrame, n_boot: int, seed: int,
+                     confidence: float = 0.95) -> pd.DataFrame:
+    """Per condition and time: mean of each quantity over replicas, its bootstrap band
+    (replicas resampled) and, for CG > 1, the ratio to the CG1 mean of the group at the
+    nearest time (``<q>_ratio``)."""
+    if kin.empty:
+        return pd.DataFrame()
+    rng = np.random.default_rng(seed)
+    out = []
+    for (name, group, cg, rule), d in kin.groupby(["condition", "group", "cg", "rule"], sort=True):
+        times = np.sort(d["time"].unique())
+        for t in times:
+            at = d[d["time"] == t]
+            vals = at[list(QUANTITIES)].to_numpy(float)
+            draws = gsdmod.bootstrap_means(vals, at["replica"].to_numpy(), n_boot, rng)
+            lo, hi = gsdmod.band(draws, confidence)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)
+                mean = np.nanmean(vals, axis=0)
+            row = {"condition": name, "group": group, "cg": cg, "rule": rule, "time": t,
+                   "replicas": len(at)}
+            for k, q in enumerate(QUANTITIES):
+                row.update({q: mean[k], f"{q}_lo": lo[k], f"{q}_hi": hi[k]})
+            out.append(row)
+    summary = pd.DataFrame(out)
+    for q in QUANTITIES:
+        summary[f"{q}_ratio"] = np.nan
+    for group, d in summary.groupby("group"):
+        ref = d[d["cg"] == 1].sort_values("time")
+        if ref.empty:
+            continue
+        for idx, row in d[d["cg"] != 1].iterrows():
+            k = int(np.abs(ref["time"].to_numpy() - row["time"]).argmin())
+            with np.errstate(divide="ignore", invalid="ignore"):
+                for q in QUANTITIES:
+                    summary.loc[idx, f"{q}_ratio"] = row[q] / ref[q].to_numpy()[k]
+    return summary
+
+
+def sensitivity_table(facts: RunFacts, frames: list[FrameFiles], definition: GranuleDefinition,
+                      min_particles: int, implementation: str = "fast") -> pd.DataFrame:
+    """Per variant of ``definition`` (label first: ``as set``) the mean over ``frames`` of
+    granule count, d50 (m), largest granule and percolating share, and d50 relative to
+    the definition as set."""
+    rows = []
+    for label, variant in definition.variants():
+        ana = GranuleAnalysis(facts, variant, implementation).run(frames)
+        stats = [gsdmod.frame_stats(r.table["volume"].to_numpy(), r.table["members"].to_numpy(),
+                                    r.table["percolating"].to_numpy(bool), min_particles)
+                 for r in ana.results if r.table is not None]
+        if not stats:
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            mean = {q: float(np.nanmean([s[q] for s in stats])) for q in
+                    ("granules", "d50", "largest_granule", "percolating_share")}
+        rows.append({"case_id": facts.case_id, "variant": label, "frames": len(stats),
+                     "method": variant.method, "velocity_frame": variant.velocity_frame,
+                     "resolution": variant.resolution,
+                     "max_velocity_angle": variant.max_velocity_angle_deg,
+                     "min_relative_force": variant.min_relative_force, **mean})
+    table = pd.DataFrame(rows)
+    if not table.empty:
+        table["d50_ratio"] = table["d50"] / table["d50"].iloc[0]
+    return table
