@@ -45,6 +45,10 @@ DEFAULT_ERROR_BAND = 0.15
 MIN_BIN_SHARE = 0.01
 
 
+#: analysis.gsd_volume -> the granule-table column the GSD bins
+VOLUME_COLUMNS = {"physical": "volume", "primary": "primary_volume"}
+
+
 @dataclass(frozen=True)
 class GsdSettings:
     """Binning, size-limit and bootstrap settings of the GSD stage."""
@@ -55,8 +59,13 @@ class GsdSettings:
     confidence: float = 0.95
     seed: int = 12345
     error_band: float = DEFAULT_ERROR_BAND
+    #: granule-table column binned: "volume" (physical, m^3) or "primary_volume" (/ n^3)
+    volume_column: str = "volume"
 
     def __post_init__(self) -> None:
+        if self.volume_column not in VOLUME_COLUMNS.values():
+            raise ValueError(f"volume_column = {self.volume_column!r}: use "
+                             f"{' or '.join(VOLUME_COLUMNS.values())}")
         if self.bins_per_decade < 1:
             raise ValueError(f"bins_per_decade = {self.bins_per_decade}: must be >= 1")
         if self.min_particles < 1:

@@ -67,13 +67,13 @@ SCALARS = ("d10", "d50", "d90", "largest_granule")
 
 
 def _per_condition(g: pd.DataFrame, cases: Sequence[CaseLike], edges: np.ndarray,
-                   min_particles: int) -> dict[Condition, dict[str, Any]]:
+                   min_particles: int, column: str) -> dict[Condition, dict[str, Any]]:
     """Per condition the per-frame histograms, scalars, shares and replica of each frame."""
     replica_of = {c.case_id: c.replica for c in cases}
     cond_of = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
     per_cond: dict[Condition, dict[str, Any]] = {}
     for (case_id, step), fr in g.groupby(["case_id", "step"], sort=True):
-        vol, mem, perc = (fr["volume"].to_numpy(), fr["members"].to_numpy(),
+        vol, mem, perc = (fr[column].to_numpy(), fr["members"].to_numpy(),
                           fr["percolating"].to_numpy(bool))
         stats = gsdmod.frame_stats(vol, mem, perc, min_particles)
         num, vhist = gsdmod.histogram(vol[gsdmod.counted(mem, perc, min_particles)], edges)
@@ -97,10 +97,11 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
         return pd.DataFrame(columns=GSD_COLUMNS), pd.DataFrame(columns=SUMMARY_COLUMNS)
     g = granules
     use = gsdmod.counted(g["members"], g["percolating"].to_numpy(bool), settings.min_particles)
-    v_all = g["volume"][use] if use.any() else g["volume"]
+    col = settings.volume_column
+    v_all = g[col][use] if use.any() else g[col]
     edges = gsdmod.log_edges(float(v_all.min()), float(v_all.max()), settings.bins_per_decade)
     rng = np.random.default_rng(settings.seed)
-    per_cond = _per_condition(g, cases, edges, settings.min_particles)
+    per_cond = _per_condition(g, cases, edges, settings.min_particles, col)
     rows, summary = [], []
     conds = sorted(per_cond, key=lambda c: (c.group, c.cg, c.rule))
     ref_of = {c.group: c for c in conds if c.cg == 1}

@@ -38,14 +38,15 @@ QUANTITIES = ("granules", "d10", "d50", "d90", "largest_granule", "granule_share
 
 
 def kinetics_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
-                   min_particles: int) -> pd.DataFrame:
+                   min_particles: int, volume_column: str = "volume") -> pd.DataFrame:
     """One row per case and frame: condition, cg, rule, replica, step, time (s) and
-    :data:`QUANTITIES`."""
+    :data:`QUANTITIES`, from the granule-table column ``volume_column`` (physical
+    ``volume`` or ``primary_volume`` = volume / n^3, as the GSD)."""
     cond = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
     replica = {c.case_id: c.replica for c in cases}
     rows = []
     for (case_id, step), fr in granules.groupby(["case_id", "step"], sort=True):
-        stats = gsdmod.frame_stats(fr["volume"].to_numpy(), fr["members"].to_numpy(),
+        stats = gsdmod.frame_stats(fr[volume_column].to_numpy(), fr["members"].to_numpy(),
                                    fr["percolating"].to_numpy(bool), min_particles)
         c = cond[case_id]
         rows.append({"case_id": case_id, "condition": c.name, "group": c.group, "cg": c.cg,

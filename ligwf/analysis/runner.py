@@ -53,7 +53,7 @@ import pandas as pd
 from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts, pvd_text
 from ligwf.analysis.frame_checks import FramePlan, plan_frames
 from ligwf.analysis.definitions import GranuleDefinition
-from ligwf.analysis.gsd import GsdSettings
+from ligwf.analysis.gsd import VOLUME_COLUMNS, GsdSettings
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.kinetics import (KINETICS_SUMMARY_TABLE, KINETICS_TABLE, SENSITIVITY_TABLE,
                                      kinetics_summary, kinetics_table, sensitivity_table)
@@ -102,7 +102,8 @@ def granule_definition(s: AnalysisSettings) -> GranuleDefinition:
 def gsd_settings(s: AnalysisSettings) -> GsdSettings:
     """The GSD settings of the settings."""
     return GsdSettings(bins_per_decade=s.bins_per_decade, min_particles=s.min_particles,
-                       n_boot=s.bootstrap, seed=s.seed, error_band=s.error_band)
+                       n_boot=s.bootstrap, seed=s.seed, error_band=s.error_band,
+                       volume_column=VOLUME_COLUMNS[s.gsd_volume])
 
 
 def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions = AnalysisOptions(),
@@ -273,7 +274,8 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
     ``settings.sensitivity_frames`` steady frames, evenly spread, of the first CG1 case
     (else the first case), analysed again under each variant of the definition."""
     cases = [f.case for f in analysed]
-    kin = kinetics_table(granules, cases, settings.min_particles)
+    kin = kinetics_table(granules, cases, settings.min_particles,
+                         VOLUME_COLUMNS[settings.gsd_volume])
     outputs.write(KINETICS_TABLE, kin.to_csv(index=False).encode())
     summary = kinetics_summary(kin, settings.bootstrap, settings.seed)
     outputs.write(KINETICS_SUMMARY_TABLE, summary.to_csv(index=False).encode())

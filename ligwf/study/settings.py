@@ -58,6 +58,10 @@ class AnalysisSettings(_Frozen):
         0.02, gt=0.0, le=100.0, allow_inf_nan=False, description="CPM resolution gamma of "
         "the communities (edge weight f_rel n^2, node weight n^3 at CG level n)")
     community_seed: int = Field(0, ge=0, description="seed of the Leiden runs")
+    gsd_volume: Literal["physical", "primary"] = Field(
+        "physical", description="granule volume the GSD bins: physical (a CG-neutral "
+        "definition such as the CPM communities gives CG-n granules of CG1 size) or primary "
+        "= volume / n^3 (the source study's estimate of the original GSD from CG-n components)")
     bins_per_decade: int = Field(5, ge=1, le=100, description="GSD bins per decade of volume")
     min_particles: int = Field(
         2, ge=1, description="granules with fewer particles are left out of the GSD and "

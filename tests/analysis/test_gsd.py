@@ -127,3 +127,22 @@ def test_cg_comparison_identical_gsd_has_zero_error():
     for cond, d in dist.groupby("condition"):
         assert d["volume_fraction"].sum() == pytest.approx(1)
         assert d["number_fraction"].sum() == pytest.approx(1)
+
+
+def test_primary_volume_convention_bins_volume_over_n3():
+    """gsd_volume: primary (the source study): CG-n granule volumes are divided by n^3, so
+    a CG2 table whose physical volumes equal CG1's comes out 8x smaller; the physical
+    convention compares them as they are."""
+    sizes = [16, 16, 32, 64, 200]
+    c1, c2 = _case("cg1", 1.0, "none", 0), _case("a", 2.0, "weber", 0)
+    table = pd.concat([_table(c1, 2, sizes), _table(c2, 2, sizes)])
+    physical = gsd.GsdSettings(n_boot=50)
+    primary = gsd.GsdSettings(n_boot=50, volume_column="primary_volume")
+    _, s_phys = gsd_tables(table, [c1, c2], physical)
+    _, s_prim = gsd_tables(table, [c1, c2], primary)
+    phys, prim = s_phys.set_index("condition"), s_prim.set_index("condition")
+    assert phys.loc["cg2-weber", "d50"] == pytest.approx(phys.loc["cg1", "d50"])
+    assert prim.loc["cg2-weber", "d50"] == pytest.approx(prim.loc["cg1", "d50"] / 2)
+    assert prim.loc["cg1", "d50"] == pytest.approx(phys.loc["cg1", "d50"])
+    with pytest.raises(ValueError, match="volume_column"):
+        gsd.GsdSettings(volume_column="mass")
