@@ -3,20 +3,24 @@
 Everything is measured in the drum cross-section (coordinates u horizontal, v up; the axis
 is averaged out). Per frame:
 
-- free surface: the top of the bed in vertical strips across the central part of the drum
-  (max of v + r per strip); the dynamic angle of repose is the magnitude of the slope of a
-  straight-line fit through those points, in degrees.
+- free surface and dynamic angle of repose: a robust straight-line fit of the surface
+  (:mod:`ligwf.analysis.surface`: centre-of-mass first guess, strip tops across the
+  central chord with airborne particles skipped, MAD outlier rejection), the angle signed
+  with respect to the rotation (positive: rising towards the wall that moves up), degrees.
 - bed centre-of-mass angle: angle of the bed's centre of mass from straight down, degrees.
-- velocity profile along the line through the drum centre normal to the free surface:
-  particles within a band around that line, the velocity component along the surface,
-  binned by distance along the line.
-- flowing layer: from the top of the bed down to where that velocity changes sign
-  (particles above flow down the slope, below they turn with the drum); its thickness
-  and mean speed.
+- velocity profile along the normal to the free surface through the drum centre, on a
+  normalised depth xi = (distance below the free surface) / (bed depth on that line), 0 at
+  the surface, 1 at the drum wall: particles within a band of half-width
+  ``PROFILE_HALF_WIDTH`` x drum radius around the line (the same physical width at every
+  CG level), their velocity along the downhill surface direction (positive in the flowing
+  layer, negative where the bed turns with the drum), averaged in ``PROFILE_BINS`` bins.
+- flowing layer: from the surface down to where that velocity changes sign; its thickness
+  (m) and mean speed.
 - rigid-block fraction: share of particles whose velocity is within ``rigid_tolerance``
   x (omega R) of the drum's rigid rotation omega x r. A frame with more than 90 % of the
   bed co-rotating is a *rigid frame* (the bed is carried up as one block: slumping).
-- rms speed of the bed (its fluctuation over time is large when the bed slumps).
+- rms speed of the bed (its fluctuation over time is large when the bed slumps) and the
+  kinetic energy per unit mass (the spin-up signal of :mod:`ligwf.analysis.steady`).
 
 Over frames: mean and standard deviation of each scalar, the share of rigid frames, and a
 velocity field on a grid of the cross-section averaged over frames.
@@ -32,10 +36,13 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ligwf.analysis.dumps import ParticleFrame
+from ligwf.analysis.surface import fit_surface
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
 
 RIGID_FRAME_SHARE = 0.9  # a frame is rigid when more than this share co-rotates
+PROFILE_HALF_WIDTH = 0.15  # profile band half-width / drum radius (CG-independent)
+PROFILE_BINS = 16         # bins of the normalised depth xi in [0, 1]
 
 
 @dataclass(frozen=True)
@@ -61,14 +68,15 @@ class FrameFlow:
 
     step: int
     time: float
-    angle_of_repose: float            # deg (nan when no surface could be fitted)
+    angle_of_repose: float            # deg, signed (nan when no surface could be fitted)
     com_angle: float                  # deg from straight down, + towards +u
     rigid_fraction: float             # share of particles co-rotating with the drum
     rms_speed: float                  # m/s
+    kinetic_energy: float             # J/kg, translational, per unit mass (mean v^2 / 2)
     flowing_layer_thickness: float    # m (nan when no sign change)
     flowing_layer_speed: float        # m/s
-    profile_s: np.ndarray = field(repr=False)   # (B,) m, distance from centre along normal
-    profile_v: np.ndarray = field(repr=False)   # (B,) m/s, mean velocity along the surface
+    profile_s: np.ndarray = field(repr=False)   # (B,) normalised depth xi of the bin centres
+    profile_v: np.ndarray = field(repr=False)   # (B,) m/s, mean downhill velocity (nan: empty)
 
 
 def cross_section(frame: ParticleFrame, geo: DrumGeometry) -> tuple[np.ndarray, ...]:
@@ -91,38 +99,21 @@ def rigid_rotation_velocity(frame: ParticleFrame, geo: DrumGeometry) -> tuple[np
     return rigid[:, iu], rigid[:, iv]
 
 
-def free_surface(u: np.ndarray, v: np.ndarray, r: np.ndarray, geo: DrumGeometry,
-                 span: float = 0.6) -> tuple[np.ndarray, np.ndarray]:
-    """Top of the bed in strips of width ~2 d over |u| < span R: (u_centre, v_top) arrays."""
-    width = 2.0 * geo.d_mean
-    edges = np.arange(-span * geo.radius, span * geo.radius + width, width)
-    strip = np.digitize(u, edges) - 1
-    ok = (strip >= 0) & (strip < len(edges) - 1)
-    tops = np.full(len(edges) - 1, -np.inf)
-    counts = np.bincount(strip[ok], minlength=len(edges) - 1)
-    np.maximum.at(tops, strip[ok], (v + r)[ok])
-    keep = counts >= 2
-    centres = 0.5 * (edges[:-1] + edges[1:])
-    return centres[keep], tops[keep]
+def rising_side(geo: DrumGeometry) -> float:
+    """+1 when the drum wall at +u moves up (rigid rotation at (u, v) = (R, 0)), else -1."""
+    ia, iu, iv = axis_frame(geo.axis)
+    w, p = np.zeros(3), np.zeros(3)
+    w[ia], p[iu] = geo.omega, geo.radius
+    return 1.0 if np.cross(w, p)[iv] >= 0 else -1.0
 
 
-def surface_angle(us: np.ndarray, vs: np.ndarray) -> tuple[float, float]:
-    """(angle in degrees, intercept in m) of a least-squares line v = a u + b."""
-    if len(us) < 3:
-        return float("nan"), float("nan")
-    a, b = np.polyfit(us, vs, 1)
-    return float(np.degrees(np.arctan(a))), float(b)
-
-
-def frame_flow(frame: ParticleFrame, geo: DrumGeometry, rigid_tolerance: float = 0.2,
-               band: float = 1.5, nbins: int = 24) -> FrameFlow:
+def frame_flow(frame: ParticleFrame, geo: DrumGeometry, rigid_tolerance: float = 0.2) -> FrameFlow:
     """All per-frame metrics (see the module docstring)."""
     u, v, vu, vv = cross_section(frame, geo)
     r = frame.radii
     mass = frame.volumes  # one density: volume weights are mass weights
-
-    us, vs = free_surface(u, v, r, geo)
-    angle, _ = surface_angle(us, vs)
+    side = rising_side(geo)
+    surf = fit_surface(u, v, r, geo.radius, geo.d_mean, side)
 
     cu, cv = np.average(u, weights=mass), np.average(v, weights=mass)
     com_angle = float(np.degrees(np.arctan2(cu, -cv)))
@@ -130,52 +121,49 @@ def frame_flow(frame: ParticleFrame, geo: DrumGeometry, rigid_tolerance: float =
     ru, rv = rigid_rotation_velocity(frame, geo)
     dev = np.hypot(vu - ru, vv - rv)
     rigid = float(np.mean(dev < rigid_tolerance * abs(geo.omega) * geo.radius))
-    speed = np.sqrt(np.sum(frame.velocities**2, axis=1))
-    rms = float(np.sqrt(np.mean(speed**2)))
+    speed2 = np.sum(frame.velocities**2, axis=1)
+    rms = float(np.sqrt(np.mean(speed2)))
+    kinetic = float(0.5 * np.average(speed2, weights=mass))
 
-    # profile along the line through the centre, normal to the surface (pointing up)
-    if np.isfinite(angle):
-        t = np.array([np.cos(np.radians(angle)), np.sin(np.radians(angle))])  # along surface
-    else:
-        t = np.array([1.0, 0.0])
-    n = np.array([-t[1], t[0]])
-    s = u * n[0] + v * n[1]                 # distance along the normal line
-    off = u * t[0] + v * t[1]               # distance from the line
-    near = np.abs(off) < band * geo.d_mean * 2
-    vt = vu * t[0] + vv * t[1]              # velocity along the surface direction
-    edges = np.linspace(-geo.radius, geo.radius, nbins + 1)
-    idx = np.digitize(s[near], edges) - 1
-    ok = (idx >= 0) & (idx < nbins)
-    sums = np.bincount(idx[ok], weights=vt[near][ok], minlength=nbins)
-    cnt = np.bincount(idx[ok], minlength=nbins)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    centres = (np.arange(PROFILE_BINS) + 0.5) / PROFILE_BINS
+    prof = np.full(PROFILE_BINS, np.nan)
+    thickness = layer_speed = float("nan")
+    if surf is not None:
+        t = np.radians(surf.tangent_deg)
+        x = u * np.cos(t) + v * np.sin(t)            # along the surface
+        y = -u * np.sin(t) + v * np.cos(t)           # along its upward normal
+        depth = surf.offset + geo.radius             # bed depth on the line through the centre
+        near = np.abs(x) < PROFILE_HALF_WIDTH * geo.radius
+        xi = np.clip((surf.offset - y[near]) / depth, 0.0, 1.0 - 1e-12)
+        down = -side * (vu[near] * np.cos(t) + vv[near] * np.sin(t))
+        idx = (xi * PROFILE_BINS).astype(int)
+        sums = np.bincount(idx, weights=down, minlength=PROFILE_BINS)
+        cnt = np.bincount(idx, minlength=PROFILE_BINS)
         prof = np.where(cnt > 0, sums / np.maximum(cnt, 1), np.nan)
-    centres = 0.5 * (edges[:-1] + edges[1:])
-
-    thickness, layer_speed = _flowing_layer(centres, prof, s[near], vt[near], geo)
-    return FrameFlow(step=frame.step, time=frame.time, angle_of_repose=abs(angle),
+        thickness, layer_speed = _flowing_layer(centres, prof, xi, down, depth)
+    return FrameFlow(step=frame.step, time=frame.time,
+                     angle_of_repose=surf.angle_deg if surf else float("nan"),
                      com_angle=com_angle, rigid_fraction=rigid, rms_speed=rms,
+                     kinetic_energy=kinetic,
                      flowing_layer_thickness=thickness, flowing_layer_speed=layer_speed,
                      profile_s=centres, profile_v=prof)
 
 
-def _flowing_layer(centres, prof, s, vt, geo: DrumGeometry) -> tuple[float, float]:
-    """Thickness and mean speed of the layer above the velocity reversal on the profile."""
+def _flowing_layer(centres, prof, xi, down, depth) -> tuple[float, float]:
+    """Thickness (m) and mean speed (m/s) of the layer above the first reversal of the
+    downhill velocity below the surface; nan when the profile does not reverse."""
     filled = np.flatnonzero(np.isfinite(prof))
-    if len(filled) < 2 or len(s) == 0:
+    if len(filled) < 2 or prof[filled[0]] <= 0:
         return float("nan"), float("nan")
-    top = float(np.max(s)) + 0.5 * geo.d_mean
-    # walk down from the top bin: flowing while the velocity has the sign of the top bin
-    sign = np.sign(prof[filled[-1]])
-    zero = None
-    for k in filled[::-1]:
-        if np.sign(prof[k]) != sign:
-            zero = centres[k]
-            break
-    if zero is None or sign == 0:
+    below = filled[prof[filled] <= 0]
+    if not len(below):
         return float("nan"), float("nan")
-    layer = s > zero
-    return top - float(zero), float(np.mean(np.abs(vt[layer]))) if layer.any() else float("nan")
+    k = below[0]
+    above = filled[filled < k][-1]
+    # linear zero crossing between the last flowing bin and the first reversed one
+    zero = centres[above] + (centres[k] - centres[above]) * prof[above] / (prof[above] - prof[k])
+    layer = xi < zero
+    return float(zero * depth), float(np.mean(np.abs(down[layer]))) if layer.any() else float("nan")
 
 
 @dataclass(frozen=True)
@@ -191,6 +179,7 @@ class FlowSummary:
     rigid_fraction_mean: float
     rms_speed_mean: float
     rms_speed_rel_fluctuation: float  # std / mean over frames
+    kinetic_energy_mean: float        # J/kg
     flowing_layer_thickness_mean: float
     flowing_layer_speed_mean: float
     profile_s: list[float]
@@ -230,6 +219,7 @@ def summarise(flows: list[FrameFlow]) -> FlowSummary:
         rigid_fraction_mean=float(np.mean(rig)),
         rms_speed_mean=rms_mean,
         rms_speed_rel_fluctuation=float(np.std(rms) / rms_mean) if rms_mean > 0 else float("nan"),
+        kinetic_energy_mean=float(np.mean([f.kinetic_energy for f in flows])),
         flowing_layer_thickness_mean=_nanstat(thick, np.mean),
         flowing_layer_speed_mean=_nanstat(lspeed, np.mean),
         profile_s=[float(x) for x in flows[0].profile_s],
@@ -261,16 +251,27 @@ def velocity_field(frames: list[ParticleFrame], geo: DrumGeometry, cells: int = 
     return c, c, mu, mv
 
 
-def profile_l2_error(s_ref: list[float], v_ref: list[float], s: list[float], v: list[float]) -> float:
-    """Relative L2 difference of a velocity profile against a reference, on common bins.
+def relative_l2(v_ref: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """||v - v_ref|| / ||v_ref|| over the last axis (profile bins), on the bins both fill;
+    broadcasts over leading axes (bootstrap draws). nan where no bin is common."""
+    v_ref, v = np.asarray(v_ref, float), np.asarray(v, float)
+    ok = np.isfinite(v_ref) & np.isfinite(v)
+    diff = np.sqrt(np.sum(np.where(ok, (v - v_ref) ** 2, 0.0), axis=-1))
+    norm = np.sqrt(np.sum(np.where(ok, v_ref**2, 0.0), axis=-1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(norm > 0, diff / np.where(norm > 0, norm, 1.0), np.nan)
 
-    ||v - v_ref|| / ||v_ref|| over the bins both profiles fill (profiles are compared in
-    drum coordinates, which CG does not change).
+
+def profile_l2_error(s_ref: list[float], v_ref: list[float], s: list[float], v: list[float]) -> float:
+    """Relative L2 difference of a velocity profile against a reference.
+
+    Both profiles are on the normalised depth xi (surface 0, wall 1), so bins compare one
+    to one across CG levels; a profile on other bin centres is interpolated onto the
+    reference's (nan where it has no data).
     """
     s_ref, v_ref, s, v = map(lambda a: np.asarray(a, float), (s_ref, v_ref, s, v))
-    vi = np.interp(s_ref, s, np.where(np.isfinite(v), v, np.nan)) if len(s) else np.full_like(s_ref, np.nan)
-    ok = np.isfinite(v_ref) & np.isfinite(vi)
-    if not ok.any():
-        return float("nan")
-    norm = np.linalg.norm(v_ref[ok])
-    return float(np.linalg.norm(vi[ok] - v_ref[ok]) / norm) if norm > 0 else float("nan")
+    if len(s) != len(s_ref) or not np.allclose(s, s_ref):
+        ok = np.isfinite(v)
+        v = (np.interp(s_ref, s[ok], v[ok], left=np.nan, right=np.nan) if ok.sum() > 1
+             else np.full_like(s_ref, np.nan))
+    return float(relative_l2(v_ref, v))

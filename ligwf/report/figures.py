@@ -43,25 +43,43 @@ def _label(cg: float, rule: str) -> str:
 
 
 def pareto(conditions: pd.DataFrame, path: Path) -> Path:
-    """Error vs run time: each condition's errors against its core-seconds (log x)."""
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    """Error vs run time on the table's footing: x is production core-seconds per simulated
+    second of production (what the speedup column divides), errors with their intervals
+    and the CG1 noise floor (dotted); a third panel shows each condition's fill, settle and
+    production core-seconds, which the x axis leaves out."""
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     for ax, col, title in ((axes[0], "angle_error", "angle of repose error vs CG1"),
                            (axes[1], "profile_error", "velocity profile error (rel. L2) vs CG1")):
         for _, r in conditions.iterrows():
-            y = r[col]
-            if not np.isfinite(y) or not np.isfinite(r["core_seconds"]):
+            y, x = r[col], r["production_core_rate"]
+            if not np.isfinite(y) or not np.isfinite(x):
                 continue
             lo, hi = r.get(f"{col}_lo"), r.get(f"{col}_hi")
             yerr = None
             if np.isfinite(lo) and np.isfinite(hi):
-                yerr = [[max(y - lo, 0)], [max(hi - y, 0)]]
-            ax.errorbar(r["core_seconds"], 100 * y, yerr=None if yerr is None else 100 * np.array(yerr),
-                        fmt="o", capsize=3, label=_label(r["cg"], r["rule"]))
-            ax.annotate(_label(r["cg"], r["rule"]), (r["core_seconds"], 100 * y),
+                yerr = 100 * np.array([[max(y - lo, 0)], [max(hi - y, 0)]])
+            ax.errorbar(x, 100 * y, yerr=yerr, fmt="o", capsize=3)
+            ax.annotate(_label(r["cg"], r["rule"]), (x, 100 * y),
                         textcoords="offset points", xytext=(4, 4), fontsize=8)
+        floors = conditions.get(f"{col}_floor", pd.Series(dtype=float)).dropna()
+        if len(floors):
+            ax.axhline(100 * floors.iloc[0], ls=":", color="grey",
+                       label=f"CG1 noise floor ({conditions[f'{col}_floor_source'].iloc[0]})")
         ax.set_xscale("log")
         ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short spans
-        _axes(ax, "run time [core-seconds]", "error [%]", title)
+        _axes(ax, "production cost [core-s per simulated s]", "error [%]", title,
+              legend=7 if len(floors) else None)
+    ax = axes[2]
+    labels = [_label(r["cg"], r["rule"]) for _, r in conditions.iterrows()]
+    bottom = np.zeros(len(conditions))
+    for phase in ("fill", "settle", "production"):
+        vals = conditions.get(f"{phase}_core_seconds", pd.Series(np.nan, index=conditions.index))
+        vals = np.nan_to_num(vals.to_numpy(float))
+        ax.bar(labels, vals, bottom=bottom, label=phase)
+        bottom += vals
+    ax.set_yscale("log")
+    _axes(ax, "condition", "core-seconds per run (mean over replicas)",
+          "run cost by phase", legend=8)
     return _save(fig, path)
 
 
@@ -80,19 +98,21 @@ def gsd_overlay(gsd: pd.DataFrame, path: Path) -> Path:
 
 
 def velocity_profiles(cases: pd.DataFrame, profiles: dict, path: Path) -> Path:
-    """Mean velocity profile along the normal to the free surface, per case."""
+    """Mean downhill velocity against the normalised depth below the free surface, per case
+    (the coordinate the profile error compares on)."""
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for _, r in cases.sort_values(["cg", "rule", "replica"]).iterrows():
         p = profiles.get(r["case_id"])
         if not p:
             continue
         v = np.array(p["v_mean"], dtype=float)
-        ax.plot(v, 1000 * np.array(p["s"]), label=r["case_id"], lw=1.2,
+        ax.plot(v, np.array(p["s"]), label=r["case_id"], lw=1.2,
                 ls="-" if r["cg"] == 1 else ("--" if r["rule"] == "weber" else ":"))
     ax.axvline(0, color="k", lw=0.5)
-    _axes(ax, "velocity along the free surface [m/s]",
-           "distance from drum centre along the surface normal [mm]",
-           "velocity profiles (solid CG1, dashed weber, dotted bond)", legend=7)
+    ax.invert_yaxis()
+    _axes(ax, "velocity down the free surface [m/s]",
+          "depth below the free surface / bed depth",
+          "velocity profiles (solid CG1, dashed weber, dotted bond)", legend=7)
     return _save(fig, path)
 
 
@@ -100,11 +120,14 @@ def snapshot(particles_vtu: Path, drum_stl: Path, axis: str, drum_angle: float, 
              path: Path, title: str) -> Path:
     """Off-screen pyvista picture of one frame seen along the drum axis, coloured by
     ``scalar`` (``speed`` or ``granule``), with the drum turned to ``drum_angle`` (rad)."""
-    from ligwf.report.paraview import rotation_matrix
-    import pyvista as pv
+    from ligwf.report.offscreen import granule_colours, pyvista_offscreen
+    from ligwf.report.paraview import read_stl, rotation_matrix
 
-    pv.OFF_SCREEN = True
+    pv = pyvista_offscreen()
     cloud = pv.read(str(particles_vtu))
+    note = ""
+    if scalar == "granule":
+        cloud["colour"], note = granule_colours(np.asarray(cloud["granule"]))
     if scalar == "speed":
         cloud["speed"] = np.linalg.norm(np.asarray(cloud["v"]), axis=1)
     if "radius" in cloud.array_names:
@@ -114,12 +137,15 @@ def snapshot(particles_vtu: Path, drum_stl: Path, axis: str, drum_angle: float, 
     else:
         spheres = cloud
     plotter = pv.Plotter(off_screen=True, window_size=(640, 640))
-    cmap = "viridis" if scalar == "speed" else "tab20"
-    plotter.add_mesh(spheres, scalars=scalar, cmap=cmap, show_scalar_bar=True)
-    drum = pv.read(str(drum_stl))
-    drum.points = np.asarray(drum.points) @ rotation_matrix(axis, drum_angle).T
+    if scalar == "granule":   # categorical: one colour per granule, no continuous bar
+        plotter.add_mesh(spheres, scalars="colour", rgb=True)
+    else:
+        plotter.add_mesh(spheres, scalars=scalar, cmap="viridis", show_scalar_bar=True)
+    tri = read_stl(drum_stl) @ rotation_matrix(axis, drum_angle).T
+    drum = pv.PolyData(tri.reshape(-1, 3),
+                       np.c_[np.full(len(tri), 3), np.arange(3 * len(tri)).reshape(-1, 3)].ravel())
     plotter.add_mesh(drum, style="wireframe", color="grey", opacity=0.3)
-    plotter.add_text(title, font_size=10)
+    plotter.add_text(title + (f"\n{note}" if note else ""), font_size=10)
     normal = {"x": (1, 0, 0), "y": (0, -1, 0), "z": (0, 0, 1)}[axis]
     plotter.view_vector(normal, viewup=(0, 0, 1) if axis != "z" else (0, 1, 0))
     png = plotter.screenshot(return_img=True)

@@ -32,6 +32,15 @@ def rotation_matrix(axis: str, angle: float) -> np.ndarray:
     return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
 
 
+def read_stl(path: Path) -> np.ndarray:
+    """Triangles (M, 3, 3) of an ASCII STL file such as the drum ligwf writes
+    (:func:`ligwf.engine.mesh.stl_text`). ligwf reads its own mesh instead of meshio, whose
+    STL reader first tries the binary layout and prints a numpy overflow warning on ASCII."""
+    words = Path(path).read_text().split()
+    coords = [words[k + 1:k + 4] for k, w in enumerate(words) if w == "vertex"]
+    return np.asarray(coords, dtype=float).reshape(-1, 3, 3)
+
+
 def _pvd(entries: list[tuple[float, int, str]]) -> str:
     lines = ['<?xml version="1.0"?>',
              '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
@@ -51,8 +60,9 @@ def case_collection(case: CaseFolder, analysis_dir: Path, out_dir: Path) -> Path
         return None
     if not frames:
         return None
-    drum = meshio.read(case.path / MESH_NAME)
-    tri = drum.cells_dict["triangle"]
+    tri_pts = read_stl(case.path / MESH_NAME)
+    points = tri_pts.reshape(-1, 3)
+    tri = np.arange(len(points)).reshape(-1, 3)
     case_out = out_dir / case.case_id
     case_out.mkdir(parents=True, exist_ok=True)
     entries = []
@@ -62,7 +72,7 @@ def case_collection(case: CaseFolder, analysis_dir: Path, out_dir: Path) -> Path
         g = labelled / f"granules_{ff.step}.vtu"
         particles = g if g.is_file() else ff.particles
         entries.append((t, 0, os.path.relpath(particles, out_dir)))
-        pts = drum.points @ rotation_matrix(s.axis, case.drum_angle(ff.step)).T
+        pts = points @ rotation_matrix(s.axis, case.drum_angle(ff.step)).T
         drum_file = case_out / f"drum_{ff.step}.vtu"
         tmp = drum_file.with_suffix(".tmp.vtu")
         meshio.write(tmp, meshio.Mesh(pts, [("triangle", tri)]), binary=True)

@@ -5,36 +5,39 @@ Inputs (all already on disk): the study (its cases' scaled scenes and manifests,
 table and profiles from the flow stage; frame and GSD summary tables from the granule
 stage when granules were analysed; names in :mod:`ligwf.study.layout`).
 
-Per case: CG level, rule, particles, dt, steps, wall and core-seconds, speedup vs CG1
-(core-seconds per simulated second of the CG1 cases of the same sweep group over this
-case's: CG levels may simulate different times, e.g. more revolutions where they are
-cheap), and errors vs
-CG1: angle of repose (relative), velocity profile (relative L2), GSD error below/above the
-size limit, largest-cluster fraction. Per condition (CG level, rule, group): mean and 95 %
-confidence interval over replicas (Student t; a single replica has no interval).
-Only ``done`` cases with a matching scene hash count; the others are listed with their
-status and reason, never averaged in.
+Per case: CG level, rule, particles, dt, steps, wall and core-seconds split into fill,
+settle and production (the manifest's per-phase times), the production cost per simulated
+second of production (core-s / s: CG levels may simulate different times, and filling
+costs differ), speedup vs CG1 on that footing, and errors vs CG1: angle of repose
+(relative), velocity profile (relative L2 on the normalised depth), GSD error below/above
+the size limit, largest-cluster fraction.
+Per condition (CG level, rule, group): value with a 95 % interval that respects the data
+(:mod:`ligwf.report.uncertainty`: block bootstrap over frames and replicas, bounded, never
+narrower than the within-run error, none for one replica) and each error against the CG1
+noise floor. Only ``done`` cases with a matching scene hash count; the others are listed
+with their status and reason, never averaged in.
 """
 
 from __future__ import annotations
 
 import json
 import math
-import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
-from ligwf.analysis.flow import profile_l2_error
+from ligwf.report.uncertainty import (ERROR_METRICS, FRAME_METRICS, ONE_GRANULE,
+                                      ConditionStats, case_series, cost_interval, mark)
 from ligwf.study import layout
 from ligwf.study.study import Study
 
-METRICS = ["core_seconds", "wall_seconds", "speedup_core", "speedup_wall",
-           "angle_of_repose", "angle_of_repose_std", "angle_error", "profile_error",
-           "rigid_frame_share", "rms_speed_rel_fluctuation", "largest_cluster_fraction",
-           "one_granule_frame_share", "gsd_error_below", "gsd_error_above"]
+METRICS = ["core_seconds", "wall_seconds", "production_core_rate", "speedup_core",
+           "speedup_wall", "angle_of_repose", "angle_of_repose_std", "angle_error",
+           "profile_error", "rigid_frame_share", "rms_speed_rel_fluctuation",
+           "largest_cluster_fraction", "one_granule_frame_share", "gsd_error_below",
+           "gsd_error_above"]
+PHASES = ("fill", "settle", "production")
 
 
 #: Already pooled over replicas by the analysis stage (bootstrap bands), not per case.
@@ -57,15 +60,26 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
     for c in usable:
         man = c.manifest()
         s = c.scaled
-        prod = (man.phases or {}).get("production", {})
+        phases = man.phases or {}
+        prod = phases.get("production", {})
+        production_seconds = s.run_steps * s.dt
+        prod_core = prod.get("core_seconds", math.nan)
+        prod_wall = prod.get("wall_seconds", math.nan)
+        if not prod:   # a manifest without phase times: whole-run cost over whole-run time
+            prod_core, prod_wall = man.core_seconds, man.wall_seconds
+            production_seconds = man.steps_done * s.dt
         rows.append({
             "case_id": c.case_id, "group": c.group, "cg": c.cg, "rule": c.rule,
             "replica": c.replica, "particles": s.particle_count, "dt": s.dt,
             "steps": man.steps_done,
             "simulated_seconds": man.steps_done * s.dt,
+            "production_seconds": production_seconds,
             "wall_seconds": man.wall_seconds,
             "core_seconds": man.core_seconds,
-            "production_core_seconds": prod.get("core_seconds", math.nan),
+            **{f"{ph}_core_seconds": phases.get(ph, {}).get("core_seconds", math.nan)
+               for ph in PHASES},
+            "production_core_rate": prod_core / production_seconds,
+            "production_wall_rate": prod_wall / production_seconds,
             "nprocs": man.nprocs,
         })
     return pd.DataFrame(rows), skipped
@@ -77,15 +91,19 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path) -> pd.DataFrame:
     flow = _read_csv(analysis_dir / layout.FLOW_TABLE)
     if not flow.empty:
         keep = flow[["case_id", "angle_of_repose_mean", "angle_of_repose_std", "rigid_frame_share",
-                     "rms_speed_rel_fluctuation", "flowing_layer_thickness_mean"]]
+                     "rms_speed_rel_fluctuation", "flowing_layer_thickness_mean",
+                     *[c for c in ("steady_fraction", "steady_from_step") if c in flow]]]
         df = df.merge(keep.rename(columns={"angle_of_repose_mean": "angle_of_repose"}),
                       on="case_id", how="left")
     frames = _read_csv(analysis_dir / layout.FRAMES_TABLE)
     if not frames.empty and "largest_fraction" in frames:
-        ok = frames[frames.get("status", "ok") == "ok"] if "status" in frames else frames
+        ok = frames[frames["status"] == "ok"] if "status" in frames else frames
+        if "steady_from_step" in df:   # the flow stage's steady window, case by case
+            first = ok["case_id"].map(df.set_index("case_id")["steady_from_step"])
+            ok = ok[ok["step"] >= first.fillna(-math.inf)]
         agg = ok.groupby("case_id")["largest_fraction"].agg(
             largest_cluster_fraction="mean",
-            one_granule_frame_share=lambda x: float(np.mean(np.asarray(x) > 0.99)))
+            one_granule_frame_share=lambda x: float(np.mean(np.asarray(x) > ONE_GRANULE)))
         df = df.merge(agg.reset_index(), on="case_id", how="left")
     summary = _read_csv(analysis_dir / layout.GSD_SUMMARY_TABLE)
     if not summary.empty:
@@ -100,73 +118,89 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path) -> pd.DataFrame:
     return df
 
 
-def compare_to_cg1(df: pd.DataFrame, profiles: dict) -> pd.DataFrame:
-    """Speedups and errors of every case against the CG1 cases of its sweep group."""
+def compare_to_cg1(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
+    """Speedups and errors of every case against the CG1 cases of its sweep group.
+
+    Speedup: CG1 production core-seconds per simulated second of production over the
+    case's (wall likewise). Errors: against the mean of the group's CG1 runs.
+    """
     df = df.copy()
-    for group, sub in df.groupby("group"):
+    for _, sub in df.groupby("group"):
         ref = sub[sub["cg"] == 1]
         if ref.empty:
             continue
-        # cost per simulated second, so cases simulated for different times compare
-        sim = df.loc[sub.index, "simulated_seconds"]
-        core1 = (ref["core_seconds"] / ref["simulated_seconds"]).mean()
-        wall1 = (ref["wall_seconds"] / ref["simulated_seconds"]).mean()
-        ang1 = ref["angle_of_repose"].mean()
-        ref_prof = [profiles[c] for c in ref["case_id"] if c in profiles]
-        if ref_prof:
-            s_ref = ref_prof[0]["s"]
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", RuntimeWarning)  # bins empty in every CG1 case
-                v_ref = np.nanmean(np.array([p["v_mean"] for p in ref_prof], dtype=float), axis=0)
         idx = sub.index
-        df.loc[idx, "speedup_core"] = core1 / (df.loc[idx, "core_seconds"] / sim)
-        df.loc[idx, "speedup_wall"] = wall1 / (df.loc[idx, "wall_seconds"] / sim)
-        df.loc[idx, "angle_error"] = (df.loc[idx, "angle_of_repose"] - ang1).abs() / ang1
-        if ref_prof:
-            for i in idx:
-                p = profiles.get(df.at[i, "case_id"])
-                if p is not None:
-                    df.at[i, "profile_error"] = profile_l2_error(s_ref, v_ref, p["s"], p["v_mean"])
+        df.loc[idx, "speedup_core"] = ref["production_core_rate"].mean() / df.loc[idx, "production_core_rate"]
+        df.loc[idx, "speedup_wall"] = ref["production_wall_rate"].mean() / df.loc[idx, "production_wall_rate"]
+        for i in idx:
+            for col in ERROR_METRICS:
+                df.at[i, col] = stats.error_metric([df.at[i, "case_id"]], list(ref["case_id"]), col).value
     return df
 
 
-def confidence(values: pd.Series, level: float = 0.95) -> tuple[float, float, float]:
-    """(mean, lo, hi) with a Student-t interval over replicas; lo = hi = nan for n < 2."""
-    x = values.dropna().to_numpy(dtype=float)
-    if len(x) == 0:
-        return math.nan, math.nan, math.nan
-    m = float(x.mean())
-    if len(x) < 2:
-        return m, math.nan, math.nan
-    half = float(stats.t.ppf(0.5 + level / 2, len(x) - 1) * x.std(ddof=1) / math.sqrt(len(x)))
-    return m, m - half, m + half
-
-
-def condition_table(df: pd.DataFrame) -> pd.DataFrame:
-    """Mean and 95 % CI of every metric per (group, CG level, rule)."""
+def condition_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
+    """Value, 95 % interval (``_lo``/``_hi``, nan: no replica interval) and within-run
+    error (``_se``) of every metric per (group, CG level, rule); each error with the
+    group's CG1 noise floor (``_floor``, ``_floor_source``) and its mark (``_vs_floor``)."""
     rows = []
     for (group, cg, rule), sub in df.groupby(["group", "cg", "rule"], sort=True):
+        ids = list(sub["case_id"])
+        ref_ids = list(df[(df["group"] == group) & (df["cg"] == 1)]["case_id"])
         row = {"group": group, "cg": cg, "rule": rule, "replicas": len(sub),
                "particles": int(sub["particles"].iloc[0]), "dt": float(sub["dt"].iloc[0]),
                "steps": int(sub["steps"].max())}
+        for ph in ("fill", "settle"):
+            row[f"{ph}_core_seconds"] = float(sub[f"{ph}_core_seconds"].mean())
         for col in METRICS:
-            if col in GSD_METRICS:  # one value per condition, with its bootstrap band
+            if col in GSD_METRICS:  # one value per condition, with its GSD-stage band
                 first = sub.iloc[0]
-                m, lo, hi = first[col], first.get(f"{col}_lo", math.nan), first.get(f"{col}_hi", math.nan)
+                iv = (first[col], first.get(f"{col}_lo", math.nan),
+                      first.get(f"{col}_hi", math.nan), math.nan)
+            elif col in FRAME_METRICS:
+                i = stats.frame_metric(ids, col)
+                iv = (i.value, i.lo, i.hi, i.se_within)
+            elif col in ERROR_METRICS:
+                i = stats.error_metric(ids, ref_ids, col) if ref_ids else None
+                iv = (i.value, i.lo, i.hi, i.se_within) if i else (math.nan,) * 4
+                fl = stats.floor(ref_ids, col)
+                row[f"{col}_floor"], row[f"{col}_floor_source"] = fl.value, fl.source
+                row[f"{col}_vs_floor"] = "reference" if cg == 1 else mark(iv[0], fl.value)
             else:
-                m, lo, hi = confidence(sub[col])
-            row[col], row[f"{col}_lo"], row[f"{col}_hi"] = m, lo, hi
+                i = cost_interval(sub[col])
+                iv = (i.value, i.lo, i.hi, i.se_within)
+            row[col], row[f"{col}_lo"], row[f"{col}_hi"], row[f"{col}_se"] = iv
         rows.append(row)
     return pd.DataFrame(rows)
 
 
-def build_tables(study: Study) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], dict]:
-    """(case table, condition table, skipped cases, profiles) of a finished study."""
+def noise_floor_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
+    """Per group and frame metric: the CG1 value and its CG1-vs-CG1 scatter."""
+    rows = []
+    for group, sub in df.groupby("group"):
+        ref_ids = list(sub[sub["cg"] == 1]["case_id"])
+        if not ref_ids:
+            continue
+        for col in FRAME_METRICS:
+            value = stats.frame_metric(ref_ids, col).value
+            scatter, source = stats.scatter(ref_ids, col)
+            rows.append({"group": group, "metric": col, "cg1_value": value,
+                         "cg1_scatter": scatter, "source": source})
+    return pd.DataFrame(rows)
+
+
+def build_tables(study: Study) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], dict, pd.DataFrame]:
+    """(case table, condition table, skipped cases, profiles, noise-floor table) of a
+    finished study."""
     cases, skipped = case_rows(study)
     analysis_dir = study.analysis_dir
     prof_path = analysis_dir / layout.FLOW_PROFILES
     profiles = json.loads(prof_path.read_text())["profiles"] if prof_path.is_file() else {}
     if cases.empty:
-        return cases, pd.DataFrame(), skipped, profiles
-    df = compare_to_cg1(merge_analysis(cases, analysis_dir), profiles)
-    return df, condition_table(df), skipped, profiles
+        return cases, pd.DataFrame(), skipped, profiles, pd.DataFrame()
+    merged = merge_analysis(cases, analysis_dir)
+    frames = _read_csv(analysis_dir / layout.FRAMES_TABLE)
+    settings = study.analysis
+    stats = ConditionStats(case_series(list(merged["case_id"]), profiles, frames),
+                           settings.bootstrap, settings.seed)
+    df = compare_to_cg1(merged, stats)
+    return df, condition_table(df, stats), skipped, profiles, noise_floor_table(df, stats)

@@ -20,6 +20,7 @@ import pandas as pd
 from ligwf import __version__
 from ligwf.analysis.frame_checks import last_usable_frame
 from ligwf.analysis.flow_run import flow_study
+from ligwf.analysis.steady import is_auto
 from ligwf.engine.render import MESH_NAME
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
@@ -34,13 +35,16 @@ from ligwf.study.study import Study
 CASE_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", "rep"),
                 ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
                 ("wall_seconds", "wall [s]"), ("core_seconds", "core-s"),
-                ("speedup_core", "speedup (core-s)"), ("angle_of_repose", "angle [deg]"),
+                ("fill_core_seconds", "fill core-s"), ("settle_core_seconds", "settle core-s"),
+                ("production_core_rate", "prod. core-s / sim. s"),
+                ("speedup_core", "speedup (core-s)"), ("steady_fraction", "steady from"), ("angle_of_repose", "angle [deg]"),
                 ("angle_of_repose_std", "angle std [deg]"), ("angle_error", "angle err"),
                 ("profile_error", "profile err (L2)"), ("rigid_frame_share", "rigid frames"),
                 ("largest_cluster_fraction", "largest cluster"),
                 ("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
 
-CONDITION_METRICS = [("speedup_core", "speedup"), ("angle_of_repose", "angle [deg]"),
+CONDITION_METRICS = [("production_core_rate", "prod. core-s / sim. s"),
+                     ("speedup_core", "speedup"), ("angle_of_repose", "angle [deg]"),
                      ("angle_error", "angle err"), ("profile_error", "profile err"),
                      ("rigid_frame_share", "rigid frames"),
                      ("largest_cluster_fraction", "largest cluster"),
@@ -58,10 +62,44 @@ def _fmt(v) -> str:
 
 
 def _ci(row, col) -> str:
+    """Value [95 % interval], "(no replica interval)" for one replica, and for an error
+    its mark against the CG1 noise floor."""
     m, lo, hi = row[col], row.get(f"{col}_lo"), row.get(f"{col}_hi")
+    mark = row.get(f"{col}_vs_floor")
+    if mark == "reference":   # CG1's error against itself
+        return "reference"
+    tail = f" {mark}" if isinstance(mark, str) and mark not in ("–", "reference") else ""
+    if not (isinstance(m, float) and math.isfinite(m)):
+        return _fmt(m)
     if isinstance(lo, float) and math.isfinite(lo):
-        return f"{_fmt(m)} [{_fmt(lo)}, {_fmt(hi)}]"
-    return _fmt(m)
+        return f"{_fmt(m)} [{_fmt(lo)}, {_fmt(hi)}]{tail}"
+    if row.get("replicas", 0) < 2 and not col.startswith("gsd_"):
+        return f"{_fmt(m)} (no replica interval){tail}"
+    return _fmt(m) + tail
+
+
+def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame) -> list[str]:
+    """The CG1 noise floor: per metric the CG1-vs-CG1 scatter, per error the floor."""
+    lines = ["## CG1 noise floor", "",
+             "How far one CG1 run is from another (other seed). An error marked `within` is "
+             "not distinguishable from seed noise; `beyond` is a CG effect.", ""]
+    if not floors.empty:
+        lines += ["| group | metric | CG1 value | CG1 scatter | from |", "|---|---|---|---|---|"]
+        for _, r in floors.iterrows():
+            lines.append(f"| {r['group']} | {r['metric']} | {_fmt(r['cg1_value'])} | "
+                         f"{_fmt(r['cg1_scatter'])} | {r['source']} |")
+        lines.append("")
+    if not conditions.empty and "angle_error_floor" in conditions:
+        lines += ["| CG | rule | angle err | floor | | profile err | floor | |",
+                  "|---|---|---|---|---|---|---|---|"]
+        for _, r in conditions[conditions["cg"] != 1].iterrows():
+            cells = [f"{r['cg']:g}", r["rule"]]
+            for col in ("angle_error", "profile_error"):
+                cells += [_fmt(r[col]), f"{_fmt(r[f'{col}_floor'])} ({r[f'{col}_floor_source']})",
+                          str(r[f"{col}_vs_floor"])]
+            lines.append("| " + " | ".join(cells) + " |")
+        lines.append("")
+    return lines
 
 
 def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame) -> str:
@@ -70,7 +108,12 @@ def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame) -> str:
     lines = ["## Cases", "", head, sep]
     for _, r in cases.sort_values(["group", "cg", "rule", "replica"]).iterrows():
         lines.append("| " + " | ".join(_fmt(r[c]) for c, _ in CASE_COLUMNS) + " |")
-    lines += ["", "## Conditions (mean [95 % CI over replicas])", ""]
+    lines += ["", "## Conditions (value [95 % interval])", "",
+              "Intervals: block bootstrap over frames (block = 2 x the measured "
+              "autocorrelation time) and replicas, never narrower than the within-run error, "
+              "bounded to the quantity's range (ligwf.analysis.intervals); run costs: t on the "
+              "logarithm over replicas; one replica: no replica interval. GSD bands come from "
+              "the GSD stage. Errors are marked `within` / `beyond` the CG1 noise floor.", ""]
     head = "| CG | rule | replicas | particles | core-s | " + " | ".join(t for _, t in CONDITION_METRICS) + " |"
     lines += [head, "|" + "---|" * (5 + len(CONDITION_METRICS))]
     for _, r in conditions.iterrows():
@@ -87,10 +130,11 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     fig_dir, pv_dir = out / "figures", out / "paraview"
     fig_dir.mkdir(parents=True, exist_ok=True)
     flow_study(study)
-    cases, conditions, _, profiles = build_tables(study)
+    cases, conditions, _, profiles, floors = build_tables(study)
     problems = study_problems(study)
     atomic_write_text(out / "cases.csv", cases.to_csv(index=False))
     atomic_write_text(out / "conditions.csv", conditions.to_csv(index=False))
+    atomic_write_text(out / "noise_floor.csv", floors.to_csv(index=False))
 
     figures: list[tuple[str, Path]] = []
     if not conditions.empty:
@@ -126,8 +170,11 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     md = "\n".join([
         f"# {name}: error against run time", "",
         f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are relative to the "
-        "CG1 cases of the same sweep group; speedup is CG1 core-seconds per simulated second over the case's.", "",
+        "CG1 cases of the same sweep group; speedup is CG1 production core-seconds per simulated "
+        "second of production over the case's (fill and settle costs in their own columns).", "",
+        f"Steady window: {steady_line(study, cases)}.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
+        *noise_markdown(conditions, floors),
         *problems.markdown(),
         "## Figures", "",
         *[f"![{t}](figures/{p.name})" for t, p in figures], "",
@@ -136,6 +183,18 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / "summary.md", md)
     atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, problems))
     return out
+
+
+def steady_line(study: Study, cases: pd.DataFrame) -> str:
+    """The steady-window rule of the study and the fractions it gave."""
+    setting = study.analysis.steady_after
+    fr = cases.get("steady_fraction", pd.Series(dtype=float)).dropna()
+    if is_auto(setting):
+        span = (f"{100 * fr.min():.0f}-{100 * fr.max():.0f} %" if len(fr) else "–")
+        return (f"`steady_after: auto` (the first frame after which running means of the flow "
+                f"angle and kinetic energy stay within their steady scatter, "
+                f"ligwf.analysis.steady): {span} of production left out")
+    return f"`steady_after: {setting}`: the first {100 * float(setting):.0f} % of production left out"
 
 
 def _html(name, cases, conditions, figures, problems) -> str:

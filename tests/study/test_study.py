@@ -44,14 +44,16 @@ def test_speedup_and_errors_against_cg1(study):
     cases = pd.read_csv(study / "report" / "cases.csv").set_index("case_id")
     flow = pd.read_csv(study / "analysis" / "flow.csv").set_index("case_id")
     frames = pd.read_csv(study / "analysis" / "frames.csv")
-    rate = cases["core_seconds"] / (cases["steps"] * cases["dt"])
+    rate = cases["production_core_seconds"] / cases["production_seconds"]
     assert np.allclose(cases["simulated_seconds"], cases["steps"] * cases["dt"])
+    assert np.allclose(cases["production_core_rate"], rate)
     ang1 = flow.loc["cg1-none-r0", "angle_of_repose_mean"]
     for cid, row in cases.iterrows():
         assert row["speedup_core"] == pytest.approx(rate["cg1-none-r0"] / rate[cid])
         assert row["angle_of_repose"] == pytest.approx(flow.loc[cid, "angle_of_repose_mean"])
         assert row["angle_error"] == pytest.approx(abs(row["angle_of_repose"] - ang1) / ang1)
-        fr = frames[(frames["case_id"] == cid) & (frames["status"] == "ok")]
+        fr = frames[(frames["case_id"] == cid) & (frames["status"] == "ok")
+                    & (frames["step"] >= flow.loc[cid, "steady_from_step"])]
         assert row["largest_cluster_fraction"] == pytest.approx(fr["largest_fraction"].mean())
     assert cases.loc["cg1-none-r0", "profile_error"] == pytest.approx(0.0)
     # CG2 is cheaper than CG1 (8x fewer particles, 2x fewer steps)
@@ -73,6 +75,49 @@ def test_gsd_errors_and_condition_means(study):
             assert c["gsd_error_above"] == pytest.approx(s["error_above"], nan_ok=True)
             lo, hi = c["angle_of_repose_lo"], c["angle_of_repose_hi"]
             assert lo <= c["angle_of_repose"] <= hi
+
+
+BOUNDS = {"rigid_frame_share": (0, 1), "largest_cluster_fraction": (0, 1),
+          "one_granule_frame_share": (0, 1), "angle_of_repose": (-90, 90)}
+POSITIVE = ("core_seconds", "wall_seconds", "production_core_rate", "speedup_core",
+            "speedup_wall", "angle_error", "profile_error", "angle_of_repose_std",
+            "rms_speed_rel_fluctuation")
+
+
+def test_intervals_respect_within_run_noise_and_bounds(study):
+    """No interval in the report is narrower than the within-run standard error of its
+    metric; no bounded quantity has a bound outside its range; one replica: no interval."""
+    conds = pd.read_csv(study / "report" / "conditions.csv")
+    profiles = json.loads((study / "analysis" / "flow_profiles.json").read_text())["profiles"]
+    cases = pd.read_csv(study / "report" / "cases.csv")
+    checked = 0
+    for _, c in conds.iterrows():
+        for col in [k[:-3] for k in conds.columns if k.endswith("_lo")]:
+            lo, hi, v = c[f"{col}_lo"], c[f"{col}_hi"], c[col]
+            if c["replicas"] < 2 and not col.startswith("gsd_"):
+                assert np.isnan(lo) and np.isnan(hi), col
+                continue
+            if np.isnan(lo):
+                continue
+            assert lo <= v <= hi, col
+            se = c.get(f"{col}_se", np.nan)
+            if np.isfinite(se):
+                assert hi - lo >= se, col
+                checked += 1
+            if col in BOUNDS:
+                assert BOUNDS[col][0] <= lo and hi <= BOUNDS[col][1], col
+            if col in POSITIVE:
+                assert lo >= 0, col
+        if c["replicas"] >= 2:   # independently: the angle's band vs the frames' plain SE
+            ids = cases[(cases["cg"] == c["cg"]) & (cases["rule"] == c["rule"])]["case_id"]
+            ses = [np.nanstd(profiles[i]["angle_series"], ddof=1)
+                   / np.sqrt(len(profiles[i]["angle_series"])) for i in ids]
+            naive = np.sqrt(np.sum(np.square(ses))) / len(ses)
+            assert c["angle_of_repose_hi"] - c["angle_of_repose_lo"] >= naive
+    assert checked > 0
+    md = (study / "report" / "summary.md").read_text()
+    assert "(no replica interval)" in md and "## CG1 noise floor" in md
+    assert set(conds.loc[conds["cg"] > 1, "angle_error_vs_floor"]) <= {"within", "beyond"}
 
 
 def test_figures_and_paraview_files(study):
