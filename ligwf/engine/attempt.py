@@ -24,6 +24,9 @@ from ligwf.study.case import CaseFolder
 from ligwf.study.layout import SCREEN_FILE
 from ligwf.study.manifest import Attempt, Manifest, now_iso, overwrite_manifest
 
+#: how the reason of an attempt ended by a full disk begins (the runner then stops)
+DISK_FULL = "disk full"
+
 _VERSION_RE = re.compile(r"^LIGGGHTS \((Version .*)\)\s*$")
 
 
@@ -140,7 +143,7 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     left = space_left(case.path)
     if status in (FAILED, KILLED) and left < LOW_SPACE_BYTES:
         # a full disk makes LIGGGHTS segfault: the case resumes once there is room
-        status, reason = KILLED, f"disk full ({left} bytes left in {case.path}): {reason}"
+        status, reason = KILLED, f"{DISK_FULL} ({left} bytes left in {case.path}): {reason}"
 
     attempt.ended = now_iso()
     attempt.wall_seconds = wall_seconds

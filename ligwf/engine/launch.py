@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Protocol, Sequence
 
-from ligwf.engine.attempt import (begin_attempt, close_lost_attempt, expectation,
+from ligwf.engine.attempt import (DISK_FULL, begin_attempt, close_lost_attempt, expectation,
                                   finish_attempt, history, merge_rows, restart_unreadable)
 from ligwf.engine.guard import (STOP_GRACE_SECONDS, EngineProcess, descendants, engine_env,
                                 engine_tree, live_engines, release, stop_engines, watch)
@@ -182,7 +182,7 @@ def run_case(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Monit
         if exc.errno in NOT_WRITABLE:   # e.g. removing old outputs on a read-only mount
             raise not_writable(exc, case.path) from exc
         raise
-    if manifest is not None and manifest.reason.startswith("disk full"):
+    if manifest is not None and manifest.reason.startswith(DISK_FULL):
         raise FolderNotWritable(f"{case.path}: {manifest.reason}")
     return manifest
 
