@@ -49,9 +49,9 @@ def steady_fraction(case: CaseFolder, steady_after, flows: list) -> float:
                          case.production_start_step * dt, case.scaled.run_steps * dt)
 
 
-def case_flow(case: CaseFolder, steady_after) -> tuple[dict, dict, list[str]]:
-    """(summary row, profiles, skipped-frame notes) of one case folder; DumpReadError when
-    no frame of the steady window is usable, ConfigError when its dump record is unreadable."""
+def _production_frames(case: CaseFolder) -> tuple[list, list, list[dict]]:
+    """Checked particle frames of the production phase, their flows, and the frames
+    refused or missing (``{"step", "reason"}``)."""
     geo = DrumGeometry.from_scaled(case.scaled)
     production = case.production_start_step
     plan = plan_frames(case)
@@ -67,7 +67,24 @@ def case_flow(case: CaseFolder, steady_after) -> tuple[dict, dict, list[str]]:
             frames.append(frame)
         except DumpReadError as exc:
             problems.append({"step": ff.step, "reason": str(exc)})
-    all_flows = [frame_flow(f, geo) for f in frames]
+    return frames, [frame_flow(f, geo) for f in frames], problems
+
+
+def steady_start_step(case: CaseFolder, steady_after) -> int:
+    """First step of the case's steady window: the fixed fraction of production, or for
+    ``auto`` the measured spin-up (reads the production frames: the granule stage asks
+    this before the flow stage has run)."""
+    if not is_auto(steady_after):
+        return case.steady_start_step(float(steady_after))
+    _, flows, _ = _production_frames(case)
+    return case.steady_start_step(steady_fraction(case, steady_after, flows))
+
+
+def case_flow(case: CaseFolder, steady_after) -> tuple[dict, dict, list[str]]:
+    """(summary row, profiles, skipped-frame notes) of one case folder; DumpReadError when
+    no frame of the steady window is usable, ConfigError when its dump record is unreadable."""
+    geo = DrumGeometry.from_scaled(case.scaled)
+    frames, all_flows, problems = _production_frames(case)
     fraction = steady_fraction(case, steady_after, all_flows)
     first = case.steady_start_step(fraction)
     skipped = [p["reason"] for p in problems if p["step"] >= first]

@@ -54,6 +54,7 @@ from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts,
 from ligwf.analysis.frame_checks import FramePlan, plan_frames
 from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.gsd import VOLUME_COLUMNS, GsdSettings
+from ligwf.analysis.flow_run import steady_start_step
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.kinetics import (KINETICS_SUMMARY_TABLE, KINETICS_TABLE, SENSITIVITY_TABLE,
                                      kinetics_summary, kinetics_table, sensitivity_table)
@@ -223,7 +224,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     if not analysed:
         raise nothing_analysed(study.path, skipped_cases, skipped_frames)
     cases = [f.case for f in analysed]
-    steady_from = {c.case_id: c.steady_start_step(settings.steady_after) for c in cases}
+    steady_from = {c.case_id: steady_start_step(c, settings.steady_after) for c in cases}
     steady = granules[granules["step"] >= granules["case_id"].map(steady_from).astype(float)]
     gsd_df, summary = gsd_tables(steady, cases, gsd_settings(settings))
     stage_tables(outputs, granules, frames, gsd_df, summary)

@@ -33,8 +33,9 @@ class AnalysisSettings(_Frozen):
     """
 
     steady_after: float | Literal["auto"] = Field(
-        0.25, description="fraction of the production time left out as start-up, for the "
-        "flow metrics and the GSD alike, or auto: from the measured spin-up (ligwf.analysis.steady)")
+        "auto", description="start-up left out of the flow metrics and the GSD alike: auto "
+        "(default: from the bed's measured spin-up, ligwf.analysis.steady) or a fraction of "
+        "the production time")
     granules: Literal["communities", "components"] = Field(
         "communities", description="granules are Leiden CPM communities of the bond graph "
         "(default) or its connected components (the source study)")
