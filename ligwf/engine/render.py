@@ -6,7 +6,7 @@ string) and are looked up through a ChoiceLoader: user folders first, then ligwf
 so a site can override one template without copying the rest.
 
 Every value substituted into a template goes through :func:`_finalize`, which refuses
-strings carrying a newline, '&', '$', '#' or a quote: no scene value can inject a
+strings carrying a newline or other control character, '&', '$', '#' or a quote: no scene value can inject a
 LIGGGHTS command (the engine has ``shell``).
 """
 
@@ -25,7 +25,7 @@ from ligwf.errors import RenderError
 from ligwf.engine.liggghts import input_angle
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
-from ligwf.scene.model import FORBIDDEN_INPUT_CHARS, GRAVITY
+from ligwf.scene.model import GRAVITY, unsafe_chars
 
 #: Name of the main input file in a case folder.
 INPUT_NAME = "in.liggghts"
@@ -57,7 +57,7 @@ def fmt_float(value: float) -> str:
 
 def _finalize(value: Any) -> Any:
     if isinstance(value, str):
-        bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
+        bad = unsafe_chars(value)
         if bad:
             raise RenderError(f"refusing to render {value!r}: contains {bad!r}, which could "
                               "inject a LIGGGHTS command")

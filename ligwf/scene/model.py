@@ -27,10 +27,16 @@ from ligwf.scene.messages import format_validation_error
 FORBIDDEN_INPUT_CHARS = ("\n", "\r", "&", "$", "#", "'", '"')
 
 
+def unsafe_chars(value: str) -> list[str]:
+    """The characters of ``value`` that could inject or break a line of a LIGGGHTS input:
+    :data:`FORBIDDEN_INPUT_CHARS` and every other control character (NUL, tab, DEL...)."""
+    bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
+    return bad + sorted({c for c in value if (ord(c) < 32 or ord(c) == 127) and c not in bad})
+
+
 def check_input_safe(value: str) -> str:
     """Refuse a string that could inject or break a line of a LIGGGHTS input."""
-    bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
-    bad += sorted({c for c in value if (ord(c) < 32 or ord(c) == 127) and c not in bad})
+    bad = unsafe_chars(value)
     if bad:
         shown = ", ".join(repr(c) for c in bad)
         raise ValueError(f"contains {shown}; strings that reach the LIGGGHTS input may not "
