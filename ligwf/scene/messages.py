@@ -11,6 +11,13 @@ from typing import Any
 from pydantic import BaseModel, ValidationError
 
 
+def short_repr(value: Any) -> str:
+    """``repr(value)`` cut to 60 characters: a refusal names the value without pasting a
+    whole list or mapping into the message."""
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
 _BOUND_WORDS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
 
 
@@ -67,9 +74,7 @@ def format_validation_error(exc: ValidationError, root: type[BaseModel], prefix:
         if err["type"] == "missing":
             lines.append(f"{path}: required field is missing")
             continue
-        shown = repr(value)
-        shown = shown if len(shown) <= 60 else shown[:57] + "..."
-        line = f"{path} = {shown}: {msg}"
+        line = f"{path} = {short_repr(value)}: {msg}"
         rng = _allowed_range(root, loc)
         if rng:
             line += f" (allowed range {rng})"

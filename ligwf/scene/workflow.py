@@ -33,7 +33,7 @@ from pydantic import Field, TypeAdapter, ValidationError
 from ligwf.errors import ConfigError
 from ligwf.yamlio import parse_yaml, read_yaml_mapping
 from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
-from ligwf.scene.messages import format_validation_error
+from ligwf.scene.messages import format_validation_error, short_repr
 from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene
 from ligwf.study.settings import AnalysisSettings, build_analysis_settings
 
@@ -145,17 +145,12 @@ def _fmt_cg(cg: float) -> str:
     return f"{cg:g}"
 
 
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
-
-
 def _mapping(value: Any, field: str, what: str) -> dict[str, Any]:
     """``value`` as a mapping with string keys, or ConfigError naming ``field``."""
     if value is None:
         return {}
     if not isinstance(value, dict):
-        raise ConfigError(f"{field} = {_short(value)}: must be a mapping of {what}")
+        raise ConfigError(f"{field} = {short_repr(value)}: must be a mapping of {what}")
     for key in value:
         if not isinstance(key, str):
             raise ConfigError(f"{field}: key {key!r} is not a name")
