@@ -11,11 +11,13 @@ import sys
 import threading
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Iterator
+from typing import Iterator, Sequence
 
-from rich.console import Console
+from rich.console import Console, Group
 from rich.table import Table
+from rich.text import Text
 
+from ligwf.engine.plan import CasePlan, Schedule, particle_steps
 from ligwf.study.pipeline import prepare_workflow
 from ligwf.study.prepare import Prepared
 
@@ -109,8 +111,54 @@ def case_table(prepared: Prepared, title: str) -> Table:
         s = rc.scaled
         table.add_row(rc.case.case_id, f"{s.cg:g}", s.rule, str(s.replica),
                       f"{s.particle_count:,}", f"{s.dt:.3g}", f"{s.dt_rayleigh_fraction:.3g}",
-                      f"{s.total_steps:,}", f"{s.particle_count * s.total_steps:.3g}")
+                      f"{s.total_steps:,}", f"{particle_steps(s):.3g}")
     return table
+
+
+def add_cores_arg(p: argparse.ArgumentParser, help_text: str | None = None) -> None:
+    p.add_argument("--cores", type=positive_int, default=None, metavar="N",
+                   help=help_text or "cores the rank plan fills (default: the tasks of the "
+                   "Slurm allocation this runs in, else the CPUs this process may use)")
+
+
+def duration(seconds: float) -> str:
+    """A wall time for people: '45 s', '12 min', '3.2 h'."""
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def case_plan_table(plans: Sequence[CasePlan], title: str, notes: Sequence[str]) -> Group:
+    """Ranks per case, what limited them and the estimated wall time; ``notes`` below,
+    one line each."""
+    table = Table(title=title)
+    for col in ("case", "particle-steps", "ranks", "limited by", "est. wall"):
+        table.add_column(col, justify="left" if col in ("case", "limited by") else "right")
+    for c in plans:
+        table.add_row(c.name, f"{c.particle_steps:.3g}", str(c.ranks), c.bound,
+                      duration(c.estimated_seconds))
+    return Group(table, *(Text(line) for line in notes))
+
+
+def plan_table(schedule: Schedule, title: str) -> Group:
+    """Ranks per case (and what limited them), then the phases in run order."""
+    lines = []
+    for number, ph in enumerate(schedule.phases, 1):
+        if ph.ensemble:
+            how = (f"side by side, {ph.groups} at a time on {ph.ranks} rank(s) each "
+                   f"(one mpirun -np {ph.total_ranks} ensemble)")
+        else:
+            how = f"one after the other on {ph.ranks} rank(s) (mpirun -np {ph.ranks})"
+        order = ", longest first" if schedule.planned and len(ph.cases) > 1 else ""
+        lines.append(f"phase {number}: {len(ph.cases)} case(s) {how}{order}: "
+                     f"~{duration(ph.estimated_seconds)}")
+    if schedule.phases:
+        lines.append(f"estimated {duration(schedule.estimated_seconds)} wall on "
+                     f"{schedule.cores} core(s), ~{schedule.core_fill:.0%} of them busy "
+                     "(rates measured on a 2-core machine: ligwf.engine.plan)")
+    return case_plan_table(schedule.cases, title, lines or ["nothing to run"])
 
 
 @contextmanager

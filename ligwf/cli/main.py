@@ -14,11 +14,13 @@ from pathlib import Path
 
 from ligwf import __version__
 from ligwf.cli import analyse, analyse_dumps, report, run, slurm, stability
-from ligwf.cli.common import (Parser, add_mesh_cache, add_workflow_args, case_table, console,
-                              err_console, folder_to_write, prepare_from_args)
+from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_workflow_args,
+                              case_table, console, err_console, folder_to_write, plan_table,
+                              prepare_from_args)
+from ligwf.engine.plan import machine_cores, plan_study
 from ligwf.errors import LigwfError
 from ligwf.fsio import NOT_WRITABLE, not_writable
-from ligwf.study.pipeline import write
+from ligwf.study.pipeline import prepared_loads, write
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
 COMMAND_MODULES = (run, slurm, analyse, analyse_dumps, stability, report)
@@ -28,6 +30,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)
     wf = prepared.workflow
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
+    cores, source = machine_cores(args.cores)
+    schedule = plan_study(prepared_loads(prepared), cores)
+    console.print(plan_table(schedule, f"rank plan for {cores} core(s) ({source}): what "
+                             "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     return 0
 
 
@@ -45,8 +51,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"ligwf {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("check", help="validate a workflow and render it in memory (writes nothing)")
+    p = sub.add_parser("check", help="validate a workflow, render it in memory and show the "
+                       "rank plan (writes nothing)")
     add_workflow_args(p)
+    add_cores_arg(p)
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser("render", help="write one folder per case (input, mesh, scene record)")

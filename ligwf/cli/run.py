@@ -1,9 +1,14 @@
 """Command line of the run stage: ``ligwf run``, ``ligwf run-case``, ``ligwf status``.
 
 ``run`` prepares a workflow into a study folder (identical cases are rewritten byte for
-byte, so their outputs stay) and runs every case that is not finished: one after the other
-under ``mpirun -np K``, or all together in one ``mpirun -np P`` allocation with
-``--ensemble P``. Running the same command again resumes (see :mod:`ligwf.engine.resume`).
+byte, so their outputs stay) and runs every case that is not finished. By default the rank
+planner (:mod:`ligwf.engine.plan`) decides: ranks per case from its particle count and the
+axial slab rule, single-rank cases side by side in one MPI ensemble, bigger ones on several
+ranks, longest first, on the cores of this machine or allocation (``--cores`` to say
+otherwise); the plan is printed before the run. ``--np K`` runs every case on K ranks one
+after the other, ``--ensemble P`` all of them in one ``mpirun -np P`` (groups of ``--np``,
+default 1), as before. Running the same command again resumes (see
+:mod:`ligwf.engine.resume`).
 ``run-case`` runs case number I of a rendered study folder with the same runner (what a
 Slurm array task calls).
 """
@@ -14,28 +19,38 @@ import argparse
 import os
 from pathlib import Path
 
-from ligwf.cli.common import (add_mesh_cache, add_workflow_args, console, folder_to_write,
-                              positive_int, prepare_from_args, stop_on_signals)
+from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, console,
+                              folder_to_write, plan_table, positive_int, prepare_from_args,
+                              stop_on_signals)
+from ligwf.engine.plan import machine_cores
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.engine.site import EngineConfig
-from ligwf.study.pipeline import RunSettings, run_study, write
+from ligwf.study.pipeline import RunSettings, cases_to_run, run_study, study_schedule, write
 from ligwf.study.study import Study
 
 
-def run_settings(args: argparse.Namespace) -> RunSettings:
-    return RunSettings(nprocs=args.np, ensemble=getattr(args, "ensemble", 0),
-                       retry_unstable=args.retry_unstable,
-                       template_dirs=tuple(getattr(args, "templates", ())))
+def run_settings(args: argparse.Namespace, cores: int = 1) -> RunSettings:
+    """The run settings of ``args``: planned on ``cores`` cores unless ``--np`` or
+    ``--ensemble`` was given (``--ensemble`` alone keeps groups of one rank)."""
+    ensemble = getattr(args, "ensemble", 0)
+    nprocs = args.np if args.np is not None else (1 if ensemble else None)
+    return RunSettings(nprocs=nprocs, ensemble=ensemble, retry_unstable=args.retry_unstable,
+                       template_dirs=tuple(getattr(args, "templates", ())), cores=cores)
 
 
 def prepare_and_run(args: argparse.Namespace) -> tuple[Study, bool]:
-    """Prepare (pre-flight first), write and run a workflow with live progress; returns
-    the study and whether every case is done (``run`` and ``study``)."""
+    """Prepare (pre-flight first), write, show the rank plan and run a workflow with live
+    progress; returns the study and whether every case is done (``run`` and ``study``)."""
     prepared = prepare_from_args(args)
+    cores, source = machine_cores(args.cores)
+    settings = run_settings(args, cores)
     study = write(prepared, args.out, args.mesh_cache)
+    schedule = study_schedule(cases_to_run(study.cases, settings.retry_unstable), settings)
+    title = (f"rank plan for {cores} core(s) ({source})" if settings.planned
+             else "ranks as asked (--np / --ensemble)")
+    console.print(plan_table(schedule, title))
     with stop_on_signals() as stop, RichMonitor(console) as monitor:
-        done = run_study(study, study.cases, EngineConfig.from_site(), run_settings(args),
-                         monitor, stop)
+        done = run_study(study, study.cases, EngineConfig.from_site(), settings, monitor, stop)
     console.print(summary_table(study.cases, f"{study.name}: {args.out}"))
     return study, done
 
@@ -64,9 +79,13 @@ def cmd_status(args: argparse.Namespace) -> int:
 def add_run_args(p: argparse.ArgumentParser) -> None:
     """The options of the run stage (``run`` and ``study``)."""
     p.add_argument("--out", type=folder_to_write, required=True, help="study folder")
-    p.add_argument("--np", type=positive_int, default=1, help="MPI ranks per case (default 1)")
+    p.add_argument("--np", type=positive_int, default=None,
+                   help="MPI ranks for every case, one case after the other (default: the "
+                   "rank plan, see 'ligwf check')")
     p.add_argument("--ensemble", type=positive_int, default=0, metavar="P",
-                   help="run all cases in ONE mpirun -np P, P/np cases at a time")
+                   help="run all cases in ONE mpirun -np P, P/np cases at a time (np "
+                   "default 1; overrides the rank plan)")
+    add_cores_arg(p)
     p.add_argument("--retry-unstable", action="store_true",
                    help="also re-run cases found unstable before")
     add_mesh_cache(p)

@@ -6,9 +6,14 @@ written or submitted -- writes the same folders, one array script with one task 
 (each runs ``ligwf run-case STUDY --index I``, the local runner with its manifests, health
 checks and resume) plus an analysis job that depends on the array (``afterany``) and runs
 the same post-processing as ``ligwf study`` (:data:`ligwf.study.pipeline.POSTPROCESS_COMMANDS`,
-with the analysis settings stored in the study), and submits both. ``--dry-run`` prints the scripts and the sbatch
-commands and writes nothing. ``status`` joins the runner's manifests with squeue/scontrol;
-``resubmit`` submits a new array with exactly the cases that are missing, failed or killed.
+with the analysis settings stored in the study), and submits both. Each case's ranks
+(``--ntasks`` of its array task) come from the rank plan (:mod:`ligwf.engine.plan`: particle
+count and axial slab rule, at most ``--cores`` if given): one array per rank count, the
+analysis job after all of them; ``--ntasks`` or the site's ``ntasks`` put every case on that
+many ranks in one array, as before. The plan is printed. ``--dry-run`` prints the plan, the
+scripts and the sbatch commands and writes nothing. ``status`` joins the runner's manifests
+with squeue/scontrol; ``resubmit`` submits new arrays with exactly the cases that are
+missing, failed or killed (a planned submission is planned again).
 """
 
 from __future__ import annotations
@@ -21,14 +26,16 @@ from typing import Any
 
 from rich.table import Table
 
-from ligwf.cli.common import (add_mesh_cache, add_workflow_args, case_table, console,
-                              err_console, folder_to_write, positive_int, prepare_from_args)
+from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_plan_table,
+                              case_table, console, duration, err_console, folder_to_write,
+                              positive_int, prepare_from_args)
+from ligwf.engine.plan import CasePlan, case_load, fixed_ranks, plan_ranks
 from ligwf.errors import SubmitError
-from ligwf.slurm.jobs import (active_tasks, cases_to_resubmit, dry_run_text, next_round,
-                              plan_jobs, read_record, recorded_site, require_scheduler,
-                              study_status, submit_jobs)
-from ligwf.slurm.site import SlurmSite, load_slurm_site
-from ligwf.study.pipeline import POSTPROCESS_COMMANDS, write
+from ligwf.slurm.jobs import (PlannedJob, active_tasks, cases_to_resubmit, dry_run_text,
+                              next_round, plan_jobs, read_record, recorded_plan, recorded_site,
+                              require_scheduler, study_status, submit_jobs)
+from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
+from ligwf.study.pipeline import POSTPROCESS_COMMANDS, prepared_loads, write
 from ligwf.study.study import Study
 
 
@@ -36,7 +43,10 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--partition", help="Slurm partition (default: site setting)")
     p.add_argument("--account", help="Slurm account (default: site setting)")
     p.add_argument("--time", help="wall time per case, e.g. 02:00:00 (default: site setting)")
-    p.add_argument("--ntasks", type=positive_int, help="MPI ranks per case (default: site setting or 1)")
+    p.add_argument("--ntasks", type=positive_int,
+                   help="MPI ranks for every case (default: site setting, else the rank plan)")
+    add_cores_arg(p, "most ranks the rank plan gives one case, e.g. a node's cores "
+                  "(default: no limit besides the slab rule and particles per rank)")
     p.add_argument("--max-concurrent", type=positive_int, metavar="K",
                    help="at most K cases at once (--array=...%%K)")
     p.add_argument("--no-analysis", action="store_true",
@@ -62,6 +72,18 @@ def _print_submitted(entries: list[dict]) -> None:
         console.print(f"submitted {e['kind']} job {e['job_id']}{dep}: {e['script']}")
 
 
+def plan_caption(plans: tuple[CasePlan, ...], jobs: list[PlannedJob]) -> list[str]:
+    """How the arrays split the cases, and the estimated total cost."""
+    lines = [f"{job.script_path.name}: {len(job.indices)} case(s), --ntasks="
+             f"{job.site.ntasks if job.site else '?'}" for job in jobs if job.kind == "array"]
+    core_hours = sum(p.ranks * p.estimated_seconds for p in plans) / 3600
+    longest = max((p.estimated_seconds for p in plans), default=0.0)
+    lines.append(f"estimated {core_hours:.3g} core-hours in all, longest case "
+                 f"~{duration(longest)} (rates measured on a 2-core machine: "
+                 "ligwf.engine.plan; --time is per case)")
+    return lines
+
+
 def cmd_submit(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)      # pre-flight before anything is written
     wf, rendered = prepared.workflow, prepared.rendered
@@ -69,9 +91,20 @@ def cmd_submit(args: argparse.Namespace) -> int:
     steps = [] if args.no_analysis else list(POSTPROCESS_COMMANDS)
     out: Path = args.out.resolve()
     round_no = next_round(out) if (out / "slurm").is_dir() else 1
-    jobs = plan_jobs(out, wf.name, site, [rc.case.index for rc in rendered], steps, round_no)
+    loads = prepared_loads(prepared)
+    if args.ntasks is not None or ntasks_configured():   # every case on site.ntasks ranks
+        plans, ranks = fixed_ranks(loads, site.ntasks, "--ntasks"), None
+        title = "ranks as asked (--ntasks / site ntasks)"
+    else:
+        plans = tuple(plan_ranks(load, args.cores) for load in loads)
+        ranks = {rc.case.index: p.ranks for rc, p in zip(rendered, plans)}
+        title = "rank plan" + (f" (at most {args.cores} per case)" if args.cores else "")
+    jobs = plan_jobs(out, wf.name, site, [rc.case.index for rc in rendered], steps, round_no,
+                     ranks, args.cores)
+    plan_view = case_plan_table(plans, title, plan_caption(plans, jobs))
     if args.dry_run:
         console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
+        console.print(plan_view)
         print(dry_run_text(jobs))
         return 0
     require_scheduler()
@@ -83,6 +116,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
                               "them, or use 'ligwf slurm resubmit'")
     write(prepared, out, args.mesh_cache)
     console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) -> {out}"))
+    console.print(plan_view)
     _print_submitted(submit_jobs(out, jobs, site))
     return 0
 
@@ -135,8 +169,14 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
         console.print("nothing to resubmit: every case is done, unstable or still queued")
         return 0
     steps = [] if args.no_analysis else list(POSTPROCESS_COMMANDS)
+    # a planned submission is planned again (same core limit unless --cores says otherwise)
+    plan = recorded_plan(study_dir) if args.ntasks is None else None
+    cores = args.cores if args.cores is not None else (plan or {}).get("cores")
+    ranks = None if plan is None else {
+        c.index: plan_ranks(case_load(c.path.name, c.scaled), cores).ranks
+        for c in study.cases if c.index in indices}
     jobs = plan_jobs(study_dir, study.name, site, indices, steps,
-                     next_round(study_dir))
+                     next_round(study_dir), ranks, cores)
     console.print(f"resubmitting {len(indices)} case(s): "
                   + ", ".join(f"{c.index} {c.case_id} ({c.manifest})"
                               for c in st.cases if c.index in indices))

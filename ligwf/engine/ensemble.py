@@ -86,9 +86,11 @@ def _key(case: CaseFolder) -> str:
 def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: int,
                  engine: EngineConfig, retry_unstable: bool = False,
                  stop: threading.Event | None = None, monitor: Monitor | None = None,
-                 poll_seconds: float = 0.5, max_launches: int | None = None) -> dict[str, str]:
+                 poll_seconds: float = 0.5, max_launches: int | None = None,
+                 label: str = "launch") -> dict[str, str]:
     """Run ``cases`` in MPI ensembles of ``nprocs`` ranks, groups of ``group_size``;
-    ``monitor`` gets the same live progress as for local runs.
+    ``monitor`` gets the same live progress as for local runs. Launch ``n`` works in
+    ``.ensemble/<label>-<n>`` (a planned run gives each phase its own label).
 
     Returns ``{case folder name: status}`` for the cases worked on.
     """
@@ -105,7 +107,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
     limit = max_launches or (2 * len(todo) + 2)
     while todo and not stop.is_set() and launches < limit:
         launches += 1
-        ens_dir = root / f"launch-{launches}"
+        ens_dir = root / f"{label}-{launches}"
         if ens_dir.exists():
             shutil.rmtree(ens_dir)
         (ens_dir / CLAIMS_DIR).mkdir(parents=True)

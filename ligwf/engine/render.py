@@ -158,12 +158,19 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
 MIN_AXIAL_SLAB = 4.0
 
 
+def axial_slab_limit(drum_length: float, d_max: float) -> int:
+    """Most ranks along the drum axis (m, m) that leave every slab at least MIN_AXIAL_SLAB
+    largest diameters long; at least 1. (A length of exactly k slabs counts as k: the
+    division is not left to round 2.9999 down.)"""
+    return max(1, math.floor(drum_length / (MIN_AXIAL_SLAB * d_max) * (1.0 + 1e-9)))
+
+
 def processor_grid(s: ScaledScene, nprocs: int) -> tuple[int, int]:
     """Ranks (across the drum, along the axis) for ``nprocs``: as many along the axis as
     divide ``nprocs`` and leave slabs of at least MIN_AXIAL_SLAB largest diameters (pure)."""
     if nprocs < 1:
         raise ValueError(f"nprocs = {nprocs}: need at least 1")
-    max_axial = max(1, int(s.drum_length / (MIN_AXIAL_SLAB * s.d_max)))
+    max_axial = axial_slab_limit(s.drum_length, s.d_max)
     axial = max(k for k in range(1, nprocs + 1) if nprocs % k == 0 and k <= max_axial)
     return nprocs // axial, axial
 

@@ -21,14 +21,14 @@ import json
 import re
 import shutil
 import subprocess
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from datetime import datetime, timezone
 from pathlib import Path, PurePosixPath
-from typing import Callable, Iterable, Sequence
+from typing import Callable, Iterable, Mapping, Sequence
 
 from ligwf import __version__
 from ligwf.engine.health import FAILED, KILLED, MISSING, RUNNING, UNSTABLE
-from ligwf.errors import SubmitError
+from ligwf.errors import ConfigError, SubmitError
 from ligwf.fsio import atomic_write_json, atomic_write_text
 from ligwf.study.manifest import read_manifest
 from ligwf.study.study import Study
@@ -96,23 +96,53 @@ def job_name(study_name: str, kind: str) -> str:
 
 @dataclass(frozen=True)
 class PlannedJob:
-    """A script to write and submit; ``after_array`` makes it depend on the array job."""
+    """A script to write and submit; ``after_array`` makes it depend on the array job(s).
+
+    ``site``: the settings this script was built with (an array of a planned study has
+    its own ``ntasks``); ``planned``: its ranks came from the rank plan (a resubmit plans
+    again, on ``plan_cores``), not from ``--ntasks`` / the site setting."""
 
     kind: str  # "array" or "analysis"
     script_path: Path
     script_text: str
     indices: tuple[int, ...] = ()
     after_array: bool = False
+    site: SlurmSite | None = None
+    planned: bool = False
+    plan_cores: int | None = None
 
 
 def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterable[int],
-              analysis_steps: Sequence[str], round_no: int) -> list[PlannedJob]:
-    """The array job over ``indices`` and (if steps are given) its analysis job (pure)."""
+              analysis_steps: Sequence[str], round_no: int,
+              ranks: Mapping[int, int] | None = None,
+              plan_cores: int | None = None) -> list[PlannedJob]:
+    """The array job over ``indices`` and (if steps are given) its analysis job (pure).
+
+    ``ranks`` (case index -> MPI ranks, from the rank plan): one array per rank count,
+    widest first, each with ``--ntasks`` of its cases (``array-R-npK.sh``; ``array-R.sh``
+    when all cases share one count); the analysis job waits for all of them. Without
+    ``ranks`` every case gets ``site.ntasks`` in one array."""
     study = PurePosixPath(Path(study_dir).resolve())
     idx = tuple(sorted(set(indices)))
     array_ctx = ScriptContext(study, job_name(study_name, "array"), __version__)
-    jobs = [PlannedJob("array", Path(study) / SLURM_DIR / f"array-{round_no}.sh",
-                       array_script(array_ctx, site, idx), idx)]
+    if ranks is None:
+        classes = {site.ntasks: idx}
+    else:
+        missing = [i for i in idx if i not in ranks]
+        if missing:
+            raise ConfigError(f"rank plan: no ranks for case index(es) {missing}")
+        classes = {}
+        for i in idx:
+            classes.setdefault(int(ranks[i]), []).append(i)
+    jobs = []
+    for ntasks in sorted(classes, reverse=True):
+        members = tuple(classes[ntasks])
+        job_site = replace(site, ntasks=ntasks)
+        name = f"array-{round_no}.sh" if len(classes) == 1 else f"array-{round_no}-np{ntasks}.sh"
+        jobs.append(PlannedJob("array", Path(study) / SLURM_DIR / name,
+                               array_script(array_ctx, job_site, members), members,
+                               site=job_site, planned=ranks is not None,
+                               plan_cores=plan_cores if ranks is not None else None))
     if analysis_steps:
         ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
         jobs.append(PlannedJob("analysis", Path(study) / SLURM_DIR / f"analysis-{round_no}.sh",
@@ -123,11 +153,14 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
 
 def dry_run_text(jobs: Sequence[PlannedJob]) -> str:
     """What ``--dry-run`` prints: each script, then the sbatch command that would submit it."""
+    arrays = sum(1 for job in jobs if job.kind == "array")
+    ids = (["<array job id>"] if arrays == 1
+           else [f"<array job id {n}>" for n in range(1, arrays + 1)])
     out = []
     for job in jobs:
-        cmd = sbatch_command(job.script_path, "1" if job.after_array else None)
+        cmd = sbatch_command(job.script_path)
         if job.after_array:
-            cmd = [c.replace("afterany:1", "afterany:<array job id>") for c in cmd]
+            cmd.insert(2, "--dependency=afterany:" + ":".join(ids))
         out += [f"# ----- {job.script_path} -----", job.script_text.rstrip("\n"),
                 f"# would run: {' '.join(cmd)}", ""]
     return "\n".join(out)
@@ -142,28 +175,37 @@ def submit_jobs(study_dir: Path, jobs: Sequence[PlannedJob], site: SlurmSite,
     """
     (Path(study_dir) / LOG_DIR).mkdir(parents=True, exist_ok=True)
     entries: list[dict] = []
-    array_id: str | None = None
+    array_ids: list[str] = []
     for job in jobs:
         atomic_write_text(job.script_path, job.script_text)
         job.script_path.chmod(0o755)
-        if job.after_array and array_id is None:
+        if job.after_array and not array_ids:
             raise SubmitError("analysis job planned without an array job")
-        cmd = sbatch_command(job.script_path, array_id if job.after_array else None)
+        cmd = sbatch_command(job.script_path, array_ids if job.after_array else None)
         out = run(cmd)
         if out.returncode != 0:
             raise SubmitError(f"{' '.join(cmd)} exited {out.returncode}: "
                               f"{(out.stderr or out.stdout).strip()}")
         job_id = parse_sbatch_parsable(out.stdout)
         if job.kind == "array":
-            array_id = job_id
+            array_ids.append(job_id)
         entry = {"kind": job.kind, "job_id": job_id, "indices": list(job.indices),
                  "script": str(job.script_path.relative_to(Path(study_dir).resolve())),
-                 "command": cmd, "after": array_id if job.after_array else None,
-                 "site": asdict(site),
+                 "command": cmd, "after": ":".join(array_ids) if job.after_array else None,
+                 "site": asdict(job.site or site),
                  "submitted": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+        if job.planned:
+            entry["planned"] = {"cores": job.plan_cores}
         append_record(study_dir, entry)
         entries.append(entry)
     return entries
+
+
+def recorded_plan(study_dir: Path) -> dict | None:
+    """``{"cores": N or None}`` if the latest array submission took its ranks from the
+    rank plan (a resubmit then plans again), else None."""
+    arrays = [s for s in read_record(study_dir) if s.get("kind") == "array"]
+    return arrays[-1].get("planned") if arrays else None
 
 
 def recorded_site(study_dir: Path) -> dict:

@@ -155,13 +155,16 @@ def analysis_script(ctx: ScriptContext, site: SlurmSite, steps: Sequence[str]) -
     return "\n".join(lines)
 
 
-def sbatch_command(script: str | PurePosixPath, after_any: str | None = None) -> list[str]:
-    """``sbatch --parsable [--dependency=afterany:ID] SCRIPT`` as argv."""
+def sbatch_command(script: str | PurePosixPath,
+                   after_any: str | Sequence[str] | None = None) -> list[str]:
+    """``sbatch --parsable [--dependency=afterany:ID[:ID...]] SCRIPT`` as argv (one id, or
+    several: a planned study has one array per rank count)."""
     cmd = ["sbatch", "--parsable"]
     if after_any is not None:
-        if not str(after_any).isdigit():
+        ids = [after_any] if isinstance(after_any, str) else list(after_any)
+        if not ids or not all(str(i).isdigit() for i in ids):
             raise ConfigError(f"dependency job id {after_any!r} is not a Slurm job id")
-        cmd.append(f"--dependency=afterany:{after_any}")
+        cmd.append("--dependency=afterany:" + ":".join(str(i) for i in ids))
     return cmd + [str(script)]
 
 

@@ -171,6 +171,13 @@ def merged_settings(site_yaml: Mapping[str, Any], environ: Mapping[str, str]) ->
     return merged
 
 
+def ntasks_configured(environ: Mapping[str, str] | None = None) -> bool:
+    """Whether the site file or ``LIGWF_SLURM_NTASKS`` sets ``ntasks``: then, like
+    ``--ntasks``, it overrides the rank plan (every case on that many ranks)."""
+    env = os.environ if environ is None else environ
+    return merged_settings(load_site(), env).get("ntasks") not in (None, "")
+
+
 def load_slurm_site(environ: Mapping[str, str] | None = None) -> SlurmSite:
     """Site settings from the environment and the site YAML (no command-line values yet)."""
     env = os.environ if environ is None else environ

@@ -14,22 +14,31 @@ The science of the post-processing (steady window, bond criterion, GSD settings)
 from the study (:attr:`ligwf.study.study.Study.analysis`, stored from the workflow's
 ``analysis:`` block), never passed in, so the local and the Slurm path compute the same
 tables. What callers choose is only how things run (ranks, ensembles, outputs).
+
+How the cases run: by default the planner (:mod:`ligwf.engine.plan`) gives each case its
+ranks and packs the cases onto the cores (:func:`study_schedule`); ``--np`` /
+``--ensemble`` override it with their old meaning.
 """
 
 from __future__ import annotations
 
+import os
 import threading
+from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Iterable, Sequence
+from typing import TYPE_CHECKING, Callable, Iterable, Sequence
 
 from ligwf.engine.ensemble import run_ensemble
 from ligwf.engine.health import DONE
-from ligwf.engine.launch import Monitor, run_case
+from ligwf.engine.launch import Monitor, run_case, take_over
+from ligwf.engine.plan import (CaseLoad, Phase, Schedule, case_load, override_schedule,
+                               plan_study)
+from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig
 from ligwf.scene.workflow import load_workflow
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import case_busy
+from ligwf.study.manifest import case_busy, case_lock
 from ligwf.study.prepare import Prepared, prepare, write_study
 from ligwf.study.study import Study
 
@@ -46,12 +55,22 @@ POSTPROCESS_COMMANDS = ("analyse", "report")
 
 @dataclass(frozen=True)
 class RunSettings:
-    """How the run stage runs (not what it computes)."""
+    """How the run stage runs (not what it computes).
 
-    nprocs: int = 1                 # MPI ranks per case
+    ``nprocs`` None and no ``ensemble``: planned (ranks per case and phases from
+    :func:`ligwf.engine.plan.plan_study` on ``cores`` cores); otherwise the override:
+    every case on ``nprocs`` ranks (1 if None), one after the other or in one ensemble.
+    """
+
+    nprocs: int | None = 1          # MPI ranks per case; None: the planner decides
     ensemble: int = 0               # > 0: all cases in ONE mpirun of this many ranks
     retry_unstable: bool = False
     template_dirs: tuple[Path, ...] = ()
+    cores: int = 1                  # cores a planned run fills
+
+    @property
+    def planned(self) -> bool:
+        return self.nprocs is None and not self.ensemble
 
 
 def prepare_workflow(workflow: Path, overrides: Sequence[str] = (),
@@ -73,36 +92,99 @@ def all_done(cases: Iterable[CaseFolder]) -> bool:
     return all((m := c.manifest()) is not None and m.status == DONE for c in cases)
 
 
+def prepared_loads(prepared: Prepared) -> list[CaseLoad]:
+    """The planner's view of every prepared case (named as its case folder will be)."""
+    return [case_load(rc.case.case_id, rc.scaled) for rc in prepared.rendered]
+
+
+def cases_to_run(cases: Iterable[CaseFolder], retry_unstable: bool = False) -> list[CaseFolder]:
+    """The cases a runner would start or resume now (not done, not unstable unless
+    ``retry_unstable``, not held by a live runner)."""
+    return [c for c in cases if plan_case(c, retry_unstable).action != SKIP]
+
+
+def study_schedule(cases: Sequence[CaseFolder], settings: RunSettings) -> Schedule:
+    """What :func:`run_study` does with ``cases`` (pass :func:`cases_to_run`): the planned
+    schedule, or the one ``--np`` / ``--ensemble`` ask for."""
+    loads = [case_load(c.path.name, c.scaled) for c in cases]
+    if settings.planned:
+        return plan_study(loads, settings.cores)
+    return override_schedule(loads, settings.nprocs or 1, settings.ensemble, settings.cores)
+
+
 def run_study(study: Study, cases: Sequence[CaseFolder], engine: EngineConfig,
               settings: RunSettings = RunSettings(), monitor: Monitor | None = None,
               stop: threading.Event | None = None) -> bool:
-    """Run ``cases`` of ``study`` (skipping finished ones, resuming killed ones): one after
-    the other, or as one MPI ensemble. Returns whether all of them are done.
+    """Run ``cases`` of ``study`` (skipping finished ones, resuming killed ones): planned
+    (:func:`study_schedule`), one after the other, or as one MPI ensemble. Returns whether
+    all of them are done.
 
     Several runners may work on one study: each case runs in one of them (a per-case
     lock, :func:`ligwf.study.manifest.case_lock`); a runner that has finished its share
-    waits for the cases the others hold, so every runner returns once the study is done."""
+    waits for the cases the others hold, so every runner returns once the study is done.
+    (An explicit ``--ensemble`` takes no locks, as before.)"""
     stop = stop or threading.Event()
     if settings.ensemble:
-        run_ensemble(study.path, list(cases), settings.ensemble, settings.nprocs, engine,
+        run_ensemble(study.path, list(cases), settings.ensemble, settings.nprocs or 1, engine,
                      retry_unstable=settings.retry_unstable, stop=stop, monitor=monitor)
-    else:
-        def one(case: CaseFolder) -> None:
-            run_case(case, settings.nprocs, engine, monitor, stop, settings.retry_unstable,
-                     settings.template_dirs)
+        return all_done(cases)
 
+    def one(case: CaseFolder, nprocs: int) -> None:
+        run_case(case, nprocs, engine, monitor, stop, settings.retry_unstable,
+                 settings.template_dirs)
+
+    if settings.planned:
+        schedule = study_schedule(cases_to_run(cases, settings.retry_unstable), settings)
+        # every case's ranks (a case taken over below may not be in this runner's phases)
+        ranks = {c.name: c.ranks for c in study_schedule(cases, settings).cases}
+        by_name = {c.path.name: c for c in cases}
+        for number, phase in enumerate(schedule.phases, 1):
+            if stop.is_set():
+                break
+            members = [by_name[name] for name in phase.cases]
+            if phase.ensemble:
+                _ensemble_phase(study, members, phase, f"phase{number}-pid{os.getpid()}",
+                                engine, settings, monitor, stop, one)
+            else:
+                for case in members:
+                    if stop.is_set():
+                        break
+                    one(case, phase.ranks)
+    else:
+        ranks = {}
         for case in cases:
             if stop.is_set():
                 break
-            one(case)
-        # cases another `ligwf run` holds: wait for them, and take over any whose runner
-        # stops before it is done (its lock goes with it)
+            one(case, settings.nprocs or 1)
+    # cases another `ligwf run` holds: wait for them, and take over any whose runner
+    # stops before it is done (its lock goes with it)
+    default = settings.nprocs or 1
+    busy = [c for c in cases if case_busy(c.path)]
+    while busy and not stop.wait(WAIT_SECONDS):
+        for case in [c for c in busy if not case_busy(c.path)]:
+            one(case, ranks.get(case.path.name, default))
         busy = [c for c in cases if case_busy(c.path)]
-        while busy and not stop.wait(WAIT_SECONDS):
-            for case in [c for c in busy if not case_busy(c.path)]:
-                one(case)
-            busy = [c for c in cases if case_busy(c.path)]
     return all_done(cases)
+
+
+def _ensemble_phase(study: Study, members: list[CaseFolder], phase: Phase, label: str,
+                    engine: EngineConfig, settings: RunSettings, monitor: Monitor | None,
+                    stop: threading.Event, one: Callable[[CaseFolder, int], None]) -> None:
+    """Run a planned phase as one MPI ensemble over the members this runner can lock
+    (held for the whole launch, so a second runner leaves them alone); a single lockable
+    member runs on its own under mpirun instead."""
+    with ExitStack() as held:
+        mine = [c for c in members if held.enter_context(case_lock(c.path))]
+        for case in mine:
+            take_over(case)         # engines and attempts a dead runner left behind
+        if len(mine) > 1:
+            groups = min(phase.groups, len(mine))
+            run_ensemble(study.path, mine, groups * phase.ranks, phase.ranks, engine,
+                         retry_unstable=settings.retry_unstable, stop=stop, monitor=monitor,
+                         label=label)
+            return
+    for case in mine:               # lock released: run_case takes it again
+        one(case, phase.ranks)
 
 
 def analyse_study(path: Path, out: Path | None = None,

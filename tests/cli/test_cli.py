@@ -64,3 +64,55 @@ def test_console_entry_point():
     out = subprocess.run([sys.executable, "-m", "ligwf.cli.main", "--help"], capture_output=True, text=True)
     assert out.returncode == 0
     assert "render" in out.stdout and "check" in out.stdout
+
+
+def test_check_prints_the_rank_plan(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("SLURM_JOB_ID", raising=False)
+    assert main(["check", str(DRUM), "--cores", "2", "--set", "sweep.cg_levels=[3,1]",
+                 "--set", "scene.drum.length=0.018"]) == 0
+    out = capsys.readouterr().out
+    assert "rank plan for 2 core(s) (--cores)" in out
+    # the plan table lists each case again after the case table: ranks, what limited them
+    plan_rows = [[c.strip() for c in line.split("│")[1:-1]] for line in out.splitlines()
+                 if line.startswith("│ cg")][3:]
+    assert [(r[0], r[2], r[3]) for r in plan_rows] == [
+        ("cg3-weber-r0", "1", "slab, particles"), ("cg3-bond-r0", "1", "slab, particles"),
+        ("cg1-none-r0", "2", "cores")]
+    assert "phase 1: 1 case(s) one after the other on 2 rank(s) (mpirun -np 2)" in out
+    assert ("phase 2: 2 case(s) side by side, 2 at a time on 1 rank(s) each (one mpirun -np 2 "
+            "ensemble), longest first") in out
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_check_plans_for_the_cores_of_a_slurm_allocation(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("SLURM_JOB_ID", "42")
+    monkeypatch.setenv("SLURM_NTASKS", "1")
+    assert main(["check", str(DRUM)]) == 0
+    out = capsys.readouterr().out
+    assert "rank plan for 1 core(s) (SLURM_NTASKS)" in out
+    assert "phase 1: 5 case(s) one after the other on 1 rank(s)" in out
+
+
+@pytest.mark.parametrize("argv, planned, nprocs, ensemble", [
+    ([], True, None, 0),
+    (["--np", "2"], False, 2, 0),
+    (["--ensemble", "2"], False, 1, 0 + 2),
+    (["--np", "2", "--ensemble", "4"], False, 2, 4),
+])
+def test_run_plans_unless_np_or_ensemble_is_given(tmp_path, argv, planned, nprocs, ensemble):
+    from ligwf.cli.main import build_parser
+    from ligwf.cli.run import run_settings
+
+    for command in ("run", "study"):
+        args = build_parser().parse_args([command, str(DRUM), "--out", str(tmp_path / "s"),
+                                          *argv])
+        settings = run_settings(args, cores=2)
+        assert (settings.planned, settings.nprocs, settings.ensemble, settings.cores) == (
+            planned, nprocs, ensemble, 2)
+
+
+def test_cores_must_be_a_positive_whole_number(capsys):
+    assert main(["check", str(DRUM), "--cores", "0"]) == 2
+    assert "--cores" in capsys.readouterr().err

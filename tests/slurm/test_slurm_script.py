@@ -41,6 +41,15 @@ def test_sbatch_command():
         sbatch_command("/s/a.sh", after_any="42;rm -rf /")
 
 
+def test_sbatch_command_waits_for_several_arrays():
+    # a planned study has one array per rank count; its analysis job waits for all
+    assert sbatch_command("/s/a.sh", after_any=["42", "43"]) == [
+        "sbatch", "--parsable", "--dependency=afterany:42:43", "/s/a.sh"]
+    for bad in ([], ["42", "43;rm -rf /"], ["42:43"]):
+        with pytest.raises(ConfigError):
+            sbatch_command("/s/a.sh", after_any=bad)
+
+
 def test_queue_commands():
     assert squeue_command("alice") == ["squeue", "-h", "-r", "-u", "alice", "-o", SQUEUE_FORMAT]
     assert scontrol_command("12") == ["scontrol", "-o", "show", "job", "12"]

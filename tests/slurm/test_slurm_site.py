@@ -9,7 +9,7 @@ import pytest
 
 from ligwf.errors import ConfigError
 from ligwf.slurm.site import (SlurmSite, default_ligwf_command, load_slurm_site,
-                              merged_settings, site_from_mapping)
+                              merged_settings, ntasks_configured, site_from_mapping)
 
 
 def test_env_overrides_site_file(tmp_path, monkeypatch):
@@ -68,3 +68,14 @@ def test_slurm_time_formats(time):
 def test_site_slurm_block_must_be_mapping():
     with pytest.raises(ConfigError):
         merged_settings({"slurm": ["partition"]}, {})
+
+
+def test_ntasks_set_in_the_site_file_or_environment_overrides_the_rank_plan(tmp_path,
+                                                                           monkeypatch):
+    site = tmp_path / "site.yaml"
+    site.write_text("slurm:\n  partition: compute\n")
+    monkeypatch.setenv("LIGWF_SITE", str(site))
+    assert not ntasks_configured({})
+    assert ntasks_configured({"LIGWF_SLURM_NTASKS": "4"})
+    site.write_text("slurm:\n  ntasks: 2\n")
+    assert ntasks_configured({})

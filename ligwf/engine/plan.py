@@ -1,0 +1,290 @@
+"""Rank planning: how many MPI ranks each case gets, and how a study's cases share the cores.
+
+Pure functions over frozen dataclasses; the one reader of the environment is
+:func:`machine_cores`, at the end. Three rules decide, each from a measurement on the
+project's 2-core machine (``docs/results/README.md``, issue 15):
+
+* **Slabs along the drum axis only.** A case is cut into slabs along its axis, never along
+  gravity (a settled bed lies in the lower half: 96 % of it on one of 2 ranks) and not
+  across the drum (a turning bed shifts to its rising side: 82/18 %, 1.4x slower than the
+  axial cut); each slab is at least ``MIN_AXIAL_SLAB`` (4) of the case's LARGEST diameters
+  long (:func:`ligwf.engine.render.axial_slab_limit`, the same rule the runner's processor
+  grid keeps). A 9 mm slice of 3 mm CG3 particles therefore runs on one rank.
+* **Enough particles per rank.** Each step of a case costs a fixed ~0.5 ms (turning mesh,
+  fixes, exchanges: the work of ~450 particles) besides its pair work; a rank should carry
+  several times that, or splitting buys little and costs core-seconds. Measured: the
+  18 mm CG1 case (11,963 particles) ran 1.49x faster on 2 axial ranks than on one; a
+  few-hundred-particle CG3 case spends 1.35x the core-seconds on 2 ranks; the 9 mm CG1
+  (5,982 particles, ~3,000 a rank) did not clearly gain. Hence ``MIN_PARTICLES_PER_RANK``.
+* **Cores stay filled, longest first.** Cases with the same rank count form one phase:
+  single-rank cases run side by side as members of one MPI ensemble
+  (:mod:`ligwf.engine.ensemble`; separate ``mpirun -np 1`` would all bind to core 0),
+  a phase of one group runs its cases one after the other under ``mpirun``. Phases run
+  widest first, and inside a phase the longest case is claimed first (list scheduling:
+  the short ones fill the gaps at the end).
+
+The cost of a case is its particle-steps (particles x steps, what ``ligwf check`` prints);
+wall-time estimates use the rates below and are only as good as those measurements.
+``--np`` / ``--ensemble`` bypass the planner: :func:`override_schedule` describes what
+they do (today's meaning) so ``check`` and ``run`` can show it the same way.
+"""
+
+from __future__ import annotations
+
+import heapq
+import os
+from dataclasses import dataclass
+from typing import Mapping, Sequence
+
+from ligwf.engine.render import axial_slab_limit
+from ligwf.errors import ConfigError
+from ligwf.scene.scaling import ScaledScene
+
+#: Fewest particles a rank should carry (see the module docstring): ~6 times the per-step
+#: fixed cost of a case in particle work; 11,963 particles gain from 2 ranks, 5,982 do not
+#: clearly, a few hundred lose. To be re-measured on a quiet machine (issue 15).
+MIN_PARTICLES_PER_RANK = 3000
+#: Fixed wall seconds per step of one wet case on one rank, whatever its size (we-vs-bo
+#: study, single-rank members: 1,495 particles 2.10 ms/step, 443 particles 0.96 ms/step).
+STEP_OVERHEAD_SECONDS = 0.48e-3
+#: Marginal particle-steps per core-second of a wet (capillary) case, same fit; it also
+#: reproduces the 18 mm CG1 on one rank (40.4 s for 3,000 steps of 11,963 particles).
+WET_RATE = 0.93e6
+#: Dry contacts run this much faster per particle-step (2.5-3.3 vs 1.5-1.7 M by hand).
+DRY_SPEEDUP = 1.8
+#: Share of the ideal speed-up a case keeps on more than one rank (11,963 particles:
+#: 27.2 s on 2 axial ranks against 40.4 s on one). Measured at 2 ranks only.
+MULTI_RANK_EFFICIENCY = 0.75
+
+#: What limited a case's ranks (:attr:`CasePlan.bound`).
+BOUND_PARTICLES, BOUND_SLAB, BOUND_CORES = "particles", "slab", "cores"
+BOUND_NP, BOUND_ENSEMBLE = "--np", "--ensemble"
+
+
+def _at_least(field: str, value: object, lowest: int) -> int:
+    """``value`` as a whole number >= ``lowest``; ConfigError naming the field otherwise."""
+    if isinstance(value, bool) or not isinstance(value, int) or value < lowest:
+        raise ConfigError(f"{field} = {value!r}: must be a whole number (allowed range "
+                          f"[{lowest}, inf))")
+    return value
+
+
+@dataclass(frozen=True)
+class CaseLoad:
+    """What the planner needs to know about one case (taken from its scaled scene)."""
+
+    name: str
+    particles: int          # scaled particle count
+    steps: int              # fill + settle + production
+    drum_length: float      # m, along the axis (the periodic slice)
+    d_max: float            # m, the largest scaled diameter
+    wet: bool = True
+
+    def __post_init__(self) -> None:
+        where = f"case {self.name!r}: " if self.name else ""
+        if not self.name:
+            raise ConfigError("case name = '': must not be empty")
+        _at_least(f"{where}particles", self.particles, 1)
+        _at_least(f"{where}steps", self.steps, 1)
+        for field in ("drum_length", "d_max"):
+            value = getattr(self, field)
+            if not isinstance(value, (int, float)) or not value > 0 or value == float("inf"):
+                raise ConfigError(f"{where}{field} = {value!r}: allowed range (0, inf) m")
+
+    @property
+    def particle_steps(self) -> int:
+        """The case's cost in particle-steps (what ``ligwf check`` prints)."""
+        return self.particles * self.steps
+
+
+def particle_steps(scaled: ScaledScene) -> int:
+    """Particles x total steps of a scaled case: the cost the planner packs by."""
+    return scaled.particle_count * scaled.total_steps
+
+
+def case_load(name: str, scaled: ScaledScene) -> CaseLoad:
+    """The planner's view of a scaled case."""
+    return CaseLoad(name, scaled.particle_count, scaled.total_steps, scaled.drum_length,
+                    scaled.d_max, scaled.wet)
+
+
+def estimated_seconds(load: CaseLoad, ranks: int) -> float:
+    """Wall seconds of ``load`` on ``ranks`` ranks from the measured rates (an estimate:
+    the fill phase has fewer particles, and the rates are one machine's)."""
+    _at_least("ranks", ranks, 1)
+    rate = WET_RATE * (1.0 if load.wet else DRY_SPEEDUP)
+    efficiency = 1.0 if ranks == 1 else MULTI_RANK_EFFICIENCY
+    return load.steps * (STEP_OVERHEAD_SECONDS + load.particles / (ranks * rate * efficiency))
+
+
+@dataclass(frozen=True)
+class CasePlan:
+    """Ranks of one case, what limited them, and its estimated wall time."""
+
+    name: str
+    ranks: int
+    bound: str                  # BOUND_* names that set ``ranks`` ("slab, particles")
+    particle_steps: int
+    estimated_seconds: float
+
+
+def rank_limits(load: CaseLoad, cores: int | None,
+                min_particles_per_rank: int = MIN_PARTICLES_PER_RANK) -> dict[str, int]:
+    """Each rule's largest rank count for ``load``: particles per rank, the axial slab
+    rule and (when given) the cores."""
+    _at_least("min_particles_per_rank", min_particles_per_rank, 1)
+    limits = {BOUND_SLAB: axial_slab_limit(load.drum_length, load.d_max),
+              BOUND_PARTICLES: max(1, load.particles // min_particles_per_rank)}
+    if cores is not None:
+        limits[BOUND_CORES] = _at_least("cores", cores, 1)
+    return limits
+
+
+def plan_ranks(load: CaseLoad, cores: int | None,
+               min_particles_per_rank: int = MIN_PARTICLES_PER_RANK) -> CasePlan:
+    """Ranks for one case: the smallest of :func:`rank_limits` (``cores`` None: no core
+    limit, as for a Slurm array task that gets its own allocation)."""
+    limits = rank_limits(load, cores, min_particles_per_rank)
+    ranks = min(limits.values())
+    bound = ", ".join(name for name, value in limits.items() if value == ranks)
+    return CasePlan(load.name, ranks, bound, load.particle_steps,
+                    estimated_seconds(load, ranks))
+
+
+@dataclass(frozen=True)
+class Phase:
+    """Cases that run in one go on ``groups`` rank groups of ``ranks`` each.
+
+    ``ensemble``: all in ONE ``mpirun`` of ``groups x ranks`` ranks, each group claiming
+    the next case of ``cases`` (:func:`ligwf.engine.ensemble.run_ensemble`); otherwise one
+    case after the other under ``mpirun -np ranks``.
+    """
+
+    ranks: int
+    groups: int
+    cases: tuple[str, ...]      # in claim order (planned: longest first)
+    ensemble: bool
+    estimated_seconds: float    # until the last group is done
+
+    @property
+    def total_ranks(self) -> int:
+        return self.ranks * self.groups
+
+
+@dataclass(frozen=True)
+class Schedule:
+    """How a study's cases run on ``cores`` cores: per case ranks, then phases in order."""
+
+    cores: int
+    cases: tuple[CasePlan, ...]     # in study order
+    phases: tuple[Phase, ...]       # in run order
+    planned: bool                   # False: what --np / --ensemble ask for
+
+    def ranks_of(self, name: str) -> int:
+        """The ranks of case ``name`` (KeyError if it is not in the schedule)."""
+        return {c.name: c.ranks for c in self.cases}[name]
+
+    @property
+    def estimated_seconds(self) -> float:
+        """Estimated wall time of the whole schedule (phases run one after the other)."""
+        return sum(p.estimated_seconds for p in self.phases)
+
+    @property
+    def core_fill(self) -> float:
+        """Estimated busy core-seconds / (cores x estimated wall time), in [0, 1]."""
+        wall = self.estimated_seconds
+        busy = sum(c.ranks * c.estimated_seconds for c in self.cases)
+        return min(1.0, busy / (self.cores * wall)) if wall > 0 else 0.0
+
+
+def list_schedule_seconds(durations: Sequence[float], groups: int) -> float:
+    """When the last of ``durations`` ends if ``groups`` workers each take the next one
+    in order as soon as they are free (what the ensemble's claims do)."""
+    _at_least("groups", groups, 1)
+    free = [0.0] * groups
+    for d in durations:
+        heapq.heappush(free, heapq.heappop(free) + d)
+    return max(free)
+
+
+def _unique_names(loads: Sequence[CaseLoad]) -> None:
+    names = [l.name for l in loads]
+    if len(set(names)) != len(names):
+        dup = sorted({n for n in names if names.count(n) > 1})
+        raise ConfigError(f"case names = {dup}: each case must appear once in a schedule")
+
+
+def plan_study(loads: Sequence[CaseLoad], cores: int,
+               min_particles_per_rank: int = MIN_PARTICLES_PER_RANK) -> Schedule:
+    """Ranks per case and the phases that pack them onto ``cores`` cores (see the module
+    docstring): one phase per rank count, widest first; in a phase as many groups as
+    fit the cores (never more than its cases), longest case first."""
+    _at_least("cores", cores, 1)
+    _unique_names(loads)
+    plans = tuple(plan_ranks(l, cores, min_particles_per_rank) for l in loads)
+    phases = []
+    for ranks in sorted({p.ranks for p in plans}, reverse=True):
+        members = sorted((p for p in plans if p.ranks == ranks),
+                         key=lambda p: -p.estimated_seconds)   # stable: ties keep study order
+        groups = min(cores // ranks, len(members))
+        phases.append(Phase(ranks, groups, tuple(p.name for p in members), groups > 1,
+                            list_schedule_seconds([p.estimated_seconds for p in members],
+                                                  groups)))
+    return Schedule(cores, plans, tuple(phases), planned=True)
+
+
+def fixed_ranks(loads: Sequence[CaseLoad], ranks: int, bound: str) -> tuple[CasePlan, ...]:
+    """Every case on ``ranks`` ranks because option ``bound`` says so (no planning)."""
+    _at_least(bound, ranks, 1)
+    return tuple(CasePlan(l.name, ranks, bound, l.particle_steps, estimated_seconds(l, ranks))
+                 for l in loads)
+
+
+def override_schedule(loads: Sequence[CaseLoad], nprocs: int, ensemble: int = 0,
+                      cores: int | None = None) -> Schedule:
+    """What ``--np K`` (every case on K ranks, one after the other) or ``--ensemble P``
+    (all cases, in study order, in one mpirun of P ranks, groups of K) do: no planning,
+    no core limit (the user asked for it); ``cores`` only for the fill estimate."""
+    _at_least("--np", nprocs, 1)
+    _at_least("--ensemble", ensemble, 0)
+    if ensemble and ensemble % nprocs:
+        raise ConfigError(f"--ensemble = {ensemble}: must be a multiple of --np = {nprocs} "
+                          f"(allowed: {nprocs}, {2 * nprocs}, {3 * nprocs}, ...)")
+    _unique_names(loads)
+    plans = fixed_ranks(loads, nprocs, BOUND_ENSEMBLE if ensemble else BOUND_NP)
+    groups = ensemble // nprocs if ensemble else 1
+    phases = ((Phase(nprocs, groups, tuple(p.name for p in plans), bool(ensemble),
+                     list_schedule_seconds([p.estimated_seconds for p in plans], groups)),)
+              if plans else ())
+    used = cores if cores is not None else (ensemble or nprocs)
+    return Schedule(_at_least("cores", used, 1), plans, phases, planned=False)
+
+
+def available_cores(explicit: int | None, environ: Mapping[str, str],
+                    affinity: int) -> tuple[int, str]:
+    """Cores a local run may fill, and where the number came from: ``explicit`` (an
+    option), else the tasks of the Slurm allocation this runs in (``SLURM_NTASKS``: the
+    ranks ``mpirun`` may start there), else the CPUs this process may run on."""
+    if explicit is not None:
+        return _at_least("--cores", explicit, 1), "--cores"
+    if environ.get("SLURM_JOB_ID") and environ.get("SLURM_NTASKS"):
+        text = environ["SLURM_NTASKS"]
+        try:
+            value = int(text)
+        except ValueError:
+            value = 0
+        if value < 1:
+            raise ConfigError(f"SLURM_NTASKS = {text!r}: must be a whole number (allowed "
+                              "range [1, inf))")
+        return value, "SLURM_NTASKS"
+    return _at_least("CPU affinity", affinity, 1), "CPUs this process may use"
+
+
+def machine_cores(explicit: int | None = None) -> tuple[int, str]:
+    """:func:`available_cores` of this process (reads the environment and CPU affinity)."""
+    try:
+        affinity = len(os.sched_getaffinity(0))
+    except AttributeError:          # not on Linux
+        affinity = os.cpu_count() or 1
+    return available_cores(explicit, os.environ, affinity)
+
