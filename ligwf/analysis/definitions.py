@@ -14,10 +14,15 @@ three parts, applied to one frame by :func:`identify_granules`:
 2. **Partition** -- ``components``: connected components of the bonds (the source study;
    in a dense wet bed one cluster spans the bed); ``communities`` (the default): Leiden
    communities maximising the constant Potts model with resolution gamma, edge weight
-   f_rel n^2 and node weight n^3 at CG level n. A CG-n contact stands for ~n^2 primary
-   contacts across the same interface and a CG-n node for n^3 primaries, so the CPM balance
-   gives the same granule volume at every n (measured CG2/CG1 d50 = 1.00). Why CPM and
-   gamma = 0.02 by default: docs/results/granule_definitions.md.
+   w n^2 and node weight n^3 at CG level n, where w is the bridge's relative rupture work
+   e_rel = W / (F_0 R*) (``weight: energy``, the default: the energy needed to pull the
+   pair apart, which grows with the bridge volume) or its relative force f_rel
+   (``weight: force``: the touching force of the capillary laws does not depend on the
+   liquid volume, so the partition barely responds to the liquid content). A CG-n contact
+   stands for ~n^2 primary contacts across the same interface and a CG-n node for n^3
+   primaries, so the CPM balance gives the same granule volume at every n (measured CG2/CG1
+   d50 = 0.98-1.02). Why CPM, rupture work and gamma = 0.002 by default:
+   docs/results/granule_definitions.md.
 3. **Granules** -- connected components of the bonds inside one partition class (for
    Leiden communities, which are connected, these are the communities), unwrapped along
    the periodic axis, each flagged when it closes a cycle around it (*percolating*).
@@ -33,13 +38,15 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ligwf.analysis.bridge_law import Liquid, relative_force
+from ligwf.analysis.bridge_law import Liquid, relative_energy, relative_force
 from ligwf.analysis.communities import cpm_labels, cpm_labels_reference
 from ligwf.analysis.dumps import ContactFrame, ParticleFrame
 from ligwf.analysis.granules import (BondCriterion, Identification, bonded_contacts,
                                      bonded_contacts_reference, components, identify)
 
 METHODS = ("communities", "components")
+#: CPM edge weights: the bridge's relative rupture work or its relative force
+WEIGHTS = ("energy", "force")
 VELOCITY_FRAMES = ("lab", "drum", "flow")
 #: thresholds switched on by the sensitivity table when the definition has them off
 NOMINAL_ANGLE_DEG = 30.0
@@ -57,15 +64,18 @@ class GranuleDefinition:
     max_velocity_angle_deg: float = 180.0
     min_bridge_force: float = 0.0          # N
     min_relative_force: float = 0.0        # F / (2 pi R* gamma cos theta)
-    resolution: float = 0.02               # CPM gamma
+    resolution: float = 0.002              # CPM gamma
     seed: int = 0                          # Leiden seed
     flow_radius: float = 3.0               # mean particle diameters
+    weight: str = "energy"                 # CPM edge weight: energy (e_rel) | force (f_rel)
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
             raise ValueError(f"method {self.method!r}: use one of {METHODS}")
         if self.velocity_frame not in VELOCITY_FRAMES:
             raise ValueError(f"velocity_frame {self.velocity_frame!r}: use one of {VELOCITY_FRAMES}")
+        if self.weight not in WEIGHTS:
+            raise ValueError(f"weight {self.weight!r}: use one of {WEIGHTS}")
         if not (self.resolution > 0 and self.flow_radius > 0 and self.min_relative_force >= 0):
             raise ValueError(f"{self}: resolution and flow_radius must be > 0, "
                              "min_relative_force >= 0")
@@ -75,7 +85,8 @@ class GranuleDefinition:
         """The definition of a study's :class:`~ligwf.study.settings.AnalysisSettings`."""
         return cls(s.granules, s.velocity_frame, float(s.max_velocity_angle),
                    float(s.min_bridge_force), float(s.min_relative_force),
-                   float(s.resolution), int(s.community_seed), float(s.flow_radius))
+                   float(s.resolution), int(s.community_seed), float(s.flow_radius),
+                   s.community_weight)
 
     @property
     def criterion(self) -> BondCriterion:
@@ -186,24 +197,32 @@ def identify_granules(particles: ParticleFrame, contacts: ContactFrame, liquid: 
     if definition.method == "components" and definition.min_relative_force == 0.0:
         return identify(particles, contacts, liquid, crit, axis, length, implementation)
     bonds = bonded_contacts if implementation == "fast" else bonded_contacts_reference
-    i, j, force = bonds(particles, contacts, liquid, crit)
+    i, j, force, rows = bonds(particles, contacts, liquid, crit, with_rows=True)
     f_rel = relative_force(force, particles.radii[i], particles.radii[j], liquid)
     keep = f_rel > definition.min_relative_force
-    i, j, force, f_rel = i[keep], j[keep], force[keep], f_rel[keep]
+    i, j, force, f_rel, rows = i[keep], j[keep], force[keep], f_rel[keep], rows[keep]
     if definition.method == "communities":
         n = len(particles)
+        weight = f_rel if definition.weight == "force" else relative_energy(
+            particles, i, j, -contacts.delta[rows], liquid, implementation)
         partition = cpm_labels if implementation == "fast" else cpm_labels_reference
-        community = partition(n, i, j, f_rel * cg ** 2, np.full(n, float(cg) ** 3),
+        community = partition(n, i, j, weight * cg ** 2, np.full(n, float(cg) ** 3),
                               definition.resolution, definition.seed)
         inside = community[i] == community[j]
         i, j, force = i[inside], j[inside], force[inside]
     return components(particles.positions, i, j, force, axis, length, implementation)
 
 
-def cpm_weights(particles: ParticleFrame, ident_i: np.ndarray, ident_j: np.ndarray,
-                force: np.ndarray, liquid: Liquid, cg: float) -> tuple[np.ndarray, np.ndarray]:
-    """(edge weights f_rel n^2, node weights n^3) of bonds (rows i, j, forces N): the CPM
-    graph of the default definition, for tests and benchmarks."""
-    f_rel = relative_force(force, particles.radii[ident_i], particles.radii[ident_j], liquid)
-    return f_rel * cg ** 2, np.full(len(particles), float(cg) ** 3)
+def cpm_weights(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid, cg: float,
+                weight: str = "energy") -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(i, j, edge weights w n^2, node weights n^3) of every bridge of a frame: the CPM
+    graph of the default definition (``weight``: energy or force), for tests and
+    benchmarks."""
+    i, j, force, rows = bonded_contacts(particles, contacts, liquid,
+                                        BondCriterion(0.0, 180.0), with_rows=True)
+    if weight == "force":
+        w = relative_force(force, particles.radii[i], particles.radii[j], liquid)
+    else:
+        w = relative_energy(particles, i, j, -contacts.delta[rows], liquid)
+    return i, j, w * cg ** 2, np.full(len(particles), float(cg) ** 3)
 

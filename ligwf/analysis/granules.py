@@ -119,8 +119,9 @@ def _unknown_id(particles: ParticleFrame, contacts: ContactFrame, count: int) ->
 
 
 def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
-                    criterion: BondCriterion = BondCriterion()):
-    """Indices (i, j) of bonded pairs into the particle arrays, and their bridge forces (N).
+                    criterion: BondCriterion = BondCriterion(), with_rows: bool = False):
+    """Indices (i, j) of bonded pairs into the particle arrays, and their bridge forces (N)
+    (``with_rows``: also each bond's row in the contact dump).
 
     One compiled pass over the contacts (:func:`ligwf.analysis.granules_numba.bond_kernel`): the
     rupture distance and velocity-angle tests, then the force law of the liquid model only
@@ -131,14 +132,17 @@ def bonded_contacts(particles: ParticleFrame, contacts: ContactFrame, liquid: Li
     from ligwf.analysis.granules_numba import bond_kernel
 
     args, _ = _kernel_args(particles, contacts, liquid, criterion)
-    count, i, j, force = bond_kernel(*args)
+    count, i, j, force, rows = bond_kernel(*args)
     if count < 0:
         _unknown_id(particles, contacts, count)
+    if with_rows:
+        return i[:count], j[:count], force[:count], rows[:count]
     return i[:count], j[:count], force[:count]
 
 
 def bonded_contacts_reference(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
-                              criterion: BondCriterion = BondCriterion()):
+                              criterion: BondCriterion = BondCriterion(),
+                              with_rows: bool = False):
     """:func:`bonded_contacts` evaluated with numpy and the model's numpy law (the reference)."""
     i = particles.index_of(contacts.id1)
     j = particles.index_of(contacts.id2)
@@ -148,6 +152,8 @@ def bonded_contacts_reference(particles: ParticleFrame, contacts: ContactFrame, 
     i, j = i[sel], j[sel]
     force = pair_forces(particles, i, j, -contacts.delta[sel], liquid)
     keep = force > criterion.min_bridge_force
+    if with_rows:
+        return i[keep], j[keep], force[keep], sel[keep]
     return i[keep], j[keep], force[keep]
 
 

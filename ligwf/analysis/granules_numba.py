@@ -74,9 +74,10 @@ def _bond(a, b, gap, velocities, radii, content, volume, within_rupture, force, 
 
 @njit(inline="always", error_model="numpy")
 def _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii, content,
-          delta, gamma, theta, cos_max, min_force, force_needed, out_i, out_j, out_f):
+          delta, gamma, theta, cos_max, min_force, force_needed, out_i, out_j, out_f, out_k):
     """The loop over the contacts shared by :func:`bond_kernel` and :func:`bond_components`:
-    bond test of each contact, bonded pairs to ``out_*``. Returns the bond count, or
+    bond test of each contact, bonded pairs to ``out_*`` (``out_k``: the contact's row in
+    the dump, whose overlap the rupture-work weight needs). Returns the bond count, or
     -1 - k when contact k refers to a row outside the frame.
 
     The model's functions are arguments of their own numba type, so each liquid model gets
@@ -98,6 +99,7 @@ def _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
         out_i[count] = a
         out_j[count] = b
         out_f[count] = f
+        out_k[count] = k
         count += 1
     return count
 
@@ -110,16 +112,18 @@ def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, volume,
     Particle rows are ``id1 - id_offset`` and ``id2 - id_offset`` (the ids themselves when
     the caller already mapped them, with offset 0). ``content``: liquid content per
     particle (fraction of its volume). Returns
-    (count, i, j, force) with the bonded pairs in the first ``count`` entries, or
-    count = -1 - k when contact k refers to a row outside the frame.
+    (count, i, j, force, contact row) with the bonded pairs in the first ``count`` entries,
+    or count = -1 - k when contact k refers to a row outside the frame.
     """
     m = len(id1)
     out_i = np.empty(m, np.int64)
     out_j = np.empty(m, np.int64)
     out_f = np.empty(m, np.float64)
+    out_k = np.empty(m, np.int64)
     count = _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
-                  content, delta, gamma, theta, cos_max, min_force, True, out_i, out_j, out_f)
-    return count, out_i, out_j, out_f
+                  content, delta, gamma, theta, cos_max, min_force, True, out_i, out_j, out_f,
+                  out_k)
+    return count, out_i, out_j, out_f, out_k
 
 
 @njit(error_model="numpy")
@@ -151,7 +155,7 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volu
     out_f = np.empty(m, np.float64)
     count = _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
                   content, delta, gamma, theta, cos_max, min_force, force_needed, out_i, out_j,
-                  out_f)
+                  out_f, np.empty(m, np.int64))
     if count < 0:
         return (count, out_i, out_j, out_f, np.arange(n), y, np.zeros(n, np.bool_), 0)
     labels, unwrapped, percolating, n_granules = components_images(n, out_i, out_j, count, y,
@@ -290,6 +294,24 @@ def granule_sums(labels, n_granules, radii, positions, axis, axis_values):
     return members, volume, moment, first
 
 
+@njit(error_model="numpy")
+def rupture_work(r_i, r_j, lo, hi, vol, force, gamma, theta, nodes, weights):
+    """Work, J, the bridge of each pair still does between gap ``lo`` and its rupture gap
+    ``hi`` (m): Gauss-Legendre quadrature of the model's numba ``force`` at ``nodes`` /
+    ``weights`` on [-1, 1] (the same nodes as the numpy reference,
+    :func:`ligwf.analysis.bridge_law.relative_energy`)."""
+    cos_theta, sin_theta = math.cos(theta), math.sin(theta)
+    out = np.empty(len(r_i), np.float64)
+    for k in range(len(r_i)):
+        half, mid = 0.5 * (hi[k] - lo[k]), 0.5 * (hi[k] + lo[k])
+        total = 0.0
+        for q in range(len(nodes)):
+            total += weights[q] * force(r_i[k], r_j[k], mid + half * nodes[q], gamma, theta,
+                                        cos_theta, sin_theta, vol[k])
+        out[k] = half * total
+    return out
+
+
 def warm_up(models: tuple[str, ...] | None = None) -> None:
     """Compile (or load from the cache) every kernel on a two-particle frame, the bond
     kernels for each of ``models`` (default: every registered wet model)."""
@@ -302,6 +324,8 @@ def warm_up(models: tuple[str, ...] | None = None) -> None:
                     0.02, 0.1, 0.5, 0.0)
         bond_components(np.array([1]), np.array([2]), 1, v, r, c, np.array([1e-6]),
                         *fns, 0.02, 0.1, 0.5, 0.0, True, v[:, 1].copy(), 1.0)
+        rupture_work(r, r, np.zeros(2), np.full(2, 1e-6), np.full(2, 1e-12), fns[2], 0.02,
+                     0.1, np.zeros(1), np.full(1, 2.0))
     i, j = np.array([0]), np.array([1])
     labels = union_find_labels(2, i, j)
     components_images(2, i, j, 1, v[:, 1].copy(), 1.0)

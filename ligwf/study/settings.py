@@ -25,9 +25,10 @@ class AnalysisSettings(_Frozen):
     """What the analysis of a study uses.
 
     The granule definition (``granules`` and the fields after it) defaults to Leiden CPM
-    communities of the bridge network, the one definition that met all five criteria of
-    docs/results/granule_definitions.md on real runs (no percolating granule, not on a
-    knife edge, box-size invariant, responds to the liquid content, CG-neutral);
+    communities of the bridge network weighted by each bridge's rupture work, the
+    definition that met all five criteria of docs/results/granule_definitions.md on real
+    runs (no percolating granule, not on a knife edge, box-size invariant, responds to the
+    liquid content, CG-neutral) and also separates a weakly wet bed from a wet one;
     ``granules: components`` with ``max_velocity_angle: 30`` reproduces the source study
     (one bed-spanning cluster in a dense wet bed).
     """
@@ -56,8 +57,14 @@ class AnalysisSettings(_Frozen):
         3.0, gt=0.0, le=50.0, description="radius of the local mean flow of velocity_frame "
         "flow, in mean particle diameters of the case")
     resolution: float = Field(
-        0.02, gt=0.0, le=100.0, allow_inf_nan=False, description="CPM resolution gamma of "
-        "the communities (edge weight f_rel n^2, node weight n^3 at CG level n)")
+        0.002, gt=0.0, le=100.0, allow_inf_nan=False, description="CPM resolution gamma of "
+        "the communities (edge weight w n^2, node weight n^3 at CG level n; the default "
+        "0.002 is for the energy weight, the force weight's scale is ~3-5x larger: 0.01-0.02)")
+    community_weight: Literal["energy", "force"] = Field(
+        "energy", description="CPM edge weight w: the bridge's rupture work over F0 R* "
+        "(energy, default: grows with the bridge volume, so granules respond to the liquid "
+        "content) or its force over that of a touching bridge (force: the touching force does "
+        "not depend on the liquid volume)")
     community_seed: int = Field(0, ge=0, description="seed of the Leiden runs")
     gsd_volume: Literal["physical", "primary"] = Field(
         "physical", description="granule volume the GSD bins: physical (a CG-neutral "

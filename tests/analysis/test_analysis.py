@@ -22,7 +22,7 @@ from ligwf.study.case import CaseFolder
 from ligwf.study.settings import AnalysisSettings
 from wetdump import wet_study
 
-FAST = AnalysisOptions(settings=AnalysisSettings(bootstrap=100, resolution=0.01))
+FAST = AnalysisOptions(settings=AnalysisSettings(bootstrap=100))
 OUTPUTS = ("granules.parquet", "frames.csv", "gsd.csv", "gsd_summary.csv", "analysis.json")
 
 
@@ -33,7 +33,7 @@ def study(engine, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("analysed") / "study"
     shutil.copytree(wet_study(engine, tmp_path_factory), out)
     record = json.loads((out / "study.json").read_text())
-    record["analysis"] = {"bootstrap": 100, "resolution": 0.01}   # CG3 at 0.02: all single
+    record["analysis"] = {"bootstrap": 100}
     (out / "study.json").write_text(json.dumps(record))
     return out
 
@@ -69,7 +69,7 @@ def test_outputs_of_a_study(study, serial):
     pd.testing.assert_frame_equal(a, b)
     # the table equals a direct run of the life-cycle class
     case = CaseFolder.open(study / "cg3-weber-r0")
-    ref = GranuleAnalysis(case, GranuleDefinition(resolution=0.01)).run()   # vs reference: test_definitions
+    ref = GranuleAnalysis(case, GranuleDefinition()).run()   # vs reference: test_definitions
     for r in ref.results:
         got = a[a.step == r.step].reset_index(drop=True)
         np.testing.assert_array_equal(got["members"], r.table["members"])

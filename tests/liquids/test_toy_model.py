@@ -1,4 +1,4 @@
-"""Extensibility: a fourth liquid model defined in tests/liquids/toy_constant.py (one new
+"""Extensibility: a fourth liquid model defined in tests/toy_constant.py (one new
 file, registered there with one line) goes through every stage without touching ligwf:
 validation, CG scaling, rendering, pre-flight and granule identification."""
 
