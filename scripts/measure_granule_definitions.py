@@ -94,6 +94,7 @@ class Frame:
     dy: np.ndarray           # minimum-image displacement y_j - y_i along the axis, m
     force: np.ndarray        # N
     frel: np.ndarray         # F / (2 pi R* gamma cos theta)
+    erel: np.ndarray         # rupture work / (F0 R*) (ligwf.analysis.bridge_law.relative_energy)
     keys: np.ndarray         # id1 * big + id2 (id1 < id2), for persistence
     cos: dict                # velocity frame -> cos(angle) per bridge (1 for zero speed)
 
@@ -119,6 +120,13 @@ def _cos(vi, vj):
     ok = nn > 0
     out[ok] = dot[ok] / nn[ok]
     return out
+
+
+def _relative_energy(p, i, j, gap, model, gamma, theta, content):
+    """The bridge's relative rupture work (the default CPM weight since 2026-11-28)."""
+    from ligwf.analysis.bridge_law import Liquid, relative_energy
+
+    return relative_energy(p, i, j, gap, Liquid(model, gamma, theta, float(content)))
 
 
 def load_case(path: Path, steady_fraction: float, flow_radii=(3.0,)) -> Case:
@@ -149,12 +157,13 @@ def load_case(path: Path, steady_fraction: float, flow_radii=(3.0,)) -> Case:
         i, j, F = i[keep], j[keep], F[keep]
         reff = p.radii[i] * p.radii[j] / (p.radii[i] + p.radii[j])
         frel = F / (2 * math.pi * reff * gamma * math.cos(theta))
+        erel = _relative_energy(p, i, j, gap[keep], model, gamma, theta, s["liquid_content"])
         y = p.positions[:, 1]
         d = y[j] - y[i]
         dy = d - length * np.round(d / length)
         lo, hi = np.minimum(p.ids[i], p.ids[j]), np.maximum(p.ids[i], p.ids[j])
         frames.append(Frame(f.step, len(p), p.ids, p.positions, p.velocities, p.radii,
-                            p.volumes, i, j, dy, F, frel,
+                            p.volumes, i, j, dy, F, frel, erel,
                             lo * big + hi, {}))
     case = Case(path, float(s["cg"]), str(s["rule"]), length, axis, omega,
                 float(s["liquid_content"]), float(np.mean(frames[0].radii) * 2) if frames else 0.0,
@@ -288,7 +297,7 @@ def leiden(n, i, j, w, objective, resolution, node_weights=None, seed=0):
     if node_weights is not None:
         kw["node_weights"] = node_weights.tolist()
     part = g.community_leiden(objective_function=objective, weights=w.tolist(),
-                              resolution=resolution, n_iterations=2, **kw)   # igraph's default
+                              resolution=resolution, n_iterations=-1, **kw)   # to convergence, as ligwf
     return np.asarray(part.membership, dtype=np.int64)
 
 
@@ -304,6 +313,7 @@ class Spec:
     k: int = 1                   # persistence (dumps)
     part: str = "cc"             # cc | louvain | leiden | cpm
     gamma: float = 0.0           # CPM resolution
+    weight: str = "force"        # CPM edge weight: force (f_rel) | energy (e_rel)
 
     def perturbations(self):
         """(parameter, spec) pairs with each threshold moved by -20 % and +20 %."""
@@ -356,6 +366,9 @@ CANDIDATES = [
     Spec("leiden cpm 0.02 rot 30", "rot", 30, part="cpm", gamma=0.02),
     Spec("leiden cpm 0.05 flow 30", "flow", 30, part="cpm", gamma=0.05),
     Spec("leiden cpm 0.05 persist k5", k=5, part="cpm", gamma=0.05),
+    Spec("leiden cpm energy 0.001", part="cpm", gamma=0.001, weight="energy"),
+    Spec("leiden cpm energy 0.002", part="cpm", gamma=0.002, weight="energy"),
+    Spec("leiden cpm energy 0.005", part="cpm", gamma=0.005, weight="energy"),
 ]
 
 
@@ -393,7 +406,8 @@ class Evaluator:
         m = self.bonds(idx, spec)
         if m is None:
             return None
-        i, j, dy, w = fr.i[m], fr.j[m], fr.dy[m], fr.frel[m]
+        i, j, dy = fr.i[m], fr.j[m], fr.dy[m]
+        w = (fr.erel if spec.weight == "energy" else fr.frel)[m]
         n, L, vprim = fr.n, self.case.length, fr.vprim
         if tiles > 1:
             y = fr.pos[:, 1]
