@@ -32,6 +32,8 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
   particles, contacts, bonds, granules, largest granule share and whether the largest
   granule percolates (wraps around the periodic axis);
 * GSD and GSD summary tables: see :mod:`ligwf.analysis.gsd_tables`;
+* GSD pooling table: the size limits and errors of CG-n replica pools of K = 1, 2, 4, 8
+  against CG1, and CG1 against itself: see :mod:`ligwf.analysis.gsd_pooling`;
 * kinetics (per case and frame, and per condition with bands and CG-n/CG1 ratios) and
   sensitivity tables: see :mod:`ligwf.analysis.kinetics`;
 * ``<case_id>/granules.pvd`` + ``granules_<step>.vtu``: particles with a ``granule`` array;
@@ -55,6 +57,7 @@ from ligwf.analysis.frame_checks import FramePlan, plan_frames
 from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.gsd import VOLUME_COLUMNS, GsdSettings
 from ligwf.analysis.flow_run import steady_start_step
+from ligwf.analysis.gsd_pooling import pooling_table
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.kinetics import (KINETICS_SUMMARY_TABLE, KINETICS_TABLE, SENSITIVITY_TABLE,
                                      kinetics_summary, kinetics_table, sensitivity_table)
@@ -65,6 +68,9 @@ from ligwf.study.settings import AnalysisSettings
 from ligwf.study.study import Study
 
 __all__ = ["AnalysisOptions", "GranuleAnalysis", "NothingAnalysed", "analyse"]
+
+#: replica pool sizes of the GSD pooling table (ensembles: the source study's fix)
+POOL_SIZES = (1, 2, 4, 8)
 
 
 class NothingAnalysed(LigwfError):
@@ -228,6 +234,8 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     steady = granules[granules["step"] >= granules["case_id"].map(steady_from).astype(float)]
     gsd_df, summary = gsd_tables(steady, cases, gsd_settings(settings))
     stage_tables(outputs, granules, frames, gsd_df, summary)
+    pooled = pooling_table(steady, cases, gsd_settings(settings), POOL_SIZES)
+    outputs.write(layout.GSD_POOLING_TABLE, pooled.to_csv(index=False).encode())
     stage_kinetics(outputs, granules, analysed, steady_from, settings, options.implementation)
     if options.write_vtu:
         for c in cases:

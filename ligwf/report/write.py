@@ -19,6 +19,7 @@ import pandas as pd
 
 from ligwf import __version__
 from ligwf.analysis.frame_checks import last_usable_frame
+from ligwf.analysis.gsd_pooling import pooling_summary
 from ligwf.analysis.flow_run import flow_study
 from ligwf.analysis.steady import is_auto
 from ligwf.engine.render import MESH_NAME
@@ -102,6 +103,43 @@ def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame) -> list[str]:
     return lines
 
 
+def pooling_markdown(analysis_dir: Path) -> list[str]:
+    """The GSD size limit against replica pooling (ligwf.analysis.gsd_pooling): per
+    condition and pool size K, the mean [min, max] over disjoint pools of the source
+    study's upper limit and the errors below / above it; the CG1 noise floor first."""
+    path = analysis_dir / layout.GSD_POOLING_TABLE
+    if not path.is_file() or path.stat().st_size <= 1:
+        return []
+    table = pd.read_csv(path)
+    if table.empty:
+        return []
+    summary = pooling_summary(table)
+    band = table["error_band"].iloc[0]
+    lines = ["## GSD size limit and replica pooling", "",
+             f"Upper limit: the largest granule volume up to which every bin holding >= 1 % "
+             f"of the CG1 granule volume is within {100 * band:g} % of CG1 (the source "
+             f"study's limit; nan: the smallest bin is already outside). Errors: relative L1 "
+             f"of the volume-weighted GSD below / above it. K replicas pooled, mean [min, max] "
+             f"over disjoint pools; `noise floor`: one CG1 replica against the others.", "",
+             "| condition | rule | K | pools | upper limit [m^3] | error below | error above "
+             "| lower limit [m^3] |", "|---|---|---|---|---|---|---|---|"]
+
+    def cell(r, v):
+        m, lo, hi = r[f"{v}_mean"], r[f"{v}_min"], r[f"{v}_max"]
+        text = _fmt(m) if r["pools"] < 2 else f"{_fmt(m)} [{_fmt(lo)}, {_fmt(hi)}]"
+        nan = r[f"{v}_nan_pools"]
+        return text + (f" ({int(nan)} nan)" if nan else "")
+
+    order = summary.assign(first=summary["rule"] != "noise floor").sort_values(
+        ["first", "condition", "k"])
+    for _, r in order.iterrows():
+        lines.append(f"| {r['condition']} | {r['rule']} | {int(r['k'])} | {int(r['pools'])} | "
+                     + " | ".join(cell(r, v) for v in ("upper_limit", "error_below_upper",
+                                                       "error_above_upper", "lower_limit"))
+                     + " |")
+    return lines + [""]
+
+
 def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame) -> str:
     head = "| " + " | ".join(t for _, t in CASE_COLUMNS) + " |"
     sep = "|" + "---|" * len(CASE_COLUMNS)
@@ -175,6 +213,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         f"Steady window: {steady_line(study, cases)}.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
         *noise_markdown(conditions, floors),
+        *pooling_markdown(study.analysis_dir),
         *problems.markdown(),
         "## Figures", "",
         *[f"![{t}](figures/{p.name})" for t, p in figures], "",

@@ -47,6 +47,7 @@ GRANULES_TABLE = "granules.parquet"
 FRAMES_TABLE = "frames.csv"
 GSD_TABLE = "gsd.csv"
 GSD_SUMMARY_TABLE = "gsd_summary.csv"
+GSD_POOLING_TABLE = "gsd_pooling.csv"
 FLOW_TABLE = "flow.csv"
 FLOW_PROFILES = "flow_profiles.json"
 

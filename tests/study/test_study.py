@@ -77,6 +77,19 @@ def test_gsd_errors_and_condition_means(study):
             assert lo <= c["angle_of_repose"] <= hi
 
 
+def test_gsd_pooling_table_and_report_section(study):
+    """Pools of K = 1 and 2 of each CG2 condition's two replicas against CG1 (one CG1
+    replica: no noise-floor rows); the report shows the section."""
+    pooled = pd.read_csv(study / "analysis" / "gsd_pooling.csv")
+    for rule in ("weber", "bond"):
+        sub = pooled[(pooled["cg"] == 2) & (pooled["rule"] == rule)]
+        assert sorted(zip(sub["k"], sub["pool"])) == [(1, "0"), (1, "1"), (2, "0+1")]
+        assert (sub["frames"] > 0).all()
+    assert "noise floor" not in set(pooled["rule"])
+    md = (study / "report" / "summary.md").read_text()
+    assert "## GSD size limit and replica pooling" in md
+
+
 BOUNDS = {"rigid_frame_share": (0, 1), "largest_cluster_fraction": (0, 1),
           "one_granule_frame_share": (0, 1), "angle_of_repose": (-90, 90)}
 POSITIVE = ("core_seconds", "wall_seconds", "production_core_rate", "speedup_core",
