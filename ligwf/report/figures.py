@@ -83,8 +83,17 @@ def pareto(conditions: pd.DataFrame, path: Path) -> Path:
     return _save(fig, path)
 
 
-def gsd_overlay(gsd: pd.DataFrame, path: Path) -> Path:
-    """Volume-weighted GSD of each condition (CG-n volumes / n^3) with bootstrap bands."""
+#: axis label and title part of each analysis.gsd_volume convention
+GSD_VOLUME_LABELS = {
+    "physical": ("granule volume [m$^3$]", "physical granule volumes"),
+    "primary": ("granule volume, primary-particle equivalent [m$^3$]", "CG-n volumes / n$^3$"),
+}
+
+
+def gsd_overlay(gsd: pd.DataFrame, path: Path, volume: str = "physical") -> Path:
+    """Volume-weighted GSD of each condition with bootstrap bands, on the volume axis of
+    the study's ``gsd_volume`` convention (physical, or primary = CG-n volume / n^3)."""
+    xlabel, what = GSD_VOLUME_LABELS[volume]
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for name, sub in gsd.groupby("condition", sort=True):
         sub = sub.sort_values("v_mid")
@@ -92,8 +101,8 @@ def gsd_overlay(gsd: pd.DataFrame, path: Path) -> Path:
         ax.fill_between(sub["v_mid"], sub["volume_lo"], sub["volume_hi"], alpha=0.2,
                         color=line.get_color())
     ax.set_xscale("log")
-    _axes(ax, "granule volume, primary-particle equivalent [m$^3$]", "volume fraction per bin",
-           "GSD: CG-n volumes / n$^3$ against CG1 (95 % bootstrap bands)", legend=8)
+    _axes(ax, xlabel, "volume fraction per bin",
+          f"GSD, {what}, against CG1 (95 % bootstrap bands)", legend=8)
     return _save(fig, path)
 
 

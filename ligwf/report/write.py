@@ -183,7 +183,8 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     if gsd_path.is_file() and gsd_path.stat().st_size > 1:
         gsd = pd.read_csv(gsd_path)
         if not gsd.empty:
-            figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / "gsd_overlay.png")))
+            figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / "gsd_overlay.png",
+                                                                 study.analysis.gsd_volume)))
     figures += granule_figures(study.analysis_dir, fig_dir)
     pvds = []
     by_id = {c.case_id: c for c in study.usable_cases()[0]}
