@@ -1,5 +1,6 @@
-"""Granules as communities of the bonded graph: Leiden CPM (the default granule definition,
-see :mod:`ligwf.analysis.definitions`) and Louvain (an extra label), canonical labels.
+"""Granules as communities of the bonded graph: CPM (the default granule definition, see
+:mod:`ligwf.analysis.definitions`; compiled Louvain, with igraph's Leiden and leidenalg as
+independent references) and modularity Louvain (an extra label), canonical labels.
 
 An alternative to the connected components of :mod:`ligwf.analysis.granules` (which
 over-merge a dense wet bed into one cluster), stored next to them on request
@@ -69,36 +70,56 @@ def cpm_quality(labels: np.ndarray, i: np.ndarray, j: np.ndarray, weight: np.nda
 def cpm_labels(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
                node_weight: np.ndarray, resolution: float, seed: int = 0,
                with_quality: bool = False):
-    """Leiden communities maximising the constant Potts model (igraph's compiled
-    ``community_leiden``, 2 iterations: iterating to convergence cost 8x the time for
-    +0.06 % quality on a 44k synthetic frame, +1 % on real CG1 frames), canonical labels.
+    """Communities maximising the constant Potts model: compiled Louvain with two
+    iterations (:func:`ligwf.analysis.cpm_numba.louvain_cpm`), canonical labels. A frame's
+    partition depends only on the frame and the seed (identical in serial and MPI runs).
+
+    Why not igraph's Leiden (the reference, :func:`cpm_labels_reference`): at 360k
+    particles it took ~5 s per frame on one core; on real CG1-CG3 bond graphs the
+    compiled Louvain ends within 1 % of the total edge weight of Leiden's CPM quality
+    (mean 0.3 %, sometimes above it) at 3x-10x the speed. ``with_quality``: also return
+    the quality the compiled code computes of its partition (the tests check it against
+    numpy's :func:`cpm_quality` to 1e-6).
+    """
+    from ligwf.analysis.cpm_numba import cpm_quality_compiled, louvain_cpm
+
+    if n == 0:
+        return (np.zeros(0, np.int64), 0.0) if with_quality else np.zeros(0, np.int64)
+    i64, j64 = np.asarray(i, np.int64), np.asarray(j, np.int64)
+    w, nw = np.asarray(weight, np.float64), np.asarray(node_weight, np.float64)
+    labels = canonical_labels(louvain_cpm(int(n), i64, j64, w, nw, float(resolution), int(seed)))
+    if with_quality:
+        return labels, float(cpm_quality_compiled(labels, i64, j64, w, nw, float(resolution)))
+    return labels
+
+
+def cpm_labels_reference(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
+                         node_weight: np.ndarray, resolution: float, seed: int = 0) -> np.ndarray:
+    """The reference of :func:`cpm_labels`: igraph's compiled Leiden (2 iterations), an
+    independent implementation with a refinement step Louvain lacks, canonical labels.
+    The two reach different local optima; they are compared by their CPM quality.
 
     The graph is built from a list of (int, int) tuples: igraph 1.0 reads a numpy edge
-    array element by element, 2.2x slower (1.56 vs 0.70 s for 1.2M edges). igraph draws from a process-wide generator:
-    it is set to a ``random.Random(seed)`` per call, so a frame's partition depends only
-    on the frame and the seed (identical in serial and MPI runs). ``with_quality``: also
-    return igraph's own quality of the partition converted to :func:`cpm_quality`'s
-    convention (x total edge weight), which the tests check against the numpy value.
-    """
+    array element by element, 2.2x slower (1.56 vs 0.70 s for 1.2M edges). igraph draws
+    from a process-wide generator: it is set to a ``random.Random(seed)`` per call."""
     import random
 
     import igraph as ig
 
     if n == 0:
-        return (np.zeros(0, np.int64), 0.0) if with_quality else np.zeros(0, np.int64)
+        return np.zeros(0, np.int64)
     ig.set_random_number_generator(random.Random(seed))
     graph = ig.Graph(n=n, edges=list(zip(np.asarray(i).tolist(), np.asarray(j).tolist())))
     part = graph.community_leiden(objective_function="CPM", weights=np.asarray(weight).tolist(),
                                   node_weights=np.asarray(node_weight).tolist(),
                                   resolution=resolution, n_iterations=2)
-    labels = canonical_labels(np.asarray(part.membership, dtype=np.int64))
-    return (labels, float(part.quality) * float(np.sum(weight))) if with_quality else labels
+    return canonical_labels(np.asarray(part.membership, dtype=np.int64))
 
 
-def cpm_labels_reference(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
+def cpm_labels_leidenalg(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
                          node_weight: np.ndarray, resolution: float, seed: int = 0) -> np.ndarray:
-    """The reference of :func:`cpm_labels`: leidenalg's own Leiden implementation
-    (``CPMVertexPartition``, iterated to convergence; ~13x slower). The two algorithms
+    """A third CPM optimiser: leidenalg's own Leiden implementation
+    (``CPMVertexPartition``, iterated to convergence; ~13x slower than igraph's). The two algorithms
     differ in their moves and, on real bond graphs, reach different local optima (CPM
     quality within ~0.5 % of the total edge weight, either one higher, on the CG3 test
     dumps); the exact check of the fast path is its own reported quality against

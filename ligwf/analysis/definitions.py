@@ -12,7 +12,7 @@ three parts, applied to one frame by :func:`identify_granules`:
    turns it) or ``flow`` (minus the mean velocity of the particles within ``flow_radius``
    mean particle diameters, periodic along the drum axis).
 2. **Partition** -- ``components``: connected components of the bonds (the source study;
-   in a dense wet bed one cluster spans the bed); ``communities`` (the default): Leiden
+   in a dense wet bed one cluster spans the bed); ``communities`` (the default):
    communities maximising the constant Potts model with resolution gamma, edge weight
    w n^2 and node weight n^3 at CG level n, where w is the bridge's relative rupture work
    e_rel = W / (F_0 R*) (``weight: energy``, the default: the energy needed to pull the
@@ -24,11 +24,12 @@ three parts, applied to one frame by :func:`identify_granules`:
    d50 = 0.98-1.02). Why CPM, rupture work and gamma = 0.002 by default:
    docs/results/granule_definitions.md.
 3. **Granules** -- connected components of the bonds inside one partition class (for
-   Leiden communities, which are connected, these are the communities), unwrapped along
+   connected communities these are the communities; Louvain can leave one disconnected,
+   which then counts as several granules), unwrapped along
    the periodic axis, each flagged when it closes a cycle around it (*percolating*).
 
 Every part has a slow obvious reference beside its fast path: numpy bond test vs compiled
-kernel, brute-force neighbour means vs a k-d tree, leidenalg vs igraph's compiled Leiden
+kernel, brute-force neighbour means vs a k-d tree, compiled Louvain vs igraph's Leiden
 (compared by their CPM quality), networkx BFS vs compiled union-find.
 """
 
@@ -65,7 +66,7 @@ class GranuleDefinition:
     min_bridge_force: float = 0.0          # N
     min_relative_force: float = 0.0        # F / (2 pi R* gamma cos theta)
     resolution: float = 0.002              # CPM gamma
-    seed: int = 0                          # Leiden seed
+    seed: int = 0                          # seed of the CPM node order
     flow_radius: float = 3.0               # mean particle diameters
     weight: str = "energy"                 # CPM edge weight: energy (e_rel) | force (f_rel)
 

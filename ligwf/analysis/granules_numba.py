@@ -327,6 +327,10 @@ def warm_up(models: tuple[str, ...] | None = None) -> None:
         rupture_work(r, r, np.zeros(2), np.full(2, 1e-6), np.full(2, 1e-12), fns[2], 0.02,
                      0.1, np.zeros(1), np.full(1, 2.0))
     i, j = np.array([0]), np.array([1])
+    from ligwf.analysis.cpm_numba import cpm_quality_compiled, louvain_cpm
+
+    cpm = louvain_cpm(2, i, j, np.ones(1), np.ones(2), 0.1, 0)
+    cpm_quality_compiled(cpm, i, j, np.ones(1), np.ones(2), 0.1)
     labels = union_find_labels(2, i, j)
     components_images(2, i, j, 1, v[:, 1].copy(), 1.0)
     for axis in (-1, 1):

@@ -24,7 +24,7 @@ from ligwf.scene.model import _Frozen
 class AnalysisSettings(_Frozen):
     """What the analysis of a study uses.
 
-    The granule definition (``granules`` and the fields after it) defaults to Leiden CPM
+    The granule definition (``granules`` and the fields after it) defaults to CPM
     communities of the bridge network weighted by each bridge's rupture work, the
     definition that met all five criteria of docs/results/granule_definitions.md on real
     runs (no percolating granule, not on a knife edge, box-size invariant, responds to the
@@ -38,7 +38,7 @@ class AnalysisSettings(_Frozen):
         "(default: from the bed's measured spin-up, ligwf.analysis.steady) or a fraction of "
         "the production time")
     granules: Literal["communities", "components"] = Field(
-        "communities", description="granules are Leiden CPM communities of the bond graph "
+        "communities", description="granules are CPM communities of the bond graph "
         "(default) or its connected components (the source study)")
     min_bridge_force: float = Field(
         0.0, ge=0.0, allow_inf_nan=False, description="a liquid bond needs a bridge force "
@@ -65,7 +65,7 @@ class AnalysisSettings(_Frozen):
         "(energy, default: grows with the bridge volume, so granules respond to the liquid "
         "content) or its force over that of a touching bridge (force: the touching force does "
         "not depend on the liquid volume)")
-    community_seed: int = Field(0, ge=0, description="seed of the Leiden runs")
+    community_seed: int = Field(0, ge=0, description="seed of the CPM optimiser's node order")
     gsd_volume: Literal["physical", "primary"] = Field(
         "physical", description="granule volume the GSD bins: physical (a CG-neutral "
         "definition such as the CPM communities gives CG-n granules of CG1 size) or primary "
