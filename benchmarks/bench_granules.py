@@ -195,7 +195,7 @@ def report_communities(label: str, p, c, length: float, liquid: Liquid) -> None:
     t_work, w = timed(lambda: relative_energy(p, i, j, -c.delta[rows], liquid), 1)
     nw = np.ones(len(p))
     t_cpm, _ = timed(lambda: cpm_labels(len(p), i, j, w, nw, definition.resolution), 1)
-    print(f"{'':>16}  communities (Leiden CPM, {definition.weight} weight, gamma "
+    print(f"{'':>16}  communities (CPM, compiled Louvain, {definition.weight} weight, gamma "
           f"{definition.resolution:g}): {t_all:6.3f} s = {1 / t_all:5.2f} frames/s | "
           f"bonds+forces {t_bond * 1e3:6.1f} ms, rupture work {t_work * 1e3:6.1f} ms, "
           f"CPM {t_cpm:6.3f} s, granules {int(ident.labels.max()) + 1:,}", flush=True)

@@ -5,7 +5,8 @@ CPM quality of a partition: Q = sum over communities c of W_in(c) - gamma N_c^2 
 W_in the edge weight inside c and N_c its node weight (:func:`ligwf.analysis.communities.
 cpm_quality` computes it in numpy). Louvain (Blondel et al. 2008) with the CPM gain:
 
-1. *local moving*: nodes in a seeded random order; each leaves its community and joins
+1. *local moving*: nodes in order (on the particle graph: id order from a seeded start,
+   for cache locality; on aggregated graphs: a seeded random order); each leaves its community and joins
    the neighbouring community c with the largest gain w(v, c) - gamma n_v N_c (or a
    community of its own, gain 0); passes repeat until no node moves;
 2. *aggregation*: each community becomes a node (weight N_c, edges summed), and 1. runs
@@ -188,9 +189,15 @@ def _levels(n, i, j, w, node_w, gamma, start, max_passes, max_levels):
     ci, cj, cw, cnw = i, j, w, node_w
     size = n
     init = start.copy()
-    for _ in range(max_levels):
+    for level_no in range(max_levels):
         indptr, indices, weights = _csr(size, ci, cj, cw)
-        order = np.random.permutation(size)
+        if level_no == 0:
+            # the particle graph in id order from a seeded start: neighbouring ids are
+            # mostly neighbouring particles, and a random order's cache misses made this
+            # level 8x slower at 360k particles (2.2 vs 0.27 s; CPM quality 0.6 % higher)
+            order = (np.arange(size) + np.random.randint(0, size)) % size
+        else:
+            order = np.random.permutation(size)
         comm, moves = _local_moving(indptr, indices, weights, cnw, gamma, order, max_passes,
                                     init)
         level, k = _renumber(comm)

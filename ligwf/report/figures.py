@@ -44,14 +44,15 @@ def _label(cg: float, rule: str) -> str:
 
 def pareto(conditions: pd.DataFrame, path: Path) -> Path:
     """Error vs run time on the table's footing: x is production core-seconds per simulated
-    second of production (what the speedup column divides), errors with their intervals
+    second of production per 1,000 particles of the original system (what the speedup
+    column divides), errors with their intervals
     and the CG1 noise floor (dotted); a third panel shows each condition's fill, settle and
     production core-seconds, which the x axis leaves out."""
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     for ax, col, title in ((axes[0], "angle_error", "angle of repose error vs CG1"),
                            (axes[1], "profile_error", "velocity profile error (rel. L2) vs CG1")):
         for _, r in conditions.iterrows():
-            y, x = r[col], r["production_core_rate"]
+            y, x = r[col], r["production_core_rate_k"]
             if not np.isfinite(y) or not np.isfinite(x):
                 continue
             lo, hi = r.get(f"{col}_lo"), r.get(f"{col}_hi")
@@ -67,7 +68,8 @@ def pareto(conditions: pd.DataFrame, path: Path) -> Path:
                        label=f"CG1 noise floor ({conditions[f'{col}_floor_source'].iloc[0]})")
         ax.set_xscale("log")
         ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short spans
-        _axes(ax, "production cost [core-s per simulated s]", "error [%]", title,
+        _axes(ax, "production cost [core-s per simulated s per 1k original particles]",
+              "error [%]", title,
               legend=7 if len(floors) else None)
     ax = axes[2]
     labels = [_label(r["cg"], r["rule"]) for _, r in conditions.iterrows()]

@@ -32,7 +32,8 @@ from ligwf.report.uncertainty import (ERROR_METRICS, FRAME_METRICS, ONE_GRANULE,
 from ligwf.study import layout
 from ligwf.study.study import Study
 
-METRICS = ["core_seconds", "wall_seconds", "production_core_rate", "speedup_core",
+METRICS = ["core_seconds", "wall_seconds", "production_core_rate", "production_core_rate_k",
+           "speedup_core",
            "speedup_wall", "angle_of_repose", "angle_of_repose_std", "angle_error",
            "profile_error", "rigid_frame_share", "rms_speed_rel_fluctuation",
            "largest_cluster_fraction", "one_granule_frame_share", "gsd_error_below",
@@ -70,7 +71,8 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
             production_seconds = man.steps_done * s.dt
         rows.append({
             "case_id": c.case_id, "group": c.group, "cg": c.cg, "rule": c.rule,
-            "replica": c.replica, "particles": s.particle_count, "dt": s.dt,
+            "replica": c.replica, "particles": s.particle_count,
+            "original_particles": s.original_particle_count, "dt": s.dt,
             "steps": man.steps_done,
             "simulated_seconds": man.steps_done * s.dt,
             "production_seconds": production_seconds,
@@ -79,6 +81,10 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
             **{f"{ph}_core_seconds": phases.get(ph, {}).get("core_seconds", math.nan)
                for ph in PHASES},
             "production_core_rate": prod_core / production_seconds,
+            # per 1,000 particles of the ORIGINAL system: slices of different length (and
+            # CG levels) on one footing
+            "production_core_rate_k": prod_core / production_seconds
+            / s.original_particle_count * 1000.0,
             "production_wall_rate": prod_wall / production_seconds,
             "nprocs": man.nprocs,
         })
@@ -121,17 +127,21 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path) -> pd.DataFrame:
 def compare_to_cg1(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
     """Speedups and errors of every case against the CG1 cases of its sweep group.
 
-    Speedup: CG1 production core-seconds per simulated second of production over the
-    case's (wall likewise). Errors: against the mean of the group's CG1 runs.
+    Speedup: CG1 production core-seconds per simulated second of production per original
+    (CG1) particle of the scene over the case's (wall likewise): the same physical system
+    on one footing even when a CG level runs a shorter slice (per_cg drum.length, as
+    we_vs_bo's CG1 does). Errors: against the mean of the group's CG1 runs.
     """
     df = df.copy()
-    for _, sub in df.groupby("group"):
+    size = df["original_particles"].astype(float)
+    for _, sub in df.groupby("group"):   # (production_core_rate / size is _rate_k / 1000)
         ref = sub[sub["cg"] == 1]
         if ref.empty:
             continue
         idx = sub.index
-        df.loc[idx, "speedup_core"] = ref["production_core_rate"].mean() / df.loc[idx, "production_core_rate"]
-        df.loc[idx, "speedup_wall"] = ref["production_wall_rate"].mean() / df.loc[idx, "production_wall_rate"]
+        for kind in ("core", "wall"):
+            rate = df[f"production_{kind}_rate"] / size
+            df.loc[idx, f"speedup_{kind}"] = rate[ref.index].mean() / rate[idx]
         for i in idx:
             for col in ERROR_METRICS:
                 df.at[i, col] = stats.error_metric([df.at[i, "case_id"]], list(ref["case_id"]), col).value

@@ -37,14 +37,14 @@ CASE_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica",
                 ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
                 ("wall_seconds", "wall [s]"), ("core_seconds", "core-s"),
                 ("fill_core_seconds", "fill core-s"), ("settle_core_seconds", "settle core-s"),
-                ("production_core_rate", "prod. core-s / sim. s"),
+                ("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
                 ("speedup_core", "speedup (core-s)"), ("steady_fraction", "steady from"), ("angle_of_repose", "angle [deg]"),
                 ("angle_of_repose_std", "angle std [deg]"), ("angle_error", "angle err"),
                 ("profile_error", "profile err (L2)"), ("rigid_frame_share", "rigid frames"),
                 ("largest_cluster_fraction", "largest cluster"),
                 ("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
 
-CONDITION_METRICS = [("production_core_rate", "prod. core-s / sim. s"),
+CONDITION_METRICS = [("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
                      ("speedup_core", "speedup"), ("angle_of_repose", "angle [deg]"),
                      ("angle_error", "angle err"), ("profile_error", "profile err"),
                      ("rigid_frame_share", "rigid frames"),
@@ -210,7 +210,9 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         f"# {name}: error against run time", "",
         f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are relative to the "
         "CG1 cases of the same sweep group; speedup is CG1 production core-seconds per simulated "
-        "second of production over the case's (fill and settle costs in their own columns).", "",
+        "second of production per 1,000 particles of the original (CG1) system over the case's, "
+        "so a CG level run on a shorter slice compares on the same footing (fill and settle "
+        "costs in their own columns).", "",
         f"Steady window: {steady_line(study, cases)}.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
         *noise_markdown(conditions, floors),

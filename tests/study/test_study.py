@@ -47,6 +47,9 @@ def test_speedup_and_errors_against_cg1(study):
     rate = cases["production_core_seconds"] / cases["production_seconds"]
     assert np.allclose(cases["simulated_seconds"], cases["steps"] * cases["dt"])
     assert np.allclose(cases["production_core_rate"], rate)
+    assert np.allclose(cases["production_core_rate_k"],
+                       rate / cases["original_particles"] * 1000)
+    rate = rate / cases["original_particles"]        # speedups on the original system
     ang1 = flow.loc["cg1-none-r0", "angle_of_repose_mean"]
     for cid, row in cases.iterrows():
         assert row["speedup_core"] == pytest.approx(rate["cg1-none-r0"] / rate[cid])
