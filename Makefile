@@ -14,9 +14,9 @@ PYTEST_ARGS ?=
 
 .PHONY: demo test install system-packages clean
 
-# The demo study: run (2 MPI ranks per case) + analyse + report -> $(DEMO_OUT)/report/
+# The demo study: run (ranks and packing from the rank plan) + analyse + report -> $(DEMO_OUT)/report/
 demo: install
-	$(LIGWF) study workflows/demo.yaml --out $(DEMO_OUT) --np 2
+	$(LIGWF) study workflows/demo.yaml --out $(DEMO_OUT)
 
 test: install
 	$(PY) -m pytest $(PYTEST_ARGS)
