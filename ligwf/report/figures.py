@@ -68,11 +68,11 @@ def pareto(conditions: pd.DataFrame, path: Path) -> Path:
                        label=f"CG1 noise floor ({conditions[f'{col}_floor_source'].iloc[0]})")
         ax.set_xscale("log")
         ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short spans
-        _axes(ax, "production cost [core-s per simulated s per 1k original particles]",
+        _axes(ax, "production core-s / simulated s / 1k original particles",
               "error [%]", title,
               legend=7 if len(floors) else None)
     ax = axes[2]
-    labels = [_label(r["cg"], r["rule"]) for _, r in conditions.iterrows()]
+    labels = [_label(r["cg"], r["rule"]).replace(" ", "\n") for _, r in conditions.iterrows()]
     bottom = np.zeros(len(conditions))
     for phase in ("fill", "settle", "production"):
         vals = conditions.get(f"{phase}_core_seconds", pd.Series(np.nan, index=conditions.index))

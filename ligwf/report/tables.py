@@ -159,7 +159,7 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
         row = {"group": group, "cg": cg, "rule": rule, "replicas": len(sub),
                "particles": int(sub["particles"].iloc[0]), "dt": float(sub["dt"].iloc[0]),
                "steps": int(sub["steps"].max())}
-        for ph in ("fill", "settle"):
+        for ph in PHASES:
             row[f"{ph}_core_seconds"] = float(sub[f"{ph}_core_seconds"].mean())
         for col in METRICS:
             if col in GSD_METRICS:  # one value per condition, with its GSD-stage band
