@@ -1,6 +1,7 @@
 """Granules as communities of the bonded graph: CPM (the default granule definition, see
-:mod:`ligwf.analysis.definitions`; compiled Louvain, with igraph's Leiden and leidenalg as
-independent references) and modularity Louvain (an extra label), canonical labels.
+:mod:`ligwf.analysis.definitions`; compiled Louvain, its plain-Python reference giving the
+same partition, igraph's Leiden and leidenalg as independent optimisers compared by
+quality) and modularity Louvain (an extra label), canonical labels.
 
 An alternative to the connected components of :mod:`ligwf.analysis.granules` (which
 over-merge a dense wet bed into one cluster), stored next to them on request
@@ -74,7 +75,7 @@ def cpm_labels(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
     iterations (:func:`ligwf.analysis.cpm_numba.louvain_cpm`), canonical labels. A frame's
     partition depends only on the frame and the seed (identical in serial and MPI runs).
 
-    Why not igraph's Leiden (the reference, :func:`cpm_labels_reference`): at 360k
+    Why not igraph's Leiden (:func:`cpm_labels_leiden`): at 360k
     particles it took ~5 s per frame on one core; on real CG1-CG3 bond graphs the
     compiled Louvain ends within 1 % of the total edge weight of Leiden's CPM quality
     (mean 0.3 %, sometimes above it) at 3x-10x the speed. ``with_quality``: also return
@@ -93,11 +94,118 @@ def cpm_labels(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
     return labels
 
 
+def _moves_reference(adj, node_w, gamma, order, max_passes, init):
+    """Plain-Python local moving of :func:`ligwf.analysis.cpm_numba._local_moving` (dicts
+    and lists, the same visiting order, sums and tie rule)."""
+    n = len(node_w)
+    comm = [int(c) for c in init]
+    comm_w = [0.0] * n
+    for v in range(n):
+        comm_w[comm[v]] += node_w[v]
+    used = set(comm)
+    free = [c for c in range(n - 1, -1, -1) if c not in used]      # a stack, top = last
+    moves = 0
+    for _ in range(max_passes):
+        moved = 0
+        for v in order:
+            cv, nv = comm[v], node_w[v]
+            acc: dict[int, float] = {}
+            for u, x in adj[v]:
+                acc[comm[u]] = acc.get(comm[u], 0.0) + x
+            comm_w[cv] -= nv
+            best, best_gain = cv, acc.get(cv, 0.0) - gamma * nv * comm_w[cv]
+            for c, a in acc.items():                # insertion order = first touch
+                if c == cv:
+                    continue
+                gain = a - gamma * nv * comm_w[c]
+                if gain > best_gain + 1e-12 * (abs(best_gain) + abs(gain)):
+                    best, best_gain = c, gain
+            if best_gain < 0.0 and comm_w[cv] > 0.0:
+                best = free.pop()
+            elif best_gain < 0.0:
+                best = cv
+            if best != cv and comm_w[cv] == 0.0:
+                free.append(cv)
+            comm_w[best] += nv
+            if best != cv:
+                comm[v] = best
+                moved += 1
+        moves += moved
+        if moved == 0:
+            break
+    return comm, moves
+
+
+def _first_appearance(comm):
+    new: dict[int, int] = {}
+    return [new.setdefault(c, len(new)) for c in comm], None
+
+
+def louvain_cpm_reference(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50,
+                          max_levels=20) -> np.ndarray:
+    """The reference of the compiled Louvain (:func:`ligwf.analysis.cpm_numba.louvain_cpm`):
+    the same algorithm written again in plain Python (adjacency lists in edge order, dict
+    sums, stable sorted aggregation), drawing the same node orders
+    (:func:`~ligwf.analysis.cpm_numba.level_order`): the same partition for a seed."""
+    from ligwf.analysis.cpm_numba import level_order, seed_orders
+
+    seed_orders(int(seed))
+    edges = [(int(a), int(b), float(x)) for a, b, x in zip(i, j, w)]
+    weights0 = [float(x) for x in node_w]
+    labels = list(range(n))
+    for _ in range(iterations):
+        out = list(range(n))
+        ed, nw, size, init = edges, weights0, n, labels
+        for level_no in range(max_levels):
+            adj: list[list[tuple[int, float]]] = [[] for _ in range(size)]
+            for a, b, x in ed:
+                if a != b:
+                    adj[a].append((b, x))
+                    adj[b].append((a, x))
+            order = level_order(size, level_no).tolist()
+            comm, moves = _moves_reference(adj, nw, gamma, order, max_passes, init)
+            level, _ = _first_appearance(comm)
+            k = max(level) + 1 if level else 0
+            out = [level[c] for c in out]
+            if moves == 0 or k == size:
+                break
+            agg_w = [0.0] * k
+            for v in range(size):
+                agg_w[level[v]] += nw[v]
+            pairs = []
+            for v in range(size):              # each undirected edge once (u > v), CSR order
+                for u, x in adj[v]:
+                    if u > v and level[u] != level[v]:
+                        a, b = sorted((level[v], level[u]))
+                        pairs.append((a * k + b, x))
+            pairs.sort(key=lambda t: t[0])      # stable, as the compiled mergesort
+            ed = []
+            for key, x in pairs:
+                if ed and ed[-1][0] == key // k and ed[-1][1] == key % k:
+                    ed[-1] = (ed[-1][0], ed[-1][1], ed[-1][2] + x)
+                else:
+                    ed.append((key // k, key % k, x))
+            nw, size, init = agg_w, k, list(range(k))
+        labels = _first_appearance(out)[0]
+    return np.asarray(labels, dtype=np.int64)
+
+
 def cpm_labels_reference(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
                          node_weight: np.ndarray, resolution: float, seed: int = 0) -> np.ndarray:
-    """The reference of :func:`cpm_labels`: igraph's compiled Leiden (2 iterations), an
-    independent implementation with a refinement step Louvain lacks, canonical labels.
-    The two reach different local optima; they are compared by their CPM quality.
+    """The reference of :func:`cpm_labels`: the same Louvain in plain Python
+    (:func:`louvain_cpm_reference`), canonical labels: the same partition for a seed."""
+    if n == 0:
+        return np.zeros(0, np.int64)
+    return canonical_labels(louvain_cpm_reference(
+        int(n), np.asarray(i), np.asarray(j), np.asarray(weight, float),
+        np.asarray(node_weight, float), float(resolution), int(seed)))
+
+
+def cpm_labels_leiden(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
+                      node_weight: np.ndarray, resolution: float, seed: int = 0) -> np.ndarray:
+    """A second, independent CPM optimiser: igraph's compiled Leiden (2 iterations), with a
+    refinement step Louvain lacks, canonical labels. The two reach different local optima;
+    they are compared by their CPM quality.
 
     The graph is built from a list of (int, int) tuples: igraph 1.0 reads a numpy edge
     array element by element, 2.2x slower (1.56 vs 0.70 s for 1.2M edges). igraph draws

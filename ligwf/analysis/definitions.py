@@ -29,8 +29,9 @@ three parts, applied to one frame by :func:`identify_granules`:
    the periodic axis, each flagged when it closes a cycle around it (*percolating*).
 
 Every part has a slow obvious reference beside its fast path: numpy bond test vs compiled
-kernel, brute-force neighbour means vs a k-d tree, compiled Louvain vs igraph's Leiden
-(compared by their CPM quality), networkx BFS vs compiled union-find.
+kernel, brute-force neighbour means vs a k-d tree, compiled Louvain vs the same Louvain in
+plain Python (the same partition; igraph's Leiden compared by CPM quality), networkx BFS vs
+compiled union-find.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ligwf.analysis.communities import (cpm_labels, cpm_labels_leidenalg,
+from ligwf.analysis.communities import (cpm_labels, cpm_labels_leiden, cpm_labels_leidenalg,
                                         cpm_labels_reference, cpm_quality)
 from ligwf.analysis.definitions import (GranuleDefinition, Motion, cpm_weights,
                                         drum_frame_velocities, flow_frame_velocities,
@@ -56,28 +56,33 @@ def test_component_definitions_reference_equals_fast(real, definition):
                                                 ("energy", 0.004), ("force", 0.01),
                                                 ("force", 0.02)])
 def test_cpm_fast_quality_checked_in_numpy_and_against_leiden(real, weight, resolution):
-    """The compiled Louvain's partition has the CPM quality it reports, as numpy computes
-    it independently (1e-6); igraph's Leiden (the reference: other algorithm, other local
-    optimum) and leidenalg reach the same quality within 2 % of the total edge weight
-    (measured on real CG1-CG3 frames: within 1 %, mean 0.3 %, either one higher); the
-    same seed gives the same partition; the definition's granules are the communities."""
+    """The compiled Louvain and its plain-Python reference (the same algorithm and node
+    orders) give the same partition for a seed; its CPM quality is the one it reports, as
+    numpy computes it (1e-6); igraph's Leiden and leidenalg (other algorithms, other local
+    optima) reach the same quality within 2 % of the total edge weight (measured on real
+    CG1-CG3 frames: within 0.6 %, either one higher); the definition's granules are the
+    communities."""
     scaled, liquid, motion, frames = real
     n_cg = scaled.cg
     for p, c in frames:
         i, j, w, nw = cpm_weights(p, c, liquid, n_cg, weight)
         fast, q_reported = cpm_labels(len(p), i, j, w, nw, resolution, seed=0, with_quality=True)
+        np.testing.assert_array_equal(fast, cpm_labels_reference(len(p), i, j, w, nw,
+                                                                 resolution, seed=0))
         q_fast = cpm_quality(fast, i, j, w, nw, resolution)
         assert q_fast == pytest.approx(q_reported, rel=1e-6, abs=1e-9)
-        for other in (cpm_labels_reference, cpm_labels_leidenalg):
+        for other in (cpm_labels_leiden, cpm_labels_leidenalg):
             ref = other(len(p), i, j, w, nw, resolution, seed=0)
             q_ref = cpm_quality(ref, i, j, w, nw, resolution)
             # in units of the total edge weight (like a modularity): the CPM quality
             # itself is a small difference of large terms
             assert np.array_equal(fast, ref) or abs(q_fast - q_ref) <= 0.02 * float(w.sum())
-        np.testing.assert_array_equal(fast, cpm_labels(len(p), i, j, w, nw, resolution, seed=0))
         ident = identify_granules(p, c, liquid, GranuleDefinition(
             resolution=resolution, weight=weight), n_cg, motion)
         np.testing.assert_array_equal(ident.labels, fast)
+        ref_ident = identify_granules(p, c, liquid, GranuleDefinition(
+            resolution=resolution, weight=weight), n_cg, motion, "reference")
+        np.testing.assert_array_equal(ref_ident.labels, ident.labels)
 
 
 def test_louvain_recovers_planted_communities():
