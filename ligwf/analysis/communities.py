@@ -137,8 +137,9 @@ def _moves_reference(adj, node_w, gamma, order, max_passes, init):
 
 
 def _first_appearance(comm):
+    """Labels numbered 0..K-1 in order of first appearance."""
     new: dict[int, int] = {}
-    return [new.setdefault(c, len(new)) for c in comm], None
+    return [new.setdefault(c, len(new)) for c in comm]
 
 
 def louvain_cpm_reference(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50,
@@ -164,7 +165,7 @@ def louvain_cpm_reference(n, i, j, w, node_w, gamma, seed, iterations=2, max_pas
                     adj[b].append((a, x))
             order = level_order(size, level_no).tolist()
             comm, moves = _moves_reference(adj, nw, gamma, order, max_passes, init)
-            level, _ = _first_appearance(comm)
+            level = _first_appearance(comm)
             k = max(level) + 1 if level else 0
             out = [level[c] for c in out]
             if moves == 0 or k == size:
@@ -186,7 +187,7 @@ def louvain_cpm_reference(n, i, j, w, node_w, gamma, seed, iterations=2, max_pas
                 else:
                     ed.append((key // k, key % k, x))
             nw, size, init = agg_w, k, list(range(k))
-        labels = _first_appearance(out)[0]
+        labels = _first_appearance(out)
     return np.asarray(labels, dtype=np.int64)
 
 

@@ -119,20 +119,29 @@ def percentile_diameters(volumes: np.ndarray, fractions=(0.1, 0.5, 0.9)) -> np.n
     return np.cbrt(6.0 * v[np.minimum(k, len(v) - 1)] / math.pi)
 
 
+def band_misses(cg: np.ndarray, ref: np.ndarray, error_band: float,
+                min_share: float = MIN_BIN_SHARE) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per row of ``cg`` / ``ref`` (volume-weighted GSDs, (..., bins)): the used bins (those
+    holding at least ``min_share`` of the CG1 volume) and, for each, whether
+    |cg - ref| > ``error_band`` x ref -- the test both size limits read (this one and
+    :func:`ligwf.analysis.gsd_pooling.upper_limit`)."""
+    out = []
+    for c, f in zip(np.atleast_2d(cg), np.atleast_2d(ref)):
+        used = np.flatnonzero(f >= min_share)
+        out.append((used, np.abs(c[used] - f[used]) > error_band * f[used]))
+    return out
+
+
 def located_limit(edges: np.ndarray, cg: np.ndarray, ref: np.ndarray, error_band: float,
                   min_share: float = MIN_BIN_SHARE) -> np.ndarray:
     """Size limit (m^3) located from the data, per row of ``cg`` / ``ref`` (volume-weighted
     GSDs, (..., bins)): the lower edge of the smallest bin from which on every bin holding
     at least ``min_share`` of the CG1 volume has |cg - ref| / ref <= ``error_band``; nan
     when the largest such bin is outside the band (CG-n never enters it)."""
-    cg2, ref2 = np.atleast_2d(cg), np.atleast_2d(ref)
-    out = np.full(len(cg2), np.nan)
-    for r, (c, f) in enumerate(zip(cg2, ref2)):
-        used = np.flatnonzero(f >= min_share)
-        if len(used) == 0:
-            continue
-        bad = np.abs(c[used] - f[used]) > error_band * f[used]
-        if bad[-1]:
+    misses = band_misses(cg, ref, error_band, min_share)
+    out = np.full(len(misses), np.nan)
+    for r, (used, bad) in enumerate(misses):
+        if len(used) == 0 or bad[-1]:
             continue
         first_ok = used[np.flatnonzero(bad)[-1] + 1] if bad.any() else used[0]
         out[r] = edges[first_ok]

@@ -52,14 +52,10 @@ def upper_limit(edges: np.ndarray, cg: np.ndarray, ref: np.ndarray, error_band: 
     """The source study's limit (m^3), per row of ``cg`` / ``ref`` (volume-weighted GSDs,
     (..., bins)): the upper edge of the largest bin up to which every used bin has
     |cg - ref| <= ``error_band`` x ref; nan when the smallest used bin is outside."""
-    cg2, ref2 = np.atleast_2d(cg), np.atleast_2d(ref)
-    out = np.full(len(cg2), np.nan)
-    for r, (c, f) in enumerate(zip(cg2, ref2)):
-        used = np.flatnonzero(f >= min_share)
-        if len(used) == 0:
-            continue
-        bad = np.abs(c[used] - f[used]) > error_band * f[used]
-        if bad[0]:
+    misses = gsdmod.band_misses(cg, ref, error_band, min_share)
+    out = np.full(len(misses), np.nan)
+    for r, (used, bad) in enumerate(misses):
+        if len(used) == 0 or bad[0]:
             continue
         last_ok = used[np.flatnonzero(bad)[0] - 1] if bad.any() else used[-1]
         out[r] = edges[last_ok + 1]

@@ -34,47 +34,41 @@ def pairs(n_pairs: int, rng, scale: float = 1.0):
     return radii, i, j, gap
 
 
-@pytest.mark.parametrize("model", ["washino", "easo"])
-def test_compiled_equals_numpy(model):
-    rng = np.random.default_rng(4)
-    radii, i, j, gap = pairs(2000, rng)
+def bonds(model: str, n_pairs: int, seed: int):
+    """(frame, liquid, radii, i, j, gap, lo, hi) of the random pairs that hold a bridge
+    (gap below the rupture gap of ``model``): only bonds are weighed."""
+    radii, i, j, gap = pairs(n_pairs, np.random.default_rng(seed))
     liquid = Liquid(model, 0.024, THETA, 0.02)
     p = frame(radii, 0.02)
     lo, hi, _ = work_limits(p, i, j, gap, liquid)
-    inside = gap < hi                                   # only bonds are weighed
-    i, j, gap = i[inside], j[inside], gap[inside]
+    keep = gap < hi
+    return p, liquid, radii, i[keep], j[keep], gap[keep], lo[keep], hi[keep]
+
+
+@pytest.mark.parametrize("model", ["washino", "easo"])
+def test_compiled_equals_numpy(model):
+    p, liquid, _, i, j, gap, _, _ = bonds(model, 2000, 4)
     fast = relative_energy(p, i, j, gap, liquid, "fast")
     ref = relative_energy(p, i, j, gap, liquid, "reference")
-    assert inside.sum() > 500 and np.all(fast > 0)
+    assert len(i) > 500 and np.all(fast > 0)
     np.testing.assert_allclose(fast, ref, rtol=1e-12, atol=0)
 
 
 def test_constant_force_integrates_exactly():
     """F = 2 pi R* gamma cos(theta) up to rupture: e_rel = (s_rupture - max(gap, 0)) / R*."""
-    rng = np.random.default_rng(5)
-    radii, i, j, gap = pairs(300, rng)
-    liquid = Liquid("toy_constant", 0.024, THETA, 0.02)
-    p = frame(radii, 0.02)
-    lo, hi, _ = work_limits(p, i, j, gap, liquid)
-    keep = gap < hi
+    p, liquid, radii, i, j, gap, _, hi = bonds("toy_constant", 300, 5)
     r_eff = radii[i] * radii[j] / (radii[i] + radii[j])
     expected = (hi - np.maximum(gap, 0.0)) / r_eff
     for impl in ("fast", "reference"):
-        got = relative_energy(p, i[keep], j[keep], gap[keep], liquid, impl)
-        np.testing.assert_allclose(got, expected[keep], rtol=1e-12)
+        got = relative_energy(p, i, j, gap, liquid, impl)
+        np.testing.assert_allclose(got, expected, rtol=1e-12)
 
 
 def test_quadrature_converged():
     """16 nodes: within 1e-6 of the same integral on 4x finer sub-intervals (washino law)."""
     from ligwf.analysis import bridge_law
 
-    rng = np.random.default_rng(6)
-    radii, i, j, gap = pairs(500, rng)
-    liquid = Liquid("washino", 0.024, THETA, 0.02)
-    p = frame(radii, 0.02)
-    lo, hi, _ = work_limits(p, i, j, gap, liquid)
-    keep = gap < hi
-    i, j, gap, lo, hi = i[keep], j[keep], gap[keep], lo[keep], hi[keep]
+    p, liquid, _, i, j, gap, lo, hi = bonds("washino", 500, 6)
     e16 = relative_energy(p, i, j, gap, liquid, "reference")
     # the same integral as four pieces [lo + k (hi - lo) / 4, ...], each from its own gap
     total = np.zeros(len(i))
