@@ -10,10 +10,15 @@ with the analysis settings stored in the study), and submits both. Each case's r
 (``--ntasks`` of its array task) come from the rank plan (:mod:`ligwf.engine.plan`: particle
 count and axial slab rule, at most ``--cores`` if given): one array per rank count, the
 analysis job after all of them; ``--ntasks`` or the site's ``ntasks`` put every case on that
-many ranks in one array, as before. The plan is printed. ``--dry-run`` prints the plan, the
-scripts and the sbatch commands and writes nothing. ``status`` joins the runner's manifests
-with squeue/scontrol; ``resubmit`` submits new arrays with exactly the cases that are
-missing, failed or killed (a planned submission is planned again).
+many ranks in one array, as before. With ``--cores-per-node`` (or the site's
+``cores_per_node``) a planned case also asks for ceil(ranks / cores per node) nodes. The
+plan is printed (:mod:`ligwf.slurm.budget`): per case (replicas alike share a row) its
+particles, steps, ranks and what bound them, nodes, the estimated wall time against
+``--time``, with a warning for each case the estimate says would outlive its ``--time``.
+``--dry-run`` prints the plan, the scripts and the sbatch commands and writes nothing.
+``status`` joins the runner's manifests with squeue/scontrol; ``resubmit`` submits new
+arrays with exactly the cases that are missing, failed or killed (a planned submission is
+planned again).
 """
 
 from __future__ import annotations
@@ -24,19 +29,35 @@ from dataclasses import asdict, fields
 from pathlib import Path
 from typing import Any
 
+from rich.console import Group
 from rich.table import Table
+from rich.text import Text
 
-from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_plan_table,
-                              case_table, console, duration, err_console, folder_to_write,
-                              positive_int, prepare_from_args)
+from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_table,
+                              console, duration, err_console, folder_to_write, positive_int,
+                              prepare_from_args)
 from ligwf.engine.plan import CasePlan, case_load, fixed_ranks, plan_ranks
 from ligwf.errors import SubmitError
+from ligwf.slurm.budget import (PlanRow, hours_minutes, over_time_warning, plan_rows,
+                                slab_note, slurm_time_seconds)
 from ligwf.slurm.jobs import (PlannedJob, active_tasks, cases_to_resubmit, dry_run_text,
                               next_round, plan_jobs, read_record, recorded_plan, recorded_site,
                               require_scheduler, study_status, submit_jobs)
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
 from ligwf.study.pipeline import POSTPROCESS_COMMANDS, prepared_loads, write
 from ligwf.study.study import Study
+
+
+def cores_per_node(text: str) -> int:
+    """argparse type of ``--cores-per-node``: a whole number of cores >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a whole number of cores, allowed range "
+                                         f"[1, inf), got {text!r}")
+    return value
 
 
 def add_site_args(p: argparse.ArgumentParser) -> None:
@@ -47,6 +68,9 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
                    help="MPI ranks for every case (default: site setting, else the rank plan)")
     add_cores_arg(p, "most ranks the rank plan gives one case, e.g. a node's cores "
                   "(default: no limit besides the slab rule and particles per rank)")
+    p.add_argument("--cores-per-node", type=cores_per_node, metavar="N",
+                   help="cores of one node: a planned case asks for ceil(ranks / N) nodes "
+                   "(default: site setting, else unknown and Slurm places the ranks)")
     p.add_argument("--max-concurrent", type=positive_int, metavar="K",
                    help="at most K cases at once (--array=...%%K)")
     p.add_argument("--no-analysis", action="store_true",
@@ -57,7 +81,8 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
 
 def site_from_args(args: argparse.Namespace, base: SlurmSite) -> SlurmSite:
     return base.with_overrides(partition=args.partition, account=args.account, time=args.time,
-                               ntasks=args.ntasks, max_concurrent=args.max_concurrent)
+                               ntasks=args.ntasks, max_concurrent=args.max_concurrent,
+                               cores_per_node=args.cores_per_node)
 
 
 def _site_from_record(values: dict[str, Any]) -> SlurmSite:
@@ -66,22 +91,65 @@ def _site_from_record(values: dict[str, Any]) -> SlurmSite:
                         for k, v in values.items() if k in names})
 
 
+def _warn(lines: list[str]) -> None:
+    for line in lines:
+        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
+
+
 def _print_submitted(entries: list[dict]) -> None:
     for e in entries:
         dep = f" (after {e['after']})" if e.get("after") else ""
         console.print(f"submitted {e['kind']} job {e['job_id']}{dep}: {e['script']}")
 
 
-def plan_caption(plans: tuple[CasePlan, ...], jobs: list[PlannedJob]) -> list[str]:
-    """How the arrays split the cases, and the estimated total cost."""
+def plan_caption(plans: tuple[CasePlan, ...], jobs: list[PlannedJob], rows: tuple[PlanRow, ...],
+                 site: SlurmSite) -> list[str]:
+    """How the arrays split the cases, where the nodes come from, the slab limits and the
+    estimated total cost."""
     lines = [f"{job.script_path.name}: {len(job.indices)} case(s), --ntasks="
-             f"{job.site.ntasks if job.site else '?'}" for job in jobs if job.kind == "array"]
+             f"{job.site.ntasks if job.site else '?'}"
+             + (f", --nodes={job.nodes}" if job.nodes is not None else "")
+             for job in jobs if job.kind == "array"]
+    planned = any(job.planned for job in jobs)
+    if site.cores_per_node is None:
+        lines.append("nodes ?: cores per node unknown (give --cores-per-node N or the site's "
+                     "slurm cores_per_node); the scripts ask for --ntasks only")
+    elif planned:
+        lines.append(f"nodes = ceil(ranks / {site.cores_per_node} cores per node), asked for "
+                     "with --nodes")
+    else:
+        lines.append(f"nodes = ceil(ranks / {site.cores_per_node} cores per node), not asked "
+                     "for: on --ntasks / site ntasks the scripts ask for --ntasks only")
+    lines += [slab_note(row) for row in rows if row.slab_bound]
+    if any(len(row.cases) > 1 for row in rows):
+        lines.append("'+N more': N more replicas of that CG level and rule, same load and plan")
     core_hours = sum(p.ranks * p.estimated_seconds for p in plans) / 3600
     longest = max((p.estimated_seconds for p in plans), default=0.0)
     lines.append(f"estimated {core_hours:.3g} core-hours in all, longest case "
                  f"~{duration(longest)} (rates measured on a 2-core machine: "
                  "ligwf.engine.plan; --time is per case)")
+    if site.time is None:
+        lines.append("no --time (nor site time): the partition's default limit applies")
     return lines
+
+
+def slurm_plan_table(rows: tuple[PlanRow, ...], title: str, time: str | None,
+                     notes: list[str]) -> Group:
+    """The Slurm plan: per row its case(s), load, ranks and their bound, nodes, estimated
+    wall time and the ``--time`` each array task asks for; ``notes`` below, one a line.
+    (The first four columns are those of ``ligwf check``'s rank plan.)"""
+    limit = slurm_time_seconds(time)
+    table = Table(title=title)
+    for col in ("case", "particle-steps", "ranks", "limited by", "nodes", "est. wall (h:mm)",
+                "--time", "particles", "steps"):
+        table.add_column(col, justify="left" if col in ("case", "limited by") else "right")
+    for row in rows:
+        table.add_row(row.label, f"{row.load.particle_steps:.3g}", str(row.ranks), row.bound,
+                      "?" if row.nodes is None else str(row.nodes),
+                      hours_minutes(row.estimated_seconds),
+                      (time or "-") + (" (too short)" if row.exceeds(limit) else ""),
+                      f"{row.load.particles:,}", f"{row.load.steps:,}")
+    return Group(table, *(Text(line) for line in notes))
 
 
 def cmd_submit(args: argparse.Namespace) -> int:
@@ -92,6 +160,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
     out: Path = args.out.resolve()
     round_no = next_round(out) if (out / "slurm").is_dir() else 1
     loads = prepared_loads(prepared)
+    groups = [(rc.scaled.cg, rc.scaled.rule) for rc in rendered]    # replicas share a row
     if args.ntasks is not None or ntasks_configured():   # every case on site.ntasks ranks
         plans, ranks = fixed_ranks(loads, site.ntasks, "--ntasks"), None
         title = "ranks as asked (--ntasks / site ntasks)"
@@ -101,10 +170,14 @@ def cmd_submit(args: argparse.Namespace) -> int:
         title = "rank plan" + (f" (at most {args.cores} per case)" if args.cores else "")
     jobs = plan_jobs(out, wf.name, site, [rc.case.index for rc in rendered], steps, round_no,
                      ranks, args.cores)
-    plan_view = case_plan_table(plans, title, plan_caption(plans, jobs))
+    rows = plan_rows(loads, plans, groups, site.cores_per_node)
+    plan_view = slurm_plan_table(rows, title, site.time, plan_caption(plans, jobs, rows, site))
+    limit = slurm_time_seconds(site.time)
+    over_time = [over_time_warning(row, site.time) for row in rows if row.exceeds(limit)]
     if args.dry_run:
         console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
         console.print(plan_view)
+        _warn(over_time)
         print(dry_run_text(jobs))
         return 0
     require_scheduler()
@@ -117,6 +190,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
     write(prepared, out, args.mesh_cache)
     console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) -> {out}"))
     console.print(plan_view)
+    _warn(over_time)
     _print_submitted(submit_jobs(out, jobs, site))
     return 0
 

@@ -32,6 +32,7 @@ from ligwf.errors import ConfigError, SubmitError
 from ligwf.fsio import atomic_write_json, atomic_write_text
 from ligwf.study.manifest import read_manifest
 from ligwf.study.study import Study
+from ligwf.slurm.budget import nodes_for
 from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_parsable,
                                parse_squeue, task_records)
 from ligwf.slurm.script import (LOG_DIR, SLURM_DIR, ScriptContext, analysis_script, array_script,
@@ -100,7 +101,8 @@ class PlannedJob:
 
     ``site``: the settings this script was built with (an array of a planned study has
     its own ``ntasks``); ``planned``: its ranks came from the rank plan (a resubmit plans
-    again, on ``plan_cores``), not from ``--ntasks`` / the site setting."""
+    again, on ``plan_cores``), not from ``--ntasks`` / the site setting; ``nodes``: the
+    ``--nodes`` each array task asks for (None: not asked, Slurm places the ranks)."""
 
     kind: str  # "array" or "analysis"
     script_path: Path
@@ -110,6 +112,7 @@ class PlannedJob:
     site: SlurmSite | None = None
     planned: bool = False
     plan_cores: int | None = None
+    nodes: int | None = None
 
 
 def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterable[int],
@@ -121,7 +124,9 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
     ``ranks`` (case index -> MPI ranks, from the rank plan): one array per rank count,
     widest first, each with ``--ntasks`` of its cases (``array-R-npK.sh``; ``array-R.sh``
     when all cases share one count); the analysis job waits for all of them. Without
-    ``ranks`` every case gets ``site.ntasks`` in one array."""
+    ``ranks`` every case gets ``site.ntasks`` in one array. Planned arrays ask for
+    ceil(ntasks / ``site.cores_per_node``) nodes when the cores per node are known; an
+    array on ``--ntasks`` / the site's ntasks asks for tasks only, as before."""
     study = PurePosixPath(Path(study_dir).resolve())
     idx = tuple(sorted(set(indices)))
     array_ctx = ScriptContext(study, job_name(study_name, "array"), __version__)
@@ -138,11 +143,13 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
     for ntasks in sorted(classes, reverse=True):
         members = tuple(classes[ntasks])
         job_site = replace(site, ntasks=ntasks)
+        nodes = nodes_for(ntasks, site.cores_per_node) if ranks is not None else None
         name = f"array-{round_no}.sh" if len(classes) == 1 else f"array-{round_no}-np{ntasks}.sh"
         jobs.append(PlannedJob("array", Path(study) / SLURM_DIR / name,
-                               array_script(array_ctx, job_site, members), members,
+                               array_script(array_ctx, job_site, members, nodes), members,
                                site=job_site, planned=ranks is not None,
-                               plan_cores=plan_cores if ranks is not None else None))
+                               plan_cores=plan_cores if ranks is not None else None,
+                               nodes=nodes))
     if analysis_steps:
         ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
         jobs.append(PlannedJob("analysis", Path(study) / SLURM_DIR / f"analysis-{round_no}.sh",

@@ -75,8 +75,10 @@ def _q(value: str | PurePosixPath) -> str:
 
 
 def _directives(site: SlurmSite, job_name: str, output: str, time: str | None,
-                ntasks: int, extra: Sequence[str]) -> list[str]:
+                ntasks: int, extra: Sequence[str], nodes: int | None = None) -> list[str]:
     lines = [f"#SBATCH --job-name={job_name}", *extra, f"#SBATCH --ntasks={ntasks}"]
+    if nodes is not None:
+        lines.append(f"#SBATCH --nodes={nodes}")
     if time:
         lines.append(f"#SBATCH --time={time}")
     if site.partition:
@@ -111,14 +113,23 @@ def _launcher_env(site: SlurmSite) -> list[str]:
     return lines
 
 
-def array_script(ctx: ScriptContext, site: SlurmSite, indices: Iterable[int]) -> str:
-    """The ``#!/bin/bash`` array script: one task per case index, running ``ligwf run-case``."""
+def array_script(ctx: ScriptContext, site: SlurmSite, indices: Iterable[int],
+                 nodes: int | None = None) -> str:
+    """The ``#!/bin/bash`` array script: one task per case index, running ``ligwf run-case``.
+
+    ``nodes``: each task asks for exactly that many nodes (``--nodes``) besides its
+    ``--ntasks``, so its ranks are not scattered over partly busy nodes; None leaves the
+    placement to Slurm."""
+    if nodes is not None and (isinstance(nodes, bool) or not isinstance(nodes, int)
+                              or not 1 <= nodes <= site.ntasks):
+        raise ConfigError(f"nodes = {nodes!r}: allowed range [1, ntasks = {site.ntasks}]")
     indices = sorted(set(indices))
     study = ctx.study_dir
     log = f"{study}/{LOG_DIR}/{ctx.job_name}_%A_%a.out"
     lines = ["#!/bin/bash",
              *_directives(site, ctx.job_name, log, site.time, site.ntasks,
-                          [f"#SBATCH --array={array_spec(indices, site.max_concurrent)}"]),
+                          [f"#SBATCH --array={array_spec(indices, site.max_concurrent)}"],
+                          nodes),
              f"# Written by ligwf {ctx.ligwf_version}: one array task per case of the study",
              f"# {study} (task id = case index in study.json; {len(indices)} case(s)).",
              "set -eo pipefail",

@@ -8,7 +8,9 @@ environment variables ``LIGWF_SLURM_*``, then the ``slurm:`` mapping of the site
       partition: compute
       account: proj123
       time: "02:00:00"          # per array task
-      ntasks: 4                 # MPI ranks per case
+      ntasks: 4                 # MPI ranks per case (unset: the rank plan decides)
+      cores_per_node: 64        # cores of one node: a planned case asks for
+                                # --nodes = ceil(ranks / cores_per_node); unset: Slurm places
       max_concurrent: 8         # the %K of --array=0-M%K
       modules: [openmpi/4.1, liggghts/3.8.0]
       setup: ["source /opt/ligwf/venv/bin/activate"]
@@ -43,7 +45,7 @@ _UNSAFE = re.compile(r"[\n\r\x00]")
 
 ENV_PREFIX = "LIGWF_SLURM_"
 KEYS = ("partition", "account", "time", "ntasks", "max_concurrent", "modules", "setup",
-        "launcher", "ligwf", "sbatch_args", "analysis_time")
+        "launcher", "ligwf", "sbatch_args", "analysis_time", "cores_per_node")
 
 
 def default_ligwf_command() -> str:
@@ -71,6 +73,7 @@ class SlurmSite:
     ligwf: str = "ligwf"
     sbatch_args: tuple[str, ...] = ()
     analysis_time: str | None = None
+    cores_per_node: int | None = None   # None: unknown, no --nodes in the scripts
 
     def __post_init__(self) -> None:
         for key in ("partition", "account"):
@@ -87,6 +90,9 @@ class SlurmSite:
             raise ConfigError(f"slurm ntasks = {self.ntasks}: allowed range [1, inf)")
         if self.max_concurrent is not None and self.max_concurrent < 1:
             raise ConfigError(f"slurm max_concurrent = {self.max_concurrent}: allowed range "
+                              "[1, inf)")
+        if self.cores_per_node is not None and self.cores_per_node < 1:
+            raise ConfigError(f"slurm cores_per_node = {self.cores_per_node}: allowed range "
                               "[1, inf)")
         for mod in self.modules:
             if not _MODULE.match(mod):
@@ -129,7 +135,8 @@ def _as_int(value: Any, key: str) -> int | None:
     try:
         return int(value)
     except (TypeError, ValueError):
-        raise ConfigError(f"slurm {key} = {value!r}: expected an integer") from None
+        raise ConfigError(f"slurm {key} = {value!r}: expected a whole number (allowed "
+                          "range [1, inf))") from None
 
 
 def site_from_mapping(values: Mapping[str, Any]) -> SlurmSite:
@@ -142,7 +149,7 @@ def site_from_mapping(values: Mapping[str, Any]) -> SlurmSite:
     for key in ("partition", "account", "time", "launcher", "ligwf", "analysis_time"):
         if values.get(key) not in (None, ""):
             kwargs[key] = str(values[key])
-    for key in ("ntasks", "max_concurrent"):
+    for key in ("ntasks", "max_concurrent", "cores_per_node"):
         number = _as_int(values.get(key), key)
         if number is not None:
             kwargs[key] = number

@@ -1,0 +1,143 @@
+"""What a Slurm submission asks of the cluster, case by case: ranks, nodes and wall time.
+
+Pure functions over the rank plan (:mod:`ligwf.engine.plan`). Nodes per case come from the
+cores of one node (``--cores-per-node`` or the site's ``slurm: cores_per_node``) at one
+rank per core; unknown cores per node leave the nodes to Slurm. The estimated wall time
+of a case (:func:`ligwf.engine.plan.estimated_seconds`, rates measured on one 2-core
+machine) is set against the ``--time`` its array task asks for, so a case Slurm would stop
+at the limit is seen before it is submitted. :func:`plan_rows` gives the rows of the table
+``ligwf slurm submit`` prints; replicas with the same load share one row.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Hashable, Sequence
+
+from ligwf.engine.plan import BOUND_PARTICLES, BOUND_SLAB, CaseLoad, CasePlan, rank_limits
+from ligwf.engine.render import MIN_AXIAL_SLAB
+from ligwf.errors import ConfigError
+
+# Slurm --time, the forms :mod:`ligwf.slurm.site` accepts: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S
+_CLOCK = re.compile(r"^(?:(\d+)-)?(\d+)(?::(\d+))?(?::(\d+))?$")
+
+
+def nodes_for(ranks: int, cores_per_node: int | None) -> int | None:
+    """Nodes that ``ranks`` MPI ranks fill at one rank per core: ceil(ranks /
+    cores_per_node); None when the cores per node are unknown."""
+    if isinstance(ranks, bool) or not isinstance(ranks, int) or ranks < 1:
+        raise ConfigError(f"ranks = {ranks!r}: must be a whole number (allowed range [1, inf))")
+    if cores_per_node is None:
+        return None
+    if (isinstance(cores_per_node, bool) or not isinstance(cores_per_node, int)
+            or cores_per_node < 1):
+        raise ConfigError(f"cores per node = {cores_per_node!r}: must be a whole number "
+                          "(allowed range [1, inf))")
+    return -(-ranks // cores_per_node)
+
+
+def slurm_time_seconds(text: str | None) -> int | None:
+    """Seconds of a Slurm ``--time`` value; None when unset or 0 (Slurm: no limit).
+
+    Slurm reads a lone number as minutes, ``A:B`` as minutes:seconds and ``A:B:C`` as
+    hours:minutes:seconds, but after a day count ``D-A:B`` is hours:minutes.
+
+    >>> slurm_time_seconds("02:00:00"), slurm_time_seconds("90"), slurm_time_seconds("1-12")
+    (7200, 5400, 129600)
+    """
+    if text is None:
+        return None
+    match = _CLOCK.match(text.strip())
+    if not match:
+        raise ConfigError(f"time = {text!r}: not a Slurm time (minutes, MM:SS, HH:MM:SS, "
+                          "D-HH, D-HH:MM or D-HH:MM:SS)")
+    days, first, *rest = match.groups()
+    parts = [int(first)] + [int(p) for p in rest if p is not None]
+    if days is not None:                                    # D-H, D-H:M, D-H:M:S
+        parts += [0] * (3 - len(parts))
+        seconds = int(days) * 86400 + parts[0] * 3600 + parts[1] * 60 + parts[2]
+    elif len(parts) == 1:                                   # M
+        seconds = parts[0] * 60
+    elif len(parts) == 2:                                   # M:S
+        seconds = parts[0] * 60 + parts[1]
+    else:                                                   # H:M:S
+        seconds = parts[0] * 3600 + parts[1] * 60 + parts[2]
+    return seconds or None
+
+
+def hours_minutes(seconds: float) -> str:
+    """A wall time as h:mm, rounded up to the next minute (a budget, not a record):
+    24,480 s -> '6:48', 61 s -> '0:02', 100 h -> '100:00'."""
+    if not seconds >= 0 or seconds == float("inf"):
+        raise ConfigError(f"wall time = {seconds!r} s: allowed range [0, inf)")
+    minutes = math.ceil(seconds / 60)
+    return f"{minutes // 60}:{minutes % 60:02d}"
+
+
+@dataclass(frozen=True)
+class PlanRow:
+    """One row of the Slurm plan: a case, or replicas with the same load and ranks."""
+
+    cases: tuple[str, ...]      # case names, study order
+    load: CaseLoad              # the first case's (every case of a row has the same load)
+    ranks: int
+    bound: str                  # what limited the ranks (CasePlan.bound)
+    nodes: int | None           # None: cores per node unknown
+    estimated_seconds: float    # wall seconds of ONE of the cases (each is its own task)
+
+    @property
+    def label(self) -> str:
+        """The first case's name, '+N more' when the row stands for N more cases."""
+        more = len(self.cases) - 1
+        return self.cases[0] + (f" +{more} more" if more else "")
+
+    @property
+    def slab_bound(self) -> bool:
+        """The axial slab rule alone limited the ranks (particles would allow more)."""
+        return self.bound == BOUND_SLAB
+
+    def exceeds(self, time_limit_seconds: int | None) -> bool:
+        """Whether the estimate is longer than the array task's time limit (None: no limit
+        asked for, nothing to compare)."""
+        return time_limit_seconds is not None and self.estimated_seconds > time_limit_seconds
+
+
+def plan_rows(loads: Sequence[CaseLoad], plans: Sequence[CasePlan],
+              groups: Sequence[Hashable], cores_per_node: int | None) -> tuple[PlanRow, ...]:
+    """The plan table's rows: ``loads[i]`` planned as ``plans[i]``; cases with the same
+    ``groups[i]`` (e.g. CG level and rule, so replicas) AND the same load and ranks share
+    a row, in order of first appearance."""
+    if not len(loads) == len(plans) == len(groups):
+        raise ConfigError(f"plan rows: {len(loads)} loads, {len(plans)} plans and "
+                          f"{len(groups)} groups must be as many")
+    rows: dict[tuple, tuple[CaseLoad, CasePlan, list[str]]] = {}
+    for load, plan, group in zip(loads, plans, groups):
+        if plan.name != load.name:
+            raise ConfigError(f"plan rows: plan {plan.name!r} is not case {load.name!r}")
+        key = (group, load.particles, load.steps, load.wet, load.drum_length, load.d_max,
+               plan.ranks, plan.bound)
+        rows.setdefault(key, (load, plan, []))[2].append(load.name)
+    return tuple(PlanRow(tuple(names), load, plan.ranks, plan.bound,
+                         nodes_for(plan.ranks, cores_per_node), plan.estimated_seconds)
+                 for load, plan, names in rows.values())
+
+
+def slab_note(row: PlanRow) -> str:
+    """Why a row's ranks stop at the axial slab rule, in numbers."""
+    load = row.load
+    by_particles = rank_limits(load, None)[BOUND_PARTICLES]
+    return (f"{row.label}: {row.ranks} ranks is the axial slab limit, "
+            f"{load.drum_length * 1e3:g} mm / ({MIN_AXIAL_SLAB:g} x {load.d_max * 1e3:g} mm "
+            f"largest diameter); particles alone would allow {by_particles} (slabs along "
+            "the axis only)")
+
+
+def over_time_warning(row: PlanRow, time: str) -> str:
+    """The warning for a row whose estimate exceeds ``--time`` (one line, no traceback)."""
+    cases = f" (each of {len(row.cases)} cases)" if len(row.cases) > 1 else ""
+    return (f"{row.label}: estimated {hours_minutes(row.estimated_seconds)} (h:mm) on "
+            f"{row.ranks} rank(s){cases} exceeds --time {time}; Slurm stops the task at the "
+            "limit (the runner then saves a restart and 'ligwf slurm resubmit' continues "
+            "it): ask for a longer --time")
