@@ -282,8 +282,11 @@ class Numerics(_Frozen):
                                     description="s between periodic restart files")
     packing_fraction: float = Field(0.6, gt=0.0, le=0.74,
                                     description="solid fraction of the settled bed")
-    skin_ratio: float = Field(0.5, gt=0.0, le=5.0,
-                              description="neighbor skin / smallest diameter")
+    skin_ratio: float | None = Field(
+        None, gt=0.0, le=5.0,
+        description="neighbour skin / smallest diameter of the settle and production "
+        "phases (the fill phase takes at least its free-fall skin); unset (default): from "
+        "the drum speed and the time step (ligwf.scene.neighbour)")
     contact_angle_compensation: bool = Field(
         True, description="compensate LIGGGHTS 3.8.0's effective contact angle "
         "0.5*theta_i*theta_j so the engine applies the scene's angle; switch off for "

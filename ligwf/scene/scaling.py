@@ -40,6 +40,7 @@ from ligwf import liquids
 from ligwf.errors import ConfigError
 from ligwf.liquids.base import LiquidModel
 from ligwf.scene.model import GRAVITY, Scene
+from ligwf.scene.neighbour import fill_skin, turning_skin
 
 
 class Rule(str, Enum):
@@ -295,6 +296,12 @@ class ScaledScene:
         return self.insertion_steps + self.settle_steps + self.run_steps
 
     @property
+    def skin_fill(self) -> float:
+        """Neighbour skin of the fill phase (m): the falling particles' skin, never thinner
+        than :attr:`skin` (that of the settle and production phases)."""
+        return max(self.skin, fill_skin(self.drum_diameter, self.dt, self.d_min))
+
+    @property
     def d_min(self) -> float:
         return min(self.diameters)
 
@@ -372,7 +379,8 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
         thermo_every=thermo_every,
         restart_every=max(thermo_every, _every(num.restart_interval, dt) // thermo_every
                           * thermo_every),
-        skin=num.skin_ratio * min(diameters),
+        skin=(num.skin_ratio * min(diameters) if num.skin_ratio is not None
+              else turning_skin(omega, drum.radius, dt, min(diameters))),
         insertion_radius=r_ins, insertion_waves=waves,
         wave_steps=max(thermo_every, _steps(fall_time, dt) // thermo_every * thermo_every),
         seeds=replica_seeds(num.seed, replica, count=len(diameters) + 1 + len(waves)),
