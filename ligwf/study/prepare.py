@@ -25,7 +25,7 @@ from typing import Iterable
 from ligwf import __version__
 from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, atomic_write_text,
                         not_writable)
-from ligwf.engine.mesh import cached_mesh, drum_stl
+from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
 from ligwf.engine.render import MESH_NAME, OUTPUT_DIRS, render
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.stability import Preflight, check_rendered
@@ -78,7 +78,7 @@ def render_case(case: Case, template_dirs: Iterable[str | Path] = ()) -> Rendere
     """Scale and render one case in memory."""
     scaled = case.scaled()
     files = render(scaled, template_dirs)
-    mesh_text = drum_stl(case.scene.drum)
+    mesh_text = drum_stl(case.scene.drum, scene_sag(case.scene))
     return RenderedCase(case, scaled, files, mesh_text, content_hash(scaled, files, mesh_text))
 
 
@@ -113,7 +113,8 @@ def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) 
     case_dir.mkdir(parents=True, exist_ok=True)
     for sub in OUTPUT_DIRS:
         (case_dir / sub).mkdir(exist_ok=True)
-    mesh_src = cached_mesh(rc.case.scene.drum, mesh_cache or default_mesh_cache())
+    mesh_src = cached_mesh(rc.case.scene.drum, scene_sag(rc.case.scene),
+                          mesh_cache or default_mesh_cache())
     # a per-process temporary name: two `ligwf run` may write one study at once
     atomic_write_bytes(case_dir / MESH_NAME, Path(mesh_src).read_bytes())
     for name, text in rc.files.items():

@@ -138,7 +138,8 @@ FLAGGED: dict[str, tuple[Callable[[Path], None], tuple[str, ...]]] = {
                                      ("SHA-256",)),
     "flipped bits, no record": (no_record(lambda s: edit_array(frame(s, 1), "Points", flip_bit)),
                                 ("header says", "outside the drum")),
-    "frame of another replica": (other_replica, ("SHA-256",)),
+    # same particle count: equal size (caught by the hash) or a byte apart (by the size)
+    "frame of another replica": (other_replica, ("SHA-256", "truncated or replaced")),
     "step beyond the run": (beyond_run, ("not a dump step",)),
     "step off the dump interval": (off_interval, ("not a dump step",)),
     "all dumps of a case deleted": (delete_all_dumps, ("no analysable frame",)),

@@ -16,6 +16,7 @@ from helpers import ROOT  # noqa: E402
 
 WORKFLOW = ROOT / "tests" / "workflows" / "runner_tiny.yaml"
 FOUR = ["--set", "sweep.replicas=2"]   # weber and bond, two seeds each
+LONGER = ["--set", "scene.process.run_time=1.0"]
 
 
 def ligwf(*args: str) -> subprocess.CompletedProcess:
@@ -56,7 +57,9 @@ BREAKAGES = {
 @pytest.mark.parametrize("kind", sorted(BREAKAGES))
 def test_broken_member_does_not_lose_the_others(tmp_path, kind):
     out = tmp_path / "study"
-    r = ligwf("render", str(WORKFLOW), "--out", str(out), *FOUR)
+    # a production long enough (~2 s) that the others are still in flight when the broken
+    # member fails at its start (at 0.1 s they could all be done: a race, not a test)
+    r = ligwf("render", str(WORKFLOW), "--out", str(out), *FOUR, *LONGER)
     assert r.returncode == 0, r.stderr
     cases = Study.open(out).cases
     broken = cases[1]

@@ -8,8 +8,12 @@ import meshio
 import numpy as np
 import pytest
 
-from ligwf.engine.mesh import cached_mesh, drum_outline, drum_stl, drum_triangles, geometry_key
+from ligwf.engine.mesh import (MIN_SEGMENTS, cached_mesh, drum_outline, drum_stl,
+                               drum_triangles, geometry_key, segment_count, wall_sag)
 from ligwf.scene.model import Drum
+
+
+SAG = wall_sag(0.001)   # 1 mm original beads
 
 
 def drum(**kw) -> Drum:
@@ -20,7 +24,7 @@ def drum(**kw) -> Drum:
 
 @pytest.mark.parametrize("axis,ia", [("x", 0), ("y", 1), ("z", 2)])
 def test_spans_exactly_the_axial_length(axis, ia):
-    tri = drum_triangles(drum(axis=axis))
+    tri = drum_triangles(drum(axis=axis), SAG)
     assert tri[..., ia].min() == 0.0
     assert tri[..., ia].max() == pytest.approx(0.018, abs=1e-15)
     radial = np.delete(tri, ia, axis=2)
@@ -30,7 +34,7 @@ def test_spans_exactly_the_axial_length(axis, ia):
 
 
 def test_outline_has_lifters_and_is_star_shaped():
-    out = drum_outline(drum())
+    out = drum_outline(drum(), SAG)
     r = np.linalg.norm(out, axis=1)
     inner = r < 0.025 - 1e-9
     assert inner.any()
@@ -44,12 +48,12 @@ def test_outline_has_lifters_and_is_star_shaped():
 
 
 def test_no_lifters_is_a_circle():
-    out = drum_outline(drum(lifters={"count": 0}))
+    out = drum_outline(drum(lifters={"count": 0}), SAG)
     assert np.linalg.norm(out, axis=1) == pytest.approx(0.025, rel=1e-12)
 
 
 def test_shell_normals_point_inward():
-    tri = drum_triangles(drum(lifters={"count": 0}))
+    tri = drum_triangles(drum(lifters={"count": 0}), SAG)
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     c = tri.mean(axis=1)
     c[:, 1] = 0.0
@@ -57,9 +61,9 @@ def test_shell_normals_point_inward():
 
 
 def test_closed_drum_has_end_caps():
-    open_tri = drum_triangles(drum(periodic=True))
-    closed = drum_triangles(drum(periodic=False))
-    n_out = len(drum_outline(drum()))
+    open_tri = drum_triangles(drum(periodic=True), SAG)
+    closed = drum_triangles(drum(periodic=False), SAG)
+    n_out = len(drum_outline(drum(), SAG))
     # one fan triangle per outline edge, less the 2 radial sides of each of the 12 lifters
     assert len(closed) - len(open_tri) == 2 * (n_out - 2 * 12)
     n = np.cross(closed[:, 1] - closed[:, 0], closed[:, 2] - closed[:, 0])
@@ -71,19 +75,44 @@ def test_closed_drum_has_end_caps():
 
 def test_stl_reads_back_with_meshio(tmp_path):
     path = tmp_path / "drum.stl"
-    path.write_text(drum_stl(drum()))
+    path.write_text(drum_stl(drum(), SAG))
     m = meshio.read(path)
     assert m.cells[0].type == "triangle"
-    assert len(m.cells[0].data) == len(drum_triangles(drum()))
+    assert len(m.cells[0].data) == len(drum_triangles(drum(), SAG))
     assert m.points[:, 1].max() == pytest.approx(0.018)
 
 
 def test_cache_is_keyed_by_geometry(tmp_path):
-    a = cached_mesh(drum(), tmp_path)
-    b = cached_mesh(drum(), tmp_path)
-    c = cached_mesh(drum(length=0.02), tmp_path)
+    a = cached_mesh(drum(), SAG, tmp_path)
+    b = cached_mesh(drum(), SAG, tmp_path)
+    c = cached_mesh(drum(length=0.02), SAG, tmp_path)
     assert a == b and a != c
-    assert geometry_key(drum()) in a.name
+    assert geometry_key(drum(), SAG) in a.name
     assert len(list(tmp_path.glob("*.stl"))) == 2
     # wall properties do not change the geometry, hence not the cached file
-    assert geometry_key(drum(wall_friction=0.3)) == geometry_key(drum())
+    assert geometry_key(drum(wall_friction=0.3), SAG) == geometry_key(drum(), SAG)
+
+
+def test_sag_follows_the_original_particle_size_not_the_cg_level():
+    # the chord sag of R (1 - cos(pi / n)) stays below 2 % of the original diameter
+    for radius, d in [(0.025, 1e-3), (0.1, 1e-3), (0.1, 2e-4)]:
+        n = segment_count(radius, wall_sag(d))
+        assert radius * (1 - math.cos(math.pi / n)) <= 0.02 * d * (1 + 1e-12)
+        assert n >= MIN_SEGMENTS
+    assert segment_count(0.025, wall_sag(1e-3)) == MIN_SEGMENTS   # small drum: the floor
+    assert segment_count(0.1, wall_sag(1e-3)) > MIN_SEGMENTS      # paper-scale drum
+    assert segment_count(0.1, wall_sag(2e-4)) > segment_count(0.1, wall_sag(1e-3))
+
+
+def test_cache_is_keyed_by_sag(tmp_path):
+    assert cached_mesh(drum(), SAG, tmp_path) != cached_mesh(drum(), 2 * SAG, tmp_path)
+
+
+def test_every_cg_level_of_a_study_shares_one_mesh(tmp_path):
+    from ligwf.scene.workflow import load_workflow
+    from ligwf.study.prepare import render_workflow
+
+    from helpers import ROOT
+    wf = load_workflow(ROOT / "workflows" / "we_vs_bo.yaml", [])
+    meshes = {rc.mesh_text for rc in render_workflow(wf)}
+    assert len(meshes) == 1

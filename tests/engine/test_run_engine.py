@@ -22,6 +22,7 @@ from helpers import ROOT  # noqa: E402
 
 WORKFLOW = ROOT / "tests" / "workflows" / "runner_tiny.yaml"
 ONE_CASE = ["--set", "sweep.rules=[weber]"]
+LONGER = ["--set", "scene.process.run_time=1.0"]
 pytestmark = [pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
 
 
@@ -80,7 +81,8 @@ def test_two_cases_np2_end_to_end_then_skipped(tmp_path):
 def test_sigterm_then_resume_from_forced_restart(tmp_path):
     out = tmp_path / "study"
     case = out / "cg3-weber-r0"
-    proc = start_run(out)
+    # a production of ~2 s, so the signal lands inside it (0.1 s can be over before)
+    proc = start_run(out, *LONGER)
     wait_for(lambda: "ligwf-phase production" in _read(case / "run.log"))
     os.kill(proc.pid, signal.SIGTERM)          # ligwf forwards it to the engine ranks
     assert proc.wait(timeout=120) == 1
@@ -88,7 +90,7 @@ def test_sigterm_then_resume_from_forced_restart(tmp_path):
     assert m.status == "killed" and 0 < m.steps_done < m.total_steps
     forced = list(case.glob("restart_forced_liggghts_*.data"))
     assert len(forced) == 1 and restart_step(forced[0]) == m.steps_done
-    r = ligwf("run", str(WORKFLOW), "--out", str(out), *ONE_CASE)
+    r = ligwf("run", str(WORKFLOW), "--out", str(out), *ONE_CASE, *LONGER)
     assert r.returncode == 0, r.stdout + r.stderr
     m = read_manifest(case)
     assert m.status == "done" and m.steps_done == m.total_steps
