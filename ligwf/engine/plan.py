@@ -10,12 +10,13 @@ project's 2-core machine (``docs/results/README.md``, issue 15):
   axial cut); each slab is at least ``MIN_AXIAL_SLAB`` (4) of the case's LARGEST diameters
   long (:func:`ligwf.engine.render.axial_slab_limit`, the same rule the runner's processor
   grid keeps). A 9 mm slice of 3 mm CG3 particles therefore runs on one rank.
-* **Enough particles per rank.** Each step of a case costs a fixed ~0.5 ms (turning mesh,
-  fixes, exchanges: the work of ~450 particles) besides its pair work; a rank should carry
-  several times that, or splitting buys little and costs core-seconds. Measured: the
-  18 mm CG1 case (11,963 particles) ran 1.49x faster on 2 axial ranks than on one; a
-  few-hundred-particle CG3 case spends 1.35x the core-seconds on 2 ranks; the 9 mm CG1
-  (5,982 particles, ~3,000 a rank) did not clearly gain. Hence ``MIN_PARTICLES_PER_RANK``.
+* **Enough particles per rank.** Each step of a case costs a fixed ~0.08 ms (turning mesh,
+  fixes) besides its pair work, and every extra rank adds exchanges; a rank should carry
+  thousands of particles, or splitting buys little and costs core-seconds. Measured
+  (``benchmarks/bench_cg_speedup.py``, docs/results/performance): the 18 mm CG1 case (11,963
+  particles, ~6,000 a rank) ran its production 1.76x faster on 2 axial ranks than on one
+  (0.88 of the ideal); a 708-particle CG2 case on 2 ranks spent half its loop exchanging.
+  Hence ``MIN_PARTICLES_PER_RANK``.
 * **Cores stay filled, longest first.** Cases with the same rank count form one phase:
   single-rank cases run side by side as members of one MPI ensemble
   (:mod:`ligwf.engine.ensemble`; separate ``mpirun -np 1`` would all bind to core 0),
@@ -40,21 +41,23 @@ from ligwf.engine.render import axial_slab_limit
 from ligwf.errors import ConfigError
 from ligwf.scene.scaling import ScaledScene
 
-#: Fewest particles a rank should carry (see the module docstring): ~6 times the per-step
-#: fixed cost of a case in particle work; 11,963 particles gain from 2 ranks, 5,982 do not
-#: clearly, a few hundred lose. To be re-measured on a quiet machine (issue 15).
+#: Fewest particles a rank should carry (see the module docstring): 11,963 particles gain
+#: 1.76x from 2 ranks; a few hundred lose.
 MIN_PARTICLES_PER_RANK = 3000
-#: Fixed wall seconds per step of one wet case on one rank, whatever its size (we-vs-bo
-#: study, single-rank members: 1,495 particles 2.10 ms/step, 443 particles 0.96 ms/step).
-STEP_OVERHEAD_SECONDS = 0.48e-3
-#: Marginal particle-steps per core-second of a wet (capillary) case, same fit; it also
-#: reproduces the 18 mm CG1 on one rank (40.4 s for 3,000 steps of 11,963 particles).
-WET_RATE = 0.93e6
-#: Dry contacts run this much faster per particle-step (2.5-3.3 vs 1.5-1.7 M by hand).
+#: Fixed wall seconds per step of one wet case on one rank, whatever its size, and the
+#: marginal particle-steps per core-second: a line through the production phases of the
+#: 18 mm we_vs_bo cases on one rank, one case at a time on the idle machine
+#: (bench_cg_speedup.py, 2026-11-28): 443 particles 0.306 ms/step, 1,495 0.842 ms,
+#: 11,963 6.56 ms. The line is within 8 % of all three.
+STEP_OVERHEAD_SECONDS = 0.08e-3
+WET_RATE = 1.8e6
+#: Dry contacts run this much faster per particle-step (2.5-3.3 vs 1.5-1.7 M by hand,
+#: an older measurement).
 DRY_SPEEDUP = 1.8
 #: Share of the ideal speed-up a case keeps on more than one rank (11,963 particles:
-#: 27.2 s on 2 axial ranks against 40.4 s on one). Measured at 2 ranks only.
-MULTI_RANK_EFFICIENCY = 0.75
+#: 379.5 production core-s on 2 axial ranks against 334.8 on one). Measured at 2 ranks
+#: only: a cluster estimate at tens of ranks is an extrapolation.
+MULTI_RANK_EFFICIENCY = 0.88
 
 #: What limited a case's ranks (:attr:`CasePlan.bound`).
 BOUND_PARTICLES, BOUND_SLAB, BOUND_CORES = "particles", "slab", "cores"

@@ -70,11 +70,16 @@ def test_case_load_and_particle_steps_from_a_scaled_scene():
     assert lo.particle_steps == particle_steps(scaled) == scaled.particle_count * scaled.total_steps
 
 
-def test_estimate_reproduces_the_measured_cg1_times():
-    # 18 mm CG1, 3,000 production steps of 11,963 particles: 40.4 s on 1 rank, 27.2 s on 2
-    cg1 = load(particles=11_963, steps=3_000, length=0.018)
-    assert estimated_seconds(cg1, 1) == pytest.approx(40.4, rel=0.1)
-    assert estimated_seconds(cg1, 2) == pytest.approx(27.2, rel=0.1)
+def test_estimate_reproduces_the_measured_production_times():
+    # 18 mm we_vs_bo production phases (bench_cg_speedup.py, docs/results/performance):
+    # CG1 11,963 particles x 51,069 steps 334.8 s on 1 rank, 189.8 s on 2; CG2 1,495 x
+    # 25,535 21.5 s; CG3 443 x 17,023 5.2 s
+    cg1 = load(particles=11_963, steps=51_069, length=0.018)
+    assert estimated_seconds(cg1, 1) == pytest.approx(334.8, rel=0.1)
+    assert estimated_seconds(cg1, 2) == pytest.approx(189.8, rel=0.1)
+    assert estimated_seconds(load(particles=1_495, steps=25_535), 1) == pytest.approx(21.5,
+                                                                                      rel=0.1)
+    assert estimated_seconds(load(particles=443, steps=17_023), 1) == pytest.approx(5.2, rel=0.1)
     assert estimated_seconds(load(wet=False), 1) < estimated_seconds(load(wet=True), 1)
 
 
