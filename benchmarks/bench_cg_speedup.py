@@ -23,7 +23,6 @@ particles, an n times larger time step). Targets (issue 15): CG2 >= 15x, CG3 >= 
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import tempfile
 import threading
@@ -32,6 +31,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.quiet import check_quiet  # noqa: E402
 from ligwf.engine.health import DONE  # noqa: E402
 from ligwf.engine.launch import run_case  # noqa: E402
 from ligwf.engine.plan import case_load, machine_cores, plan_ranks  # noqa: E402
@@ -115,10 +115,7 @@ def main() -> int:
     modes = [m.strip() for m in args.modes.split(",") if m.strip()]
     if not modes or any(m not in ("single", "planner") for m in modes):
         ap.error(f"--modes = {args.modes!r}: allowed single, planner (comma-separated)")
-    load = os.getloadavg()[0]
-    if load > 0.5:
-        print(f"WARNING: load average {load:.2f} > 0.5: other work shares the cores, the "
-              "ratios below are not to be trusted", flush=True)
+    check_quiet("the ratios below")
     overrides = ["sweep.cg_levels=[1,2,3]", "sweep.rules=[weber]", "sweep.replicas=1",
                  "sweep.per_cg={}", f"scene.process.settle_time={args.settle_time}",
                  f"scene.process.run_time={args.run_time}", "scene.analysis.granules=true"]

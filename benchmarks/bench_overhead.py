@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import shutil
 import statistics
 import subprocess
@@ -47,6 +46,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.quiet import check_quiet  # noqa: E402
 from ligwf.engine.guard import engine_env  # noqa: E402
 from ligwf.engine.health import DONE  # noqa: E402
 from ligwf.engine.render import INPUT_NAME, grid_vars  # noqa: E402
@@ -62,8 +62,6 @@ from ligwf.yamlio import read_yaml_mapping  # noqa: E402
 WORKFLOW = ROOT / "workflows" / "we_vs_bo.yaml"
 #: the issue's acceptance: median ligwf / hand wall ratio at most 1 + this
 TARGET_OVERHEAD = 0.03
-#: 1-min load average above which timings are not to be trusted
-QUIET_LOAD = 0.5
 #: default (settle, run) times per CG level, s; None keeps the workflow's
 DEFAULT_TIMES = {3: (None, None), 1: (0.1, 0.2)}
 LOG_FILE = "log.liggghts"       # the -log name of EngineConfig.command
@@ -168,12 +166,6 @@ def run_ligwf(workflow: Path, sets: list[str], study: Path, nprocs: int, mesh_ca
     return wall, manifest.attempts[0].wall_seconds
 
 
-def load_line(when: str) -> float:
-    one, five, _ = os.getloadavg()
-    print(f"load average {when}: {one:.2f} (1 min), {five:.2f} (5 min)", flush=True)
-    return one
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -195,10 +187,7 @@ def main() -> None:
     run = args.run_time if args.run_time is not None else default_run
     sets = overrides(args.workflow, args.cg, settle, run)
 
-    start_load = load_line("at start")
-    if start_load > QUIET_LOAD:
-        print(f"WARNING: load {start_load:.2f} > {QUIET_LOAD}: other work shares the cores, "
-              "the timings below are not to be trusted", flush=True)
+    check_quiet("the timings below")
     work = Path(tempfile.mkdtemp(prefix="ligwf-overhead-"))
     mesh_cache = work / "meshes"
     rows = []
@@ -241,9 +230,6 @@ def main() -> None:
           f"(min {(min(ratios) - 1) * 100:+.2f} %, max {(max(ratios) - 1) * 100:+.2f} %)")
     verdict = "meets" if median <= 1.0 + TARGET_OVERHEAD else "MISSES"
     print(f"{verdict} the target of <= {TARGET_OVERHEAD * 100:g} % (CG{args.cg}, -np {args.np})")
-    end_load = load_line("at end")
-    if max(start_load, end_load) > QUIET_LOAD:
-        print("WARNING: the machine was busy; repeat on a quiet machine before trusting this")
     if args.keep:
         print(f"run folders kept in {work}")
 

@@ -15,7 +15,6 @@ Slurm plan for CG1 (``ligwf slurm submit --dry-run``: ranks, nodes, estimated wa
 from __future__ import annotations
 
 import argparse
-import os
 import subprocess
 import sys
 import time
@@ -24,6 +23,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.quiet import check_quiet  # noqa: E402
 from ligwf.engine.health import DONE  # noqa: E402
 from ligwf.study.study import Study  # noqa: E402
 
@@ -48,9 +48,7 @@ def main() -> int:
     ap.add_argument("--cores-per-node", type=int, default=64,
                     help="cluster node size for the CG1 plan (default 64)")
     args = ap.parse_args()
-    load = os.getloadavg()[0]
-    if load > 0.5:
-        print(f"WARNING: load average {load:.2f} > 0.5: the rate below is not to be trusted")
+    check_quiet("the rates below")
     cg3 = sets(["sweep.cg_levels=[3]", *ONE_CASE, f"scene.process.run_time={args.run_time}"])
     t0 = time.perf_counter()
     run = ligwf("run", str(WORKFLOW), "--out", str(args.out), *cg3)

@@ -15,7 +15,6 @@ A ratio of 1.00 means no core was idle and ligwf added nothing between cases; ta
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 import subprocess
 import sys
@@ -26,6 +25,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from benchmarks.quiet import check_quiet  # noqa: E402
 from ligwf.engine.health import DONE  # noqa: E402
 from ligwf.engine.plan import machine_cores  # noqa: E402
 from ligwf.study.study import Study  # noqa: E402
@@ -45,10 +45,7 @@ def main() -> int:
     args = ap.parse_args()
     sets = args.set if args.set is not None else ["sweep.cg_levels=[2,3]"]
     cores, source = machine_cores(args.cores)
-    load = os.getloadavg()[0]
-    if load > 0.5:
-        print(f"WARNING: load average {load:.2f} > 0.5: other work shares the cores",
-              flush=True)
+    check_quiet("the wall time below")
     work = Path(tempfile.mkdtemp(prefix="ligwf-fill-"))
     out = args.keep or work / "study"
     cmd = [sys.executable, "-m", "ligwf.cli.main", "run", args.workflow, "--out", str(out),
