@@ -34,14 +34,17 @@ class Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def positive_int(text: str) -> int:
-    """argparse type: a whole number >= 1 (ranks, ensemble sizes)."""
+def positive_int(text: str, unit: str = "") -> int:
+    """argparse type: a whole number >= 1 (ranks, ensemble sizes, cores); ``unit`` names
+    what is counted in the message (``functools.partial(positive_int, unit="cores")``)."""
     try:
         value = int(text)
     except ValueError:
         value = 0
     if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number >= 1, got {text!r}")
+        what = f"a whole number of {unit}" if unit else "a whole number"
+        raise argparse.ArgumentTypeError(f"must be {what}, allowed range [1, inf), "
+                                         f"got {text!r}")
     return value
 
 

@@ -26,6 +26,7 @@ from __future__ import annotations
 import argparse
 import json
 from dataclasses import asdict, fields
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -48,18 +49,6 @@ from ligwf.study.pipeline import POSTPROCESS_COMMANDS, prepared_loads, write
 from ligwf.study.study import Study
 
 
-def cores_per_node(text: str) -> int:
-    """argparse type of ``--cores-per-node``: a whole number of cores >= 1."""
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be a whole number of cores, allowed range "
-                                         f"[1, inf), got {text!r}")
-    return value
-
-
 def add_site_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--partition", help="Slurm partition (default: site setting)")
     p.add_argument("--account", help="Slurm account (default: site setting)")
@@ -68,7 +57,7 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
                    help="MPI ranks for every case (default: site setting, else the rank plan)")
     add_cores_arg(p, "most ranks the rank plan gives one case, e.g. a node's cores "
                   "(default: no limit besides the slab rule and particles per rank)")
-    p.add_argument("--cores-per-node", type=cores_per_node, metavar="N",
+    p.add_argument("--cores-per-node", type=partial(positive_int, unit="cores"), metavar="N",
                    help="cores of one node: a planned case asks for ceil(ranks / N) nodes "
                    "(default: site setting, else unknown and Slurm places the ranks)")
     p.add_argument("--max-concurrent", type=positive_int, metavar="K",

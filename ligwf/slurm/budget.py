@@ -12,16 +12,14 @@ at the limit is seen before it is submitted. :func:`plan_rows` gives the rows of
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 from typing import Hashable, Sequence
 
 from ligwf.engine.plan import BOUND_PARTICLES, BOUND_SLAB, CaseLoad, CasePlan, rank_limits
 from ligwf.engine.render import MIN_AXIAL_SLAB
 from ligwf.errors import ConfigError
+from ligwf.slurm.site import SLURM_TIME
 
-# Slurm --time, the forms :mod:`ligwf.slurm.site` accepts: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S
-_CLOCK = re.compile(r"^(?:(\d+)-)?(\d+)(?::(\d+))?(?::(\d+))?$")
 
 
 def nodes_for(ranks: int, cores_per_node: int | None) -> int | None:
@@ -49,13 +47,13 @@ def slurm_time_seconds(text: str | None) -> int | None:
     """
     if text is None:
         return None
-    match = _CLOCK.match(text.strip())
-    if not match:
+    text = text.strip()
+    if not SLURM_TIME.match(text):          # the forms the site settings accept
         raise ConfigError(f"time = {text!r}: not a Slurm time (minutes, MM:SS, HH:MM:SS, "
                           "D-HH, D-HH:MM or D-HH:MM:SS)")
-    days, first, *rest = match.groups()
-    parts = [int(first)] + [int(p) for p in rest if p is not None]
-    if days is not None:                                    # D-H, D-H:M, D-H:M:S
+    days, _, clock = text.rpartition("-")
+    parts = [int(p) for p in clock.split(":")]
+    if days:                                                # D-H, D-H:M, D-H:M:S
         parts += [0] * (3 - len(parts))
         seconds = int(days) * 86400 + parts[0] * 3600 + parts[1] * 60 + parts[2]
     elif len(parts) == 1:                                   # M

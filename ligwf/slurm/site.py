@@ -39,8 +39,8 @@ from ligwf.errors import ConfigError
 
 _NAME = re.compile(r"^[A-Za-z0-9_.,+-]+$")
 _MODULE = re.compile(r"^[A-Za-z0-9_./+-]+$")
-# Slurm --time: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S
-_TIME = re.compile(r"^(\d+|\d+:\d{1,2}|\d+:\d{1,2}:\d{1,2}|\d+-\d{1,2}(:\d{1,2}){0,2})$")
+#: Slurm --time: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S (read by ligwf.slurm.budget)
+SLURM_TIME = re.compile(r"^(\d+|\d+:\d{1,2}|\d+:\d{1,2}:\d{1,2}|\d+-\d{1,2}(:\d{1,2}){0,2})$")
 _UNSAFE = re.compile(r"[\n\r\x00]")
 
 ENV_PREFIX = "LIGWF_SLURM_"
@@ -83,7 +83,7 @@ class SlurmSite:
                                   "are allowed")
         for key in ("time", "analysis_time"):
             value = getattr(self, key)
-            if value is not None and not _TIME.match(value):
+            if value is not None and not SLURM_TIME.match(value):
                 raise ConfigError(f"slurm {key} = {value!r}: not a Slurm time (minutes, "
                                   "MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS)")
         if self.ntasks < 1:
