@@ -14,11 +14,16 @@ folder that are not analysis outputs (the flow tables, a user's notes) are left 
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 import shutil
 import uuid
 from dataclasses import dataclass
 from pathlib import Path
+
+from ligwf.errors import LigwfError
+from ligwf.study.case import file_digest, folder_fingerprint
 
 #: A per-case folder holding this file (or labelled frames) is a granule series of ours.
 SERIES_FILE = "granules.pvd"
@@ -56,14 +61,26 @@ class OutputSet:
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
 
-    def commit(self, record_name: str) -> None:
-        """Move the staged set into ``out_dir`` (``record_name`` last) and drop the old."""
+    def digests(self) -> dict[str, list]:
+        """``{name: [size in bytes, SHA-256]}`` of every file staged so far at the top of
+        the set (the tables; the per-case series are not listed)."""
+        if not self.stage.is_dir():
+            return {}
+        return {p.name: [p.stat().st_size, file_digest(p)] for p in sorted(self.stage.iterdir())
+                if p.is_file()}
+
+    def commit(self, record_name: str, obsolete: tuple[str, ...] = ()) -> None:
+        """Move the staged set into ``out_dir`` (``record_name`` last) and drop the old
+        (series folders, and the files named in ``obsolete`` this set does not hold)."""
         out, stage = self.out_dir, self.stage
         trash = out / f".replaced-{self.token}"
         trash.mkdir()
         for old in sorted(out.iterdir()):
             if not old.name.startswith(".") and is_series_dir(old):
                 os.replace(old, trash / old.name)
+        for name in obsolete:
+            if (out / name).is_file() and not (stage / name).exists():
+                os.replace(out / name, trash / name)
         staged = sorted(stage.iterdir())
         for new in staged:
             if new.is_dir():
@@ -78,3 +95,67 @@ class OutputSet:
     def discard(self) -> None:
         """Drop the staged files; the outputs in place stay as they were."""
         shutil.rmtree(self.stage, ignore_errors=True)
+
+
+# ------------------------------------------------------------------ provenance
+# What an analysis was computed from, stored in its record: the analysis settings and, per
+# case of the study, the scene hash and the dump record. A reader (the report) compares it
+# with the study as it is now and with the tables on disk.
+
+
+class StaleAnalysis(LigwfError):
+    """The analysis outputs no longer match the study, or were changed after writing."""
+
+
+def _json_digest(data) -> str:
+    return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
+
+
+def study_provenance(study, settings) -> dict:
+    """The inputs of an analysis of ``study`` (a :class:`~ligwf.study.study.Study`) with
+    ``settings``: the settings' digest and per case its scene hash and the digest of its
+    dump record (None where missing or unreadable)."""
+    cases = {d.name: folder_fingerprint(d) for d in study.case_dirs}
+    return {"settings": _json_digest(settings.model_dump(mode="json")), "cases": cases}
+
+
+def provenance_mismatch(study, settings, record: dict) -> str | None:
+    """What changed since ``record`` (an analysis record) was written, in words; None when
+    the study, its dumps and the settings are still those the analysis used."""
+    then = record.get("provenance")
+    if not isinstance(then, dict) or not isinstance(then.get("cases"), dict):
+        return ("it records no provenance (scene and dump hashes): written by an older ligwf "
+                "or for another study")
+    now = study_provenance(study, settings)
+    if then.get("settings") != now["settings"]:
+        return "the study's analysis settings changed since it was written"
+    old, new = then["cases"], now["cases"]
+    if set(old) != set(new):
+        added, gone = sorted(set(new) - set(old)), sorted(set(old) - set(new))
+        return ("it was written for other cases ("
+                + "; ".join(x for x in (f"not analysed: {', '.join(added)}" if added else "",
+                                        f"not in the study: {', '.join(gone)}" if gone else "")
+                            if x) + ")")
+    for cid in new:
+        if old[cid].get("scene_hash") != new[cid]["scene_hash"]:
+            return f"case {cid}: its scene changed since the analysis (re-rendered)"
+        if old[cid].get("dump_record") != new[cid]["dump_record"]:
+            return f"case {cid}: its dumps changed since the analysis (run again)"
+    return None
+
+
+def damaged_outputs(out_dir: Path, record: dict) -> list[str]:
+    """Tables of ``out_dir`` that differ from what the analysis of ``record`` wrote (size or
+    SHA-256), one line each; missing ones are not listed here."""
+    bad = []
+    for name, entry in sorted((record.get("outputs") or {}).items()):
+        path = Path(out_dir) / name
+        if not path.is_file():
+            continue
+        size = path.stat().st_size
+        if size != entry[0]:
+            bad.append(f"{name}: {size} bytes, the analysis wrote {entry[0]} (truncated or "
+                       "replaced)")
+        elif file_digest(path) != entry[1]:
+            bad.append(f"{name}: content differs from what the analysis wrote (edited)")
+    return bad

@@ -61,9 +61,11 @@ from ligwf.analysis.gsd_pooling import pooling_table
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.kinetics import (KINETICS_SUMMARY_TABLE, KINETICS_TABLE, SENSITIVITY_TABLE,
                                      kinetics_summary, kinetics_table, sensitivity_table)
-from ligwf.analysis.outputs import OutputSet, new_token
+from ligwf.analysis.dumps import FrameFiles
+from ligwf.analysis.outputs import OutputSet, new_token, study_provenance
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.study import layout
+from ligwf.study.case import granules_absent
 from ligwf.study.settings import AnalysisSettings
 from ligwf.study.study import Study
 
@@ -128,8 +130,12 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     outputs = OutputSet(out_dir, token)
 
     usable, skipped_cases = study.usable_cases(options.require_manifest)
+    absent = [{"case_id": c.case_id, "reason": why} for c in usable
+              if (why := granules_absent(c.scaled)) is not None]
     facts: list[RunFacts] = []
     for c in usable:
+        if granules_absent(c.scaled) is not None:
+            continue
         try:
             facts.append(RunFacts.of_case(c, plan_frames(c)))
         except ConfigError as exc:
@@ -142,7 +148,7 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
             ana = GranuleAnalysis(f, granule_definition(settings), options.implementation,
                                   outputs.case_dir(f.case_id) if options.write_vtu else None,
                                   options.louvain)
-            mine.extend(ana.run([ff]).results)
+            mine.append(analyse_frame(ana, ff))
     except BaseException:
         outputs.discard()
         raise
@@ -155,7 +161,8 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     else:
         results = mine
     try:
-        record = write_outputs(study, outputs, facts, skipped_cases, results, settings, options)
+        record = write_outputs(study, outputs, facts, skipped_cases, results, settings, options,
+                               absent)
     except BaseException:
         outputs.discard()
         raise
@@ -163,6 +170,20 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
         if comm is not None:
             comm.barrier()
     return record
+
+
+def analyse_frame(ana: GranuleAnalysis, ff: FrameFiles) -> FrameResult:
+    """The granules of one frame; a frame the analysis fails on for any reason is a
+    skipped frame with that reason (one bad frame never blocks the others)."""
+    f = ana.case
+    try:
+        return ana.run([ff]).results[0]
+    except (ConfigError, MemoryError, KeyboardInterrupt):
+        raise
+    except Exception as exc:   # a frame that passed its checks and still breaks the analysis
+        return FrameResult(f.case_id, ff.step, ff.step * f.dt,
+                           error=f"{ff.particles}: analysis failed on this frame "
+                                 f"({type(exc).__name__}: {exc})")
 
 
 def frame_tables(facts: list[RunFacts], results: list[FrameResult]):
@@ -220,15 +241,36 @@ def nothing_analysed(where: Path, skipped_cases: list[dict], skipped_frames: lis
 
 
 def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipped_cases,
-                  results, settings: AnalysisSettings, options: AnalysisOptions) -> dict:
-    """Tables, series and record of a study analysis, committed as one set."""
+                  results, settings: AnalysisSettings, options: AnalysisOptions,
+                  absent: list[dict] = ()) -> dict:
+    """Tables, series and record of a study analysis, committed as one set. ``absent``:
+    usable cases whose runs hold no granule data (``{case_id, reason}``: dry, or no
+    contact dumps); when every usable case is one, the record says so and no granule
+    table is written (the flow stage and the report still use those cases)."""
     granules, frames, skipped_frames, frame_index, results = frame_tables(facts, results)
     analysed = [f for f in facts if frame_index.get(f.case_id, 0) > 0]
     skipped_cases = skipped_cases + [
         {"case_id": f.case_id, "reason": f"no analysable frame ({f.plan.expected} expected; "
          "see the skipped frames)"} for f in facts if f not in analysed]
+    base = {
+        "run_dir": str(study.path),
+        "settings": settings.model_dump(mode="json"),
+        "definition": asdict(granule_definition(settings)),
+        "gsd": asdict(gsd_settings(settings)),
+        "options": {"implementation": options.implementation, "louvain": options.louvain,
+                    "write_vtu": options.write_vtu,
+                    "require_manifest": options.require_manifest},
+        "granules_absent": list(absent),
+        "provenance": study_provenance(study, settings),
+        "skipped_cases": skipped_cases,
+        "skipped_frames": skipped_frames,
+    }
     if not analysed:
-        raise nothing_analysed(study.path, skipped_cases, skipped_frames)
+        if not absent:
+            raise nothing_analysed(study.path, skipped_cases, skipped_frames)
+        record = {**base, "cases": []}
+        commit(outputs, record, obsolete=GRANULE_OUTPUTS)
+        return record
     cases = [f.case for f in analysed]
     steady_from = {c.case_id: steady_start_step(c, settings.steady_after) for c in cases}
     steady = granules[granules["step"] >= granules["case_id"].map(steady_from).astype(float)]
@@ -245,21 +287,13 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     steady_frames = steady.groupby("case_id")["step"].nunique() if len(steady) else {}
     plans: dict[str, FramePlan] = {f.case_id: f.plan for f in analysed}
     record = {
-        "run_dir": str(study.path),
-        "settings": settings.model_dump(mode="json"),
-        "definition": asdict(granule_definition(settings)),
-        "gsd": asdict(gsd_settings(settings)),
-        "options": {"implementation": options.implementation, "louvain": options.louvain,
-                    "write_vtu": options.write_vtu,
-                    "require_manifest": options.require_manifest},
+        **base,
         "cases": [{"case_id": c.case_id, "cg": c.cg, "rule": c.rule, "replica": c.replica,
                    "frames": plans[c.case_id].expected,
                    "analysed": frame_index.get(c.case_id, 0),
                    "dump_record": plans[c.case_id].record is not None,
                    "steady_from_step": steady_from[c.case_id],
                    "steady_frames": int(steady_frames.get(c.case_id, 0))} for c in cases],
-        "skipped_cases": skipped_cases,
-        "skipped_frames": skipped_frames,
     }
     commit(outputs, record)
     return record
@@ -301,8 +335,18 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
     outputs.write(SENSITIVITY_TABLE, table.to_csv(index=False).encode())
 
 
-def commit(outputs: OutputSet, record: dict) -> None:
-    """Stage the analysis record and move the whole set into place (record last)."""
+#: Tables of a granule analysis: an analysis without granule data removes old ones.
+GRANULE_OUTPUTS = (layout.GRANULES_TABLE, layout.FRAMES_TABLE, layout.GSD_TABLE,
+                   layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE, KINETICS_TABLE,
+                   KINETICS_SUMMARY_TABLE, SENSITIVITY_TABLE)
+
+
+def commit(outputs: OutputSet, record: dict, obsolete: tuple[str, ...] = ()) -> None:
+    """Stage the analysis record and move the whole set into place (record last). The
+    record lists the size and SHA-256 of every staged table (``outputs``), so a reader can
+    tell a truncated or replaced table from the one written here; ``obsolete``: outputs of
+    an earlier analysis to remove with the set when this one did not write them."""
+    record = {**record, "outputs": outputs.digests()}
     outputs.write(layout.ANALYSIS_RECORD,
                   (json.dumps(record, indent=2, sort_keys=True) + "\n").encode())
-    outputs.commit(layout.ANALYSIS_RECORD)
+    outputs.commit(layout.ANALYSIS_RECORD, obsolete)

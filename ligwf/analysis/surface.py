@@ -20,7 +20,8 @@ The estimator (all lengths in m, angles in degrees):
 4. Robust line fit: least median of squares over all point pairs (up to half the points
    may be outliers), then least squares on the points within 3 scaled median absolute
    deviations of it (at least half a diameter), until nothing changes.
-5. Repeat 2-4 once about the refined tangent (strips then cut the surface square on).
+5. Repeat 2-4 once about the refined tangent (strips then cut the surface square on);
+   when that pass finds fewer than 4 strips, the first pass's line is the fit.
 
 The angle is signed with respect to the rotation: positive when the surface rises towards
 the wall that moves up (the ordinary dynamic angle of repose), negative for a surface
@@ -118,10 +119,12 @@ def fit_surface(u: np.ndarray, v: np.ndarray, r: np.ndarray, radius: float, d: f
         half = span * math.sqrt(max(radius**2 - min(h * h, radius**2), 0.0))
         xs, ys = _strip_tops(x, y + r, 2.0 * d, half, d)
         if len(xs) < 4:
-            return fit
+            break   # the first pass's line stands when the second finds too few strips
         a, b, keep = robust_line(xs, ys, 0.5 * d)
         tangent += math.atan(a)
         fit = (tangent, b * math.cos(math.atan(a)), int(keep.sum()), int((~keep).sum()))
+    if fit is None:
+        return None
     tangent, offset, used, rejected = fit
     deg = math.degrees(tangent)
     deg = (deg + 90.0) % 180.0 - 90.0

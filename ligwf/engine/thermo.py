@@ -229,3 +229,32 @@ def rows_from_csv(text: str) -> list[ThermoRow]:
         values["step"] = float(step)
         rows.append(ThermoRow(step=step, values=values, phase=phase))
     return rows
+
+
+#: Columns every thermo row of a finished run must hold as finite numbers.
+REQUIRED_FINITE = ("time", "atoms", "ke")
+
+
+def table_problem(rows: list[ThermoRow], thermo_every: int) -> str | None:
+    """Why a finished run's thermo rows cannot be its own (None: they are plausible).
+
+    The runner writes one row every ``thermo_every`` steps (and at the end of each
+    ``run`` command), steps rising strictly from the first row on; a done run never
+    printed nan (its health check would have stopped it). So a nan or missing number, a
+    step repeated or going back, or a gap wider than ``thermo_every`` means the table was
+    edited, merged wrongly or lost rows.
+    """
+    prev = None
+    for k, row in enumerate(rows):
+        bad = [c for c in REQUIRED_FINITE if not math.isfinite(row.get(c))]
+        if bad:
+            return f"row {k + 1} (step {row.step}) has no finite {', '.join(bad)} (nan or missing)"
+        if prev is not None:
+            if row.step <= prev:
+                return (f"step {row.step} follows step {prev} (rows duplicated or out of "
+                        "order)")
+            if row.step - prev > thermo_every:
+                return (f"rows missing between steps {prev} and {row.step} (the run writes "
+                        f"one every {thermo_every} steps)")
+        prev = row.step
+    return None

@@ -29,6 +29,7 @@ class Problems:
     cases: tuple[tuple[str, str], ...]              # (case_id, reason)
     frames: tuple[tuple[str, str, str, str], ...]   # (case_id, step, kind, reason)
     outputs: tuple[str, ...]                        # analysis outputs missing or unreadable
+    granules_absent: tuple[tuple[str, str], ...] = ()   # (case_id, why): no granule data by design
 
     @property
     def count(self) -> int:
@@ -48,7 +49,23 @@ class Problems:
             lines.append("none")
         lines += ["", "## Analysis outputs", ""]
         lines += [f"- {cell(o)}" for o in self.outputs] or ["complete"]
+        lines += ["", *self.granule_lines()]
         return lines + [""]
+
+    def granule_lines(self) -> list[str]:
+        """The granule section: why granules, GSD and kinetics are absent for some cases
+        (their flow metrics are in the tables above all the same)."""
+        if not self.granules_absent:
+            return []
+        reasons = {why for _, why in self.granules_absent}
+        head = ("Granules, GSD and kinetics were not analysed for these cases (their "
+                "granule columns are empty; the flow metrics above are theirs):")
+        if len(reasons) == 1:
+            head = (f"Granules, GSD and kinetics were not analysed: {next(iter(reasons))}. "
+                    "The granule columns (largest cluster, GSD errors) stay empty and the "
+                    "GSD figures are left out; the flow metrics are complete. Cases:")
+        return ["## Granules", "", head, "",
+                *[f"- {cid}: {why}" for cid, why in self.granules_absent], ""]
 
     def html(self) -> str:
         """The same sections as HTML."""
@@ -59,9 +76,12 @@ class Problems:
         frames = (f"<table><tr><th>case</th><th>step</th><th>kind</th><th>reason</th></tr>{rows}"
                   "</table>" if rows else "<p>none</p>")
         outputs = "".join(f"<li>{e(o)}</li>" for o in self.outputs) or "<li>complete</li>"
+        absent = "".join(f"<li>{e(c)}: {e(w)}</li>" for c, w in self.granules_absent)
+        granules = (f"<h2>Granules</h2><p>Granules, GSD and kinetics were not analysed for "
+                    f"these cases (flow metrics complete):</p><ul>{absent}</ul>" if absent else "")
         return (f"<h2>Skipped cases</h2><ul>{cases}</ul>"
                 f"<h2>Skipped or missing frames</h2>{frames}"
-                f"<h2>Analysis outputs</h2><ul>{outputs}</ul>")
+                f"<h2>Analysis outputs</h2><ul>{outputs}</ul>{granules}")
 
 
 def _read_json(path: Path, what: str, outputs: list[str]) -> dict:
@@ -83,9 +103,11 @@ def collect(study_skipped: list[dict], analysis_dir: Path) -> Problems:
     outputs: list[str] = []
     record = _read_json(analysis_dir / layout.ANALYSIS_RECORD,
                         "granules were not analysed (run `ligwf analyse`)", outputs)
-    if record:
+    if record.get("cases"):        # granules were analysed: the tables must be there
         outputs += [f"{name} missing: rerun `ligwf analyse` (granule and GSD columns are empty)"
                     for name in ANALYSIS_OUTPUTS if not (analysis_dir / name).is_file()]
+    absent = tuple((str(a.get("case_id", "?")), str(a.get("reason", "")))
+                   for a in record.get("granules_absent", []) if isinstance(a, dict))
     flow = _read_json(analysis_dir / layout.FLOW_PROFILES, "flow metrics missing", [])
     cases: dict[str, str] = {}
     for s in [*study_skipped, *record.get("skipped_cases", []), *flow.get("skipped_cases", [])]:
@@ -100,7 +122,7 @@ def collect(study_skipped: list[dict], analysis_dir: Path) -> Problems:
                 frames.add((str(cid), "-", "flow", str(why)))
     return Problems(tuple(sorted(cases.items())),
                     tuple(sorted(frames, key=lambda f: (f[0], f[1].zfill(12), f[3]))),
-                    tuple(outputs))
+                    tuple(outputs), absent)
 
 
 def study_problems(study) -> Problems:

@@ -91,8 +91,10 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
     return pd.DataFrame(rows), skipped
 
 
-def merge_analysis(cases: pd.DataFrame, analysis_dir: Path) -> pd.DataFrame:
-    """Add flow, cluster and GSD quantities to the case table (nan where not analysed)."""
+def merge_analysis(cases: pd.DataFrame, analysis_dir: Path, granules: bool = True) -> pd.DataFrame:
+    """Add flow, cluster and GSD quantities to the case table (nan where not analysed;
+    ``granules`` False: the granule tables are not used, see
+    :func:`ligwf.report.write.checked_analysis`)."""
     df = cases.copy()
     flow = _read_csv(analysis_dir / layout.FLOW_TABLE)
     if not flow.empty:
@@ -101,7 +103,7 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path) -> pd.DataFrame:
                      *[c for c in ("steady_fraction", "steady_from_step") if c in flow]]]
         df = df.merge(keep.rename(columns={"angle_of_repose_mean": "angle_of_repose"}),
                       on="case_id", how="left")
-    frames = _read_csv(analysis_dir / layout.FRAMES_TABLE)
+    frames = _read_csv(analysis_dir / layout.FRAMES_TABLE) if granules else pd.DataFrame()
     if not frames.empty and "largest_fraction" in frames:
         ok = frames[frames["status"] == "ok"] if "status" in frames else frames
         if "steady_from_step" in df:   # the flow stage's steady window, case by case
@@ -111,14 +113,14 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path) -> pd.DataFrame:
             largest_cluster_fraction="mean",
             one_granule_frame_share=lambda x: float(np.mean(np.asarray(x) > ONE_GRANULE)))
         df = df.merge(agg.reset_index(), on="case_id", how="left")
-    summary = _read_csv(analysis_dir / layout.GSD_SUMMARY_TABLE)
+    summary = _read_csv(analysis_dir / layout.GSD_SUMMARY_TABLE) if granules else pd.DataFrame()
     if not summary.empty:
         cols = {f"error_{side}{sfx}": f"gsd_error_{side}{sfx}"
                 for side in ("below", "above") for sfx in ("", "_lo", "_hi")}
         g = summary[["group", "cg", "rule", *[c for c in cols if c in summary]]].rename(columns=cols)
         g = g.assign(group=g["group"].astype(str))
         df = df.merge(g, on=["group", "cg", "rule"], how="left")
-    for col in METRICS:
+    for col in [*METRICS, "steady_fraction", "steady_from_step"]:
         if col not in df:
             df[col] = math.nan
     return df
@@ -198,17 +200,18 @@ def noise_floor_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def build_tables(study: Study) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], dict, pd.DataFrame]:
+def build_tables(study: Study, granules: bool = True
+                 ) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], dict, pd.DataFrame]:
     """(case table, condition table, skipped cases, profiles, noise-floor table) of a
-    finished study."""
+    finished study (``granules`` False: without the granule analysis' tables)."""
     cases, skipped = case_rows(study)
     analysis_dir = study.analysis_dir
     prof_path = analysis_dir / layout.FLOW_PROFILES
     profiles = json.loads(prof_path.read_text())["profiles"] if prof_path.is_file() else {}
     if cases.empty:
         return cases, pd.DataFrame(), skipped, profiles, pd.DataFrame()
-    merged = merge_analysis(cases, analysis_dir)
-    frames = _read_csv(analysis_dir / layout.FRAMES_TABLE)
+    merged = merge_analysis(cases, analysis_dir, granules)
+    frames = _read_csv(analysis_dir / layout.FRAMES_TABLE) if granules else pd.DataFrame()
     settings = study.analysis
     stats = ConditionStats(case_series(list(merged["case_id"]), profiles, frames),
                            settings.bootstrap, settings.seed)

@@ -12,6 +12,7 @@ with its reason in ``summary.md`` and ``index.html`` (:mod:`ligwf.report.problem
 from __future__ import annotations
 
 import html
+import json
 import math
 from pathlib import Path
 
@@ -20,9 +21,11 @@ import pandas as pd
 from ligwf import __version__
 from ligwf.analysis.frame_checks import last_usable_frame
 from ligwf.analysis.gsd_pooling import pooling_summary
+from ligwf.analysis.outputs import StaleAnalysis, damaged_outputs, provenance_mismatch
 from ligwf.analysis.flow_run import flow_study
 from ligwf.analysis.steady import is_auto
 from ligwf.engine.render import MESH_NAME
+from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
 from ligwf.report.granule_figures import granule_figures
@@ -165,10 +168,12 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     """Compute flow metrics (steady window from the study's analysis settings), build the
     tables and write the report folder; returns it."""
     out = Path(out) if out else study.report_dir
+    trusted = checked_analysis(study)
+    flow = flow_study(study)
+    nothing_to_report(study, flow)
     fig_dir, pv_dir = out / "figures", out / "paraview"
     fig_dir.mkdir(parents=True, exist_ok=True)
-    flow_study(study)
-    cases, conditions, _, profiles, floors = build_tables(study)
+    cases, conditions, _, profiles, floors = build_tables(study, granules=trusted)
     problems = study_problems(study)
     atomic_write_text(out / "cases.csv", cases.to_csv(index=False))
     atomic_write_text(out / "conditions.csv", conditions.to_csv(index=False))
@@ -180,12 +185,13 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         figures.append(("Velocity profiles", figs.velocity_profiles(cases, profiles,
                                                                     fig_dir / "velocity_profiles.png")))
     gsd_path = study.analysis_dir / layout.GSD_TABLE
-    if gsd_path.is_file() and gsd_path.stat().st_size > 1:
+    if trusted and gsd_path.is_file() and gsd_path.stat().st_size > 1:
         gsd = pd.read_csv(gsd_path)
         if not gsd.empty:
             figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / "gsd_overlay.png",
                                                                  study.analysis.gsd_volume)))
-    figures += granule_figures(study.analysis_dir, fig_dir)
+    if trusted:
+        figures += granule_figures(study.analysis_dir, fig_dir)
     pvds = []
     by_id = {c.case_id: c for c in study.usable_cases()[0]}
     for case_id in cases.get("case_id", []):
@@ -200,7 +206,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
                 last.particles, mesh, axis, angle, "speed",
                 fig_dir / f"{case_id}_speed.png", f"{case_id} step {last.step}: speed [m/s]")))
             labelled = study.analysis_dir / case_id / f"granules_{last.step}.vtu"
-            if labelled.is_file():
+            if trusted and labelled.is_file():
                 figures.append((f"{case_id}: granules", figs.snapshot(
                     labelled, mesh, axis, angle, "granule",
                     fig_dir / f"{case_id}_granules.png", f"{case_id} step {last.step}: granule id")))
@@ -216,7 +222,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         f"Steady window: {steady_line(study, cases)}.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
         *noise_markdown(conditions, floors),
-        *pooling_markdown(study.analysis_dir),
+        *(pooling_markdown(study.analysis_dir) if trusted else []),
         *problems.markdown(),
         "## Figures", "",
         *[f"![{t}](figures/{p.name})" for t, p in figures], "",
@@ -225,6 +231,49 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / "summary.md", md)
     atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, problems))
     return out
+
+
+class NothingToReport(LigwfError):
+    """Usable cases, but not one frame of any of them could be used."""
+
+
+def checked_analysis(study: Study) -> bool:
+    """Whether the granule analysis outputs may be used: True when the analysis record
+    is there and its provenance (scene hashes, dump records, settings) and tables
+    (sizes, SHA-256) still match; False when there is no readable record (the report
+    lists that, and leaves the granule columns empty). StaleAnalysis (one line naming what
+    changed) when the outputs are of another study, of an earlier run, or were edited."""
+    path = study.analysis_dir / layout.ANALYSIS_RECORD
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return False
+    if not isinstance(record, dict):
+        return False
+    where = study.analysis_dir
+    if (why := provenance_mismatch(study, study.analysis, record)) is not None:
+        raise StaleAnalysis(f"{where}: the analysis outputs are stale: {why}; run `ligwf "
+                            "analyse` again (or `ligwf study`, which does)")
+    if damaged := damaged_outputs(where, record):
+        raise StaleAnalysis(f"{where}/{damaged[0]}" + (f" (and {len(damaged) - 1} more)"
+                            if len(damaged) > 1 else "") + "; run `ligwf analyse` again")
+    return True
+
+
+def nothing_to_report(study: Study, flow: pd.DataFrame) -> None:
+    """NothingToReport when the study has usable cases but the flow stage could use no
+    frame of any (every dump refused: e.g. ``post/`` folders swapped between cases)."""
+    usable = study.usable_cases()[0]
+    if not usable or not flow.empty:
+        return
+    try:
+        notes = json.loads((study.analysis_dir / layout.FLOW_PROFILES).read_text())["skipped_frames"]
+        cid, reasons = next(iter(notes.items()))
+        first = f"{cid}: {reasons[0]}"
+    except (OSError, ValueError, KeyError, TypeError, StopIteration, IndexError):
+        first = "no reason recorded"
+    raise NothingToReport(f"nothing to report in {study.path}: no frame of the {len(usable)} "
+                          f"usable case(s) could be used; first: {first}")
 
 
 def steady_line(study: Study, cases: pd.DataFrame) -> str:

@@ -22,10 +22,12 @@ from pathlib import Path
 from typing import Any
 
 from ligwf.engine.health import DONE
-from ligwf.engine.thermo import rows_from_csv
+from ligwf.engine.render import INPUT_NAME, MESH_NAME
+from ligwf.engine.thermo import rows_from_csv, table_problem
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.model import Scene
+from ligwf.scene.scaling import ScaledScene, scale
 from ligwf.study.layout import (DUMP_RECORD, MANIFEST_FILE, POST_DIR, SCENE_FILE, SCREEN_FILE,
                                 THERMO_FILE)
 from ligwf.study.manifest import Manifest, read_manifest, write_manifest
@@ -60,6 +62,82 @@ class DumpRecord:
             return (f"{path}: content differs from the dump the run left (SHA-256 mismatch: "
                     "edited, corrupted or copied from another run)")
         return None
+
+
+def content_hash(scaled: ScaledScene, files: dict[str, str], mesh_text: str) -> str:
+    """sha256 over the scaled parameters, the rendered files and the mesh (the scene hash
+    rendering stores in the scene record and the runner in the manifest)."""
+    h = hashlib.sha256()
+    h.update(json.dumps(scaled.to_dict(), sort_keys=True).encode())
+    for name in sorted(files):
+        h.update(name.encode() + b"\0" + files[name].encode() + b"\0")
+    h.update(hashlib.sha256(mesh_text.encode()).digest())
+    return h.hexdigest()
+
+
+def recomputed_hash(path: Path, scaled: ScaledScene) -> str | None:
+    """The content hash of a case folder as rendering computed it (scaled parameters,
+    input, mesh: :func:`content_hash`), from what the folder holds now;
+    None when its input or mesh is missing (a case folder put together by hand)."""
+    try:
+        files = {INPUT_NAME: (path / INPUT_NAME).read_text()}
+        mesh = (path / MESH_NAME).read_text()
+    except (OSError, UnicodeDecodeError):
+        return None
+    return content_hash(scaled, files, mesh)
+
+
+def _changed_fields(rec: dict, scaled: ScaledScene) -> list[str]:
+    """Scaled fields that do not follow from the record's own scene, CG level and rule
+    (``field = stored (expected ...)``); empty when that cannot be worked out."""
+    changed = [f"{key} = {rec[key]!r} (scaled.{key} = {getattr(scaled, key)!r})"
+               for key in ("cg", "rule") if str(rec[key]) != str(getattr(scaled, key))
+               and not (key == "cg" and float(rec[key]) == scaled.cg)]
+    try:
+        expected = scale(Scene.model_validate(rec["scene"]), scaled.cg, scaled.rule,
+                         scaled.replica).to_dict()
+    except Exception:                    # an edited scene that no longer validates
+        return changed or ["scene (no longer a valid scene)"]
+    stored = scaled.to_dict()
+    return changed + [f"scaled.{k} = {stored[k]!r} (its scene gives {expected[k]!r})"
+                      for k in stored if k in expected and stored[k] != expected[k]]
+
+
+def scene_record_problem(path: Path, rec: dict, scaled: ScaledScene) -> str | None:
+    """Why a case folder's scene record is not the one rendering wrote (None: its stored
+    content hash is recomputed and matches, and its CG level and rule are the scaled
+    scene's), naming the changed fields where they can be told."""
+    if str(rec["rule"]) != scaled.rule or float(rec["cg"]) != scaled.cg:
+        return "changed: " + "; ".join(_changed_fields(rec, scaled))
+    digest = recomputed_hash(path, scaled)
+    if digest is None or digest == rec["scene_hash"]:
+        return None
+    fields = _changed_fields(rec, scaled)
+    what = ("changed: " + "; ".join(fields)) if fields else (
+        f"the scaled parameters, {INPUT_NAME} or {MESH_NAME} differ from what was rendered")
+    return f"content hash recomputed on read differs from the stored scene_hash ({what})"
+
+
+def folder_fingerprint(path: Path) -> dict:
+    """What identifies a case folder's results: the stored scene hash and the SHA-256 of
+    its dump record (None where missing or unreadable); an analysis records it per case."""
+    try:
+        scene = json.loads((path / SCENE_FILE).read_text()).get("scene_hash")
+    except (OSError, ValueError, AttributeError):
+        scene = None
+    record = path / DUMP_RECORD
+    return {"scene_hash": scene, "dump_record": file_digest(record) if record.is_file() else None}
+
+
+def granules_absent(scaled: ScaledScene) -> str | None:
+    """Why a case's run holds no granule data, in words (None: it dumped its contacts)."""
+    if not scaled.wet:
+        return (f"dry scene (liquid.model: {scaled.liquid_model}): no liquid bridges hold "
+                "particles together, so there are no granules to analyse")
+    if not scaled.granules:
+        return ("scene.analysis.granules: false: the run wrote no contact dumps (set it to "
+                "true to analyse granules and their size distribution)")
+    return None
 
 
 def group_of(varied: dict[str, Any]) -> str:
@@ -163,15 +241,33 @@ class CaseFolder:
         except (OSError, ValueError, KeyError, TypeError) as exc:
             return f"{self.thermo.name} is unreadable (truncated or corrupt?): {exc}"
         last = rows[-1].step if rows else None
+        if (why := table_problem(rows, self.scaled.thermo_every)) is not None:
+            return f"{self.thermo.name}: {why}"
         if last != manifest.steps_done:
             return (f"{self.thermo.name} ends at step {last}, the manifest says "
                     f"{manifest.steps_done} steps were run (truncated or replaced)")
         return None
 
     # ----------------------------------------------------------------- usability
+    def record_problem(self) -> str | None:
+        """Why the scene record is not the one rendering wrote (None: its content hash,
+        recomputed from the scaled parameters, input and mesh in the folder, matches the
+        stored one, and its CG level and rule are the scaled scene's). Asked by every stage
+        that uses a case's results, not by the runner (an engine run of an edited input
+        ends in its own verdict)."""
+        try:
+            rec = json.loads((self.path / SCENE_FILE).read_text())
+        except (OSError, ValueError) as exc:
+            return f"{SCENE_FILE} unreadable: {exc}"
+        why = scene_record_problem(self.path, rec, self.scaled)
+        return (None if why is None else f"{SCENE_FILE}: {why}; the record no longer describes "
+                "the run (edited after rendering?): render and run the case again")
+
     def why_not_usable(self) -> str | None:
-        """Why later stages may not use this case (None: its manifest says done and was
-        written for the scene the folder holds now)."""
+        """Why later stages may not use this case (None: its scene record is the rendered
+        one, its manifest says done and was written for the scene the folder holds now)."""
+        if (why := self.record_problem()) is not None:
+            return why
         if not (self.path / MANIFEST_FILE).is_file():
             return "no manifest (the case was not run by `ligwf run`)"
         try:

@@ -15,8 +15,6 @@ runner can tell whether a finished case still matches what the workflow asks for
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,6 +28,7 @@ from ligwf.engine.render import MESH_NAME, OUTPUT_DIRS, render
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.stability import Preflight, check_rendered
 from ligwf.scene.workflow import Case, Workflow
+from ligwf.study.case import content_hash
 from ligwf.study.layout import SCENE_FILE, STUDY_FILE
 from ligwf.study.study import Study
 
@@ -62,16 +61,6 @@ class RenderedCase:
             "scaled": self.scaled.to_dict(),
             "scene_hash": self.scene_hash,
         }
-
-
-def content_hash(scaled: ScaledScene, files: dict[str, str], mesh_text: str) -> str:
-    """sha256 over the scaled parameters, the rendered files and the mesh."""
-    h = hashlib.sha256()
-    h.update(json.dumps(scaled.to_dict(), sort_keys=True).encode())
-    for name in sorted(files):
-        h.update(name.encode() + b"\0" + files[name].encode() + b"\0")
-    h.update(hashlib.sha256(mesh_text.encode()).digest())
-    return h.hexdigest()
 
 
 def render_case(case: Case, template_dirs: Iterable[str | Path] = ()) -> RenderedCase:

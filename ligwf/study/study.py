@@ -38,8 +38,12 @@ class Study:
                 rec = json.loads((path / STUDY_FILE).read_text())
                 cases = sorted(rec["cases"], key=lambda c: int(c["index"]))
                 ids = tuple(str(c["case_id"]) for c in cases)
-            except (OSError, ValueError, KeyError, TypeError) as exc:
+            except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
                 raise ConfigError(f"{path}: unreadable study record ({exc})") from None
+            twice = sorted({i for i in ids if ids.count(i) > 1})
+            if twice:
+                raise ConfigError(f"{path / STUDY_FILE}: lists case {', '.join(twice)} more than "
+                                  "once (edited or merged by hand?): render the study again")
             return cls(path, str(rec.get("name", path.name)),
                        build_analysis_settings(rec.get("analysis"), "study analysis"), ids)
         if is_case_folder(path):
@@ -76,7 +80,7 @@ class Study:
             except ConfigError as exc:
                 skipped.append({"case_id": d.name, "reason": str(exc)})
                 continue
-            problem = case.why_not_usable() if require_manifest else None
+            problem = case.why_not_usable() if require_manifest else case.record_problem()
             if problem:
                 skipped.append({"case_id": case.case_id, "reason": problem})
             else:
