@@ -14,8 +14,9 @@ import re
 from ligwf import __version__
 from ligwf.fsio import LOW_SPACE_BYTES, FolderNotWritable, atomic_write_text, space_left
 from ligwf.engine.guard import start_time
-from ligwf.engine.health import (FAILED, KILLED, RUNNING, UNSTABLE, Expectation, assess,
+from ligwf.engine.health import (DONE, FAILED, KILLED, RUNNING, UNSTABLE, Expectation, assess,
                                  engine_signal, kinetic_energy_ceiling, verdict)
+from ligwf.engine.restart_id import CaseIdentity, stamp
 from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for, render_resume,
                                  rotate_screen)
 from ligwf.engine.thermo import ThermoRow, parse_screen, phase_group, rows_from_csv, rows_to_csv
@@ -84,6 +85,41 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
     return manifest, attempt
 
 
+_DUMP_STEP_RE = re.compile(r"_(\d+)\.vtu$")
+
+
+def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | None:
+    """The first hole in a case's record: (last step a resume may restart from, why).
+
+    A full disk (or a writer killed mid-file) leaves thermo rows missing from a screen and
+    dump files empty; a run that resumes from a restart past the hole never writes them
+    again. Holes: a thermo gap wider than ``thermo_every`` (restart at or before the row
+    before it), an empty file in ``post/`` or a missing particle dump at a step the run
+    has reached (restart before that step). None when the record is whole.
+    """
+    holes: list[tuple[int, str]] = []
+    every = case.scaled.thermo_every
+    for a, b in zip(rows, rows[1:]):
+        if not 0 < b.step - a.step <= every:
+            holes.append((a.step, f"thermo rows missing or repeated between steps {a.step} "
+                          f"and {b.step}"))
+            break
+    post = case.path / "post"
+    reached = rows[-1].step if rows else 0
+    if post.is_dir():
+        names = set()
+        for f in post.iterdir():
+            names.add(f.name)
+            m = _DUMP_STEP_RE.search(f.name)
+            if m and f.is_file() and f.stat().st_size == 0 and int(m.group(1)) <= reached:
+                holes.append((int(m.group(1)) - 1, f"empty dump {f.name}"))
+        for step in case.expected_dump_steps(reached):
+            if f"particles_{step}.vtu" not in names:
+                holes.append((step - 1, f"particle dump of step {step} missing"))
+                break
+    return min(holes) if holes else None
+
+
 def merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int,
                dt: float) -> list[ThermoRow]:
     """Thermo of earlier attempts up to the restart step, then this attempt's rows.
@@ -126,10 +162,16 @@ def history(case: CaseFolder, manifest: Manifest, attempt: Attempt) -> list[Ther
 def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
                    exit_code: int | None, wall_seconds: float, killed: bool = False,
                    engine_version_line: str | None = None,
-                   stop_problem: str | None = None) -> Manifest:
+                   stop_problem: str | None = None, stamp_new: bool = True) -> Manifest:
     """Judge the attempt from its screen capture and write thermo table + manifest.
-    ``stop_problem``: why the live check stopped the run (None: it did not)."""
+    ``stop_problem``: why the live check stopped the run (None: it did not). The restarts
+    the attempt wrote get their identity sidecars first (the engine has ended), unless
+    ``stamp_new`` is False: a runner recording a DEAD runner's attempt cannot tell the
+    engine's files from ones dropped in since (the watchdog stamped them when it stopped
+    that engine)."""
     s = case.scaled
+    if stamp_new:
+        stamp_restarts(case, attempt)
     screen = case.path / attempt.screen
     text = screen.read_text(errors="replace") if screen.exists() else ""
     parser = parse_screen(text)
@@ -140,6 +182,11 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     signal = engine_signal(parser.lines, exit_code)
     status, reason = verdict(issues, exit_code, steps_done, s.total_steps, killed, signal,
                              stop_problem)
+    hole = record_hole(case, rows) if status in (DONE, KILLED) else None
+    if hole is not None and status == DONE:
+        # never done with a gap or an empty frame: resume from a restart before the hole
+        status, reason = KILLED, (f"incomplete record ({hole[1]}): resumes from a restart "
+                                  f"at or before step {hole[0]}")
     left = space_left(case.path)
     if status in (FAILED, KILLED) and left < LOW_SPACE_BYTES:
         # a full disk makes LIGGGHTS segfault: the case resumes once there is room
@@ -162,6 +209,7 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     manifest.engine = []
     manifest.add_up_attempts()
     manifest.steps_done = steps_done
+    manifest.complete_upto = hole[0] if hole is not None else None
     if rows:
         manifest.atoms_start = int(rows[0].get("atoms")) if manifest.atoms_start is None else \
             manifest.atoms_start
@@ -181,6 +229,13 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     return manifest
 
 
+def stamp_restarts(case: CaseFolder, attempt: Attempt, settle: float = 0.0) -> list[str]:
+    """Identity sidecars for the restarts ``attempt`` of ``case`` wrote (changed since it
+    began, 1 s of clock granularity allowed; :mod:`ligwf.engine.restart_id`)."""
+    return stamp(case.path, CaseIdentity.of(case), attempt.number, attempt.started_at - 1.0,
+                 settle)
+
+
 def close_lost_attempt(case: CaseFolder, manifest: Manifest) -> Manifest:
     """Record the last attempt of a case whose runner died (SIGKILL, crash, lost node)
     from its screen: rows, steps, and wall time up to the screen's last write. The
@@ -191,7 +246,7 @@ def close_lost_attempt(case: CaseFolder, manifest: Manifest) -> Manifest:
     wall = sum(parser.phase_walls().values())
     if screen.exists():
         wall = max(wall, screen.stat().st_mtime - attempt.started_at)
-    return finish_attempt(case, manifest, attempt, None, wall, killed=True)
+    return finish_attempt(case, manifest, attempt, None, wall, killed=True, stamp_new=False)
 
 
 def _cause_step(issues, status: str) -> int | None:
@@ -215,5 +270,5 @@ def restart_unreadable(manifest: Manifest, attempt: Attempt) -> bool:
             and manifest.steps_done <= attempt.from_step)
 
 
-__all__ = ["begin_attempt", "finish_attempt", "close_lost_attempt", "case_rows", "history",
+__all__ = ["begin_attempt", "finish_attempt", "stamp_restarts", "close_lost_attempt", "case_rows", "history",
            "expectation", "engine_version", "phase_group", "restart_unreadable"]

@@ -8,35 +8,48 @@ members mid-run. The supervisor is what makes that survivable:
 * members that finished before the abort already have their manifest (written by their
   group leader) and ``claims/<i>.done``: nothing is lost;
 * a member in flight whose screen carries an ``ERROR`` line is the culprit: it is recorded
-  ``failed`` with that line;
-* the other members in flight are innocent victims: they are marked ``killed`` and the
-  supervisor launches a new ``mpirun`` for the remaining work, where they continue from
-  their newest restart file (:mod:`ligwf.engine.resume`).
+  ``failed`` with that line (an unreadable restart is set aside instead, and the member
+  resumes from an older one);
+* the other members -- in flight, or stopped by ``mpirun``'s SIGTERM after a rank died
+  (they write a forced restart, :mod:`ligwf.engine.ensemble_worker`) -- are ``killed``
+  with their attempt recorded from its screen (steps, wall time), and the supervisor
+  launches a new ``mpirun`` for the remaining work, where they continue from their newest
+  own restart (:mod:`ligwf.engine.resume`, :mod:`ligwf.engine.restart_id`).
 
-A launch that makes no progress at all (no member finished, no culprit found) marks its
-in-flight members ``failed`` with the launcher's output, so the loop always ends.
+Ranks that outlive a killed ``mpirun`` are stopped (SIGTERM, then SIGKILL once their
+attempt is recorded) before anything is settled. A stop on request (Ctrl-C, SIGTERM of
+ligwf) ends every member ``killed``, "interrupted by the user", forced restarts written.
+The supervisor stamps the members' new restarts with their identity while they run. A
+member that finds its folder full stops the launch: FolderNotWritable, the others
+resumable. A launch in which no member makes progress (no step gained, none finished)
+marks its members ``failed`` with the launcher's output, so the loop always ends.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
+import signal
+import socket
 import subprocess
 import sys
 import threading
 import time
 from pathlib import Path
 
-from ligwf.engine.attempt import finish_attempt
+from ligwf.engine.attempt import DISK_FULL, finish_attempt, restart_unreadable, stamp_restarts
 from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
 from ligwf.engine.health import FAILED, KILLED, log_errors
-from ligwf.engine.guard import engine_env, release, watch
-from ligwf.engine.launch import Monitor, NullMonitor, signal_engine
-from ligwf.engine.resume import SKIP, plan_case
+from ligwf.engine.guard import (RANK_NAMES, STOP_GRACE_SECONDS, EngineProcess, engine_env,
+                                engine_tree, process, release, watch)
+from ligwf.engine.launch import Monitor, NullMonitor, interrupted_reason, signal_engine
+from ligwf.engine.restart_id import SETTLE_SECONDS
+from ligwf.engine.resume import SKIP, RestartFile, discard_restart, plan_case
 from ligwf.engine.site import EngineConfig
 from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.errors import SimulationFailed
-from ligwf.fsio import atomic_write_json
+from ligwf.fsio import FolderNotWritable, atomic_write_json
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import Manifest
 
@@ -63,19 +76,68 @@ def _done(ens_dir: Path, pos: int) -> bool:
     return (ens_dir / CLAIMS_DIR / f"{pos}.done").exists()
 
 
-def _settle_in_flight(case: CaseFolder, exit_code: int | None, wall: float) -> Manifest | None:
-    """Record a member that was running when the job ended: culprit or victim."""
+def _settle_in_flight(case: CaseFolder, exit_code: int | None) -> Manifest | None:
+    """Record a member that was running when the job ended, from its screen: the culprit
+    (its screen has an ERROR line) is judged as usual; any other was stopped with the job
+    and is ``killed`` (resumable), its attempt kept with the steps and wall time it ran."""
     m = case.manifest()
-    if m is None or not m.attempts:
-        return None
+    if m is None or not m.attempts or m.attempts[-1].ended is not None:
+        return m
     attempt = m.attempts[-1]
     screen = case.path / attempt.screen
     lines = screen.read_text(errors="replace").splitlines() if screen.exists() else []
+    wall = max(0.0, (screen.stat().st_mtime if screen.exists() else time.time())
+               - attempt.started_at)
     if log_errors(lines):
-        return finish_attempt(case, m, attempt, exit_code, wall)
-    m.status, m.reason = KILLED, "stopped when another ensemble member aborted the job"
-    case.write_manifest(m)
-    return m
+        m = finish_attempt(case, m, attempt, exit_code, wall)
+        if restart_unreadable(m, attempt) and attempt.from_restart:
+            # the engine could not read the restart (and its error aborted the job): set
+            # it aside; the next launch resumes from an older one
+            discard_restart(case.path, RestartFile(attempt.from_restart, attempt.from_step))
+            m.status = KILLED
+            m.reason = f"restart {attempt.from_restart} unreadable ({m.reason}); set aside"
+            case.write_manifest(m)
+        return m
+    return finish_attempt(case, m, attempt, None, wall, killed=True)
+
+
+def _job_end(launch_log: str, exit_code: int | None) -> str:
+    """How the job ended, in words (mpirun's notice about a rank, else the exit code)."""
+    for line in launch_log.splitlines():
+        if "exited on signal" in line:
+            return line.strip()
+    return f"mpirun exit code {exit_code}"
+
+
+def _stop_leftovers(ranks: list[EngineProcess], ens_dir: Path, grace: float = 20.0) -> None:
+    """Ranks still running after ``mpirun`` ended (it was killed): SIGTERM (forced
+    restart, the rank records its attempt and marks its claim done), then SIGKILL once
+    their claims are done or after ``grace`` seconds (MPI_Finalize without mpirun would
+    wait forever)."""
+    alive = [r for r in ranks if r.alive()]
+    if not alive:
+        return
+    for r in alive:
+        try:
+            os.kill(r.pid, signal.SIGTERM)
+        except ProcessLookupError:
+            pass
+    deadline = time.monotonic() + grace
+    while time.monotonic() < deadline:
+        busy = {c.get("pid") for pos, c in _claims(ens_dir).items() if not _done(ens_dir, pos)}
+        alive = [r for r in alive if r.alive()]
+        if not alive or not any(r.pid in busy for r in alive):
+            break
+        time.sleep(0.2)
+    for r in alive:
+        if r.alive():
+            try:
+                os.kill(r.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+    t = time.monotonic()
+    while any(r.alive() for r in alive) and time.monotonic() - t < 5:
+        time.sleep(0.1)
 
 
 def _key(case: CaseFolder) -> str:
@@ -92,7 +154,8 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
     ``monitor`` gets the same live progress as for local runs. Launch ``n`` works in
     ``.ensemble/<label>-<n>`` (a planned run gives each phase its own label).
 
-    Returns ``{case folder name: status}`` for the cases worked on.
+    Returns ``{case folder name: status}`` for the cases worked on. FolderNotWritable
+    when a member found its folder full (the others were stopped and are resumable).
     """
     if group_size < 1 or nprocs % group_size:
         raise SimulationFailed(f"--ensemble {nprocs} cannot be split into groups of --np "
@@ -105,6 +168,9 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
     root = Path(study) / ENSEMBLE_DIR
     launches = 0
     limit = max_launches or (2 * len(todo) + 2)
+    me = process(os.getpid())
+    runner = {"host": socket.gethostname(), "pid": os.getpid(),
+              "start": me.start if me is not None else None}
     while todo and not stop.is_set() and launches < limit:
         launches += 1
         ens_dir = root / f"{label}-{launches}"
@@ -112,78 +178,109 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
             shutil.rmtree(ens_dir)
         (ens_dir / CLAIMS_DIR).mkdir(parents=True)
         atomic_write_json(ens_dir / QUEUE_FILE, {"cases": [_key(c) for c in todo],
-                                                 "retry_unstable": retry_unstable})
+                                                 "retry_unstable": retry_unstable,
+                                                 "runner": runner})
+        before = {_key(c): (c.manifest().steps_done if c.manifest() else 0) for c in todo}
         cmd = worker_command(engine, nprocs, ens_dir, group_size)
-        t0 = time.monotonic()
+        t_launch = time.time()
         tails: dict[int, tuple[LogTail, ThermoParser]] = {}
         ended: set[int] = set()
         with open(ens_dir / "launch.log", "wb") as out:
             proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT,
                                     stdin=subprocess.DEVNULL, env=engine_env(),
                                     start_new_session=True)
-        watchdog = watch(proc)   # stops the job if this runner dies
+        watchdog = watch(proc, [ens_dir])   # stops the job if this runner dies
+        ranks: dict[int, EngineProcess] = {}
         stop_sent = False
-        while True:
-            finished = proc.poll() is not None
-            for pos, claim in _claims(ens_dir).items():
-                case = by_key[claim["case"]]
-                name = case.path.name
-                if pos not in tails:
+        try:
+            while True:
+                finished = proc.poll() is not None
+                if not finished:
+                    for p in engine_tree(proc.pid):
+                        if p.name in RANK_NAMES:
+                            ranks.setdefault(p.pid, p)
+                for pos, claim in _claims(ens_dir).items():
+                    case = by_key[claim["case"]]
+                    name = case.path.name
                     m = case.manifest()
-                    if m is None or not m.attempts:
-                        continue
-                    tails[pos] = (LogTail(case.screen), ThermoParser())
-                    monitor.start(name, m.total_steps, m.attempts[-1].from_step)
-                tail, parser = tails[pos]
-                for line in tail.read_lines():
-                    parser.feed(line)
-                monitor.update(name, parser)
-                if pos not in ended and _done(ens_dir, pos):
-                    ended.add(pos)
-                    m = case.manifest()
-                    if m is not None:
-                        outcome[name] = m.status
-                        monitor.end(name, m, plan_case(case))
-            if finished:
-                break
-            if stop.is_set() and not stop_sent:
+                    if pos not in tails:
+                        if m is None or not m.attempts:
+                            continue
+                        tails[pos] = (LogTail(case.screen), ThermoParser())
+                        monitor.start(name, m.total_steps, m.attempts[-1].from_step)
+                    tail, parser = tails[pos]
+                    for line in tail.read_lines():
+                        parser.feed(line)
+                    monitor.update(name, parser)
+                    if m is not None and m.attempts and m.attempts[-1].ended is None:
+                        stamp_restarts(case, m.attempts[-1], SETTLE_SECONDS)
+                    if pos not in ended and _done(ens_dir, pos):
+                        ended.add(pos)
+                        if m is not None:
+                            outcome[name] = m.status
+                if finished:
+                    break
+                if stop.is_set() and not stop_sent:
+                    signal_engine(proc)
+                    stop_sent = True
+                time.sleep(poll_seconds)
+        except BaseException:
+            # ligwf itself is going down: the ranks write their restarts first
+            if proc.poll() is None:
                 signal_engine(proc)
-                stop_sent = True
-            time.sleep(poll_seconds)
-        release(watchdog)
-        wall = time.monotonic() - t0
+                try:
+                    proc.wait(timeout=STOP_GRACE_SECONDS)
+                except subprocess.TimeoutExpired:
+                    os.killpg(proc.pid, signal.SIGKILL)
+            raise
+        finally:
+            release(watchdog)
+        _stop_leftovers(list(ranks.values()), ens_dir)   # mpirun killed under its ranks
         launch_log = (ens_dir / "launch.log").read_text(errors="replace")
         claims = _claims(ens_dir)
-        progressed = bool(ended)
-        victims: list[CaseFolder] = []
+        how = _job_end(launch_log, proc.returncode)
+        progressed, retry, full = False, set(), None
         for pos, claim in claims.items():
-            if pos in ended or _done(ens_dir, pos):
-                continue
             case = by_key[claim["case"]]
-            m = _settle_in_flight(case, proc.returncode, wall)
+            m = _settle_in_flight(case, proc.returncode)
             if m is None:
                 continue
+            if m.status == KILLED and m.attempts and m.attempts[-1].started_at >= t_launch - 1:
+                if m.reason.startswith(DISK_FULL):
+                    full = full or f"{case.path}: {m.reason}"
+                elif stop.is_set():
+                    m.reason = interrupted_reason(stop, m.steps_done, m.total_steps)
+                elif not m.reason.startswith("incomplete record") and \
+                        not m.reason.startswith("restart "):
+                    m.reason = (f"stopped when the ensemble job ended ({how}) at step "
+                                f"{m.steps_done} of {m.total_steps}")
+                m.attempts[-1].reason = m.reason
+                case.write_manifest(m)
             outcome[case.path.name] = m.status
-            if m.status == KILLED:
-                victims.append(case)
-            else:
+            if m.status != KILLED or m.steps_done > before.get(_key(case), 0):
                 progressed = True
+            if m.status == KILLED:
+                retry.add(_key(case))
+            if pos not in ended or m.status == KILLED:
                 monitor.end(case.path.name, m, plan_case(case))
         if not claims and proc.returncode:
             raise SimulationFailed(
                 f"ensemble launch failed before any case started (exit {proc.returncode})",
                 exit_code=proc.returncode, run_dir=str(ens_dir), log_tail=launch_log[-2000:])
-        if not progressed and victims and not stop.is_set():
-            for case in victims:
+        if full is not None:
+            raise FolderNotWritable(full)
+        if not progressed and retry and not stop.is_set():
+            for key in retry:
+                case = by_key[key]
                 m = case.manifest()
                 if m is not None:
                     m.status = FAILED
-                    m.reason = (f"ensemble job ended (exit {proc.returncode}) with no member "
-                                f"finished and no ERROR line; see {ens_dir / 'launch.log'}")
+                    m.reason = (f"ensemble job ended ({how}) with no member making progress "
+                                f"and no ERROR line; see {ens_dir / 'launch.log'}")
                     case.write_manifest(m)
                     outcome[case.path.name] = FAILED
                     monitor.end(case.path.name, m, plan_case(case))
+            retry = set()
         settled = {c["case"] for c in claims.values()}
-        retried = {_key(v) for v in victims} if progressed else set()
-        todo = [c for c in todo if _key(c) not in settled or _key(c) in retried]
+        todo = [c for c in todo if _key(c) not in settled or _key(c) in retry]
     return outcome

@@ -11,6 +11,16 @@ Each finished case is judged and recorded by the leader right away (same manifes
 health checks as a local run, :mod:`ligwf.engine.attempt`), and ``claims/<index>.done`` is
 written, so the results of finished members survive when another member's engine error
 MPI_Aborts the whole job; the supervisor then sorts out the members that were in flight.
+
+Stopping: the ranks install LIGGGHTS' own SIGINT/SIGTERM handler (what the ``liggghts``
+executable's ``main`` does; a library user gets none), so a SIGTERM from the supervisor or
+from ``mpirun`` (when another rank died) makes the engine write
+``restart_forced_liggghts_<step>.data`` and end its run; the leader records the attempt
+(``killed``, resumable) and the group claims nothing more. A resumed member whose restart
+the engine cannot read sets that restart aside and resumes from the next older one (as a
+local run does). The manifest names the supervisor as the case's runner (its lock holder)
+and this rank as its engine process; the rank calls itself
+:data:`ligwf.engine.guard.ENSEMBLE_RANK_NAME` so a later runner finds it like ``liggghts``.
 """
 
 from __future__ import annotations
@@ -19,14 +29,17 @@ import argparse
 import ctypes
 import json
 import os
+import signal
 import sys
 import time
 from pathlib import Path
 
-from ligwf.engine.attempt import begin_attempt, finish_attempt
+from ligwf.engine.attempt import DISK_FULL, begin_attempt, finish_attempt, restart_unreadable
+from ligwf.engine.guard import ENSEMBLE_RANK_NAME, process
+from ligwf.engine.health import KILLED
 from ligwf.engine.liggghts import Liggghts
 from ligwf.fsio import atomic_write_json
-from ligwf.engine.resume import SKIP, input_for, plan_case
+from ligwf.engine.resume import FRESH, RESUME, SKIP, discard_restart, input_for, plan_case
 from ligwf.study.case import CaseFolder
 
 QUEUE_FILE = "queue.json"
@@ -69,10 +82,40 @@ def run_file(engine: Liggghts, comm, case: CaseFolder, input_name: str) -> None:
             os.close(saved)
 
 
+_HANDLER = "_ZN9LAMMPS_NS13SignalHandler11int_handlerEi"
+_QUIT = "_ZN9LAMMPS_NS13SignalHandler12request_quitE"
+
+
+def install_engine_signals(engine: Liggghts) -> None:
+    """SIGINT and SIGTERM to LIGGGHTS' handler (forced restart at the next step, then the
+    run ends), as the ``liggghts`` executable installs them; and name the process."""
+    _libc.prctl(15, ENSEMBLE_RANK_NAME.encode(), 0, 0, 0)   # 15 = PR_SET_NAME
+    _libc.signal.argtypes = [ctypes.c_int, ctypes.c_void_p]
+    _libc.signal.restype = ctypes.c_void_p
+    handler = ctypes.cast(getattr(engine.lib, _HANDLER), ctypes.c_void_p)
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        _libc.signal(int(sig), handler)
+
+
+def quit_requested(engine: Liggghts) -> bool:
+    """Whether this rank has been asked to stop (LIGGGHTS' flag, set by its handler)."""
+    return bool(ctypes.c_bool.in_dll(engine.lib, _QUIT).value)
+
+
 def line_buffered_stdout() -> None:
     """Make C stdout line-buffered (must run before anything is written to it)."""
     stdout = ctypes.c_void_p.in_dll(_libc, "stdout")
     _libc.setvbuf(stdout, None, 1, 0)  # 1 = _IOLBF
+
+
+def _record_runner(case: CaseFolder, manifest, runner: dict, me) -> None:
+    """The supervisor is the case's runner (it holds the case lock and outlives this
+    launch); this rank is its engine process."""
+    if runner.get("pid"):
+        manifest.host = runner.get("host", manifest.host)
+        manifest.pid, manifest.pid_start = int(runner["pid"]), runner.get("start")
+    manifest.engine = [me.to_dict()] if me is not None else []
+    case.write_manifest(manifest)
 
 
 def claim_next(ens_dir: Path, cases: list[str], record: dict) -> tuple[int, str] | None:
@@ -109,12 +152,16 @@ def main(argv: list[str] | None = None) -> int:
     sub = world.Split(group, world.rank)
     ranks = list(range(group * k, group * k + k))
     queue = json.loads((args.ens_dir / QUEUE_FILE).read_text())
+    runner = queue.get("runner", {})
     engine = Liggghts()
+    install_engine_signals(engine)
     engine.warm_up_vtk()
     world.Barrier()
+    me = process(os.getpid())
+    stop_claiming = False
     while True:
         job = None
-        if sub.rank == 0:
+        if sub.rank == 0 and not stop_claiming and not quit_requested(engine):
             while True:
                 claim = claim_next(args.ens_dir, queue["cases"],
                                    {"group": group, "world_ranks": ranks, "pid": os.getpid()})
@@ -126,21 +173,42 @@ def main(argv: list[str] | None = None) -> int:
                 if plan.action == SKIP:
                     atomic_write_json(args.ens_dir / CLAIMS_DIR / f"{pos}.done", {"skipped": True})
                     continue
-                manifest, attempt = begin_attempt(case, plan, k, "ensemble",
-                                                  [f"ensemble group {group}", input_for(plan)])
-                job = (pos, case_path, attempt.input)
+                job = (pos, case_path, plan)
                 break
         job = sub.bcast(job, root=0)
         if job is None:
             break
-        pos, case_path, input_name = job
+        pos, case_path, plan = job
         case = CaseFolder.open(case_path)
-        t0 = time.monotonic()
-        run_file(engine, sub, case, input_name)
-        sub.Barrier()
-        if sub.rank == 0:
-            finish_attempt(case, manifest, attempt, 0, time.monotonic() - t0)
-            atomic_write_json(args.ens_dir / CLAIMS_DIR / f"{pos}.done", {"group": group})
+        while True:
+            if sub.rank == 0:
+                manifest, attempt = begin_attempt(case, plan, k, "ensemble",
+                                                  [f"ensemble group {group}", input_for(plan)])
+                _record_runner(case, manifest, runner, me)
+            t0 = time.monotonic()
+            run_file(engine, sub, case, input_for(plan))
+            sub.Barrier()
+            again = None
+            if sub.rank == 0:
+                quit = quit_requested(engine)
+                manifest = finish_attempt(case, manifest, attempt, 0, time.monotonic() - t0,
+                                          killed=quit)
+                if (not quit and plan.restart is not None
+                        and restart_unreadable(manifest, attempt)):
+                    # a restart the engine could not read: set it aside, take the next one
+                    discard_restart(case.path, plan.restart)
+                    manifest.status = KILLED
+                    case.write_manifest(manifest)
+                    plan = plan_case(case, queue.get("retry_unstable", False))
+                    again = plan if plan.action in (FRESH, RESUME) else None
+                if again is None:
+                    atomic_write_json(args.ens_dir / CLAIMS_DIR / f"{pos}.done",
+                                      {"group": group, "quit": quit})
+                stop_claiming = quit or manifest.reason.startswith(DISK_FULL)
+            again = sub.bcast(again, root=0)
+            if again is None:
+                break
+            plan = again
     sub.Free()
     return 0
 

@@ -20,6 +20,7 @@ nobody watches:
 
 from __future__ import annotations
 
+import json
 import os
 import signal
 import subprocess
@@ -28,8 +29,13 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+#: the process name an MPI-ensemble rank gives itself (``python -m
+#: ligwf.engine.ensemble_worker`` sets it with prctl, so it can be found like ``liggghts``)
+ENSEMBLE_RANK_NAME = "ligwf-ensemble"
+#: process names of the engine's ranks (they write the forced restart on SIGTERM)
+RANK_NAMES = ("liggghts", ENSEMBLE_RANK_NAME)
 #: process names of an engine run (``orted`` only appears on multi-node launches)
-ENGINE_NAMES = ("liggghts", "mpirun", "orterun", "orted", "prterun")
+ENGINE_NAMES = RANK_NAMES + ("mpirun", "orterun", "orted", "prterun")
 #: seconds a stopped engine gets to write its forced restart before it is killed
 STOP_GRACE_SECONDS = 60.0
 
@@ -66,7 +72,9 @@ class EngineProcess:
 
 
 def start_time(pid: int) -> int | None:
-    """Start time of ``pid`` (field 22 of /proc/<pid>/stat), None when it does not exist."""
+    """Start time of ``pid`` (field 22 of /proc/<pid>/stat), None when it does not exist
+    or has ended (a zombie, state Z or X, waiting for its parent to reap it, is no
+    process that runs: never a live runner or engine)."""
     try:
         with open(f"/proc/{pid}/stat", "rb") as fh:
             stat = fh.read().decode(errors="replace")
@@ -74,6 +82,8 @@ def start_time(pid: int) -> int | None:
         return None
     # the command name (field 2) may hold spaces and parentheses: split after the last ')'
     fields = stat[stat.rfind(")") + 2:].split()
+    if fields and fields[0] in ("Z", "X"):
+        return None
     try:
         return int(fields[19])
     except (IndexError, ValueError):
@@ -119,20 +129,31 @@ def engine_tree(pid: int) -> list[EngineProcess]:
     return [p for p in found if p is not None]
 
 
-def watch(launcher: subprocess.Popen) -> subprocess.Popen:
+def watch(launcher: subprocess.Popen, case_dirs=()) -> subprocess.Popen:
     """Start the watchdog of an engine launch (see the module docstring); the runner
-    calls :func:`release` when the engine has ended."""
+    calls :func:`release` when the engine has ended. ``case_dirs``: the case folders the
+    launch works on (an ensemble folder stands for the cases it claimed); when the
+    watchdog stops the engine of a dead runner it gives their new restarts their
+    identity sidecars (:mod:`ligwf.engine.restart_id`)."""
     root = process(launcher.pid)
     return subprocess.Popen([sys.executable, "-m", "ligwf.engine.guard", str(launcher.pid),
-                             str(root.start if root else 0)],
+                             str(root.start if root else 0), *map(str, case_dirs)],
                             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
+
+
+#: what a runner writes to its watchdog before closing the pipe: "released, not dead"
+RELEASED = b"released\n"
 
 
 def release(watchdog: subprocess.Popen) -> None:
     """Tell a watchdog its engine ended under the runner's eyes (it then exits)."""
     if watchdog.stdin is not None:
-        watchdog.stdin.close()
+        try:
+            watchdog.stdin.write(RELEASED)
+            watchdog.stdin.close()
+        except (BrokenPipeError, OSError):
+            pass
     try:
         watchdog.wait(timeout=10)
     except subprocess.TimeoutExpired:
@@ -156,7 +177,7 @@ def live_engines(case_dir: Path, recorded: list[EngineProcess] = ()) -> list[Eng
             p = process(int(entry))
             if p is not None and p.name in ENGINE_NAMES and _cwd_matches(p.pid, folder):
                 found[p.pid] = p
-    return sorted(found.values(), key=lambda p: p.name != "liggghts")
+    return sorted(found.values(), key=lambda p: p.name not in RANK_NAMES)
 
 
 def _signal(procs: list[EngineProcess], sig: int) -> None:
@@ -172,7 +193,7 @@ def stop_engines(procs: list[EngineProcess], grace: float = STOP_GRACE_SECONDS) 
     """Stop engine processes of a case: SIGTERM to the ranks (LIGGGHTS writes a forced
     restart), then to the launchers, SIGKILL after ``grace`` seconds. Returns whether a
     SIGKILL was needed."""
-    ranks = [p for p in procs if p.name == "liggghts"]
+    ranks = [p for p in procs if p.name in RANK_NAMES]
     _signal(ranks or procs, signal.SIGTERM)
     deadline = time.monotonic() + grace
     while any(p.alive() for p in ranks) and time.monotonic() < deadline:
@@ -185,13 +206,45 @@ def stop_engines(procs: list[EngineProcess], grace: float = STOP_GRACE_SECONDS) 
     return bool(left)
 
 
+def stamp_lost(folders: list[str]) -> None:
+    """Identity sidecars for the restarts the dead runner's attempts wrote, in case folders
+    or the case folders an ensemble folder's claims name."""
+    from ligwf.engine.attempt import stamp_restarts
+    from ligwf.study.case import CaseFolder
+
+    cases: list[Path] = []
+    for folder in map(Path, folders):
+        claims = folder / "claims"
+        if claims.is_dir():
+            for p in claims.glob("*.json"):
+                try:
+                    cases.append(Path(json.loads(p.read_text())["case"]))
+                except (OSError, ValueError, KeyError, TypeError):
+                    pass
+        else:
+            cases.append(folder)
+    for path in cases:
+        try:
+            case = CaseFolder.open(path)
+            m = case.manifest()
+            if m is not None and m.attempts and m.attempts[-1].ended is None:
+                stamp_restarts(case, m.attempts[-1])
+        except Exception:  # noqa: BLE001 - the watchdog must never die before its engine
+            continue
+
+
 def main(argv: list[str]) -> int:
-    """The watchdog: ``python -m ligwf.engine.guard LAUNCHER_PID START``. Waits for the end
-    of stdin, then stops the launcher's engine if it still runs."""
+    """The watchdog: ``python -m ligwf.engine.guard LAUNCHER_PID START [FOLDER ...]``.
+    Waits for the end of stdin, then stops the launcher's engine if it still runs and
+    stamps the restarts it left (:func:`stamp_lost`). A runner that released it normally
+    has recorded its attempts itself."""
     root = EngineProcess(int(argv[0]), int(argv[1]), "launcher")
-    sys.stdin.buffer.read()    # returns when the runner closes the pipe or dies
+    data = sys.stdin.buffer.read()  # returns when the runner closes the pipe or dies
+    if data.endswith(RELEASED):
+        return 0
     if root.alive():
         stop_engines(engine_tree(root.pid))
+    stamp_lost(argv[2:])
     return 0
 
 

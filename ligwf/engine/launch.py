@@ -25,7 +25,9 @@ from pathlib import Path
 from typing import Callable, Protocol, Sequence
 
 from ligwf.engine.attempt import (DISK_FULL, begin_attempt, close_lost_attempt, expectation,
-                                  finish_attempt, history, merge_rows, restart_unreadable)
+                                  finish_attempt, history, merge_rows, restart_unreadable,
+                                  stamp_restarts)
+from ligwf.engine.restart_id import SETTLE_SECONDS, CaseIdentity, stamp
 from ligwf.engine.guard import (STOP_GRACE_SECONDS, EngineProcess, descendants, engine_env,
                                 engine_tree, live_engines, release, stop_engines, watch)
 from ligwf.engine.health import KILLED, RUNNING, Expectation, physics_issues
@@ -88,14 +90,24 @@ def live_problem(rows: Sequence[ThermoRow], expect: Expectation | None) -> str |
     return issues[0].message if issues else None
 
 
+def interrupted_reason(stop: threading.Event | None, steps_done: int, total_steps: int) -> str:
+    """The reason of an attempt the user (or the scheduler) stopped: the stop event may
+    carry the signal (``stop.signum``, set by the CLI's handler)."""
+    sig = getattr(stop, "signum", None)
+    name = f" ({signal.Signals(sig).name})" if sig else ""
+    return f"interrupted by the user{name} at step {steps_done} of {total_steps}"
+
+
 def launch(case_dir: Path, command: Sequence[str], case_id: str = "",
            monitor: Monitor | None = None, stop: threading.Event | None = None,
            poll_seconds: float = 0.5,
            judge: Callable[[ThermoParser], str | None] | None = None,
-           on_engine: Callable[[list[EngineProcess]], None] | None = None) -> LaunchResult:
+           on_engine: Callable[[list[EngineProcess]], None] | None = None,
+           tick: Callable[[], None] | None = None) -> LaunchResult:
     """Run ``command`` in ``case_dir``; stdout+stderr -> run.log. ``judge``: the live
     health check (a reason to stop, or None); ``on_engine``: told the engine's processes
-    once its ranks are up (the manifest records them)."""
+    once its ranks are up (the manifest records them); ``tick``: called every poll (the
+    runner stamps new restarts)."""
     case_dir = Path(case_dir)
     screen = case_dir / SCREEN_FILE
     parser, tail = ThermoParser(), LogTail(screen)
@@ -104,7 +116,7 @@ def launch(case_dir: Path, command: Sequence[str], case_id: str = "",
         proc = subprocess.Popen(list(command), cwd=case_dir, stdout=out,
                                 stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                 env=engine_env(), start_new_session=True)
-    watchdog = watch(proc)
+    watchdog = watch(proc, [case_dir])
     killed, problem, recorded = False, None, False
     stop_sent_at: float | None = None
     # a thread blocks in waitpid; this one sleeps on an event between polls. (Popen.wait
@@ -122,6 +134,8 @@ def launch(case_dir: Path, command: Sequence[str], case_id: str = "",
                 parser.feed(line)
             if monitor is not None:
                 monitor.update(case_id, parser)
+            if tick is not None:
+                tick()
             if stop_sent_at is None:
                 problem = judge(parser) if judge is not None else None
                 if problem or (stop is not None and stop.is_set()):
@@ -157,8 +171,14 @@ def take_over(case: CaseFolder) -> None:
         return  # an ensemble worker (it takes no case lock): plan_case skips the case
     orphans = live_engines(case.path, m.engine_processes() if m else [])
     if orphans:
+        asked = time.time()
         stop_engines(orphans)
-    if m is not None and m.status == RUNNING and m.attempts:
+        if m is not None and m.attempts:
+            # what the orphans wrote once told to stop is theirs (a file dropped in
+            # earlier is not stamped here; the dead runner's watchdog may stamp the rest)
+            stamp(case.path, CaseIdentity.of(case), m.attempts[-1].number, asked)
+        m = case.manifest()        # the stopped engine may have recorded its attempt
+    if m is not None and m.status == RUNNING and m.attempts and not runner_alive(m):
         close_lost_attempt(case, m)
 
 
@@ -211,10 +231,16 @@ def _run_locked(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Mo
             manifest.engine = [p.to_dict() for p in procs]
             case.write_manifest(manifest)
 
-        result = launch(case.path, cmd, case_id, monitor, stop, poll_seconds, judge, record)
+        result = launch(case.path, cmd, case_id, monitor, stop, poll_seconds, judge, record,
+                        tick=lambda: stamp_restarts(case, attempt, SETTLE_SECONDS))
         manifest = finish_attempt(case, manifest, attempt, result.exit_code,
                                   result.wall_seconds, killed=result.killed,
                                   stop_problem=result.problem)
+        if result.killed and manifest.status == KILLED:
+            manifest.reason = interrupted_reason(stop, manifest.steps_done,
+                                                 manifest.total_steps)
+            attempt.reason = manifest.reason
+            case.write_manifest(manifest)
         if restart_unreadable(manifest, attempt) and plan.restart is not None:
             # a restart cut short by SIGKILL: set it aside and try the next one (or afresh)
             discard_restart(case.path, plan.restart)

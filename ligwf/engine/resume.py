@@ -6,8 +6,11 @@ Running a study again must not redo finished work:
 * ``unstable`` with a matching hash               -> skip (the engine is deterministic:
   re-running gives the same blow-up; pass ``retry_unstable`` to force it);
 * ``failed``, no manifest, or a stale hash        -> fresh run (old outputs removed);
-* ``killed`` (or ``running`` with a dead runner)  -> continue from the newest restart file,
-  else fresh.
+* ``killed`` (or ``running`` with a dead runner)  -> continue from the newest restart file
+  that is the case's own (:mod:`ligwf.engine.restart_id`: its identity sidecar names this
+  case, replica and seeds, its content is what the engine wrote, its step is not past the
+  progress the manifest records), else fresh. Restarts that are not its own are named in
+  the plan's reason and never used.
 
 LIGGGHTS writes ``restart_forced_liggghts_<step>.data`` in the case folder (the engine's
 working directory) when a rank gets SIGTERM, and the drum input writes periodic restarts
@@ -25,6 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ligwf.engine.liggghts import FORCED_RESTART_RE, PERIODIC_RESTARTS, restart_step
+from ligwf.engine.restart_id import SIDECAR_SUFFIX, CaseIdentity, remove_sidecar, why_not_own
 from ligwf.engine.health import DONE, FAILED, RUNNING, UNSTABLE
 from ligwf.engine.render import INPUT_NAME, OUTPUT_DIRS, render_template, template_context
 from ligwf.scene.scaling import ScaledScene
@@ -73,9 +77,24 @@ def restart_files(case_dir: Path) -> list[RestartFile]:
     return sorted(found, key=lambda r: r.step, reverse=True)
 
 
+def own_restarts(case: CaseFolder, max_step: int | None) -> tuple[list[RestartFile], list[str]]:
+    """The case's own restarts, newest step first, and why each other one is refused
+    (``"<path>: <reason>"``); ``max_step``: the progress the manifest records."""
+    identity = CaseIdentity.of(case)
+    mine, refused = [], []
+    for r in restart_files(case.path):
+        why = why_not_own(case.path / r.path, identity, max_step)
+        if why is None:
+            mine.append(r)
+        else:
+            refused.append(f"{r.path}: {why}")
+    return mine, refused
+
+
 def discard_restart(case_dir: Path, restart: RestartFile) -> None:
     """Set a restart file aside (renamed ``*.corrupt``) after the engine could not read it."""
     p = Path(case_dir) / restart.path
+    remove_sidecar(p)
     if p.exists():
         p.rename(p.with_name(p.name + ".corrupt"))
 
@@ -96,11 +115,16 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> Plan:
         return Plan(FRESH, f"re-run after {status}: {m.reason}")
     if status == RUNNING:
         return Plan(SKIP, f"running in process {m.pid} on {m.host}")
-    restarts = restart_files(case.path)
+    limit = m.steps_done + case.scaled.thermo_every
+    if m.complete_upto is not None:
+        limit = min(limit, m.complete_upto)
+    restarts, refused = own_restarts(case, limit)
+    ignored = f" (ignored {'; '.join(refused)})" if refused else ""
     if restarts:
-        return Plan(RESUME, f"killed at step {m.steps_done}; resume from {restarts[0].path}",
-                    restarts[0])
-    return Plan(FRESH, f"killed at step {m.steps_done} before any restart file was written")
+        return Plan(RESUME, f"killed at step {m.steps_done}; resume from {restarts[0].path}"
+                    f"{ignored}", restarts[0])
+    return Plan(FRESH, f"killed at step {m.steps_done} before any restart file of its own was "
+                f"written{ignored}")
 
 
 def clean_outputs(case_dir: Path) -> None:
@@ -112,8 +136,8 @@ def clean_outputs(case_dir: Path) -> None:
             shutil.rmtree(d)
         d.mkdir()
     for p in case_dir.iterdir():
-        if (FORCED_RESTART_RE.match(p.name) or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT,
-                                                   "log.liggghts")
+        if (FORCED_RESTART_RE.match(p.name.removesuffix(SIDECAR_SUFFIX))
+                or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT, "log.liggghts")
                 or re.fullmatch(r"run(\.\d+)?\.log", p.name)):
             p.unlink()
 

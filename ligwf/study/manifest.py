@@ -88,6 +88,9 @@ class Manifest:
     wall_seconds: float = 0.0           # launcher wall time, sum over attempts, s
     core_seconds: float = 0.0           # wall x ranks, sum over attempts, core-s
     steps_done: int = 0
+    #: last step up to which thermo rows and dumps are whole (None: no hole found); a
+    #: resume takes no restart past it, so a hole left by a full disk is run again
+    complete_upto: int | None = None
     total_steps: int = 0
     atoms_start: int | None = None
     atoms_after_settle: int | None = None

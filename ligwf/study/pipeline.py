@@ -23,6 +23,7 @@ ranks and packs the cases onto the cores (:func:`study_schedule`); ``--np`` /
 from __future__ import annotations
 
 import os
+import signal
 import threading
 from contextlib import ExitStack
 from dataclasses import dataclass
@@ -36,11 +37,25 @@ from ligwf.engine.plan import (CaseLoad, Phase, Schedule, case_load, override_sc
                                plan_study)
 from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig
+from ligwf.errors import LigwfError
 from ligwf.scene.workflow import load_workflow
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import case_busy, case_lock
 from ligwf.study.prepare import Prepared, prepare, write_study
 from ligwf.study.study import Study
+
+class Interrupted(LigwfError):
+    """The run was stopped on request (Ctrl-C, SIGTERM): the engines wrote their forced
+    restarts and the cases are ``killed`` (the same command resumes them); nothing after
+    the run stage may run. ``exit_code`` is the shell's 128 + signal number."""
+
+    def __init__(self, signum: int | None) -> None:
+        self.signum = int(signum or signal.SIGINT)
+        self.exit_code = 128 + self.signum
+        super().__init__(f"interrupted by the user ({signal.Signals(self.signum).name}): "
+                         "forced restarts written, cases marked killed; the same command "
+                         "resumes them")
+
 
 if TYPE_CHECKING:  # the analysis and report stages load numba / matplotlib: imported on use
     from ligwf.analysis.runner import AnalysisOptions
@@ -122,8 +137,20 @@ def run_study(study: Study, cases: Sequence[CaseFolder], engine: EngineConfig,
     Several runners may work on one study: each case runs in one of them (a per-case
     lock, :func:`ligwf.study.manifest.case_lock`); a runner that has finished its share
     waits for the cases the others hold, so every runner returns once the study is done.
-    (An explicit ``--ensemble`` takes no locks, as before.)"""
+    (An explicit ``--ensemble`` takes no locks, as before.)
+
+    A stop on request (``stop`` set; the CLI's signal handler records the signal as
+    ``stop.signum``) ends the engines with forced restarts and raises
+    :class:`Interrupted`, so nothing after the run stage (analysis, report) runs."""
     stop = stop or threading.Event()
+    done = _run_cases(study, cases, engine, settings, monitor, stop)
+    if stop.is_set():
+        raise Interrupted(getattr(stop, "signum", None))
+    return done
+
+
+def _run_cases(study: Study, cases: Sequence[CaseFolder], engine: EngineConfig,
+               settings: RunSettings, monitor: Monitor | None, stop: threading.Event) -> bool:
     if settings.ensemble:
         run_ensemble(study.path, list(cases), settings.ensemble, settings.nprocs or 1, engine,
                      retry_unstable=settings.retry_unstable, stop=stop, monitor=monitor)
