@@ -172,6 +172,7 @@ def stop_on_signals() -> Iterator[threading.Event]:
     previous = {}
 
     def handler(signum, frame):  # noqa: ARG001 - signal handler signature
+        stop.signum = signum        # the pipeline's Interrupted exits 128 + signum
         stop.set()
 
     for sig in (signal.SIGTERM, signal.SIGINT):

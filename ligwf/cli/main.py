@@ -20,7 +20,7 @@ from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_workflo
 from ligwf.engine.plan import machine_cores, plan_study
 from ligwf.errors import LigwfError
 from ligwf.fsio import NOT_WRITABLE, not_writable
-from ligwf.study.pipeline import prepared_loads, write
+from ligwf.study.pipeline import Interrupted, prepared_loads, write
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
 COMMAND_MODULES = (run, slurm, analyse, analyse_dumps, stability, report)
@@ -80,6 +80,9 @@ def main(argv: list[str] | None = None) -> int:
         exc = not_writable(exc, Path.cwd()) if exc.errno in NOT_WRITABLE else exc
         err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
         return 2
+    except Interrupted as exc:         # Ctrl-C / SIGTERM: 130 / 143, as a shell would
+        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
+        return exc.exit_code
     except LigwfError as exc:
         err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
         return 2
