@@ -55,7 +55,7 @@ def _production_frames(case: CaseFolder) -> tuple[list, list, list[dict]]:
     geo = DrumGeometry.from_scaled(case.scaled)
     production = case.production_start_step
     plan = plan_frames(case)
-    frames = []
+    frames, flows = [], []
     problems = [p for p in plan.problems if p["step"] >= production]
     for ff in plan.frames:
         if ff.step < production:
@@ -64,10 +64,20 @@ def _production_frames(case: CaseFolder) -> tuple[list, list, list[dict]]:
             plan.check_record(ff)
             frame = read_particles(ff.particles, ff.step, case.scaled.dt)
             check_particles(case, frame)
-            frames.append(frame)
         except DumpReadError as exc:
             problems.append({"step": ff.step, "reason": str(exc)})
-    return frames, [frame_flow(f, geo) for f in frames], problems
+            continue
+        try:
+            flow = frame_flow(frame, geo)
+        except (MemoryError, KeyboardInterrupt):
+            raise
+        except Exception as exc:   # a frame that passed its checks and still breaks a metric
+            problems.append({"step": ff.step, "reason": f"{ff.particles}: flow metrics failed "
+                             f"on this frame ({type(exc).__name__}: {exc})"})
+            continue
+        frames.append(frame)
+        flows.append(flow)
+    return frames, flows, problems
 
 
 def steady_start_step(case: CaseFolder, steady_after) -> int:

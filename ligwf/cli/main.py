@@ -21,6 +21,7 @@ from ligwf.engine.plan import machine_cores, plan_study
 from ligwf.errors import LigwfError
 from ligwf.fsio import NOT_WRITABLE, not_writable
 from ligwf.study.pipeline import Interrupted, prepared_loads, write
+from ligwf.study.case import granules_absent
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
 COMMAND_MODULES = (run, slurm, analyse, analyse_dumps, stability, report)
@@ -30,11 +31,27 @@ def cmd_check(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)
     wf = prepared.workflow
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
+    for line in analysis_plan(prepared):
+        console.print(line, highlight=False)
     cores, source = machine_cores(args.cores)
     schedule = plan_study(prepared_loads(prepared), cores)
     console.print(plan_table(schedule, f"rank plan for {cores} core(s) ({source}): what "
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     return 0
+
+
+def analysis_plan(prepared) -> list[str]:
+    """What `ligwf study` will and will not analyse, case by case, before anything runs."""
+    absent = {rc.case.case_id: why for rc in prepared.rendered
+              if (why := granules_absent(rc.scaled)) is not None}
+    lines = [f"analysis: flow metrics (angle of repose, rigid-block share, velocity profile, "
+             f"flowing layer) for all {len(prepared.rendered)} case(s)"]
+    if not absent:
+        return lines + ["analysis: granules, GSD and kinetics for every case"]
+    if len(absent) == len(prepared.rendered) and len(set(absent.values())) == 1:
+        return lines + [f"analysis: NO granules, GSD or kinetics: {next(iter(absent.values()))}"]
+    return lines + [f"analysis: no granules, GSD or kinetics for {cid}: {why}"
+                    for cid, why in absent.items()]
 
 
 def cmd_render(args: argparse.Namespace) -> int:

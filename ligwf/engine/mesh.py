@@ -188,8 +188,16 @@ def mesh_file_name(drum: Drum, sag: float) -> str:
 
 
 def cached_mesh(drum: Drum, sag: float, cache_dir: Path) -> Path:
-    """Path of the drum's STL in ``cache_dir``, generated on first use."""
+    """Path of the drum's STL in ``cache_dir``, generated on first use. A cached file is
+    checked against the mesh it must hold (generating the text is pure and quick) before
+    it is used: one truncated, edited or of another mesh version is written again, so a
+    damaged cache never reaches a case (where it would show up as lost atoms)."""
     path = Path(cache_dir) / mesh_file_name(drum, sag)
-    if not path.exists():
-        atomic_write_text(path, drum_stl(drum, sag))
+    text = drum_stl(drum, sag)
+    try:
+        same = path.read_bytes() == text.encode()
+    except (FileNotFoundError, IsADirectoryError):
+        same = False
+    if not same:
+        atomic_write_text(path, text)
     return path

@@ -135,7 +135,7 @@ def granules_absent(scaled: ScaledScene) -> str | None:
         return (f"dry scene (liquid.model: {scaled.liquid_model}): no liquid bridges hold "
                 "particles together, so there are no granules to analyse")
     if not scaled.granules:
-        return ("scene.analysis.granules: false: the run wrote no contact dumps (set it to "
+        return ("scene.analysis.granules: false: the runs write no contact dumps (set it to "
                 "true to analyse granules and their size distribution)")
     return None
 
