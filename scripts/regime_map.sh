@@ -29,3 +29,13 @@ queue_b() {
   one wet_mu0.3_gamma0.072 scene.liquid.viscosity=0.3 scene.liquid.surface_tension=0.072
 }
 queue_a & queue_b & wait
+# liquid placed as pre-formed wet granules in a dry bed (3 spheres of 3.5 mm, content 0.05:
+# ~8 % of the bed), binder-like and water-like, with the twin of the binder-like one
+placed="scene.liquid.placement=granules"
+wg="scene.liquid.wet_granules={count: 3, radius: 0.0035, liquid_content: 0.05}"
+if [ "${PLACED:-1}" = 1 ]; then
+  ( one placed_mu0.3 "$placed" "$wg" scene.liquid.viscosity=0.3
+    one placed_twin_mu0.3 "$placed" "$wg" scene.liquid.viscosity=3.0e-4 scene.liquid.surface_tension=2.4e-5
+    one placed_mu0.001 "$placed" "$wg" scene.liquid.viscosity=0.001 ) &
+  wait
+fi

@@ -1,0 +1,48 @@
+"""Where placed liquid goes: the wet spheres of ``liquid.placement: granules`` (pure).
+
+The settled bed of fill fraction f fills a circular segment of the cross-section: its
+chord lies at depth c = R cos(phi / 2) below the drum axis, phi - sin(phi) = 2 pi f. The
+wet spheres are spread across the chord (at 0.6 of its half-width, equal steps), each
+half-way between the free surface and the lifter tips below it, in the middle of the slice
+along the axis. Coordinates are the drum frame's (axial, across, vertical) of
+:func:`ligwf.engine.render.axis_frame`: the renderer maps them onto x, y, z.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ligwf.errors import ConfigError
+
+
+def segment_angle(fill: float) -> float:
+    """Central angle phi (rad) of the circular segment holding ``fill`` of the circle."""
+    lo, hi = 0.0, 2.0 * math.pi
+    for _ in range(200):                       # phi - sin(phi) is monotonic on [0, 2 pi]
+        mid = 0.5 * (lo + hi)
+        if mid - math.sin(mid) < 2.0 * math.pi * fill:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def wet_sphere_centres(radius: float, inner_radius: float, length: float, fill: float,
+                       count: int, sphere_radius: float) -> tuple[tuple[float, float, float], ...]:
+    """(axial, across, vertical) centres, m, of ``count`` wet spheres of ``sphere_radius``
+    in the settled bed of a drum of ``radius`` (``inner_radius``: at the lifter tips)."""
+    phi = segment_angle(fill)
+    depth = radius * math.cos(0.5 * phi)                 # chord below the axis, m (< 0: above)
+    half = 0.6 * radius * math.sin(0.5 * phi)
+    out = []
+    for k in range(count):
+        u = -half + 2.0 * half * (k + 0.5) / count
+        floor = -math.sqrt(max(inner_radius ** 2 - u * u, 0.0))
+        v = 0.5 * (-depth + floor)
+        if (-depth) - v < sphere_radius or v - floor < sphere_radius:
+            raise ConfigError(
+                f"scene.liquid.wet_granules.radius = {sphere_radius:g} m: a wet sphere does not "
+                f"fit in the settled bed ({(-depth - floor) / 2:.3g} m from its surface to the "
+                "lifter tips at its place); use a smaller radius or a larger fill_fraction")
+        out.append((0.5 * length, u, v))
+    return tuple(out)

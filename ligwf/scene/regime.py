@@ -1,0 +1,81 @@
+"""Dimensionless numbers of a wet drum, and whether the regime map expects granules there.
+
+For equal spheres of radius R and density rho, at the drum's wall speed v = omega D / 2
+(the scale of the collision speeds in the flowing layer):
+
+* viscous Stokes number St_v = 8 rho R v / (9 mu) (Ennis, Tardos, Pfeffer 1991): below a
+  critical value of order 1-10 colliding wet particles stick, far above it they rebound;
+* granular Bond number Bo_g = F_cap / (m g) = 3 gamma cos(theta) / (4 R^2 rho g), with the
+  touching capillary force 2 pi R* gamma cos(theta), R* = R / 2: cohesion against weight;
+* capillary number Ca = mu v / gamma: viscous against capillary forces in a bridge;
+* Froude number Fr = omega^2 (D / 2) / g (the flow regime of the drum).
+
+Under Weber scaling (gamma, mu x n) St_v and Ca are CG-invariant and Bo_g falls as 1/n;
+under Bond scaling (gamma, mu x n^2) Bo_g is invariant and St_v falls as 1/n. The numbers
+of the ORIGINAL (CG1) particles decide whether the bed granulates; ``ligwf check`` prints
+both.
+
+:data:`GRANULATING_ST_V` is the regime map's boundary on this engine's drums
+(docs/results/granule_definitions.md, "Regime map"): at St_v above it no definition found
+granules that beat the cohesionless twin.
+"""
+
+from __future__ import annotations
+
+import math
+
+GRAVITY = 9.81
+
+#: St_v above which the regime map (CG1, docs/results/granule_definitions.md) found no
+#: granules beating the cohesionless control
+GRANULATING_ST_V = 3.0
+
+
+def regime_numbers(s) -> dict[str, float]:
+    """St_v, Bo_g, Ca and Fr of a :class:`~ligwf.scene.scaling.ScaledScene` (its own,
+    scaled particles), for the number-mean radius."""
+    radius = 0.5 * sum(d * f for d, f in zip(s.diameters, s.number_fractions))
+    v = float(s.omega) * 0.5 * float(s.drum_diameter)
+    wet = s.liquid_model != "none" and s.surface_tension > 0
+    theta = math.radians(s.contact_angle_deg)
+    mu, gamma = float(s.viscosity), float(s.surface_tension)
+    stokes = 8.0 * s.density * radius * v / (9.0 * mu) if wet and mu > 0 else math.inf
+    bond = 3.0 * gamma * math.cos(theta) / (4.0 * radius ** 2 * s.density * GRAVITY) if wet else 0.0
+    capillary = mu * v / gamma if wet else 0.0
+    return {"stokes_viscous": stokes, "bond_granular": bond, "capillary": capillary,
+            "froude": float(s.froude), "liquid_content": float(s.liquid_content) if wet else 0.0}
+
+
+def granulation_warning(numbers: dict[str, float]) -> str | None:
+    """A sentence when the regime map expects no granules at these CG1 numbers, else None."""
+    st = numbers["stokes_viscous"]
+    if numbers["bond_granular"] <= 0:
+        return "the bed is dry: there are no liquid bridges, hence no granules to analyse"
+    if st > GRANULATING_ST_V:
+        return (f"St_v = {st:.3g} > {GRANULATING_ST_V:g}: colliding wet particles rebound at "
+                "this viscosity; the regime map (docs/results/granule_definitions.md) found no "
+                "granules that beat a cohesionless control there, so a granule analysis will "
+                "measure the definition, not granulation (raise liquid.viscosity)")
+    return None
+
+
+def original_numbers(case) -> dict[str, float]:
+    """:func:`regime_numbers` of a workflow case's ORIGINAL (CG1) particles."""
+    from dataclasses import replace
+
+    from ligwf.scene.scaling import Rule
+
+    return regime_numbers(replace(case, cg=1.0, rule=Rule.NONE).scaled())
+
+
+def regime_warnings(rendered) -> list[str]:
+    """One warning per distinct CG1 regime of the cases that ask for granule analysis
+    (contact dumps on; control twins left out: they are meant to have no granules)."""
+    out: list[str] = []
+    for rc in rendered:
+        if not rc.scaled.granules or any(k == "control" for k, _ in rc.case.varied):
+            continue
+        msg = granulation_warning(original_numbers(rc.case))
+        if msg and all(not w.endswith(msg) for w in out):
+            out.append(f"{rc.case.case_id}: granule analysis asked for, but {msg}")
+    return out

@@ -1,0 +1,74 @@
+"""Dimensionless numbers, the granulation warning of `ligwf check`, and control twins."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from ligwf.cli.main import main
+from ligwf.errors import ConfigError
+from ligwf.scene.regime import GRANULATING_ST_V, original_numbers, regime_numbers
+from ligwf.scene.workflow import load_workflow
+
+from helpers import ROOT
+
+DEMO = ROOT / "workflows" / "demo.yaml"
+
+
+def _case(overrides=()):
+    return load_workflow(DEMO, list(overrides)).cases
+
+
+def test_numbers_by_hand_and_under_both_rules():
+    cases = _case(["sweep.cg_levels=[1, 2]"])
+    cg1 = next(c for c in cases if c.cg == 1)
+    n = regime_numbers(cg1.scaled())
+    r, v = 0.75e-3, 2 * math.pi * 30 / 60 * 0.02      # 1.5 mm beads, 40 mm drum at 30 rpm
+    assert n["stokes_viscous"] == pytest.approx(8 * 2500 * r * v / (9 * 1e-3), rel=1e-9)
+    assert n["bond_granular"] == pytest.approx(
+        3 * 0.024 * math.cos(math.radians(30)) / (4 * r * r * 2500 * 9.81), rel=1e-9)
+    we = regime_numbers(next(c for c in cases if c.rule.value == "weber").scaled())
+    bo = regime_numbers(next(c for c in cases if c.rule.value == "bond").scaled())
+    # Weber keeps St_v and Ca, halves Bo_g at CG2; Bond keeps Bo_g, halves St_v
+    assert we["stokes_viscous"] == pytest.approx(n["stokes_viscous"])
+    assert we["bond_granular"] == pytest.approx(n["bond_granular"] / 2)
+    assert bo["bond_granular"] == pytest.approx(n["bond_granular"])
+    assert bo["stokes_viscous"] == pytest.approx(n["stokes_viscous"] / 2)
+    assert original_numbers(next(c for c in cases if c.cg == 2)) == pytest.approx(n)
+
+
+def test_check_warns_where_the_map_expects_no_granules(capsys):
+    """Water-like viscosity (St_v ~ 105): warned; a binder-like one (St_v < the map's
+    boundary): not; a case without contact dumps: not (no granule analysis asked for)."""
+    assert main(["check", str(DEMO)]) == 0
+    err = capsys.readouterr().err
+    assert "granule analysis asked for, but St_v = 105" in err
+    mu = 2 * 0.105 / GRANULATING_ST_V            # St_v half the boundary
+    assert main(["check", str(DEMO), "--set", f"scene.liquid.viscosity={mu}"]) == 0
+    assert "granule analysis asked for" not in capsys.readouterr().err
+    assert main(["check", str(DEMO), "--set", "scene.analysis.granules=false"]) == 0
+    assert "granule analysis asked for" not in capsys.readouterr().err
+
+
+def test_cohesionless_twin_keeps_everything_but_the_bridge_forces():
+    cases = _case(["sweep.controls=[cohesionless]"])
+    wet = next(c for c in cases if c.case_id == "cg1-none-r0")
+    twin = next(c for c in cases if c.case_id == "cg1-none-r0_cohesionless")
+    assert dict(twin.varied)["control"] == "cohesionless"
+    a, b = wet.scaled(), twin.scaled()
+    assert b.surface_tension == pytest.approx(a.surface_tension / 1000)
+    assert b.viscosity == pytest.approx(a.viscosity / 1000)
+    same = ("seeds", "particle_count", "dt", "liquid_content", "granules", "run_steps")
+    assert all(getattr(a, k) == getattr(b, k) for k in same)
+    assert sum(c.cg == 1 for c in cases) == 2 and sum(c.cg == 2 for c in cases) == 4
+
+
+def test_controls_refused_on_a_dry_scene_and_at_a_missing_level():
+    with pytest.raises(ConfigError, match="dry"):
+        _case(["sweep.controls=[cohesionless]", "scene.liquid.model=none",
+               "sweep.rules=[weber]", "scene.analysis.granules=false"])
+    with pytest.raises(ConfigError, match="control_cg_levels"):
+        _case(["sweep.controls=[cohesionless]", "sweep.control_cg_levels=[3]"])
+    with pytest.raises(ConfigError, match="controls"):
+        _case(["sweep.controls=[wet]"])
