@@ -66,9 +66,12 @@ def pair_forces(particles: ParticleFrame, i: np.ndarray, j: np.ndarray, gap: np.
     if not law.wet or len(i) == 0:
         return np.zeros(len(i))
     content = content_of(particles, liquid)
-    return np.asarray(law.capillary_force(
-        particles.radii[i], particles.radii[j], gap,
-        liquid.surface_tension, liquid.contact_angle_rad, content[i], content[j]), dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        force = np.asarray(law.capillary_force(
+            particles.radii[i], particles.radii[j], gap,
+            liquid.surface_tension, liquid.contact_angle_rad, content[i], content[j]), dtype=float)
+    # two dry particles (placed liquid: a dry bed around wet granules) hold no bridge
+    return np.where((content[i] > 0) | (content[j] > 0), force, 0.0)
 
 
 def force_law_positive(particles: ParticleFrame, liquid: Liquid, content: np.ndarray) -> bool:

@@ -57,6 +57,8 @@ def _bond(a, b, gap, velocities, radii, content, volume, within_rupture, force, 
     # operation for operation, so bridge volumes agree with the numpy reference bitwise
     lva = 4.0 / 3.0 * np.pi * (ra * ra * ra) * content[a]
     lvb = 4.0 / 3.0 * np.pi * (rb * rb * rb) * content[b]
+    if not lva + lvb > 0.0:
+        return -1.0            # two dry particles: no liquid, no bridge (placed liquid)
     vol = volume(ra, rb, lva, lvb)
     if not within_rupture(gap, vol, theta):
         return -1.0

@@ -19,6 +19,8 @@ from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_workflo
                               prepare_from_args)
 from ligwf.engine.plan import machine_cores, plan_study
 from ligwf.errors import LigwfError
+from ligwf.scene.regime import granulation_warning, original_numbers, regime_numbers
+from rich.table import Table
 from ligwf.fsio import NOT_WRITABLE, not_writable
 from ligwf.study.pipeline import Interrupted, prepared_loads, write
 from ligwf.study.case import granules_absent
@@ -31,6 +33,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)
     wf = prepared.workflow
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
+    console.print(regime_table(prepared))
     for line in analysis_plan(prepared):
         console.print(line, highlight=False)
     cores, source = machine_cores(args.cores)
@@ -38,6 +41,23 @@ def cmd_check(args: argparse.Namespace) -> int:
     console.print(plan_table(schedule, f"rank plan for {cores} core(s) ({source}): what "
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     return 0
+
+
+def regime_table(prepared) -> Table:
+    """Dimensionless numbers of every case: its own particles and the CG1 originals
+    (:mod:`ligwf.scene.regime`), and whether the regime map expects granules there."""
+    table = Table(title="regime (St_v viscous Stokes, Bo_g granular Bond, Ca capillary, Fr "
+                  "Froude; CG1: the original particles)")
+    for col in ("case", "St_v", "Bo_g", "Ca", "Fr", "St_v CG1", "Bo_g CG1", "granules expected"):
+        table.add_column(col, justify="left" if col == "case" else "right")
+    for rc in prepared.rendered:
+        own, cg1 = regime_numbers(rc.scaled), original_numbers(rc.case)
+        control = any(k == "control" for k, _ in rc.case.varied)
+        verdict = ("control" if control else "no" if granulation_warning(cg1) else "yes")
+        table.add_row(rc.case.case_id, *(f"{own[k]:.3g}" for k in
+                                         ("stokes_viscous", "bond_granular", "capillary", "froude")),
+                      f"{cg1['stokes_viscous']:.3g}", f"{cg1['bond_granular']:.3g}", verdict)
+    return table
 
 
 def analysis_plan(prepared) -> list[str]:

@@ -151,7 +151,15 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
             s, input_angle(s.contact_angle_deg, s.contact_angle_compensation)),
         "liquid_dump_columns": s.liquid.dump_columns,
         "mesh_name": MESH_NAME,
+        "wet_spheres": [_xyz(ia, iu, iv, w) for w in s.wet_spheres],
     }
+
+
+def _xyz(ia: int, iu: int, iv: int, sphere) -> dict:
+    """A wet sphere (axial, across, vertical, radius) as box coordinates x, y, z, r."""
+    xyz = [0.0, 0.0, 0.0]
+    xyz[ia], xyz[iu], xyz[iv] = sphere[0], sphere[1], sphere[2]
+    return {"x": xyz[0], "y": xyz[1], "z": xyz[2], "r": sphere[3]}
 
 
 #: thinnest slab of the domain along the drum axis one rank gets, in largest diameters

@@ -10,7 +10,10 @@ the value and the allowed range before any file is written or any engine launche
 
 from __future__ import annotations
 
+import enum
 import math
+import re
+import types
 import typing
 from typing import Annotated, Any, Literal
 
@@ -19,7 +22,7 @@ from pydantic import (AfterValidator, BaseModel, ConfigDict, Field, ValidationEr
 
 from ligwf import liquids
 from ligwf.errors import ConfigError
-from ligwf.scene.messages import format_validation_error
+from ligwf.scene.messages import ItemProblem, format_validation_error
 
 #: Characters that must never reach a LIGGGHTS input: a newline ends the command and starts
 #: a new one, '&' continues a line, '$' expands variables, '#' starts a comment and quotes
@@ -46,33 +49,138 @@ def check_input_safe(value: str) -> str:
 
 SafeStr = Annotated[str, AfterValidator(check_input_safe)]
 
+# Physical floors (SI): below them a value is a typo or a unit slip, and the derived times
+# (Rayleigh time, steps) underflow or divide by zero.
+#: m: smallest particle diameter, drum length or lifter height (1 um)
+MIN_LENGTH = 1e-6
+#: s: shortest run, dump, thermo or restart interval (1 us)
+MIN_TIME = 1e-6
+#: smallest restitution coefficient (LIGGGHTS damps with ln e)
+MIN_RESTITUTION = 1e-3
+#: largest liquid content (liquid volume / solid volume) and why: see PENDULAR_REASON
+MAX_LIQUID_CONTENT = 0.2
+PENDULAR_REASON = ("the bridge laws describe separate pendular bridges; at 0.2 of the solid "
+                   "volume a bed at packing 0.6 has its pores 30 % full, the end of the "
+                   "pendular regime (funicular beyond)")
 
-def _admits_bool(annotation: Any) -> bool:
-    if annotation is bool:
-        return True
-    return any(_admits_bool(a) for a in typing.get_args(annotation))
+
+def _members(annotation: Any) -> tuple[Any, ...]:
+    """The alternatives of a union (``float | None``), unwrapping ``Annotated``."""
+    if typing.get_origin(annotation) is Annotated:
+        return _members(typing.get_args(annotation)[0])
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        return tuple(m for a in typing.get_args(annotation) for m in _members(a))
+    return (annotation,)
+
+
+def _admits(annotation: Any, kinds: tuple[type, ...]) -> bool:
+    """Whether a scalar of one of ``kinds`` may stand where ``annotation`` is."""
+    for member in _members(annotation):
+        if typing.get_origin(member) is Literal:
+            if any(isinstance(a, kinds) for a in typing.get_args(member)):
+                return True
+        elif isinstance(member, type) and (
+                (issubclass(member, kinds) and (member is not bool or bool in kinds))
+                or (str in kinds and issubclass(member, enum.Enum))):
+            return True
+        elif member is Any:
+            return True
+    return False
+
+
+_BASE60 = re.compile(r"[-+]?[0-9][0-9_]*(?::[0-5]?[0-9])+(?:\.[0-9_]*)?")
+_LEADING_ZERO = re.compile(r"[-+]?0[0-9_]+")
+_NOT_DECIMAL = re.compile(r"[-+]?0[xXoObB][0-9a-fA-F_]+")
+_YAML11_WORDS = {"yes", "no", "on", "off", "y", "n"}
+
+
+def _text_for_number(text: str) -> str:
+    """Why ``text`` (a string where a number belongs) is refused, and what to write."""
+    why = "a number is expected, not text"
+    word = text.strip()
+    if _BASE60.fullmatch(word):
+        sign, digits = (-1, word[1:]) if word[0] == "-" else (1, word.lstrip("+"))
+        total = 0.0
+        for part in digits.replace("_", "").split(":"):
+            total = 60 * total + float(part)
+        return (f"{why}: YAML 1.1 would read {word} as the base-60 number {sign * total:g}; "
+                "write the number you mean")
+    if word.lower() in _YAML11_WORDS:
+        return f"{why}: {word!r} is a YAML 1.1 yes/no word, not a number"
+    if _LEADING_ZERO.fullmatch(word):
+        return f"{why}: YAML 1.1 would read the leading zero as octal; write it without the 0"
+    if _NOT_DECIMAL.fullmatch(word):
+        return f"{why}: write the number in decimal"
+    try:
+        float(word)
+    except ValueError:
+        return why
+    return f"{why}: write {word} without quotes"
+
+
+def _scalar_problem(value: Any, annotation: Any,
+                    where: tuple[Any, ...] = ()) -> ItemProblem | None:
+    """Why ``value`` may not stand where ``annotation`` is, looking into lists and mappings
+    (``cg_levels: [true]`` names ``cg_levels[0]``), or None. Pydantic's lax mode would read
+    ``true`` as 1 and ``"2500"`` as 2500; a workflow says what it means."""
+    numbers = (int, float)
+    if isinstance(value, bool):
+        if _admits(annotation, (bool,)) or not _admits(annotation, numbers):
+            return None
+        return ItemProblem(where, value, f"{str(value).lower()} is a yes/no value; a number "
+                           "is expected")
+    if isinstance(value, str):
+        if _admits(annotation, (str,)) or not _admits(annotation, numbers):
+            return None
+        return ItemProblem(where, value, _text_for_number(value))
+    if isinstance(value, (list, tuple)):
+        for member in _members(annotation):
+            args = typing.get_args(member)
+            if typing.get_origin(member) in (tuple, list) and args:
+                items = (args[0],) * len(value) if len(args) == 1 or args[1:] == (...,) else args
+                for k, (item, ann) in enumerate(zip(value, items)):
+                    problem = _scalar_problem(item, ann, (*where, k))
+                    if problem:
+                        return problem
+    if isinstance(value, dict):
+        for member in _members(annotation):
+            args = typing.get_args(member)
+            if typing.get_origin(member) is dict and len(args) == 2:
+                for key, item in value.items():
+                    problem = (_scalar_problem(key, args[0], (*where, key))
+                               or _scalar_problem(item, args[1], (*where, key)))
+                    if problem:
+                        return problem
+    return None
 
 
 class _Frozen(BaseModel):
     """Base of all parameter objects: immutable, unknown keys are errors (typos), numbers
-    are finite and never a YAML ``true``/``false`` (pydantic would read true as 1.0)."""
+    are finite, never a YAML ``true``/``false`` (pydantic would read true as 1.0) and never
+    text (pydantic would read "2500" as 2500)."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True,
                               allow_inf_nan=False)
 
     @field_validator("*", mode="before")
     @classmethod
-    def _no_bool_for_non_bool(cls, value: Any, info: ValidationInfo) -> Any:
-        if isinstance(value, bool) and info.field_name in cls.model_fields and \
-                not _admits_bool(cls.model_fields[info.field_name].annotation):
-            raise ValueError(f"{str(value).lower()} is a yes/no value; a "
-                             f"{_kind(cls.model_fields[info.field_name].annotation)} is expected")
+    def _numbers_are_numbers(cls, value: Any, info: ValidationInfo) -> Any:
+        field = cls.model_fields.get(info.field_name) if info.field_name else None
+        problem = _scalar_problem(value, field.annotation) if field is not None else None
+        if problem:
+            raise problem
         return value
 
 
-def _kind(annotation: Any) -> str:
-    names = {a.__name__ for a in (annotation, *typing.get_args(annotation)) if isinstance(a, type)}
-    return "number" if names & {"float", "int"} else "value"
+def zero_or_at_least(floor: float, most: float, unit: str):
+    """AfterValidator: 0 (the effect switched off) or a value in [floor, most]; a positive
+    value below ``floor`` is physically zero and numerically a trap (1e-300 N/m)."""
+    def check(value: float) -> float:
+        if 0.0 < value < floor:
+            raise ValueError(f"below the physical floor (allowed: 0 to switch it off, or "
+                             f"the range [{floor:g}, {most:g}] {unit})")
+        return value
+    return AfterValidator(check)
 
 
 # ---------------------------------------------------------------------------------------
@@ -83,8 +191,9 @@ class Lifters(_Frozen):
     """Rectangular lifter bars cut radially into the drum shell, evenly spaced."""
 
     count: int = Field(0, ge=0, le=360, description="number of lifters")
-    height: float = Field(0.0, ge=0.0, description="radial height, m")
-    width_deg: float = Field(3.0, gt=0.0, lt=180.0, description="angular width, degrees")
+    height: float = Field(0.0, ge=0.0, description="radial height, m (> 0 with lifters; "
+                          "at least MIN_LENGTH)")
+    width_deg: float = Field(3.0, ge=0.1, lt=180.0, description="angular width, degrees")
 
     @model_validator(mode="after")
     def _fit_around(self) -> "Lifters":
@@ -97,15 +206,16 @@ class Lifters(_Frozen):
 class Drum(_Frozen):
     """The rotating drum: a cylinder shell (with lifters), axis through the origin."""
 
-    diameter: float = Field(gt=0.0, le=10.0, description="inner shell diameter, m")
-    length: float = Field(gt=0.0, le=10.0, description="axial length, m (the periodic length)")
+    diameter: float = Field(ge=1e-3, le=10.0, description="inner shell diameter, m")
+    length: float = Field(ge=MIN_LENGTH, le=10.0,
+                          description="axial length, m (the periodic length)")
     axis: Literal["x", "y", "z"] = Field("y", description="rotation axis")
     periodic: bool = Field(True, description="periodic boundary along the axis; "
                            "otherwise the drum has end walls")
     lifters: Lifters = Field(default_factory=Lifters)
     wall_friction: float | None = Field(None, ge=0.0, le=10.0,
                                         description="particle-wall friction (default: particles')")
-    wall_restitution: float | None = Field(None, gt=0.0, le=1.0,
+    wall_restitution: float | None = Field(None, ge=MIN_RESTITUTION, le=1.0,
                                            description="particle-wall restitution "
                                            "(default: particles')")
 
@@ -116,10 +226,13 @@ class Drum(_Frozen):
     @model_validator(mode="after")
     def _lifters_fit(self) -> "Drum":
         if self.lifters.count and self.lifters.height >= self.radius:
-            raise ValueError(f"lifters.height = {self.lifters.height:g} m must be < the drum "
-                             f"radius {self.radius:g} m")
-        if self.lifters.count and self.lifters.height <= 0.0:
-            raise ValueError("lifters.height must be > 0 when lifters.count > 0")
+            raise ValueError(f"lifters.height = {self.lifters.height:g}: must be < the drum "
+                             f"radius {self.radius:g} m (allowed range [{MIN_LENGTH:g}, "
+                             f"{self.radius:g}) m)")
+        if self.lifters.count and self.lifters.height < MIN_LENGTH:
+            raise ValueError(f"lifters.height = {self.lifters.height:g}: with lifters.count "
+                             f"= {self.lifters.count} the lifters need a height (allowed range "
+                             f"[{MIN_LENGTH:g}, {self.radius:g}) m)")
         return self
 
 
@@ -135,7 +248,7 @@ class SizeClass(_Frozen):
     approximates a uniform number distribution between the two diameters.
     """
 
-    diameter: float | None = Field(None, gt=0.0, le=1.0, description="diameter, m")
+    diameter: float | None = Field(None, ge=MIN_LENGTH, le=1.0, description="diameter, m")
     diameter_range: tuple[float, float] | None = Field(None, description="[min, max] diameter, m")
     bins: int = Field(4, ge=1, le=64, description="classes a range is split into")
     fraction: float = Field(gt=0.0, le=1.0, description="number fraction")
@@ -146,8 +259,9 @@ class SizeClass(_Frozen):
             raise ValueError("give exactly one of diameter or diameter_range")
         if self.diameter_range is not None:
             lo, hi = self.diameter_range
-            if not (0.0 < lo < hi <= 1.0):
-                raise ValueError(f"diameter_range = [{lo:g}, {hi:g}]: need 0 < min < max <= 1 m")
+            if not (MIN_LENGTH <= lo < hi <= 1.0):
+                raise ValueError(f"diameter_range = [{lo:g}, {hi:g}]: need {MIN_LENGTH:g} m "
+                                 "<= min < max <= 1 m")
         return self
 
     def discrete(self) -> list[tuple[float, float]]:
@@ -162,10 +276,10 @@ class SizeClass(_Frozen):
 class Particles(_Frozen):
     """Material and size distribution of the primary (CG1) particles."""
 
-    density: float = Field(gt=0.0, le=1e5, description="kg/m^3")
-    youngs_modulus: float = Field(gt=0.0, le=1e13, description="Pa")
+    density: float = Field(ge=10.0, le=1e5, description="kg/m^3")
+    youngs_modulus: float = Field(ge=1e3, le=1e13, description="Pa")
     poisson_ratio: float = Field(0.3, gt=0.0, lt=0.5)
-    restitution: float = Field(gt=0.0, le=1.0)
+    restitution: float = Field(ge=MIN_RESTITUTION, le=1.0)
     friction: float = Field(ge=0.0, le=10.0, description="sliding friction coefficient")
     rolling_friction: float = Field(0.0, ge=0.0, le=10.0,
                                     description="rolling friction coefficient (model cdt); "
@@ -176,7 +290,8 @@ class Particles(_Frozen):
     def _fractions_sum(self) -> "Particles":
         total = sum(c.fraction for c in self.size_distribution)
         if not math.isclose(total, 1.0, abs_tol=1e-6):
-            raise ValueError(f"size_distribution fractions sum to {total:g}; they must sum to 1")
+            raise ValueError(f"size_distribution: the fractions sum to {total:g}; they must "
+                             "sum to 1")
         return self
 
     def size_classes(self) -> list[tuple[float, float]]:
@@ -197,6 +312,22 @@ def check_liquid_model(name: str) -> str:
     return name
 
 
+class WetGranules(_Frozen):
+    """Pre-formed wet granules in a dry bed (``liquid.placement: granules``): after the
+    fill, every particle is dried and those whose centres lie in one of ``count`` spheres
+    of ``radius`` get ``liquid_content``; the spheres sit in the settled bed (half-way
+    between its free surface and the shell, spread across it, in the middle of the slice).
+    The granule size is physical (m), the same at every CG level. The engine moves liquid
+    to dry partners when a bridge ruptures, so the granules also wet the bed around them
+    (accretion) -- measured in docs/results/granule_definitions.md."""
+
+    count: int = Field(3, ge=1, le=100, description="wet spheres")
+    radius: float = Field(gt=0.0, le=1.0, description="m, radius of each wet sphere")
+    liquid_content: float = Field(
+        0.05, ge=1e-5, le=MAX_LIQUID_CONTENT, description="liquid volume / solid volume "
+        "inside the spheres", json_schema_extra={"bound_reason": PENDULAR_REASON})
+
+
 class Liquid(_Frozen):
     """The binder liquid and its bridge model (a name of :mod:`ligwf.liquids`' registry).
 
@@ -206,19 +337,38 @@ class Liquid(_Frozen):
     """
 
     model: Annotated[str, AfterValidator(check_liquid_model)] = "none"
-    surface_tension: float = Field(0.072, ge=0.0, le=1e4, description="N/m")
+    surface_tension: Annotated[float, zero_or_at_least(1e-6, 1e4, "N/m")] = Field(
+        0.072, ge=0.0, le=1e4, description="N/m (0: no cohesion)")
     contact_angle_deg: float = Field(30.0, ge=0.0, le=180.0, description="degrees")
-    viscosity: float = Field(1e-3, ge=0.0, le=1e6, description="Pa s")
-    liquid_content: float = Field(0.02, gt=0.0, le=1.0,
-                                  description="liquid volume / solid volume")
-    min_separation_ratio: float = Field(1.01, gt=0.0, le=10.0,
-                                        description="minSeparationDistanceRatio")
-    max_separation_ratio: float = Field(1.1, gt=0.0, le=10.0,
+    viscosity: Annotated[float, zero_or_at_least(1e-9, 1e6, "Pa s")] = Field(
+        1e-3, ge=0.0, le=1e6, description="Pa s (0: no viscous force)")
+    liquid_content: float = Field(
+        0.02, ge=1e-5, le=MAX_LIQUID_CONTENT, description="liquid volume / solid volume",
+        json_schema_extra={"bound_reason": PENDULAR_REASON})
+    min_separation_ratio: float = Field(1.01, ge=1.0, le=10.0,
+                                        description="minSeparationDistanceRatio (distance "
+                                        "over the sum of radii: >= 1, outside contact)")
+    max_separation_ratio: float = Field(1.1, ge=1.0, le=10.0,
                                         description="maxSeparationDistanceRatio")
+    placement: Literal["uniform", "granules"] = Field(
+        "uniform", description="uniform: every particle starts with liquid_content; "
+        "granules: a dry bed with pre-formed wet granules (wet_granules)")
+    wet_granules: WetGranules | None = Field(None, description="the wet granules of "
+                                             "placement: granules")
 
     @property
     def wet(self) -> bool:
         return liquids.get(self.model).wet
+
+    @model_validator(mode="after")
+    def _placement(self) -> "Liquid":
+        if self.placement == "granules" and self.wet_granules is None:
+            raise ValueError("placement granules needs wet_granules: {count, radius, "
+                             "liquid_content}")
+        if self.placement == "uniform" and self.wet_granules is not None:
+            raise ValueError("wet_granules is set but placement is uniform (set placement: "
+                             "granules, or drop wet_granules)")
+        return self
 
     @model_validator(mode="after")
     def _model_limits(self) -> "Liquid":
@@ -238,8 +388,8 @@ GRAVITY = 9.81  # m/s^2, the value written to the LIGGGHTS input
 class Rotation(_Frozen):
     """Drum speed, as rpm or as Froude number Fr = omega^2 R / g (give exactly one)."""
 
-    rpm: float | None = Field(None, gt=0.0, le=1e4)
-    froude: float | None = Field(None, gt=0.0, le=100.0)
+    rpm: float | None = Field(None, ge=0.01, le=1e4)
+    froude: float | None = Field(None, ge=1e-6, le=100.0)
 
     @model_validator(mode="after")
     def _one_of(self) -> "Rotation":
@@ -258,32 +408,34 @@ class Process(_Frozen):
     """How the drum is filled and turned."""
 
     rotation: Rotation
-    fill_fraction: float = Field(gt=0.0, le=0.7,
+    fill_fraction: float = Field(ge=0.01, le=0.7,
                                  description="bed volume (solids + voids) / drum volume")
     particle_count: int | None = Field(None, gt=0, le=10**9,
                                        description="CG1 particle count; overrides the count "
                                        "derived from fill_fraction")
     settle_time: float = Field(0.5, ge=0.0, le=1e3, description="s, drum at rest")
-    run_time: float = Field(gt=0.0, le=1e4, description="s, drum rotating")
+    run_time: float = Field(ge=MIN_TIME, le=1e4, description="s, drum rotating")
 
 
 class Numerics(_Frozen):
     """Integration and output settings."""
 
-    dt_rayleigh_fraction: float = Field(0.15, gt=0.0, le=2.0,
+    dt_rayleigh_fraction: float = Field(0.15, ge=1e-3, le=2.0,
                                         description="time step / Rayleigh time of the "
                                         "smallest (scaled) particle")
-    dt: float | None = Field(None, gt=0.0, le=1.0,
+    dt: float | None = Field(None, ge=1e-10, le=1.0,
                              description="fixed time step, s; unset (default): "
                              "dt_rayleigh_fraction x Rayleigh time at every CG level")
-    dump_interval: float = Field(0.05, gt=0.0, le=1e3, description="s between dumps")
-    thermo_interval: float = Field(0.005, gt=0.0, le=1e3, description="s between thermo lines")
-    restart_interval: float = Field(0.25, gt=0.0, le=1e4,
+    dump_interval: float = Field(0.05, ge=MIN_TIME, le=1e3, description="s between dumps "
+                                 "(at most the run time)")
+    thermo_interval: float = Field(0.005, ge=MIN_TIME, le=1e3, description="s between thermo "
+                                   "lines (at most the run time and the fill's fall time)")
+    restart_interval: float = Field(0.25, ge=MIN_TIME, le=1e4,
                                     description="s between periodic restart files")
-    packing_fraction: float = Field(0.6, gt=0.0, le=0.74,
+    packing_fraction: float = Field(0.6, ge=0.1, le=0.74,
                                     description="solid fraction of the settled bed")
     skin_ratio: float | None = Field(
-        None, gt=0.0, le=5.0,
+        None, ge=0.01, le=5.0,
         description="neighbour skin / smallest diameter of the settle and production "
         "phases (the fill phase takes at least its free-fall skin); unset (default): from "
         "the drum speed and the time step (ligwf.scene.neighbour)")
@@ -321,8 +473,8 @@ class Scene(_Frozen):
     def _granules_need_liquid(self) -> "Scene":
         if self.analysis.granules and not self.liquid.wet:
             wet = " or ".join(n for n in liquids.names() if liquids.get(n).wet)
-            raise ValueError("analysis.granules needs a liquid model (granules are held by "
-                             f"liquid bridges); set liquid.model to {wet}")
+            raise ValueError("analysis.granules = true: needs a liquid model (granules are "
+                             f"held by liquid bridges); set liquid.model to {wet}")
         return self
 
     @model_validator(mode="after")
@@ -336,6 +488,30 @@ class Scene(_Frozen):
                 raise ValueError(f"numerics.{name} = {interval:g}: {run:g} s of production "
                                  f"would write {run / interval:.3g} outputs; allowed at most "
                                  f"{most:,} (numerics.{name} >= {run / most:.3g} s)")
+        return self
+
+    @model_validator(mode="after")
+    def _intervals_fit_the_run(self) -> "Scene":
+        """A dump interval longer than the production run leaves it without a frame to
+        analyse; the fill's insertion waves last whole thermo intervals, so a thermo
+        interval longer than the free fall across the drum stretches the fill (30x at 3 s)."""
+        run, num = self.process.run_time, self.numerics
+        if num.dump_interval > run:
+            raise ValueError(f"numerics.dump_interval = {num.dump_interval:g}: longer than "
+                             f"process.run_time = {run:g} s, production would write no frame "
+                             f"(allowed range [{MIN_TIME:g}, {run:g}] s)")
+        fall = math.sqrt(2.0 * self.drum.diameter / GRAVITY)
+        most = min(run, fall)
+        if num.thermo_interval > most:
+            why = []
+            if num.thermo_interval > run:
+                why.append(f"longer than process.run_time = {run:g} s (no thermo line in "
+                           "production)")
+            if num.thermo_interval > fall:
+                why.append(f"longer than the fall across the drum ({fall:.3g} s): every "
+                           "insertion wave of the fill would last a thermo interval")
+            raise ValueError(f"numerics.thermo_interval = {num.thermo_interval:g}: "
+                             f"{'; '.join(why)} (allowed range [{MIN_TIME:g}, {most:.3g}] s)")
         return self
 
 

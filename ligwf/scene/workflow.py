@@ -26,7 +26,7 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import Field, TypeAdapter, ValidationError
 
@@ -53,6 +53,12 @@ class Sweep(_Frozen):
     per_cg: dict[float, dict[str, Any]] = Field(
         default_factory=dict, description="scene fields set for one CG level only, e.g. "
         "{2: {process.run_time: 6.0}} (more revolutions where they are cheap)")
+    controls: tuple[Literal["cohesionless"], ...] = Field(
+        (), description="null controls run beside the cases: cohesionless = a twin of each "
+        "case at control_cg_levels with surface tension and viscosity / 1000 (same seeds), "
+        "a bed that should hold no granules")
+    control_cg_levels: tuple[float, ...] = Field(
+        (1.0,), min_length=1, description="CG levels whose cases get the control twins")
 
     def replicas_for(self, cg: float) -> int:
         if isinstance(self.replicas, int):
@@ -168,8 +174,11 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
         else:
             known[key] = value
     if "rules" in known and isinstance(known["rules"], list):
-        for r in known["rules"]:
-            parse_rule(r)
+        for k, r in enumerate(known["rules"]):
+            try:
+                parse_rule(r)
+            except ConfigError as exc:
+                raise ConfigError(f"sweep.rules[{k}] {str(exc).removeprefix('rule ')}") from None
     try:
         sweep = Sweep.model_validate(known)
     except ValidationError as exc:
@@ -196,10 +205,65 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
     return sweep, varied
 
 
+#: longest case folder name (file systems allow 255 bytes; the study path comes on top)
+MAX_CASE_ID = 200
+
+
+def _check_plain(value: Any, path: str) -> None:
+    """Refuse what the JSON study record cannot hold (``!!timestamp``, ``!!binary``,
+    ``!!set`` values): it would fail after the case folders were written."""
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if not isinstance(key, (str, int, float, bool)) and key is not None:
+                raise ConfigError(f"{path}: key {short_repr(key)} is a "
+                                  f"{type(key).__name__}; a key is a name or a number")
+            _check_plain(item, f"{path}.{key}" if path else str(key))
+    elif isinstance(value, (list, tuple)):
+        for k, item in enumerate(value):
+            _check_plain(item, f"{path}[{k}]")
+    elif not isinstance(value, (str, int, float, bool)) and value is not None:
+        raise ConfigError(f"{path} = {short_repr(value)}: a {type(value).__name__} is not a "
+                          "workflow value (text, numbers, true/false, lists and mappings "
+                          "are); quote it to keep it as text")
+
+
+def _unique_case_ids(cases: list[Case]) -> None:
+    """Two cases in one folder would overwrite each other: sweep values that differ only
+    in what the folder name drops ('a b' and 'a-b', 0.0 and -0.0) are refused, naming both."""
+    first: dict[str, Case] = {}
+    for case in cases:
+        if len(case.case_id) > MAX_CASE_ID:
+            raise ConfigError(f"case folder {case.case_id[:60]}...: {len(case.case_id)} "
+                              f"characters, allowed at most {MAX_CASE_ID}; shorten the swept "
+                              "values")
+        other = first.setdefault(case.case_id, case)
+        if other is case:
+            continue
+        diff = [(p, a, b) for (p, a), (_, b) in zip(other.varied, case.varied)
+                if repr(a) != repr(b)]
+        what = "; ".join(f"sweep.scene.{p}: {a!r} and {b!r}" for p, a, b in diff) or \
+            "two cases"
+        raise ConfigError(f"{what} give the same case folder {case.case_id} (folder names "
+                          "keep letters, digits and . + -): make the values differ there")
+
+
+def comparison_warnings(wf: Workflow) -> list[str]:
+    """Documented warnings about what the study can compare (``check`` and ``study`` print
+    them; nothing is refused)."""
+    levels = sorted({c.cg for c in wf.cases})
+    if levels and 1.0 not in levels:
+        shown = "[" + ", ".join(f"{c:g}" for c in levels) + "]"
+        return [f"sweep.cg_levels = {shown}: no CG1 case, so no CG-n "
+                "result can be compared with the original size (errors, size limit and "
+                "CG-n/CG1 ratios stay empty); add 1 to sweep.cg_levels to compare"]
+    return []
+
+
 def expand(raw: dict[str, Any]) -> Workflow:
     """Validate a raw workflow mapping and expand it into its cases (pure)."""
     if not isinstance(raw, dict):
         raise ConfigError("a workflow file must be a YAML mapping with scene: and sweep:")
+    _check_plain(raw, "")
     unknown = set(raw) - _TOP_KEYS
     if unknown:
         raise ConfigError(f"workflow: unknown key(s) {', '.join(sorted(map(str, unknown)))} "
@@ -223,6 +287,14 @@ def expand(raw: dict[str, Any]) -> Workflow:
         raise ConfigError(f"sweep.rules = {[r.value for r in sweep.rules]}: on a dry scene "
                           f"(liquid.model {first.liquid.model}) every rule gives the same case; "
                           "sweep one rule")
+
+    if sweep.controls and not first.liquid.wet:
+        raise ConfigError(f"sweep.controls = {list(sweep.controls)}: the scene is dry (liquid.model "
+                          f"{first.liquid.model}): it is its own cohesionless control")
+    stray = sorted(set(sweep.control_cg_levels) - set(sweep.cg_levels)) if sweep.controls else []
+    if stray:
+        raise ConfigError(f"sweep.control_cg_levels: CG level {stray[0]:g} is not in "
+                          f"sweep.cg_levels {[float(c) for c in sweep.cg_levels]}")
 
     cases: list[Case] = []
     combos = itertools.product(*[vals for _, vals in varied]) if varied else [()]
@@ -249,10 +321,35 @@ def expand(raw: dict[str, Any]) -> Workflow:
                         continue
                     seen.add(key)
                     case_id = f"cg{_fmt_cg(cg)}-{rule.value}-r{rep}{tag}"
-                    cases.append(Case(len(cases), case_id, scene, float(cg), rule, rep,
-                                      tuple((p, v) for (p, _), v in zip(varied, combo))))
+                    values = tuple((p, v) for (p, _), v in zip(varied, combo))
+                    cases.append(Case(len(cases), case_id, scene, float(cg), rule, rep, values))
+                    if cg in sweep.control_cg_levels:
+                        for control in sweep.controls:
+                            cases.append(Case(len(cases), f"{case_id}_{control}",
+                                              control_scene(scene, control), float(cg), rule,
+                                              rep, values + ((CONTROL_KEY, control),)))
+    _unique_case_ids(cases)
     return Workflow(name=name, description=str(raw.get("description", "")), raw=raw,
                     cases=tuple(cases), analysis=analysis)
+
+
+#: the ``varied`` entry that marks a control twin (its own comparison group)
+CONTROL_KEY = "control"
+#: factor on surface tension and viscosity of a cohesionless twin
+COHESIONLESS_FACTOR = 1e-3
+
+
+def control_scene(scene: Scene, control: str) -> Scene:
+    """The scene of a control twin: ``cohesionless`` keeps everything (seeds, liquid
+    content, contact dumps) but divides surface tension and viscosity by 1000, so bridges
+    still form and are dumped, but hold nothing: the bed flows like a dry one
+    (LIGGGHTS_NOTES: 32.2 deg against 32.3 dry and 40.2 wet on the demo bed)."""
+    if control != "cohesionless":
+        raise ConfigError(f"sweep.controls: {control!r}: allowed: cohesionless")
+    liquid = scene.liquid.model_copy(update={
+        "surface_tension": scene.liquid.surface_tension * COHESIONLESS_FACTOR,
+        "viscosity": scene.liquid.viscosity * COHESIONLESS_FACTOR})
+    return scene.model_copy(update={"liquid": liquid})
 
 
 def load_workflow(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Workflow:
