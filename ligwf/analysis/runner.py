@@ -59,6 +59,7 @@ from ligwf.analysis.gsd import VOLUME_COLUMNS, GsdSettings
 from ligwf.analysis.flow_run import steady_start_step
 from ligwf.analysis.gsd_pooling import pooling_table
 from ligwf.analysis.gsd_tables import gsd_tables
+from ligwf.analysis.study_controls import control_pairs, study_controls
 from ligwf.analysis.kinetics import (KINETICS_SUMMARY_TABLE, KINETICS_TABLE, SENSITIVITY_TABLE,
                                      kinetics_summary, kinetics_table, sensitivity_table)
 from ligwf.analysis.dumps import FrameFiles
@@ -279,6 +280,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     pooled = pooling_table(steady, cases, gsd_settings(settings), POOL_SIZES)
     outputs.write(layout.GSD_POOLING_TABLE, pooled.to_csv(index=False).encode())
     stage_kinetics(outputs, granules, analysed, steady_from, settings, options.implementation)
+    stage_controls(outputs, cases, steady_from, settings)
     if options.write_vtu:
         for c in cases:
             entries = [(r.time, r.vtu) for r in results if r.case_id == c.case_id and r.vtu]
@@ -297,6 +299,19 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     }
     commit(outputs, record)
     return record
+
+
+def stage_controls(outputs: OutputSet, cases: list, steady_from: dict[str, int],
+                   settings: AnalysisSettings) -> None:
+    """``controls.csv``: every wet case beside its cohesionless twin (none without twins),
+    measured from the wet case's steady window on (:mod:`ligwf.analysis.study_controls`)."""
+    pairs = control_pairs(cases)
+    if not pairs:
+        return
+    start = {w.case_id: (steady_from[w.case_id] - w.production_start_step) * w.scaled.dt
+             for w, _ in pairs}
+    table = study_controls(cases, granule_definition(settings), start)
+    outputs.write(layout.CONTROLS_TABLE, table.to_csv(index=False).encode())
 
 
 def stage_tables(outputs: OutputSet, granules: pd.DataFrame, frames: pd.DataFrame,

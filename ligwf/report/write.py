@@ -31,6 +31,7 @@ from ligwf.report import figures as figs
 from ligwf.report.granule_figures import granule_figures
 from ligwf.report.paraview import case_collection
 from ligwf.report.problems import study_problems
+from ligwf.report.controls import controls_html, controls_markdown
 from ligwf.report.tables import build_tables
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -222,6 +223,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         f"Steady window: {steady_line(study, cases)}.", "",
         markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
         *noise_markdown(conditions, floors),
+        *(controls_markdown(study.analysis_dir) if trusted else []),
         *(pooling_markdown(study.analysis_dir) if trusted else []),
         *problems.markdown(),
         "## Figures", "",
@@ -229,7 +231,8 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         "## ParaView", "",
         *[f"- `paraview/{p.name}`" for p in pvds], ""])
     atomic_write_text(out / "summary.md", md)
-    atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, problems))
+    atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, problems,
+                                                controls_html(study.analysis_dir) if trusted else ""))
     return out
 
 
@@ -288,7 +291,7 @@ def steady_line(study: Study, cases: pd.DataFrame) -> str:
     return f"`steady_after: {setting}`: the first {100 * float(setting):.0f} % of production left out"
 
 
-def _html(name, cases, conditions, figures, problems) -> str:
+def _html(name, cases, conditions, figures, problems, controls: str = "") -> str:
     def table(df: pd.DataFrame) -> str:
         if df.empty:
             return "<p>none</p>"
@@ -302,6 +305,7 @@ td,th{{padding:2px 6px;border-bottom:1px solid #ddd}}img{{max-width:720px}}</sty
 <h1>{html.escape(name)}: error against run time</h1>
 <h2>Cases</h2>{table(cases[cols] if not cases.empty else cases)}
 <h2>Conditions (mean, 95 % CI bounds over replicas)</h2>{table(conditions)}
+{controls}
 {problems.html()}
 <h2>Figures</h2>{imgs}</body></html>
 """

@@ -49,6 +49,8 @@ GSD_TABLE = "gsd.csv"
 GSD_SUMMARY_TABLE = "gsd_summary.csv"
 GSD_POOLING_TABLE = "gsd_pooling.csv"
 FLOW_TABLE = "flow.csv"
+#: granule controls: each wet case beside its cohesionless twin, per definition
+CONTROLS_TABLE = "controls.csv"
 FLOW_PROFILES = "flow_profiles.json"
 
 

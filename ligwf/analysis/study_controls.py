@@ -1,0 +1,82 @@
+"""The granule controls of a study: every wet case beside its cohesionless twin.
+
+A workflow with ``sweep.controls: [cohesionless]`` runs, beside each case at the control
+CG levels, a twin with surface tension and viscosity / 1000 (``ligwf.scene.workflow``).
+:func:`study_controls` pairs each twin with its wet case (same sweep values, CG level,
+rule and replica), measures both with the study's granule definition and the candidate
+definitions (:mod:`ligwf.analysis.control_run`), and judges every definition by the
+pre-registered criteria (:mod:`ligwf.analysis.control_verdict`). The table it returns is
+``analysis/controls.csv``; the report prints it beside the GSD with the verdict sentence.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pandas as pd
+
+from ligwf.analysis.control_run import DEFAULT_CANDIDATES, control_rows, load_series, summarise
+from ligwf.analysis.control_verdict import verdict
+from ligwf.analysis.definitions import GranuleDefinition
+from ligwf.study.case import CaseFolder
+
+#: the ``varied`` key and value of a cohesionless twin (ligwf.scene.workflow.CONTROL_KEY)
+CONTROL_KEY, COHESIONLESS = "control", "cohesionless"
+
+
+def _varied(case: CaseFolder) -> dict:
+    return json.loads(case.group)
+
+
+def control_pairs(cases: list[CaseFolder]) -> list[tuple[CaseFolder, CaseFolder]]:
+    """(wet case, its cohesionless twin) for every twin whose wet case is among ``cases``."""
+    wet = {}
+    for c in cases:
+        v = _varied(c)
+        if CONTROL_KEY not in v:
+            wet[(json.dumps(v, sort_keys=True), c.cg, c.rule, c.replica)] = c
+    out = []
+    for c in cases:
+        v = _varied(c)
+        if v.get(CONTROL_KEY) == COHESIONLESS:
+            v.pop(CONTROL_KEY)
+            w = wet.get((json.dumps(v, sort_keys=True), c.cg, c.rule, c.replica))
+            if w is not None:
+                out.append((w, c))
+    return out
+
+
+def is_control(case: CaseFolder) -> bool:
+    """True for a control twin (it is never a CG1 reference of a comparison)."""
+    return CONTROL_KEY in _varied(case)
+
+
+def candidates_for(definition: GranuleDefinition):
+    """The study's own definition first, then the candidates of the regime map."""
+    own = ("study definition (" + definition.method + ")", "frame", definition)
+    return (own,) + tuple(c for c in DEFAULT_CANDIDATES if c[0] != definition.method)
+
+
+def study_controls(cases: list[CaseFolder], definition: GranuleDefinition,
+                   steady_from: dict[str, float] | None = None) -> pd.DataFrame:
+    """One row per (wet case, definition): the wet and twin measures side by side, whether
+    the definition passes, and the sentence a report prints. Empty without twins.
+    ``steady_from``: production time (s) of each wet case's steady start (default 0.5 s);
+    its twin is measured from the same time."""
+    rows = []
+    for wet, twin in control_pairs(cases):
+        cands = candidates_for(definition)
+        t0 = (steady_from or {}).get(wet.case_id, 0.5)
+        sw = summarise(control_rows(load_series(wet.path), cands, steady_from=t0))
+        st = summarise(control_rows(load_series(twin.path), cands, steady_from=t0))
+        for (_, w), (_, t) in zip(sw.iterrows(), st.iterrows()):
+            ok, sentence = verdict(w.to_dict(), t.to_dict(), w["definition"])
+            row = {"case_id": wet.case_id, "twin_id": twin.case_id, "definition": w["definition"],
+                   "passes": ok, "verdict": sentence}
+            for k in ("share_2", "share_10", "count_10", "d50_mm", "largest_share",
+                      "persist_short", "persist_quarter", "comove_ratio", "ari_seed",
+                      "ari_order", "percolating"):
+                row[k] = w.get(k, float("nan"))
+                row[f"twin_{k}"] = t.get(k, float("nan"))
+            rows.append(row)
+    return pd.DataFrame(rows)

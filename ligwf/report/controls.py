@@ -1,0 +1,85 @@
+"""The report's "Granule controls" section: the granules beside a bed that should have none.
+
+Reads ``analysis/controls.csv`` (:mod:`ligwf.analysis.study_controls`; it computes
+nothing). With twins, a table per wet case of every definition's measures against the
+twin's, and the verdict sentence of the study's own definition first; without twins, one
+sentence saying that the granules of this study were never checked against a control, and
+what the regime map found (docs/results/granule_definitions.md).
+"""
+
+from __future__ import annotations
+
+import html
+from pathlib import Path
+
+import pandas as pd
+
+from ligwf.study import layout
+
+#: (column, header) of the control table; each is shown as "wet / twin"
+COLUMNS = (("share_10", "bed in granules >= 10"), ("count_10", "granules >= 10"),
+           ("d50_mm", "d50 [mm]"), ("persist_quarter", "persistence T/4"),
+           ("comove_ratio", "co-movement"), ("percolating", "percolating frames"))
+
+NO_CONTROL = ("This study ran no cohesionless control (`sweep.controls: [cohesionless]`), so "
+              "its granules were never shown to differ from those of a bed without cohesion. "
+              "On the beds measured so far (docs/results/granule_definitions.md) a uniformly "
+              "wetted bed had no granules that beat that control under any definition: read "
+              "the granule sizes, GSD errors and size limits below as properties of the "
+              "definition, not as findings about granulation.")
+
+
+def read_controls(analysis_dir: Path) -> pd.DataFrame | None:
+    """The controls table, or None when the study has no twins (or no analysis)."""
+    path = Path(analysis_dir) / layout.CONTROLS_TABLE
+    if not path.is_file() or path.stat().st_size == 0:
+        return None
+    table = pd.read_csv(path)
+    return table if len(table) else None
+
+
+def _cell(r, col: str) -> str:
+    def f(v):
+        return "–" if pd.isna(v) else f"{v:.3g}"
+    return f"{f(r[col])} / {f(r['twin_' + col])}"
+
+
+def controls_markdown(analysis_dir: Path) -> list[str]:
+    """Markdown lines of the section (always present: without twins it says so)."""
+    table = read_controls(analysis_dir)
+    lines = ["## Granule controls (wet bed / cohesionless twin)", ""]
+    if table is None:
+        return lines + [NO_CONTROL, ""]
+    for case_id, rows in table.groupby("case_id", sort=False):
+        own = rows.iloc[0]
+        lines += [f"**{case_id}** against `{own['twin_id']}`: {own['verdict']}.", "",
+                  "| definition | passes | " + " | ".join(h for _, h in COLUMNS) + " |",
+                  "|---|---|" + "---|" * len(COLUMNS)]
+        for _, r in rows.iterrows():
+            lines.append(f"| {r['definition']} | {'yes' if r['passes'] else 'no'} | "
+                         + " | ".join(_cell(r, c) for c, _ in COLUMNS) + " |")
+        lines.append("")
+    passing = table[table["passes"].astype(bool)]["definition"].unique()
+    lines.append("Definitions that beat the control here: "
+                 + (", ".join(f"`{d}`" for d in passing) if len(passing) else "none") + ".")
+    return lines + [""]
+
+
+def controls_html(analysis_dir: Path) -> str:
+    """The same section as HTML."""
+    table = read_controls(analysis_dir)
+    out = ["<h2>Granule controls (wet bed / cohesionless twin)</h2>"]
+    if table is None:
+        return out[0] + f"<p>{html.escape(NO_CONTROL)}</p>"
+    for case_id, rows in table.groupby("case_id", sort=False):
+        own = rows.iloc[0]
+        out.append(f"<p><b>{html.escape(str(case_id))}</b> against "
+                   f"<code>{html.escape(str(own['twin_id']))}</code>: "
+                   f"{html.escape(str(own['verdict']))}.</p>")
+        head = "".join(f"<th>{html.escape(h)}</th>" for _, h in COLUMNS)
+        body = "".join(
+            f"<tr><td>{html.escape(str(r['definition']))}</td><td>{'yes' if r['passes'] else 'no'}"
+            "</td>" + "".join(f"<td>{_cell(r, c)}</td>" for c, _ in COLUMNS) + "</tr>"
+            for _, r in rows.iterrows())
+        out.append(f"<table><tr><th>definition</th><th>passes</th>{head}</tr>{body}</table>")
+    return "\n".join(out)

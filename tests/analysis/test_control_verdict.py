@@ -1,0 +1,38 @@
+"""The pre-registered control criteria on hand-made summary rows."""
+
+from ligwf.analysis.control_verdict import criteria, verdict
+
+GOOD = {"share_10": 0.10, "persist_quarter": 0.8, "comove_ratio": 0.2, "ari_order": 1.0,
+        "percolating": 0.0}
+TWIN = {"share_10": 0.01, "persist_quarter": 0.1}
+
+
+def test_a_definition_that_beats_its_twin_passes():
+    ok, sentence = verdict(GOOD, TWIN, "held_1s")
+    assert ok and "beat the cohesionless control on every" in sentence
+
+
+def test_each_criterion_fails_on_its_own():
+    cases = {
+        "granules exist": {**GOOD, "share_10": 0.01},
+        "beats the twin": {**GOOD, "share_10": 0.04},     # twin 0.01 > 0.2 x 0.04
+        "survives": {**GOOD, "persist_quarter": 0.45},
+        "moves together": {**GOOD, "comove_ratio": 0.8},
+        "reproducible": {**GOOD, "ari_seed": 0.5},
+        "no bed-spanning granule": {**GOOD, "percolating": 0.5},
+    }
+    for name, wet in cases.items():
+        failed = [c.name for c in criteria(wet, TWIN) if not c.passed]
+        assert name in failed, (name, failed)
+        ok, sentence = verdict(wet, TWIN, "communities")
+        assert not ok and "do NOT beat" in sentence and name in sentence
+
+
+def test_persistence_against_a_twin_with_granules():
+    twin = {"share_10": 0.015, "persist_quarter": 0.45}      # 0.8 < 2 x 0.45
+    assert "survives" in [c.name for c in criteria(GOOD, twin) if not c.passed]
+
+
+def test_missing_numbers_fail_rather_than_pass():
+    ok, _ = verdict({}, {}, "x")
+    assert not ok
