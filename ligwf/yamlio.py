@@ -6,6 +6,14 @@ chain ("billion laughs") expands into gigabytes later, deep nesting overflows th
 composer, and ``1e-3`` (no dot) is a string in YAML 1.1. This loader refuses the first four
 with a one-line :class:`~ligwf.errors.ConfigError` naming the file and where, and reads
 ``1e-3`` as the number everybody means.
+
+Scalars are resolved as in YAML 1.2's core schema, not 1.1's surprises: ``yes`` / ``no`` /
+``on`` / ``off`` are words (only ``true`` / ``false`` are booleans), ``1:30`` is text (not
+the base-60 number 90), ``012`` and ``0x1f`` are text (not octal 10 / hex 31), and a date
+such as ``2024-01-01`` stays text (a date object cannot be stored in the JSON study
+record). A number field given such text refuses it with the field and the reason
+(:mod:`ligwf.scene.model`). Merge keys (``<<: *base``) work; a key repeated next to a merge
+overrides the merged value, as YAML says.
 """
 
 from __future__ import annotations
@@ -31,12 +39,24 @@ _FLOAT = re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
                     |\.(?:nan|NaN|NAN))$""", re.X)
 
 
+#: YAML 1.2 core integers in decimal; 012 (1.1: octal), 0x1f, 1:30 (1.1: base 60) stay text
+_INT = re.compile(r"^[-+]?(?:0|[1-9][0-9_]*)$")
+_BOOL = re.compile(r"^(?:true|True|TRUE|false|False|FALSE)$")
+#: resolvers replaced (int, float, bool) or dropped (timestamp: a date is text; value: a
+#: lone '=' is text)
+_REPLACED = {"tag:yaml.org,2002:float", "tag:yaml.org,2002:int", "tag:yaml.org,2002:bool",
+             "tag:yaml.org,2002:timestamp", "tag:yaml.org,2002:value"}
+
+
 class _StrictLoader(yaml.SafeLoader):
-    """SafeLoader that refuses duplicate keys and reads 1e-3 as a float."""
+    """SafeLoader with YAML 1.2 scalars that refuses duplicate keys and reads 1e-3 as a
+    float."""
 
     def construct_mapping(self, node, deep=False):
         seen: dict[Any, Any] = {}
         for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue    # '<<: *base': merged keys may be overridden (flatten_mapping)
             key = self.construct_object(key_node, deep=deep)
             try:
                 hash(key)
@@ -53,8 +73,10 @@ class _StrictLoader(yaml.SafeLoader):
 
 
 _StrictLoader.yaml_implicit_resolvers = {
-    k: [(tag, rx) for tag, rx in v if tag != "tag:yaml.org,2002:float"]
+    k: [(tag, rx) for tag, rx in v if tag not in _REPLACED]
     for k, v in yaml.SafeLoader.yaml_implicit_resolvers.items()}
+_StrictLoader.add_implicit_resolver("tag:yaml.org,2002:bool", _BOOL, list("tTfF"))
+_StrictLoader.add_implicit_resolver("tag:yaml.org,2002:int", _INT, list("-+0123456789"))
 _StrictLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT,
                                     list("-+0123456789."))
 

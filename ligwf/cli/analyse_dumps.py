@@ -50,19 +50,20 @@ def register(subparsers) -> None:
 
 
 def cmd_analyse_dumps(args: argparse.Namespace) -> int:
-    import yaml
-
     from ligwf.analysis.foreign import ForeignRun, analyse_dumps
     from ligwf.errors import ConfigError
     from ligwf.study.settings import build_analysis_settings
+    from ligwf.yamlio import parse_yaml
 
     values = {}
     for item in args.settings:
         key, sep, value = item.partition("=")
         if not sep:
             raise ConfigError(f"--set {item!r}: use KEY=VALUE")
-        values[key.strip()] = yaml.safe_load(value)
-    settings = build_analysis_settings(values, "--set")
+        if not key.strip():
+            raise ConfigError(f"--set {item!r}: empty key")
+        values[key.strip()] = parse_yaml(value, f"--set {key.strip()}: value {value!r}")
+    settings = build_analysis_settings(values, "analysis")
     run = ForeignRun(args.liquid, args.surface_tension, args.contact_angle,
                      args.angle_convention, args.periodic_axis, args.box_length, args.dt,
                      args.liquid_content, args.cg)

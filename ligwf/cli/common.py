@@ -17,7 +17,7 @@ from rich.console import Console, Group
 from rich.table import Table
 from rich.text import Text
 
-from ligwf.engine.plan import CasePlan, Schedule, particle_steps
+from ligwf.engine.plan import MAX_RANKS, CasePlan, Schedule, particle_steps
 from ligwf.study.pipeline import prepare_workflow
 from ligwf.study.prepare import Prepared
 
@@ -45,6 +45,16 @@ def positive_int(text: str, unit: str = "") -> int:
         what = f"a whole number of {unit}" if unit else "a whole number"
         raise argparse.ArgumentTypeError(f"must be {what}, allowed range [1, inf), "
                                          f"got {text!r}")
+    return value
+
+
+def rank_count(text: str) -> int:
+    """argparse type: a number of MPI ranks or cores, a whole number in [1, MAX_RANKS]
+    (``--np 1000000000000`` would otherwise be accepted and spin in the rank layout)."""
+    value = positive_int(text)
+    if value > MAX_RANKS:
+        raise argparse.ArgumentTypeError(f"must be a whole number, allowed range "
+                                         f"[1, {MAX_RANKS}], got {text!r}")
     return value
 
 
@@ -119,7 +129,7 @@ def case_table(prepared: Prepared, title: str) -> Table:
 
 
 def add_cores_arg(p: argparse.ArgumentParser, help_text: str | None = None) -> None:
-    p.add_argument("--cores", type=positive_int, default=None, metavar="N",
+    p.add_argument("--cores", type=rank_count, default=None, metavar="N",
                    help=help_text or "cores the rank plan fills (default: the tasks of the "
                    "Slurm allocation this runs in, else the CPUs this process may use)")
 

@@ -20,7 +20,7 @@ import os
 from pathlib import Path
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, console,
-                              folder_to_write, plan_table, positive_int, prepare_from_args,
+                              folder_to_write, plan_table, prepare_from_args, rank_count,
                               stop_on_signals)
 from ligwf.engine.plan import machine_cores
 from ligwf.engine.progress import RichMonitor, summary_table
@@ -44,13 +44,14 @@ def prepare_and_run(args: argparse.Namespace) -> tuple[Study, bool]:
     prepared = prepare_from_args(args)
     cores, source = machine_cores(args.cores)
     settings = run_settings(args, cores)
+    engine = EngineConfig.from_site()   # a bad site setting is refused before writing
     study = write(prepared, args.out, args.mesh_cache)
     schedule = study_schedule(cases_to_run(study.cases, settings.retry_unstable), settings)
     title = (f"rank plan for {cores} core(s) ({source})" if settings.planned
              else "ranks as asked (--np / --ensemble)")
     console.print(plan_table(schedule, title))
     with stop_on_signals() as stop, RichMonitor(console) as monitor:
-        done = run_study(study, study.cases, EngineConfig.from_site(), settings, monitor, stop)
+        done = run_study(study, study.cases, engine, settings, monitor, stop)
     console.print(summary_table(study.cases, f"{study.name}: {args.out}"))
     return study, done
 
@@ -79,10 +80,10 @@ def cmd_status(args: argparse.Namespace) -> int:
 def add_run_args(p: argparse.ArgumentParser) -> None:
     """The options of the run stage (``run`` and ``study``)."""
     p.add_argument("--out", type=folder_to_write, required=True, help="study folder")
-    p.add_argument("--np", type=positive_int, default=None,
+    p.add_argument("--np", type=rank_count, default=None,
                    help="MPI ranks for every case, one case after the other (default: the "
                    "rank plan, see 'ligwf check')")
-    p.add_argument("--ensemble", type=positive_int, default=0, metavar="P",
+    p.add_argument("--ensemble", type=rank_count, default=0, metavar="P",
                    help="run all cases in ONE mpirun -np P, P/np cases at a time (np "
                    "default 1; overrides the rank plan)")
     add_cores_arg(p)
@@ -103,7 +104,7 @@ def register(subparsers) -> None:
                               "(Slurm array tasks call this)")
     p.add_argument("study", type=Path, help="rendered study folder")
     p.add_argument("--index", type=int, required=True, help="case index in the study")
-    p.add_argument("--np", type=positive_int, default=0,
+    p.add_argument("--np", type=rank_count, default=0,
                    help="MPI ranks (default $SLURM_NTASKS, else 1)")
     p.add_argument("--retry-unstable", action="store_true")
     p.set_defaults(func=cmd_run_case)

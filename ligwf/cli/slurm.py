@@ -36,7 +36,7 @@ from rich.text import Text
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_table,
                               console, duration, err_console, folder_to_write, positive_int,
-                              prepare_from_args)
+                              prepare_from_args, rank_count)
 from ligwf.engine.plan import CasePlan, case_load, fixed_ranks, plan_ranks
 from ligwf.errors import SubmitError
 from ligwf.slurm.budget import (PlanRow, hours_minutes, over_time_warning, plan_rows,
@@ -53,7 +53,7 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--partition", help="Slurm partition (default: site setting)")
     p.add_argument("--account", help="Slurm account (default: site setting)")
     p.add_argument("--time", help="wall time per case, e.g. 02:00:00 (default: site setting)")
-    p.add_argument("--ntasks", type=positive_int,
+    p.add_argument("--ntasks", type=rank_count,
                    help="MPI ranks for every case (default: site setting, else the rank plan)")
     add_cores_arg(p, "most ranks the rank plan gives one case, e.g. a node's cores "
                   "(default: no limit besides the slab rule and particles per rank)")

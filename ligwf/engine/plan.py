@@ -62,6 +62,9 @@ MULTI_RANK_EFFICIENCY = 0.88
 #: What limited a case's ranks (:attr:`CasePlan.bound`).
 BOUND_PARTICLES, BOUND_SLAB, BOUND_CORES = "particles", "slab", "cores"
 BOUND_NP, BOUND_ENSEMBLE = "--np", "--ensemble"
+#: most MPI ranks ligwf launches for one case or ensemble (2**20, beyond the largest
+#: machines' jobs): an absurd --np would otherwise spin in the processor-grid search
+MAX_RANKS = 2**20
 
 
 def _at_least(field: str, value: object, lowest: int) -> int:
@@ -250,6 +253,9 @@ def override_schedule(loads: Sequence[CaseLoad], nprocs: int, ensemble: int = 0,
     no core limit (the user asked for it); ``cores`` only for the fill estimate."""
     _at_least("--np", nprocs, 1)
     _at_least("--ensemble", ensemble, 0)
+    for field, value in (("--np", nprocs), ("--ensemble", ensemble)):
+        if value > MAX_RANKS:
+            raise ConfigError(f"{field} = {value}: allowed range [1, {MAX_RANKS}] MPI ranks")
     if ensemble and ensemble % nprocs:
         raise ConfigError(f"--ensemble = {ensemble}: must be a multiple of --np = {nprocs} "
                           f"(allowed: {nprocs}, {2 * nprocs}, {3 * nprocs}, ...)")

@@ -34,6 +34,11 @@ def load_site() -> dict:
     return read_yaml_mapping(path, "site file") if path.exists() else {}
 
 
+def _setting(site: dict, key: str) -> str:
+    """``LIGWF_<KEY>``, else the site file's ``key``, else the program name ``key``."""
+    return str(os.environ.get(f"LIGWF_{key.upper()}", site.get(key, key)))
+
+
 @dataclass(frozen=True)
 class EngineConfig:
     """How to start LIGGGHTS on this site."""
@@ -45,14 +50,19 @@ class EngineConfig:
     @classmethod
     def from_site(cls) -> "EngineConfig":
         site = load_site()
-        args = os.environ.get("LIGWF_MPIRUN_ARGS", site.get("mpirun_args", ""))
+        if "LIGWF_MPIRUN_ARGS" in os.environ:
+            args, where = os.environ["LIGWF_MPIRUN_ARGS"], "LIGWF_MPIRUN_ARGS"
+        else:
+            args, where = site.get("mpirun_args", ""), f"site file {_site_file()}: mpirun_args"
         if isinstance(args, list):
             args = " ".join(map(str, args))
-        return cls(
-            liggghts=os.environ.get("LIGWF_LIGGGHTS", site.get("liggghts", "liggghts")),
-            mpirun=os.environ.get("LIGWF_MPIRUN", site.get("mpirun", "mpirun")),
-            mpirun_args=tuple(shlex.split(str(args))),
-        )
+        try:
+            words = tuple(shlex.split(str(args)))
+        except ValueError as exc:     # an unclosed quote: "No closing quotation"
+            raise ConfigError(f"{where} = {str(args)!r}: not a valid argument list "
+                              f"({str(exc).lower()}); quote as in a shell") from None
+        return cls(liggghts=_setting(site, "liggghts"), mpirun=_setting(site, "mpirun"),
+                   mpirun_args=words)
 
     def liggghts_path(self) -> str:
         path = shutil.which(self.liggghts)

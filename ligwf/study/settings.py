@@ -21,6 +21,10 @@ from ligwf.scene.messages import format_validation_error
 from ligwf.scene.model import _Frozen
 
 
+#: largest seed: numpy's legacy generator (the compiled CPM optimiser's) takes 32 bits
+MAX_SEED = 2**32 - 1
+
+
 class AnalysisSettings(_Frozen):
     """What the analysis of a study uses.
 
@@ -65,7 +69,9 @@ class AnalysisSettings(_Frozen):
         "(energy, default: grows with the bridge volume, so granules respond to the liquid "
         "content) or its force over that of a touching bridge (force: the touching force does "
         "not depend on the liquid volume)")
-    community_seed: int = Field(0, ge=0, description="seed of the CPM optimiser's node order")
+    community_seed: int = Field(0, ge=0, le=MAX_SEED, description="seed of the CPM "
+                                "optimiser's node order (the compiled optimiser seeds "
+                                "numpy's generator, which takes [0, 2**32 - 1])")
     gsd_volume: Literal["physical", "primary"] = Field(
         "physical", description="granule volume the GSD bins: physical (a CG-neutral "
         "definition such as the CPM communities gives CG-n granules of CG1 size) or primary "
@@ -79,7 +85,7 @@ class AnalysisSettings(_Frozen):
         "that locates the size limit")
     bootstrap: int = Field(1000, ge=1, le=1_000_000, description="bootstrap draws of the "
                            "GSD confidence bands")
-    seed: int = Field(12345, ge=0, description="seed of the bootstrap draws")
+    seed: int = Field(12345, ge=0, le=MAX_SEED, description="seed of the bootstrap draws")
     sensitivity_frames: int = Field(
         4, ge=0, le=1000, description="steady frames of one case re-analysed with each "
         "threshold moved x0.8 / x1.25 (0: no sensitivity table)")
@@ -91,6 +97,9 @@ class AnalysisSettings(_Frozen):
         """``auto`` or a fraction in [0, 1) (one message with the allowed range)."""
         if value == "auto":
             return value
+        if isinstance(value, str):
+            raise ValueError("must be auto or a fraction of the production time in the "
+                             "allowed range [0, 1), a number without quotes")
         try:
             fraction = float(value)
         except (TypeError, ValueError):

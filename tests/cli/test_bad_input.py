@@ -56,6 +56,13 @@ LAUGHS = "a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
     f"*{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, *{chr(97 + k)}, "
     f"*{chr(97 + k)}, *{chr(97 + k)}]\n" for k in range(9)) + "scene: *j\n"
 
+#: the facts ``analyse-dumps`` needs (its dump folder is the harness's workflow argument)
+FOREIGN = ("--liquid", "washino", "--surface-tension", "0.2", "--contact-angle", "30",
+           "--angle-convention", "engine", "--periodic-axis", "none", "--dt", "1e-5")
+#: numeric scene fields whose physical floor is 0 or a value that stays finite when tiny
+#: (a friction, a Poisson ratio, an angle or a settling time of 1e-300 is 0 in effect)
+TINY_ACCEPTED = {"poisson_ratio", "friction", "contact_angle_deg", "settle_time"}
+
 CORPUS: list[Bad] = [
     # --- the file itself (item 7) ---
     Bad("binary-bytes", ("workflow", "UTF-8"), text=b"name: x\nscene: \xff\xfe\x00\x01\n"),
@@ -135,9 +142,107 @@ CORPUS: list[Bad] = [
     Bad("workflow-missing", ("no-such.yaml",), text=None, extra={"workflow": "no-such.yaml"}),
     Bad("workflow-directory", ("directory",), text=None, extra={"workflow": "."}),
     Bad("templates-missing", ("--templates", "nowhere"), options=("--templates", "nowhere")),
+    # --- issue 21: tracebacks, hangs and silent accepts ---
+    Bad("community-seed-huge", ("analysis.community_seed", "99999999999999999999",
+                                "[0, 4294967295]"),
+        overrides=("analysis.community_seed=99999999999999999999",)),
+    Bad("bootstrap-seed-huge", ("analysis.seed", "[0, 4294967295]"),
+        overrides=("analysis.seed=18446744073709551616",)),
+    Bad("steady-after-text", ("analysis.steady_after", "without quotes"),
+        overrides=("analysis.steady_after='0.25'",)),
+    Bad("description-explicit-date", ("description", "date", "quote it"),
+        text=BASE.replace("description: ", "description: !!timestamp 2024-01-01 #", 1)),
+    Bad("binary-value", ("name", "bytes"), overrides=("name=!!binary aGVsbG8=",)),
+    Bad("rpm-base-60", ("scene.process.rotation.rpm = '1:30'", "base-60", "90"),
+        overrides=("scene.process.rotation.rpm=1:30",)),
+    Bad("density-yes", ("scene.particles.density = 'yes'", "yes/no word"),
+        overrides=("scene.particles.density=yes",)),
+    Bad("friction-off", ("scene.particles.friction = 'off'", "yes/no word"),
+        overrides=("scene.particles.friction=off",)),
+    Bad("count-octal", ("scene.drum.lifters.count = '012'", "octal"),
+        overrides=("scene.drum.lifters.count=012",)),
+    Bad("count-hex", ("scene.drum.lifters.count = '0x0c'", "decimal"),
+        overrides=("scene.drum.lifters.count=0x0c",)),
+    Bad("density-quoted", ("scene.particles.density = '2500'", "without quotes", "[10, 100000]"),
+        overrides=('scene.particles.density="2500"',)),
+    Bad("diameter-range-quoted", ("scene.particles.size_distribution[0].diameter_range[1]",
+                                  "'0.002'"),
+        overrides=("scene.particles.size_distribution=[{diameter_range: [0.001, '0.002'], "
+                   "fraction: 1.0}]",)),
+    Bad("cg-levels-true", ("sweep.cg_levels[0] = True", "yes/no"),
+        overrides=("sweep.cg_levels=[true]",)),
+    Bad("replicas-text", ("sweep.replicas[2] = 'x'",), overrides=("sweep.replicas={1: 1, 2: x}",)),
+    Bad("liquid-content-whole", ("scene.liquid.liquid_content = 1", "[1e-05, 0.2]", "pendular"),
+        overrides=("scene.liquid.liquid_content=1",)),
+    Bad("surface-tension-denormal", ("scene.liquid.surface_tension", "physical floor", "0 to"),
+        overrides=("scene.liquid.surface_tension=1e-300",)),
+    Bad("size-denormal", ("scene.particles.size_distribution[0].diameter = 5e-324", "[1e-06, 1]"),
+        overrides=("scene.particles.size_distribution=[{diameter: 5e-324, fraction: 1.0}]",)),
+    Bad("range-denormal", ("scene.particles.size_distribution[0].diameter_range", "1e-06 m"),
+        overrides=("scene.particles.size_distribution=[{diameter_range: [1e-300, 1e-3], "
+                   "fraction: 1.0}]",)),
+    Bad("dt-denormal", ("scene.numerics.dt = 5e-324", "[1e-10, 1]"),
+        overrides=("scene.numerics.dt=5e-324",)),
+    Bad("froude-denormal", ("scene.process.rotation.froude", "[1e-06, 100]"),
+        overrides=("scene.process.rotation={froude: 1e-300}",)),
+    Bad("lifter-height-denormal", ("scene.drum.lifters.height = 1e-300", "[1e-06, 0.025) m"),
+        overrides=("scene.drum.lifters.height=1e-300",)),
+    Bad("thermo-longer-than-run", ("scene.numerics.thermo_interval = 0.6", "run_time",
+                                   "allowed range [1e-06, 0.101] s"),
+        overrides=("scene.numerics.thermo_interval=0.6",)),
+    Bad("thermo-stretches-fill", ("scene.numerics.thermo_interval = 0.3", "fall across the drum"),
+        overrides=("scene.numerics.thermo_interval=0.3",)),
+    Bad("thermo-longer-than-short-run", ("scene.numerics.thermo_interval = 0.05",
+                                         "process.run_time = 0.04", "[1e-06, 0.04] s"),
+        overrides=("scene.process.run_time=0.04", "scene.numerics.thermo_interval=0.05",
+                   "scene.numerics.dump_interval=0.01")),
+    Bad("dump-longer-than-run", ("scene.numerics.dump_interval = 0.6", "no frame",
+                                 "[1e-06, 0.5] s"),
+        overrides=("scene.numerics.dump_interval=0.6",)),
+    Bad("per-cg-dump-longer-than-run", ("sweep.per_cg.2 -> scene.numerics.dump_interval",
+                                        "no frame"),
+        overrides=("sweep.per_cg={2: {process.run_time: 0.04}}",)),
+    Bad("no-cg1-to-compare", ("warning", "sweep.cg_levels = [2, 3]", "no CG1 case"),
+        overrides=("sweep.cg_levels=[2, 3]",), command="check", warns=True),
+    Bad("case-folders-collide", ("sweep.scene.name", "'a b' and 'a-b'", "same case folder"),
+        overrides=("sweep.scene.name=['a b', 'a-b']",)),
+    Bad("case-folders-collide-signed-zero", ("sweep.scene.particles.rolling_friction",
+                                             "0.0 and -0.0", "same case folder"),
+        overrides=("sweep.scene.particles.rolling_friction=[0.0, -0.0]",)),
+    Bad("case-folders-collide-slurm-dry-run", ("0.0 and -0.0", "same case folder"),
+        overrides=("sweep.scene.particles.rolling_friction=[0.0, -0.0]",),
+        command="slurm submit", options=("--dry-run",)),
+    Bad("rule-unknown-path", ("sweep.rules[1] = 'bnd'",), overrides=("sweep.rules=[weber,bnd]",)),
+    Bad("fractions-sum-path", ("scene.particles.size_distribution: the fractions sum to 0.5",),
+        overrides=("scene.particles.size_distribution=[{diameter: 0.001, fraction: 0.5}]",)),
+    Bad("output-count-path", ("scene.numerics.dump_interval = 1e-09",),
+        overrides=("scene.numerics.dump_interval=1e-9",)),
+    Bad("mpirun-args-unclosed-quote", ("LIGWF_MPIRUN_ARGS", '\'"--bind-to\'', "no closing"),
+        command="run", overrides=("sweep.cg_levels=[3]", "sweep.rules=[bond]"),
+        extra={"env": {"LIGWF_MPIRUN_ARGS": '"--bind-to'}}),
+    Bad("site-mpirun-args-unclosed-quote", ("site file", "mpirun_args", "no closing"),
+        command="run", overrides=("sweep.cg_levels=[3]", "sweep.rules=[bond]"),
+        extra={"site": "mpirun_args: \"'--bind-to\"\n"}),
+    Bad("np-huge", ("--np", "[1, 1048576]", "1000000000000"), command="run",
+        options=("--np", "1000000000000")),
+    Bad("ensemble-huge", ("--ensemble", "[1, 1048576]"), command="study",
+        options=("--ensemble", "1048577")),
+    Bad("cores-huge", ("--cores", "[1, 1048576]"), command="check",
+        options=("--cores", "99999999999999")),
+    Bad("ntasks-huge", ("--ntasks", "[1, 1048576]"), command="slurm submit",
+        options=("--dry-run", "--ntasks", "1000000000000")),
+    Bad("analyse-dumps-set-bad-yaml", ("--set seed", "not valid YAML"),
+        command="analyse-dumps", overrides=("seed=[1",), options=FOREIGN),
+    Bad("analyse-dumps-seed-huge", ("analysis.community_seed", "[0, 4294967295]"),
+        command="analyse-dumps", overrides=("community_seed=99999999999999999999",),
+        options=FOREIGN),
 ]
 CORPUS += [Bad(f"{path}={raw}", (path.rpartition(".")[2], shown), overrides=(f"{path}={raw}",))
            for path in NUMERIC_FIELDS for raw, shown in NOT_A_NUMBER.items()]
+# below every physical floor (issue 21: ZeroDivisionError / OverflowError in the scaling)
+CORPUS += [Bad(f"{path}={raw}", (path, "allowed"), overrides=(f"{path}={raw}",))
+           for path in NUMERIC_FIELDS if path.rpartition(".")[2] not in TINY_ACCEPTED
+           for raw in ("1e-300", "5e-324")]
 
 
 def test_the_corpus_is_large_enough():
@@ -164,8 +269,13 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
     if bad.setup == "cache-file":
         (tmp_path / "cachefile").write_text("x")
         options += ["--mesh-cache", str(tmp_path / "cachefile")]
+    for name, value in bad.extra.get("env", {}).items():
+        monkeypatch.setenv(name, value)
+    if "site" in bad.extra:
+        (tmp_path / "site.yaml").write_text(bad.extra["site"])
+    monkeypatch.setenv("LIGWF_SITE", str(tmp_path / "site.yaml"))
     before = sorted(p.name for p in tmp_path.iterdir())
-    argv = [bad.command, str(workflow), *options]
+    argv = [*bad.command.split(), str(workflow), *options]
     if bad.command != "check":
         argv += ["--out", str(out)]
     for o in bad.overrides:
@@ -177,7 +287,22 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
     assert code == (0 if bad.warns else 2), f"exit {code}, stderr:\n{err}"
     assert "Traceback" not in err
     assert err.startswith("ligwf: "), err
+    flat = " ".join(err.split())     # the console wraps long lines
     for frag in bad.expect:
-        assert frag in err, f"{frag!r} not in the message:\n{err}"
+        assert frag in flat, f"{frag!r} not in the message:\n{err}"
+    assert "= {'" not in flat, f"a whole mapping instead of its field:\n{err}"
     assert elapsed < 5.0, f"{elapsed:.1f} s before the refusal"
     assert sorted(p.name for p in tmp_path.iterdir()) == before, "something was written"
+
+
+def test_the_planner_refuses_more_ranks_than_it_can_lay_out():
+    """The CLI refuses --np / --ensemble above MAX_RANKS; the planner does too, for callers
+    that build run settings themselves (the processor-grid search is linear in the ranks)."""
+    from ligwf.engine.plan import MAX_RANKS, CaseLoad, override_schedule
+    from ligwf.errors import ConfigError
+
+    loads = [CaseLoad("c", 1000, 100, 0.01, 0.001)]
+    assert override_schedule(loads, MAX_RANKS).phases[0].ranks == MAX_RANKS
+    for kwargs in ({"nprocs": 10**12}, {"nprocs": 1, "ensemble": MAX_RANKS + 1}):
+        with pytest.raises(ConfigError, match=r"allowed range \[1, 1048576\] MPI ranks"):
+            override_schedule(loads, **kwargs)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import json
 
 import pytest
 import yaml
@@ -46,23 +47,24 @@ def test_demo_is_valid():
 @pytest.mark.parametrize("value", [0.0, -0.001])
 def test_non_positive_size_refused(value):
     raw = with_value("scene.particles.size_distribution", [{"diameter": value, "fraction": 1.0}])
-    expect_error(raw, "scene.particles.size_distribution.0.diameter", repr(value), "(0, 1]")
+    expect_error(raw, "scene.particles.size_distribution[0].diameter", repr(value), "[1e-06, 1]")
 
 
 def test_negative_drum_diameter_refused():
-    expect_error(with_value("scene.drum.diameter", -0.05), "scene.drum.diameter", "-0.05", "(0, 10]")
+    expect_error(with_value("scene.drum.diameter", -0.05), "scene.drum.diameter", "-0.05", "[0.001, 10]")
 
 
 def test_fractions_must_sum_to_one():
     raw = with_value("scene.particles.size_distribution",
                      [{"diameter": 1e-3, "fraction": 0.8}, {"diameter": 2e-3, "fraction": 0.3}])
-    expect_error(raw, "scene.particles", "sum to 1.1", "must sum to 1")
+    msg = expect_error(raw, "scene.particles.size_distribution: ", "sum to 1.1", "must sum to 1")
+    assert "{" not in msg   # the field, not the whole particles block
 
 
 @pytest.mark.parametrize("value", [0.0, 0.75, -0.1])
 def test_fill_fraction_range(value):
     expect_error(with_value("scene.process.fill_fraction", value),
-                 "scene.process.fill_fraction", repr(value), "(0, 0.7]")
+                 "scene.process.fill_fraction", repr(value), "[0.01, 0.7]")
 
 
 def test_fill_fraction_upper_bound_accepted():
@@ -70,9 +72,10 @@ def test_fill_fraction_upper_bound_accepted():
 
 
 def test_lifter_height_must_be_below_radius():
-    msg = expect_error(with_value("scene.drum.lifters.height", 0.025), "scene.drum",
-                       "lifters.height = 0.025", "< the drum radius 0.025")
-    assert "radius" in msg
+    msg = expect_error(with_value("scene.drum.lifters.height", 0.025),
+                       "scene.drum.lifters.height = 0.025", "< the drum radius 0.025",
+                       "allowed range [1e-06, 0.025) m")
+    assert "{" not in msg
 
 
 @pytest.mark.parametrize("value", [-1, 181, 400])
@@ -152,3 +155,78 @@ def test_scene_is_frozen():
     scene = build_scene(copy.deepcopy(demo_raw()["scene"]))
     with pytest.raises(Exception):
         scene.drum.diameter = 1.0  # type: ignore[misc]
+
+
+# --- issue 21: YAML 1.1 surprises, merge keys, dates, strict numbers ---
+
+def _load_text(tmp_path, text: str, overrides=()):
+    path = tmp_path / "wf.yaml"
+    path.write_text(text)
+    return load_workflow(path, overrides)
+
+
+def test_yaml_merge_keys_are_accepted(tmp_path):
+    text = DRUM.read_text() + (
+        "  per_cg:\n"
+        "    2: &slow {process.run_time: 0.6, numerics.dump_interval: 0.1}\n"
+        "    3: {<<: *slow, numerics.dump_interval: 0.2}\n")
+    wf = _load_text(tmp_path, text)
+    by_cg = {c.cg: c.scene for c in wf.cases}
+    assert by_cg[2.0].process.run_time == by_cg[3.0].process.run_time == 0.6
+    # the mapping's own key overrides the merged one
+    assert (by_cg[2.0].numerics.dump_interval, by_cg[3.0].numerics.dump_interval) == (0.1, 0.2)
+    with pytest.raises(ConfigError, match="duplicate key"):
+        _load_text(tmp_path, text.replace("numerics.dump_interval: 0.2}",
+                                          "numerics.dump_interval: 0.2, "
+                                          "numerics.dump_interval: 0.3}"))
+
+
+def test_yaml_dates_stay_text(tmp_path):
+    wf = _load_text(tmp_path, DRUM.read_text().replace(
+        "description: Small wet drum with lifters, CG1 and We/Bo-scaled CG2 and CG3.",
+        "description: 2024-01-01", 1))
+    assert wf.description == "2024-01-01"
+    json.dumps(wf.raw)   # the study record can hold it
+
+
+@pytest.mark.parametrize("word, value", [("yes", True), ("no", False), ("on", True),
+                                         ("off", False), ("true", True)])
+def test_yaml_yes_no_words_only_fit_yes_no_fields(word, value):
+    wf = load_workflow(DRUM, [f"scene.drum.periodic={word}"])
+    assert wf.cases[0].scene.drum.periodic is value
+    with pytest.raises(ConfigError, match="scene.particles.friction = "):
+        load_workflow(DRUM, [f"scene.particles.friction={word}"])
+
+
+def test_yaml_1_2_numbers():
+    wf = load_workflow(DRUM, ["scene.particles.youngs_modulus=5e6", "scene.drum.lifters.count=6",
+                              "scene.numerics.seed=10_007", "sweep.cg_levels=[1, 2]"])
+    scene = wf.cases[0].scene
+    assert scene.particles.youngs_modulus == 5e6 and scene.drum.lifters.count == 6
+    assert scene.numerics.seed == 10007
+    with pytest.raises(ConfigError, match="base-60 number 5400"):
+        load_workflow(DRUM, ["scene.process.rotation.rpm=1:30:00"])
+
+
+def test_whole_numbers_stand_for_floats():
+    # strict about text and yes/no, not about 2500 vs 2500.0
+    wf = load_workflow(DRUM, ["scene.particles.density=2500", "sweep.cg_levels=[1, 2]",
+                              "scene.liquid.liquid_content=0.2"])
+    assert wf.cases[0].scene.particles.density == 2500.0
+
+
+def test_signed_zero_sweep_is_refused_not_collapsed():
+    raw = demo_raw()
+    raw["sweep"]["scene.particles.rolling_friction"] = [0.0, -0.0]
+    expect_error(raw, "0.0 and -0.0", "same case folder")
+    raw["sweep"]["scene.particles.rolling_friction"] = [0.0, 0.1]
+    assert len({c.case_id for c in expand(raw).cases}) == len(expand(raw).cases) == 10
+
+
+def test_model_level_errors_name_the_field_not_the_block():
+    msg = expect_error(with_value("scene.liquid.max_separation_ratio", 1.005),
+                       "scene.liquid.max_separation_ratio = 1.005", "min_separation_ratio")
+    assert "{" not in msg
+    msg = expect_error(with_value("scene.process.rotation", {"rpm": 30, "froude": 0.1}),
+                       "scene.process.rotation: give exactly one")
+    assert "{" not in msg
