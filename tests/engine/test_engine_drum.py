@@ -58,7 +58,9 @@ def test_fill_reaches_the_exact_count_for_every_seed(engine, tmp_path):
     a particle fewer or more than asked (seen: 221 of 222 for one seed). The top-up wave asks
     for extra particles and deletes the newest: exactly N for every seed, on 2 ranks."""
     wf = load_workflow(DRUM, ["sweep.cg_levels=[3]", "sweep.rules=[weber]", "sweep.replicas=4",
-                              "scene.process.settle_time=0.02", "scene.process.run_time=0.001"])
+                              "scene.process.settle_time=0.02", "scene.process.run_time=0.001",
+                              "scene.numerics.dump_interval=0.001",
+                              "scene.numerics.thermo_interval=0.001"])
     rendered = render_workflow(wf)
     write_study(wf, rendered, tmp_path, mesh_cache=tmp_path / "meshes")
     trimmed = []
