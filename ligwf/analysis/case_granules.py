@@ -19,7 +19,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.dumps import FrameFiles, ParticleFrame, read_contacts, read_particles
+from ligwf.analysis.dumps import (ContactFrame, FrameFiles, ParticleFrame, read_contacts,
+                                  read_particles)
+from ligwf.analysis.persistent import Frame, bridge_keys, held_through, persistent_labels
 from ligwf.analysis.frame_checks import FramePlan, check_contacts, check_particles, plan_frames
 from ligwf.analysis.definitions import GranuleDefinition, Motion, identify_granules
 from ligwf.analysis.granules import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
@@ -138,15 +140,15 @@ class GranuleAnalysis:
             if ff.contacts is None:
                 raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
                                     "(was the case rendered with analysis.granules: true?)")
-            if f.plan is not None:
-                f.plan.check_record(ff)
-            particles = read_particles(ff.particles, ff.step, f.dt)
-            contacts = read_contacts(ff.contacts, ff.step)
-            if f.case is not None:
-                check_particles(f.case, particles)
-            check_contacts(particles, contacts, f.periodic_axis, f.box_length)
-            ident = identify_granules(particles, contacts, f.liquid, self.definition, f.cg,
-                                      f.motion, self.implementation)
+            particles, contacts = self._read(ff)
+            if self.definition.method == "held":
+                ident = self._held(ff, particles, contacts)
+            else:
+                ident = identify_granules(particles, contacts, f.liquid, self.definition, f.cg,
+                                          f.motion, self.implementation)
+        except HoldWindowOpen as exc:
+            res.error, res.kind = str(exc), "window"
+            return res
         except (DumpReadError, ValueError) as exc:
             res.error = str(exc)
             return res
@@ -167,8 +169,62 @@ class GranuleAnalysis:
                                table["members"].to_numpy()[labels], extra)
         return res
 
+    def _read(self, ff: FrameFiles) -> tuple[ParticleFrame, ContactFrame]:
+        """One frame, read and checked against its run (record, particles, contacts)."""
+        f = self._facts
+        if ff.contacts is None:
+            raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
+                                "(was the case rendered with analysis.granules: true?)")
+        if f.plan is not None:
+            f.plan.check_record(ff)
+        particles = read_particles(ff.particles, ff.step, f.dt)
+        contacts = read_contacts(ff.contacts, ff.step)
+        if f.case is not None:
+            check_particles(f.case, particles)
+        check_contacts(particles, contacts, f.periodic_axis, f.box_length)
+        return particles, contacts
+
+    def _held(self, ff: FrameFiles, particles: ParticleFrame, contacts: ContactFrame):
+        """Granules of ``granules: held`` at ``ff``: the bridges present in every frame of
+        [t, t + hold_time] (:func:`ligwf.analysis.persistent.persistent_labels`); the frames
+        after ``ff`` come from the run's frame plan, their bridge keys cached while the
+        frames are analysed in order."""
+        f = self._facts
+        if f.plan is None:
+            raise ConfigError(f"{f.case_id}: granules: held follows bridges over the run's "
+                              "frames; it needs a ligwf case (its frame plan)")
+        frames = list(f.plan.frames)
+        steps = [x.step for x in frames]
+        k = steps.index(ff.step)
+        interval = (steps[1] - steps[0]) * f.dt if len(steps) > 1 else float("inf")
+        span = max(1, int(round(self.definition.hold_time / interval)))
+        if k + span >= len(frames) or steps[k + span] - ff.step != span * (steps[1] - steps[0]):
+            raise HoldWindowOpen(f"step {ff.step}: its hold window of "
+                                 f"{self.definition.hold_time:g} s runs past the last frame "
+                                 "(or over a missing one): no granules can be held through it")
+        if not hasattr(self, "_keys"):
+            self._keys: dict[int, np.ndarray] = {}
+        window = []
+        for q in range(k, k + span + 1):
+            step = steps[q]
+            if step not in self._keys:
+                p, c = (particles, contacts) if q == k else self._read(frames[q])
+                if not np.array_equal(p.ids, particles.ids):
+                    raise DumpReadError(f"{frames[q].particles}: not the particles of step "
+                                        f"{ff.step} (a hold window needs the same particles)")
+                self._keys[step] = bridge_keys(Frame(p, c), f.liquid)
+            window.append(self._keys[step])
+        for old in [s for s in self._keys if s < ff.step]:
+            del self._keys[old]
+        return persistent_labels([Frame(particles, contacts)], [held_through(window)],
+                                 f.motion)
+
     def _conclude(self) -> None:
         self.results.sort(key=lambda r: r.step)
+
+
+class HoldWindowOpen(DumpReadError):
+    """A frame too close to the end of the run for its hold window (not an error of it)."""
 
 
 def write_particle_vtu(path: Path, particles: ParticleFrame, labels: np.ndarray,

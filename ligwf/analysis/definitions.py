@@ -46,7 +46,7 @@ from ligwf.analysis.dumps import ContactFrame, ParticleFrame
 from ligwf.analysis.granules import (BondCriterion, Identification, bonded_contacts,
                                      bonded_contacts_reference, components, identify)
 
-METHODS = ("communities", "components")
+METHODS = ("communities", "components", "held")
 #: CPM edge weights: the bridge's relative rupture work or its relative force
 WEIGHTS = ("energy", "force")
 VELOCITY_FRAMES = ("lab", "drum", "flow")
@@ -70,6 +70,7 @@ class GranuleDefinition:
     seed: int = 0                          # seed of the CPM node order
     flow_radius: float = 3.0               # mean particle diameters
     weight: str = "energy"                 # CPM edge weight: energy (e_rel) | force (f_rel)
+    hold_time: float = 0.5                 # s, method held: bridges present through [t, t + this]
 
     def __post_init__(self) -> None:
         if self.method not in METHODS:
@@ -78,6 +79,8 @@ class GranuleDefinition:
             raise ValueError(f"velocity_frame {self.velocity_frame!r}: use one of {VELOCITY_FRAMES}")
         if self.weight not in WEIGHTS:
             raise ValueError(f"weight {self.weight!r}: use one of {WEIGHTS}")
+        if not self.hold_time > 0:
+            raise ValueError(f"hold_time {self.hold_time!r}: must be > 0 s")
         if not (self.resolution > 0 and self.flow_radius > 0 and self.min_relative_force >= 0):
             raise ValueError(f"{self}: resolution and flow_radius must be > 0, "
                              "min_relative_force >= 0")
@@ -88,7 +91,7 @@ class GranuleDefinition:
         return cls(s.granules, s.velocity_frame, float(s.max_velocity_angle),
                    float(s.min_bridge_force), float(s.min_relative_force),
                    float(s.resolution), int(s.community_seed), float(s.flow_radius),
-                   s.community_weight)
+                   s.community_weight, float(getattr(s, "hold_time", 0.5)))
 
     @property
     def criterion(self) -> BondCriterion:
@@ -101,6 +104,10 @@ class GranuleDefinition:
         (angle 180 deg, relative force 0) is switched on at a nominal value (30 deg,
         f_rel 0.5) moved by the same factors, so the table shows what it would change."""
         out = [("as set", self)]
+        if self.method == "held":      # the one threshold it has: how long a bridge must hold
+            return out + [(f"hold {self.hold_time * fac:.3g} s",
+                           replace(self, hold_time=self.hold_time * fac))
+                          for fac in SENSITIVITY_FACTORS]
         for fac in SENSITIVITY_FACTORS:
             if self.method == "communities":
                 out.append((f"resolution x{fac:g}", replace(self, resolution=self.resolution * fac)))
@@ -191,6 +198,9 @@ def identify_granules(particles: ParticleFrame, contacts: ContactFrame, liquid: 
     ``cg``: the case's CG level n (CPM weights)."""
     if implementation not in ("fast", "reference"):
         raise ValueError(f"implementation {implementation!r}: use fast or reference")
+    if definition.method == "held":
+        raise ValueError("granules: held needs the frames of its hold window "
+                         "(ligwf.analysis.persistent), not one frame")
     crit = definition.criterion
     if definition.max_velocity_angle_deg < 180.0 and definition.velocity_frame != "lab":
         particles = replace(particles, velocities=frame_velocities(

@@ -144,12 +144,14 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     tasks = [(fi, ff) for fi, f in enumerate(facts) for ff in f.plan.frames]
     mine: list[FrameResult] = []
     try:
+        analyses: dict[int, GranuleAnalysis] = {}   # one per case: held windows share reads
         for fi, ff in tasks[rank::size]:
             f = facts[fi]
-            ana = GranuleAnalysis(f, granule_definition(settings), options.implementation,
-                                  outputs.case_dir(f.case_id) if options.write_vtu else None,
-                                  options.louvain)
-            mine.append(analyse_frame(ana, ff))
+            if fi not in analyses:
+                analyses[fi] = GranuleAnalysis(
+                    f, granule_definition(settings), options.implementation,
+                    outputs.case_dir(f.case_id) if options.write_vtu else None, options.louvain)
+            mine.append(analyse_frame(analyses[fi], ff))
     except BaseException:
         outputs.discard()
         raise

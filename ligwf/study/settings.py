@@ -41,9 +41,14 @@ class AnalysisSettings(_Frozen):
         "auto", description="start-up left out of the flow metrics and the GSD alike: auto "
         "(default: from the bed's measured spin-up, ligwf.analysis.steady) or a fraction of "
         "the production time")
-    granules: Literal["communities", "components"] = Field(
+    granules: Literal["communities", "components", "held"] = Field(
         "communities", description="granules are CPM communities of the bond graph "
-        "(default) or its connected components (the source study)")
+        "(default), its connected components (the source study), or components of the "
+        "bridges that held through hold_time (held: a body that stays together)")
+    hold_time: float = Field(
+        0.5, gt=0.0, le=1e3, allow_inf_nan=False, description="granules: held: a bridge "
+        "counts when it is present in every frame of [t, t + hold_time], s (a physical time: "
+        "the same at every CG level)")
     min_bridge_force: float = Field(
         0.0, ge=0.0, allow_inf_nan=False, description="a liquid bond needs a bridge force "
         "above this, N (0: any unbroken bridge; NOT CG-neutral when > 0)")
