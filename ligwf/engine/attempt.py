@@ -59,6 +59,12 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
         clean_outputs(case.path)
         manifest = Manifest(case_id=case.case_id, index=case.index, scene_hash=case.scene_hash,
                             ligwf_version=__version__, liggghts_version="")
+        if previous is not None and previous.scene_hash == case.scene_hash:
+            # the same case again from step 0 (killed before a restart of its own, or
+            # failed): its earlier attempts cost what they cost and stay in the record
+            manifest.attempts = list(previous.attempts)
+            for a in manifest.attempts:
+                a.screen = ""       # removed with the old outputs; the name may be reused
         from_step, restart_path = 0, None
     elif plan.action == RESUME and plan.restart is not None:
         for name, text in render_resume(case.scaled, plan.restart, template_dirs).items():
@@ -142,7 +148,7 @@ def case_rows(case: CaseFolder, attempts: list[Attempt]) -> list[ThermoRow]:
     rows: list[ThermoRow] = []
     for a in attempts:
         screen = case.path / a.screen
-        if screen.is_file():
+        if a.screen and screen.is_file():
             new = parse_screen(screen.read_text(errors="replace")).rows
             rows = merge_rows(rows, new, a.from_step, case.scaled.dt)
         elif case.thermo.is_file():

@@ -51,7 +51,7 @@ from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.errors import SimulationFailed
 from ligwf.fsio import FolderNotWritable, atomic_write_json
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import Manifest
+from ligwf.study.manifest import Manifest, overwrite_manifest
 
 ENSEMBLE_DIR = ".ensemble"
 
@@ -96,9 +96,18 @@ def _settle_in_flight(case: CaseFolder, exit_code: int | None) -> Manifest | Non
             discard_restart(case.path, RestartFile(attempt.from_restart, attempt.from_step))
             m.status = KILLED
             m.reason = f"restart {attempt.from_restart} unreadable ({m.reason}); set aside"
-            case.write_manifest(m)
+            _record(case, m)
         return m
     return finish_attempt(case, m, attempt, None, wall, killed=True)
+
+
+def _record(case: CaseFolder, m: Manifest) -> None:
+    """Write a member's manifest; in place when a full disk leaves no room for the atomic
+    copy (the reason then says so)."""
+    try:
+        case.write_manifest(m)
+    except FolderNotWritable:
+        overwrite_manifest(case.path, m)
 
 
 def _job_end(launch_log: str, exit_code: int | None) -> str:
@@ -255,7 +264,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                     m.reason = (f"stopped when the ensemble job ended ({how}) at step "
                                 f"{m.steps_done} of {m.total_steps}")
                 m.attempts[-1].reason = m.reason
-                case.write_manifest(m)
+                _record(case, m)
             outcome[case.path.name] = m.status
             if m.status != KILLED or m.steps_done > before.get(_key(case), 0):
                 progressed = True
@@ -277,7 +286,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                     m.status = FAILED
                     m.reason = (f"ensemble job ended ({how}) with no member making progress "
                                 f"and no ERROR line; see {ens_dir / 'launch.log'}")
-                    case.write_manifest(m)
+                    _record(case, m)
                     outcome[case.path.name] = FAILED
                     monitor.end(case.path.name, m, plan_case(case))
             retry = set()

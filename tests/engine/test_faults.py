@@ -1,7 +1,10 @@
-"""Fault injection on the real engine (84-particle case, one rank): kill -9 of ligwf, of
-LIGGGHTS, of both, at chosen phases and several times in a row; two runners on one study;
-a full disk; a read-only study. docs/reliability.md ("Faults during a run") says what each
-test holds ligwf to.
+"""Fault injection on the real engine (84-particle cases). On one case alone under mpirun:
+kill -9 of ligwf, of LIGGGHTS, of both, at chosen phases and several times in a row; two
+runners on one study; a full disk; a read-only study. On the DEFAULT path, the rank
+planner's MPI ensemble of two replicas side by side (no --np): kill -9 of ligwf, of one
+rank, of mpirun, SIGINT and SIGTERM of ligwf, each at fill, settle and production; a full
+disk; another replica's restart dropped in. docs/reliability.md ("Faults during a run")
+says what each test holds ligwf to.
 
 Every scenario checks that no engine ever runs without its runner for long, that two
 engines never write one case, and that the case ends ``done`` with a complete record.
@@ -50,7 +53,10 @@ def run(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
                           stdin=subprocess.DEVNULL)
 
 
-def engines_in(folder: Path, names=("liggghts", "mpirun", "orterun")) -> list[int]:
+RANKS = ("liggghts", "ligwf-ensemble")   # a local rank, an MPI-ensemble rank
+
+
+def engines_in(folder: Path, names=RANKS + ("mpirun", "orterun")) -> list[int]:
     """Pids of engine processes whose working folder is ``folder`` (from /proc)."""
     found = []
     for entry in os.listdir("/proc"):
@@ -76,7 +82,7 @@ class EngineWatch:
 
     def _loop(self) -> None:
         while not self._stop.wait(0.05):
-            self.most = max(self.most, len(engines_in(self.folder, ("liggghts",))))
+            self.most = max(self.most, len(engines_in(self.folder, RANKS)))
 
     def __enter__(self) -> "EngineWatch":
         self._thread.start()
@@ -280,3 +286,165 @@ def test_read_only_study_ends_in_one_line_per_command(tmp_path):
         for cmd in (["analyse", str(out)], ["report", str(out), "--no-snapshots"]):
             r = run(*cmd)
             one_line_error(r, out)
+
+
+# --------------------------------------------------------------------------------------
+# The default path: the planner runs the two single-rank replicas as ONE MPI ensemble
+# --------------------------------------------------------------------------------------
+
+#: two replicas of one case (different insertion seeds) on 2 cores: the rank plan puts
+#: them side by side in one mpirun -np 2 ensemble (no --np / --ensemble given)
+PAIR_ARGS = ["--cores", "2", "--set", "sweep.rules=[weber]", "--set", "sweep.replicas=2",
+             "--set", "scene.process.settle_time=0.3", "--set", "scene.process.run_time=0.6"]
+PAIR = ("cg3-weber-r0", "cg3-weber-r1")
+PHASES = ("ligwf-phase fill 2", "ligwf-phase settle", "ligwf-phase production")
+#: what ends a ligwf run (the test starts it again); the others it survives by itself
+ENDS_LIGWF = {"ligwf": -signal.SIGKILL, "sigint": 130, "sigterm": 143}
+
+
+def start_pair(out: Path) -> subprocess.Popen:
+    return subprocess.Popen(ligwf_cmd("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS),
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+
+
+def attempts(case: Path) -> int:
+    m = read_manifest(case)
+    return len(m.attempts) if m is not None else 0
+
+
+def in_phase(case: Path, marker: str, after: int) -> bool:
+    """An attempt after the first ``after`` runs, its screen shows ``marker`` and its rank
+    is up."""
+    return (attempts(case) > after and screen_has(case, marker, after + 1)
+            and bool(engines_in(case, ("ligwf-ensemble",))))
+
+
+def mpirun_of(proc: subprocess.Popen) -> int:
+    from ligwf.engine.guard import descendants, process
+    found = [p for p in descendants(proc.pid) if (q := process(p)) and q.name == "mpirun"]
+    assert found, "no mpirun below ligwf"
+    return found[0]
+
+
+class PairWatch(EngineWatch):
+    """The most ranks ever running in either case folder at once."""
+
+    def __init__(self, folders: list[Path]) -> None:
+        super().__init__(folders[0])
+        self.folders = folders
+
+    def _loop(self) -> None:
+        while not self._stop.wait(0.05):
+            self.most = max([self.most] + [len(engines_in(f, RANKS)) for f in self.folders])
+
+
+def assert_pair_complete(cases: list[Path]) -> None:
+    """Every case done with an exact count, a whole thermo table, every expected dump
+    non-empty with 84 particles, costs summed over all attempts; and each replica's
+    frames its own (they differ from the other replica's at every step)."""
+    from ligwf.study.case import CaseFolder
+
+    frames = {}
+    for path in cases:
+        case = CaseFolder.open(path)
+        m = read_manifest(path)
+        assert m.status == "done", (path.name, m.status, m.reason)
+        assert m.steps_done == m.total_steps and m.atoms_end == m.atoms_after_settle == 84
+        steps = [r.step for r in rows_from_csv((path / "thermo.csv").read_text())]
+        every = case.scaled.thermo_every
+        assert steps[0] == 0 and steps[-1] == m.total_steps
+        gaps = [(a, b) for a, b in zip(steps, steps[1:]) if not 0 < b - a <= every]
+        assert not gaps, f"{path.name}: thermo gaps or duplicates: {gaps[:5]}"
+        expected = case.expected_dump_steps(m.total_steps)
+        assert expected
+        for step in expected:
+            for kind in ("particles", "contacts"):
+                f = path / "post" / f"{kind}_{step}.vtu"
+                assert f.is_file() and f.stat().st_size > 0, f
+            points = meshio.read(path / "post" / f"particles_{step}.vtu").points
+            assert len(points) == 84, (path.name, step)
+            frames.setdefault(step, []).append(points)
+        assert not [p for p in (path / "post").iterdir() if p.stat().st_size == 0]
+        assert m.wall_seconds == pytest.approx(sum(a.wall_seconds for a in m.attempts))
+        assert m.core_seconds == pytest.approx(sum(a.wall_seconds * a.nprocs for a in m.attempts))
+        assert sum(p["steps"] for p in m.phases.values()) == sum(a.steps for a in m.attempts)
+        assert all(a.wall_seconds > 0 and a.ended for a in m.attempts), m.attempts
+        reached = 0
+        for a in m.attempts:
+            assert a.from_step <= reached, (path.name, a.number, a.from_step, reached)
+            reached = max(reached, a.from_step + a.steps)
+        assert reached == m.total_steps
+    both = {step: f for step, f in frames.items() if len(f) == 2}
+    assert len(both) == len(frames), "the replicas wrote different frame steps"
+    for step, (a, b) in both.items():
+        assert abs(a - b).max() > 1e-6, f"the replicas' frames are identical at step {step}"
+
+
+@pytest.mark.parametrize("fault", ["ligwf", "rank", "mpirun", "sigint", "sigterm"])
+def test_fault_campaign_on_the_planned_ensemble(tmp_path, fault):
+    """One fault kind, once in each phase (fill, settle, production) of the replica r0,
+    on the default planned path; then every case done, nothing mixed, nothing missing."""
+    out = tmp_path / "study"
+    cases = [out / c for c in PAIR]
+    victim = cases[0]
+    t0 = time.monotonic()
+    with PairWatch(cases) as watch:
+        p = start_pair(out)
+        hit = 0                 # attempts of the victim when it was last hit
+        for marker in PHASES:
+            wait_for(lambda: in_phase(victim, marker, hit) or p.poll() is not None,
+                     timeout=180, what=f"{marker} in an attempt after number {hit}")
+            assert p.poll() is None, f"ligwf ended before {marker}: {p.stderr.read()}"
+            time.sleep(0.3)
+            before = hit = attempts(victim)
+            if fault == "ligwf":
+                os.kill(p.pid, signal.SIGKILL)
+            elif fault in ("sigint", "sigterm"):
+                os.kill(p.pid, signal.SIGINT if fault == "sigint" else signal.SIGTERM)
+            elif fault == "rank":
+                ranks = engines_in(victim, ("ligwf-ensemble",))
+                assert ranks, "no rank to kill"
+                os.kill(ranks[0], signal.SIGKILL)
+            else:
+                os.kill(mpirun_of(p), signal.SIGKILL)
+            if fault in ENDS_LIGWF:
+                rc = p.wait(timeout=120)
+                err = p.stderr.read()
+                assert rc == ENDS_LIGWF[fault], (rc, err)
+                for case in cases:
+                    no_engine_left(case, within=30)
+                if fault != "ligwf":
+                    assert "interrupted by the user" in err, err
+                    assert "Traceback" not in err, err
+                    for case in cases:
+                        m = read_manifest(case)
+                        assert m.status == "killed", (case.name, m.status, m.reason)
+                        assert m.reason.startswith("interrupted by the user"), m.reason
+                        assert m.attempts[-1].ended and m.attempts[-1].wall_seconds > 0
+                        assert not (out / "report").exists() and not (out / "analysis").exists()
+                p = start_pair(out)
+            else:
+                # the supervisor settles the job and relaunches both from their restarts
+                wait_for(lambda: attempts(victim) > before or p.poll() is not None,
+                         timeout=120, what="the relaunch")
+                m = read_manifest(victim)
+                lost = m.attempts[before - 1]
+                assert lost.status == "killed" and lost.wall_seconds > 0, lost
+                assert "ensemble job ended" in lost.reason, lost.reason
+        rc = p.wait(timeout=300)
+        assert rc == 0, p.stderr.read()[-3000:]
+        r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS)   # nothing left to do
+        assert r.returncode == 0, r.stderr
+    assert watch.most == 1, f"{watch.most} engines wrote one case at once"
+    for case in cases:
+        assert not engines_in(case)
+    assert_pair_complete(cases)
+    m = read_manifest(victim)
+    assert len(m.attempts) >= 4, [(a.status, a.from_step) for a in m.attempts]
+    assert [a.status for a in m.attempts][-1] == "done"
+    assert all(a.status == "killed" for a in m.attempts[:-1]), [a.status for a in m.attempts]
+    # the production fault resumed from a restart of its own, not from step 0
+    assert m.attempts[-1].from_restart and m.attempts[-1].from_step > 0
+    assert list((out / ".ensemble").iterdir()), "the planned run used no ensemble"
+    print(f"\n{fault} campaign: {time.monotonic() - t0:.1f} s")
