@@ -101,7 +101,8 @@ def case_flow(case: CaseFolder, steady_after) -> tuple[dict, dict, list[str]]:
     steady = [k for k, f in enumerate(frames) if f.step >= first]
     if not steady:
         raise DumpReadError(f"{case.path}: no readable particle dump in the steady part "
-                            f"(steps >= {first:.0f})")
+                            f"(steps >= {first:.0f})"
+                            + (f"; first refused: {problems[-1]['reason']}" if problems else ""))
     flows = [all_flows[k] for k in steady]
     summ = summarise(flows)
     cu, cv, mu, mv = velocity_field([frames[k] for k in steady], geo)

@@ -127,8 +127,6 @@ def provenance_mismatch(study, settings, record: dict) -> str | None:
         return ("it records no provenance (scene and dump hashes): written by an older ligwf "
                 "or for another study")
     now = study_provenance(study, settings)
-    if then.get("settings") != now["settings"]:
-        return "the study's analysis settings changed since it was written"
     old, new = then["cases"], now["cases"]
     if set(old) != set(new):
         added, gone = sorted(set(new) - set(old)), sorted(set(old) - set(new))
@@ -141,6 +139,8 @@ def provenance_mismatch(study, settings, record: dict) -> str | None:
             return f"case {cid}: its scene changed since the analysis (re-rendered)"
         if old[cid].get("dump_record") != new[cid]["dump_record"]:
             return f"case {cid}: its dumps changed since the analysis (run again)"
+    if then.get("settings") != now["settings"]:
+        return "the study's analysis settings changed since it was written"
     return None
 
 
