@@ -14,8 +14,14 @@ own (:mod:`ligwf.analysis.frame_checks`: expected steps, dump record, particle c
 ids, radii, drum, contact geometry). Everything else is listed with its reason -- skipped
 cases, and missing, unexpected or refused frames -- in the analysis record and the frame
 table, which the report shows; a case left without any analysable frame is a skipped
-case. When nothing at all could be analysed, :class:`NothingAnalysed` is raised and the
-previous outputs stay as they were; otherwise the outputs are replaced as one set
+case. A usable case whose run holds no granule data by design (a dry scene, or
+``scene.analysis.granules: false``: no contact dumps) is not a skipped case: the record
+lists it under ``granules_absent`` with the reason in words, and when every usable case
+is one, the record is written without granule tables (the flow stage and the report use
+those cases all the same). When nothing at all could be analysed otherwise,
+:class:`NothingAnalysed` is raised and the previous outputs stay as they were; a frame
+the analysis fails on for any reason is a skipped frame (one bad frame never blocks the
+others). Otherwise the outputs are replaced as one set
 (:class:`~ligwf.analysis.outputs.OutputSet`). The science settings (bond criterion, GSD
 binning and bootstrap, steady window) come from the study
 (:class:`~ligwf.study.settings.AnalysisSettings`), so every path that analyses a study
@@ -38,7 +44,10 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
   sensitivity tables: see :mod:`ligwf.analysis.kinetics`;
 * ``<case_id>/granules.pvd`` + ``granules_<step>.vtu``: particles with a ``granule`` array;
 * the analysis record (JSON): settings, analysed and skipped cases with their steady
-  window, skipped frames with reasons.
+  window, skipped frames with reasons, cases without granule data, its provenance (the
+  settings' digest and per case of the study its scene hash and the SHA-256 of its dump
+  record: :func:`~ligwf.analysis.outputs.study_provenance`) and the size and SHA-256 of
+  every table, which the report checks before it uses any of them.
 """
 
 from __future__ import annotations
