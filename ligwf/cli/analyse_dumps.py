@@ -16,6 +16,8 @@ from pathlib import Path
 
 from ligwf import liquids
 from ligwf.cli.analyse import print_record
+from ligwf.cli.common import number_in
+from ligwf.scene.model import MAX_LIQUID_CONTENT
 
 
 def register(subparsers) -> None:
@@ -33,12 +35,15 @@ def register(subparsers) -> None:
                    help="engine: the value written into a LIGGGHTS 3.8.0 input (which applied "
                    "0.5 theta^2); scene: the angle the engine applied (fixed engine)")
     p.add_argument("--periodic-axis", required=True, choices=("x", "y", "z", "none"))
-    p.add_argument("--box-length", type=float, help="m, length of the periodic box "
+    p.add_argument("--box-length", type=number_in(1e-6, 10.0, "m"), help="m, length of the periodic box "
                    "(it spans [0, L]); required with a periodic axis")
-    p.add_argument("--dt", type=float, required=True, help="time step, s")
-    p.add_argument("--liquid-content", type=float, default=None,
+    p.add_argument("--dt", type=number_in(1e-10, 1.0, "s"), required=True,
+                   help="time step, s")
+    p.add_argument("--liquid-content", type=number_in(1e-5, MAX_LIQUID_CONTENT),
+                   default=None,
                    help="fraction of particle volume, when the dumps lack f_surfaceLiquidContent")
-    p.add_argument("--cg", type=float, default=1.0, help="coarse-graining factor of the run")
+    p.add_argument("--cg", type=number_in(1.0, 1000.0), default=1.0,
+                   help="coarse-graining factor of the run")
     p.add_argument("--steady-from-step", type=int, default=0,
                    help="first step of the GSD window (default: every frame)")
     p.add_argument("--particles", default="particles_*.vtu", help="particle file pattern")

@@ -5,6 +5,7 @@ warnings, the case table and the stop-on-signal event. Holds no pipeline logic (
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import signal
 import sys
@@ -46,6 +47,23 @@ def positive_int(text: str, unit: str = "") -> int:
         raise argparse.ArgumentTypeError(f"must be {what}, allowed range [1, inf), "
                                          f"got {text!r}")
     return value
+
+
+def number_in(low: float, high: float, unit: str = ""):
+    """argparse type: a finite number in [low, high] (``unit`` shown after the range), so
+    ``--dt 5e-324`` or ``--cg 0`` is refused in one line before any file is read."""
+    shown = f"[{low:g}, {high:g}]" + (f" {unit}" if unit else "")
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not low <= value <= high:      # nan fails too
+            raise argparse.ArgumentTypeError(f"must be a number, allowed range {shown}, "
+                                             f"got {text!r}")
+        return value
+    return parse
 
 
 def rank_count(text: str) -> int:
