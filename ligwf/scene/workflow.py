@@ -183,13 +183,15 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
         sweep = Sweep.model_validate(known)
     except ValidationError as exc:
         raise ConfigError("invalid sweep:\n" + format_validation_error(exc, Sweep, "sweep")) from None
-    for cg in list(sweep.cg_levels) + list(sweep.per_cg):
+    levels = [(f"sweep.cg_levels[{k}]", cg) for k, cg in enumerate(sweep.cg_levels)]
+    for where, cg in levels + [(f"sweep.per_cg.{cg:g}", cg) for cg in sweep.per_cg]:
         if cg < 1:
-            raise ConfigError(f"sweep.cg_levels: CG level {cg:g} is < 1 (allowed range [1, inf))")
-    reps = sweep.replicas.values() if isinstance(sweep.replicas, dict) else [sweep.replicas]
-    for n in reps:
+            raise ConfigError(f"{where} = {cg:g}: CG level is < 1 (allowed range [1, inf))")
+    reps = ([(f"sweep.replicas.{cg:g}", n) for cg, n in sweep.replicas.items()]
+            if isinstance(sweep.replicas, dict) else [("sweep.replicas", sweep.replicas)])
+    for where, n in reps:
         if not 1 <= n <= MAX_REPLICAS:
-            raise ConfigError(f"sweep.replicas = {n}: allowed range [1, {MAX_REPLICAS}] "
+            raise ConfigError(f"{where} = {n}: allowed range [1, {MAX_REPLICAS}] "
                               "replicas per CG level")
     stray = sorted(set(sweep.per_cg) - set(sweep.cg_levels))
     if stray:

@@ -63,10 +63,10 @@ class AnalysisSettings(_Frozen):
         "lab", description="velocities of the angle test: as dumped (lab), relative to the "
         "drum's rigid rotation (drum), or minus the local mean flow (flow)")
     flow_radius: float = Field(
-        3.0, gt=0.0, le=50.0, description="radius of the local mean flow of velocity_frame "
+        3.0, ge=0.1, le=50.0, description="radius of the local mean flow of velocity_frame "
         "flow, in mean particle diameters of the case")
     resolution: float = Field(
-        0.002, gt=0.0, le=100.0, allow_inf_nan=False, description="CPM resolution gamma of "
+        0.002, ge=1e-9, le=100.0, allow_inf_nan=False, description="CPM resolution gamma of "
         "the communities (edge weight w n^2, node weight n^3 at CG level n; the default "
         "0.002 is for the energy weight, the force weight's scale is ~3-5x larger: 0.01-0.02)")
     community_weight: Literal["energy", "force"] = Field(
@@ -86,7 +86,7 @@ class AnalysisSettings(_Frozen):
         2, ge=1, description="granules with fewer particles are left out of the GSD and "
         "the kinetics (single particles are not granules)")
     error_band: float = Field(
-        0.15, gt=0.0, le=10.0, description="relative per-bin GSD error of CG-n against CG1 "
+        0.15, ge=1e-3, le=10.0, description="relative per-bin GSD error of CG-n against CG1 "
         "that locates the size limit")
     bootstrap: int = Field(1000, ge=1, le=1_000_000, description="bootstrap draws of the "
                            "GSD confidence bands")
