@@ -104,7 +104,7 @@ def _bound_reason(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str | 
     return extra.get("bound_reason") if isinstance(extra, dict) else None
 
 
-_LEADING_FIELD = re.compile(r"([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)(?=[ :=])")
+_LEADING_FIELD = re.compile(r"([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)(?= = |: )")
 
 
 def _model_level(root: type[BaseModel], loc: tuple[Any, ...], prefix: str, msg: str) -> str:

@@ -40,8 +40,10 @@ class Lifters(_Frozen):
     @model_validator(mode="after")
     def _fit_around(self) -> "Lifters":
         if self.count and self.count * self.width_deg >= 360.0:
-            raise ValueError(f"count x width_deg = {self.count * self.width_deg:g} deg; "
-                             "the lifters must leave gaps: count x width_deg < 360")
+            most = math.ceil(360.0 / self.width_deg) - 1
+            raise ValueError(f"count = {self.count}: {self.count} lifters of width_deg = "
+                             f"{self.width_deg:g} span {self.count * self.width_deg:g} deg; "
+                             f"they must leave gaps (allowed range [0, {most}] lifters)")
         return self
 
 

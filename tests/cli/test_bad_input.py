@@ -215,6 +215,8 @@ CORPUS: list[Bad] = [
     Bad("rule-unknown-path", ("sweep.rules[1] = 'bnd'",), overrides=("sweep.rules=[weber,bnd]",)),
     Bad("fractions-sum-path", ("scene.particles.size_distribution: the fractions sum to 0.5",),
         overrides=("scene.particles.size_distribution=[{diameter: 0.001, fraction: 0.5}]",)),
+    Bad("lifters-overlap-path", ("scene.drum.lifters.count = 100", "[0, 89] lifters"),
+        overrides=("scene.drum.lifters={count: 100, height: 0.002, width_deg: 4}",)),
     Bad("output-count-path", ("scene.numerics.dump_interval = 1e-09",),
         overrides=("scene.numerics.dump_interval=1e-9",)),
     Bad("mpirun-args-unclosed-quote", ("LIGWF_MPIRUN_ARGS", '\'"--bind-to\'', "no closing"),
