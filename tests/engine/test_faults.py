@@ -448,3 +448,92 @@ def test_fault_campaign_on_the_planned_ensemble(tmp_path, fault):
     assert m.attempts[-1].from_restart and m.attempts[-1].from_step > 0
     assert list((out / ".ensemble").iterdir()), "the planned run used no ensemble"
     print(f"\n{fault} campaign: {time.monotonic() - t0:.1f} s")
+
+
+def test_foreign_truncated_and_garbled_restarts_are_never_resumed(tmp_path):
+    """Both replicas stopped in production (SIGTERM: forced restarts). Then the replica
+    behind gets the other's newer forced restart (with its identity record) and the
+    other's periodic restart over its own, and its own forced restart is cut in half; the
+    other replica's own periodic restart is garbled (same size). The re-run resumes each
+    from an older restart of its own, and nothing is mixed or missing."""
+    from ligwf.engine.liggghts import FORCED_RESTART_RE, restart_step
+
+    out = tmp_path / "study"
+    cases = [out / c for c in PAIR]
+    p = start_pair(out)
+    wait_for(lambda: all(in_phase(c, "ligwf-phase production", 0) for c in cases)
+             or p.poll() is not None, timeout=180, what="production in both")
+    time.sleep(1.0)
+    os.kill(p.pid, signal.SIGTERM)
+    assert p.wait(timeout=120) == 143, p.stderr.read()
+
+    def forced(case: Path) -> Path:
+        found = sorted((f for f in case.iterdir() if FORCED_RESTART_RE.match(f.name)),
+                       key=restart_step)
+        assert found, f"no forced restart in {case.name}"
+        return found[-1]
+
+    progress = {c: read_manifest(c).steps_done for c in cases}
+    victim, donor = sorted(cases, key=lambda c: progress[c])
+    theirs, mine = forced(donor), forced(victim)
+    if restart_step(theirs) != restart_step(mine):     # else: same name, mine is replaced
+        (victim / (theirs.name + ".id.json")).write_bytes(
+            (donor / (theirs.name + ".id.json")).read_bytes())
+    (victim / theirs.name).write_bytes(theirs.read_bytes())
+    if restart_step(theirs) != restart_step(mine):
+        data = mine.read_bytes()
+        mine.write_bytes(data[: len(data) // 2])       # truncated
+    periodic = {c: sorted((c / "restart").glob("restart_?.liggghts"), key=restart_step)
+                for c in cases}
+    (victim / "restart" / periodic[donor][-1].name).write_bytes(periodic[donor][-1].read_bytes())
+    garbled = periodic[donor][0]
+    data = bytearray(garbled.read_bytes())
+    mid = len(data) // 2
+    data[mid:mid + 64] = bytes(64)
+    garbled.write_bytes(bytes(data))
+    before = {c: attempts(c) for c in cases}
+
+    r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS, timeout=300)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr
+    for case in cases:
+        resumed = read_manifest(case).attempts[before[case]]
+        assert resumed.from_step <= progress[case], (case.name, resumed.from_step)
+        assert resumed.from_restart not in (None, ), f"{case.name} re-ran from step 0"
+        if case == victim:
+            # not the other's forced restart, not its own cut one, not the other's periodic
+            assert resumed.from_restart != theirs.name and resumed.from_restart != mine.name
+            assert resumed.from_restart != f"restart/{periodic[donor][-1].name}"
+        else:
+            assert resumed.from_restart != f"restart/{garbled.name}"
+    assert_pair_complete(cases)
+    for case in cases:
+        assert not engines_in(case)
+
+
+def test_disk_full_in_the_planned_ensemble_then_resumed_whole(tmp_path):
+    """A disk that fills while both replicas run side by side: one line, exit 2, no case
+    left 'running', no engine left; with room again both end done with no thermo gap and
+    no empty frame."""
+    with tmpfs(tmp_path / "disk", "8m") as disk:
+        out = disk / "study"
+        r = run("render", str(WORKFLOW), "--out", str(out), *PAIR_ARGS[2:])
+        assert r.returncode == 0, r.stderr
+        used = int(subprocess.run(["du", "-sk", str(disk)], capture_output=True,
+                                  text=True).stdout.split()[0])
+        mesh = (out / PAIR[0] / "drum.stl").stat().st_size // 1024
+        subprocess.run(["mount", "-o", f"remount,size={used + 2 * mesh + 400}k", str(disk)],
+                       check=True)
+        r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS)
+        one_line_error(r, out)
+        assert "disk full" in r.stderr or "No space" in r.stderr, r.stderr
+        cases = [out / c for c in PAIR]
+        for case in cases:
+            m = read_manifest(case)
+            assert m is not None and m.status != "running", (case.name, m and m.reason)
+            assert m.status != "done" or m.steps_done == m.total_steps
+            assert not engines_in(case)
+        assert any(read_manifest(c).reason.startswith("disk full") for c in cases)
+        subprocess.run(["mount", "-o", "remount,size=64m", str(disk)], check=True)
+        r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS)
+        assert r.returncode == 0, r.stdout[-3000:] + r.stderr
+        assert_pair_complete(cases)
