@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Iterable
 
 from ligwf import __version__
+from ligwf.errors import ConfigError
 from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, atomic_write_text,
                         not_writable)
 from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
@@ -64,9 +65,31 @@ class RenderedCase:
         }
 
 
+#: most steps LIGGGHTS runs in one ``run`` command ("Invalid run command N value" above)
+ENGINE_MAX_RUN_STEPS = 2**31 - 1
+
+
+def check_run_lengths(case: Case, scaled: ScaledScene) -> None:
+    """Refuse a phase longer than one LIGGGHTS ``run`` command takes: the engine would stop
+    with "Invalid run command N value" after the fill (a tiny dt with a long run)."""
+    fall = "the fill's insertion wave (the fall across the drum)"
+    for field, steps in (("process.settle_time", scaled.settle_steps),
+                         ("process.run_time", scaled.run_steps), (fall, scaled.wave_steps)):
+        if steps > ENGINE_MAX_RUN_STEPS:
+            seconds = steps * scaled.dt
+            most = ENGINE_MAX_RUN_STEPS * scaled.dt
+            shown = f"{field} = {seconds:g} s" if field != fall else f"{field}, {seconds:.3g} s,"
+            raise ConfigError(f"case {case.case_id}: {shown} is {steps:,} steps of dt = "
+                              f"{scaled.dt:.3g} s; LIGGGHTS runs at most "
+                              f"{ENGINE_MAX_RUN_STEPS:,} steps in one run command (allowed "
+                              f"range (0, {most:.3g}] s at this dt; or raise numerics.dt / "
+                              "numerics.dt_rayleigh_fraction)")
+
+
 def render_case(case: Case, template_dirs: Iterable[str | Path] = ()) -> RenderedCase:
     """Scale and render one case in memory."""
     scaled = case.scaled()
+    check_run_lengths(case, scaled)
     files = render(scaled, template_dirs)
     mesh_text = drum_stl(case.scene.drum, scene_sag(case.scene))
     return RenderedCase(case, scaled, files, mesh_text, content_hash(scaled, files, mesh_text))
