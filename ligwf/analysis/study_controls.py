@@ -53,7 +53,9 @@ def is_control(case: CaseFolder) -> bool:
 
 def candidates_for(definition: GranuleDefinition):
     """The study's own definition first, then the candidates of the regime map."""
-    own = ("study definition (" + definition.method + ")", "frame", definition)
+    name = "study definition (" + definition.method + ")"
+    own = ((name, "window", (definition.hold_time, None)) if definition.method == "held"
+           else (name, "frame", definition))
     return (own,) + tuple(c for c in DEFAULT_CANDIDATES if c[0] != definition.method)
 
 
