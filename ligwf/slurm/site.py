@@ -159,8 +159,12 @@ def site_from_mapping(values: Mapping[str, Any]) -> SlurmSite:
         kwargs["setup"] = _as_tuple(values["setup"], "setup", split_text=False)
     if "sbatch_args" in values:
         raw = values["sbatch_args"]
-        kwargs["sbatch_args"] = (tuple(shlex.split(raw)) if isinstance(raw, str)
-                                 else _as_tuple(raw, "sbatch_args", split_text=False))
+        try:
+            kwargs["sbatch_args"] = (tuple(shlex.split(raw)) if isinstance(raw, str)
+                                     else _as_tuple(raw, "sbatch_args", split_text=False))
+        except ValueError as exc:     # an unclosed quote: "No closing quotation"
+            raise ConfigError(f"slurm sbatch_args = {raw!r}: not a valid argument list "
+                              f"({str(exc).lower()}); quote as in a shell") from None
     kwargs.setdefault("ligwf", default_ligwf_command())
     return SlurmSite(**kwargs)
 
