@@ -156,6 +156,33 @@ def _step_at(lines: Sequence[str], index: int) -> int | None:
     return None
 
 
+#: What an engine error line means, for the reason of a failed case: (pattern, hint).
+#: The first match wins; the hint says what happened and what to change.
+ENGINE_ERROR_HINTS: tuple[tuple[re.Pattern, str], ...] = (
+    (re.compile(r"Internal error \(\S*tri_mesh_I\.h"),
+     "LIGGGHTS found a mesh-wall contact point in no region of its triangle "
+     "(TriMesh::resolveTriSphereContactBary: its barycentric coordinates are not "
+     "finite), i.e. a particle position turned nan/inf: the integration blew up. Seen "
+     "with stiff particles (hard_particles, E > 1e9 Pa) at dt above 0.16 of the Rayleigh "
+     "time; lower numerics.dt_rayleigh_fraction (0.16 ran) or particles.youngs_modulus"),
+    (re.compile(r"Internal error"),
+     "an internal consistency check of LIGGGHTS failed, usually after a nan reached the "
+     "particle data (look at the thermo rows before it); lower the time step"),
+    (re.compile(r"Atom types must start from 1|Lost atoms"),
+     "particles left the domain (a time step far too large, or a leaking drum)"),
+    (re.compile(r"mesh elements have been lost|left the domain", re.I),
+     "the drum mesh does not fit the simulation box (mesh or box length changed?)"),
+)
+
+
+def error_hint(message: str) -> str | None:
+    """The hint for an engine error line (None: no known meaning)."""
+    for pattern, hint in ENGINE_ERROR_HINTS:
+        if pattern.search(message):
+            return hint
+    return None
+
+
 def log_errors(lines: Sequence[str]) -> list[HealthIssue]:
     """``ERROR`` / ``ERROR on proc N`` lines, and MPI_ABORT notices without one."""
     for i, line in enumerate(lines):
@@ -243,7 +270,8 @@ def verdict(issues: Sequence[HealthIssue], exit_code: int | None, steps_done: in
     errors = [i for i in issues if i.kind == "error"]
     physics = [i for i in issues if not i.fatal]
     if errors:
-        return FAILED, errors[0].message
+        hint = error_hint(errors[0].message)
+        return FAILED, errors[0].message + (f" -- {hint}" if hint else "")
     if physics:
         first = physics[0]
         return UNSTABLE, f"{first.kind}: {first.message}"
