@@ -28,10 +28,29 @@ def _site_file() -> Path:
     return Path(os.environ.get("XDG_CONFIG_HOME", Path.home() / ".config")) / "ligwf" / "site.yaml"
 
 
+#: what a site file may set (anything else is a typo that would be ignored silently)
+SITE_KEYS = ("liggghts", "mpirun", "mpirun_args", "libliggghts", "slurm")
+
+
 def load_site() -> dict:
-    """The site YAML as a mapping ({} when there is none)."""
+    """The site YAML as a mapping ({} when there is none); unknown keys are refused."""
     path = _site_file()
-    return read_yaml_mapping(path, "site file") if path.exists() else {}
+    site = read_yaml_mapping(path, "site file") if path.exists() else {}
+    unknown = sorted(set(site) - set(SITE_KEYS))
+    if unknown:
+        raise ConfigError(f"site file {path}: unknown key(s) {', '.join(unknown)} (typo?; "
+                          f"allowed: {', '.join(SITE_KEYS)})")
+    for key in ("liggghts", "mpirun", "libliggghts"):
+        if key in site and (not isinstance(site[key], str) or not site[key].strip()):
+            raise ConfigError(f"site file {path}: {key} = {site[key]!r}: must be a program "
+                              "or file name")
+    args = site.get("mpirun_args")
+    if args is not None and not isinstance(args, str) and not (
+            isinstance(args, list) and all(isinstance(a, (str, int, float)) and
+                                           not isinstance(a, bool) for a in args)):
+        raise ConfigError(f"site file {path}: mpirun_args is a {type(args).__name__} "
+                          "(or holds one): must be a string or a list of arguments")
+    return site
 
 
 def _setting(site: dict, key: str) -> str:
