@@ -95,7 +95,8 @@ class SizeClass(_Frozen):
     diameter: float | None = Field(None, ge=MIN_LENGTH, le=1.0, description="diameter, m")
     diameter_range: tuple[float, float] | None = Field(None, description="[min, max] diameter, m")
     bins: int = Field(4, ge=1, le=64, description="classes a range is split into")
-    fraction: float = Field(gt=0.0, le=1.0, description="number fraction")
+    fraction: float = Field(ge=1e-6, le=1.0, description="number fraction (a class below "
+                            "1e-6 of the particles is a typo, not a size class)")
 
     @model_validator(mode="after")
     def _one_of(self) -> "SizeClass":

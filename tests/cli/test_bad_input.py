@@ -178,6 +178,10 @@ CORPUS: list[Bad] = [
         overrides=("scene.liquid.surface_tension=1e-300",)),
     Bad("size-denormal", ("scene.particles.size_distribution[0].diameter = 5e-324", "[1e-06, 1]"),
         overrides=("scene.particles.size_distribution=[{diameter: 5e-324, fraction: 1.0}]",)),
+    Bad("fraction-denormal", ("scene.particles.size_distribution[1].fraction = 1e-300",
+                              "[1e-06, 1]"),
+        overrides=("scene.particles.size_distribution=[{diameter: 0.001, fraction: 1.0}, "
+                   "{diameter: 0.002, fraction: 1e-300}]",)),
     Bad("range-denormal", ("scene.particles.size_distribution[0].diameter_range", "1e-06 m"),
         overrides=("scene.particles.size_distribution=[{diameter_range: [1e-300, 1e-3], "
                    "fraction: 1.0}]",)),
