@@ -9,6 +9,7 @@ no number field accepts.
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -34,8 +35,9 @@ class Bad:
     overrides: tuple[str, ...] = ()
     command: str = "render"
     options: tuple[str, ...] = ()
-    setup: str = ""                       # "out-file", "out-under-file", "cache-file"
+    setup: str = ""     # "out-file", "out-under-file", "cache-file", "study-listed-twice"
     warns: bool = False                   # a documented warning (check exits 0), not a refusal
+    seconds: float = 5.0                  # time allowed before the refusal
     extra: dict = field(default_factory=dict)
 
 
@@ -241,6 +243,9 @@ CORPUS: list[Bad] = [
     Bad("site-unknown-key", ("site file", "mpirun_arg", "typo"),
         command="run", overrides=("sweep.cg_levels=[3]", "sweep.rules=[bond]"),
         extra={"site": "mpirun_arg: --bind-to none\n"}),
+    Bad("report-case-listed-twice", ("study.json", "cg3-bond-r0", "more than"),
+        command="report", setup="study-listed-twice",
+        seconds=30.0),   # report imports scipy.stats and matplotlib before it reads the study
     Bad("np-huge", ("--np", "[1, 1048576]", "1000000000000"), command="run",
         options=("--np", "1000000000000")),
     Bad("ensemble-huge", ("--ensemble", "[1, 1048576]"), command="study",
@@ -298,6 +303,15 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
     if "site" in bad.extra:
         (tmp_path / "site.yaml").write_text(bad.extra["site"])
     monkeypatch.setenv("LIGWF_SITE", str(tmp_path / "site.yaml"))
+    if bad.setup == "study-listed-twice":     # a rendered study whose record repeats a case
+        study = tmp_path / "rendered"
+        assert main(["render", str(workflow), "--out", str(study), "--set", "sweep.cg_levels=[3]",
+                     "--set", "sweep.rules=[bond]"]) == 0
+        record = json.loads((study / "study.json").read_text())
+        record["cases"].append(record["cases"][0])
+        (study / "study.json").write_text(json.dumps(record))
+        capsys.readouterr()
+        workflow = study
     before = sorted(p.name for p in tmp_path.iterdir())
     argv = [*bad.command.split(), str(workflow), *options]
     if bad.command != "check":
@@ -315,7 +329,7 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
     for frag in bad.expect:
         assert frag in flat, f"{frag!r} not in the message:\n{err}"
     assert "= {'" not in flat, f"a whole mapping instead of its field:\n{err}"
-    assert elapsed < 5.0, f"{elapsed:.1f} s before the refusal"
+    assert elapsed < bad.seconds, f"{elapsed:.1f} s before the refusal"
     assert sorted(p.name for p in tmp_path.iterdir()) == before, "something was written"
 
 
