@@ -34,6 +34,15 @@ _RANK = {OK: 0, MARGINAL: 1, REFUSED: 2}
 #: dt / t_R above which LIGGGHTS' check/timestep/gran warns (and the runner marks the case
 #: unstable); the LIGGGHTS documentation recommends < 20 % of the Rayleigh time.
 DT_RAYLEIGH_LIMIT = 0.2
+#: Young's modulus above which ligwf renders ``hard_particles yes`` (templates/_materials.j2)
+HARD_PARTICLE_MODULUS = 1e9
+#: dt / t_R limit for hard particles. The engine does not hold 0.2 there: a 320-particle
+#: closed drum at E = 5e9 Pa crashed the same way every time at 0.19 ("ERROR on proc 0:
+#: Internal error (./src/tri_mesh_I.h:109)": TriMesh::resolveTriSphereContactBary finds
+#: the contact point in no region of the triangle, i.e. the particle's position is nan --
+#: the integration had blown up) and completed at 0.16 (issue 21). Refused above 0.18,
+#: which is also where the soft-particle limit turns marginal.
+DT_RAYLEIGH_LIMIT_HARD = 0.18
 #: dt / t_H limit: the same 20 % that check/timestep/gran applies to the Hertz time.
 DT_HERTZ_LIMIT = 0.2
 #: dt / t_c limit for the capillary spring: velocity Verlet is stable for dt < 2 t_c; the
@@ -58,6 +67,11 @@ CLOSED_MIN = 3.0
 #: (warned). The default max_separation_ratio 1.1 gives 0.58-0.85 on the shipped scenes
 #: (LIGGGHTS_NOTES, measured 2026-11-28): the engine always cuts somewhat early.
 BRIDGE_CUT_WARN = 0.5
+#: Bed cohesion number (timescales.cohesion_number) from which the bed holds its own weight
+#: over its whole depth and turns with the drum as one block (warned: it will not flow).
+#: Measured on the shipped scenes: 0.17-0.2 flows (CG1, weber), 0.4-0.6 turns rigid in
+#: 30-38 % of the frames (bond CG2/CG3 of we_vs_bo, LIGGGHTS_NOTES).
+COHESION_NO_FLOW = 1.0
 
 
 @dataclass(frozen=True)
@@ -142,17 +156,25 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
     dt_field = _dt_field(s, explicit_dt)
     out: list[Finding] = []
 
-    def timestep(check: str, what: str, t: float, limit: float, cure: str) -> None:
+    def timestep(check: str, what: str, t: float, limit: float, cure: str,
+                 why: str = "") -> None:
         ratio = dt / t
         verdict = _grade(ratio, limit)
         msg = (f"{dt_field}: dt = {dt:.2g} s is {ratio:.3g}x the {what} of the smallest {tag} "
-               f"particle ({t:.2g} s); limit {limit:g}x")
+               f"particle ({t:.2g} s); limit {limit:g}x{why}")
         if verdict != OK:
-            msg += f"; use dt <= {limit * t:.2g} s{cure}"
+            # a marginal dt already meets the limit: suggest one below the marginal band
+            safe = limit if verdict == REFUSED else MARGINAL_SHARE * limit
+            msg += f"; use dt <= {safe * t:.2g} s{cure.format(safe=safe)}"
         out.append(Finding(check, dt_field, ratio, limit, verdict, msg))
 
-    timestep("dt_rayleigh", "Rayleigh time", sc.rayleigh_time, DT_RAYLEIGH_LIMIT,
-             f" (dt_rayleigh_fraction <= {DT_RAYLEIGH_LIMIT:g})")
+    hard = s.youngs_modulus > HARD_PARTICLE_MODULUS
+    timestep("dt_rayleigh", "Rayleigh time", sc.rayleigh_time,
+             DT_RAYLEIGH_LIMIT_HARD if hard else DT_RAYLEIGH_LIMIT,
+             " (dt_rayleigh_fraction <= {safe:.2g})",
+             f" (hard particles, E = {s.youngs_modulus:.3g} Pa > {HARD_PARTICLE_MODULUS:g}: "
+             "the engine crashed at 0.19 with a nan position at a wall contact, "
+             "tri_mesh_I.h:109)" if hard else "")
     timestep("dt_hertz", f"Hertz contact time at {2 * sc.impact_velocity:.2g} m/s", sc.hertz_time,
              DT_HERTZ_LIMIT, "")
     if sc.capillary_time is not None and math.isfinite(sc.capillary_time):
@@ -211,6 +233,21 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
                     f" use max_separation_ratio >= {1.0 + sc.rupture_distance / d:.3g}")
         out.append(Finding("bridge_cut", "liquid.max_separation_ratio", ratio,
                            BRIDGE_CUT_WARN, verdict, msg))
+
+    if sc.cohesion_number is not None:
+        co = sc.cohesion_number
+        verdict = MARGINAL if co >= COHESION_NO_FLOW else OK
+        msg = (f"liquid.surface_tension: bed cohesion number Co = {co:.3g} (bridge force "
+               f"{sc.bridge_force:.2g} N at contact, {s.rule} rule, against the weight of a "
+               f"{sc.bed_depth:.2g} m deep bed; Fr = {s.froude:.3g}); warn at "
+               f"{COHESION_NO_FLOW:g}")
+        if verdict != OK:
+            msg += (f"; the bed holds its own weight and will not flow: it turns with the "
+                    f"drum as one rigid block (no angle of repose, no flowing layer); "
+                    f"multiply liquid.surface_tension by <= {COHESION_NO_FLOW / co:.2g}, use "
+                    f"the weber rule or a deeper bed")
+        out.append(Finding("bed_flow", "liquid.surface_tension", co, COHESION_NO_FLOW,
+                           verdict, msg))
 
     verdict = MARGINAL if sc.regime in ("centrifuging", "slumping") else OK
     msg = (f"process.rotation: {s.rpm:.3g} rpm, Fr = {s.froude:.3g} ({sc.regime}); "

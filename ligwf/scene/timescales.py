@@ -25,6 +25,12 @@ m = 4/3 pi r^3 rho, same material):
   together against Hertz (4/3) E* sqrt(R*) delta^(3/2); the equilibrium delta is the
   static overlap a wet bed keeps. When the capillary pull grows faster than Hertz there is
   no equilibrium: the pair collapses (the engine then loses atoms).
+* Bed cohesion number (wet): Co = sigma_t / (rho_b g H), the tensile strength of the
+  pendular bed (Rumpf 1958: sigma_t = (1 - eps) / eps * F_0 / d^2, porosity eps = 0.4)
+  over the weight stress at the bed's depth H (chord height of the circular segment the
+  particles fill at that porosity), bulk density rho_b = (1 - eps) rho: Co = F_0 / (eps d^2 rho g H) =
+  1.31 Bo_g d / H with the granular Bond number Bo_g = F_0 / (m g). Co >= 1: the bed holds
+  its own weight over its whole depth and turns with the drum as one block.
 * Froude number Fr = omega^2 R / g; critical speed n_c = 60 / (2 pi) sqrt(g / R) rpm
   (Fr = 1). Regimes after Mellmann, Powder Technol. 118 (2001) 251, Table 2: slumping
   Fr < 1e-4, rolling < 3e-3, cascading < 0.1, cataracting < 1, centrifuging >= 1
@@ -61,6 +67,9 @@ class TimeScales:
     froude: float
     critical_rpm: float
     regime: str
+    bridge_force: float | None = None   # N, bridge force at contact F_0 (wet)
+    bed_depth: float = 0.0              # m, depth of the bed at rest (chord height)
+    cohesion_number: float | None = None  # Co (wet), see the module docstring
 
 
 def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
@@ -119,6 +128,35 @@ def capillary_overlap(radius: float, youngs_modulus: float, poisson_ratio: float
     return hi
 
 
+#: porosity of the bed in the cohesion number (random packing of spheres)
+BED_POROSITY = 0.4
+
+
+def bed_depth(drum_diameter: float, fill_fraction: float) -> float:
+    """Depth (m) of a bed at rest filling ``fill_fraction`` of a circle of diameter
+    ``drum_diameter``: the height h of the circular segment of that area (bisection)."""
+    r = 0.5 * drum_diameter
+    target = fill_fraction * math.pi * r * r
+
+    def area(h: float) -> float:
+        return r * r * math.acos((r - h) / r) - (r - h) * math.sqrt(max(2 * r * h - h * h, 0.0))
+
+    lo, hi = 0.0, 2.0 * r
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if area(mid) < target else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def cohesion_number(bridge_force: float, diameter: float, density: float,
+                    depth: float, gravity: float = GRAVITY) -> float:
+    """Co = F_0 / (eps d^2 rho g H): the pendular bed's tensile strength (Rumpf) over its
+    weight stress at depth H (see the module docstring)."""
+    if depth <= 0.0:
+        return math.inf
+    return bridge_force / (BED_POROSITY * diameter**2 * density * gravity * depth)
+
+
 def regime(froude: float) -> str:
     for edge, name in REGIMES:
         if froude < edge:
@@ -132,7 +170,12 @@ def time_scales(s: ScaledScene) -> TimeScales:
     v_imp = impact_velocity(s.omega, s.drum_diameter)
     t_h = hertz_time(r, s.density, s.youngs_modulus, s.poisson_ratio, 2.0 * v_imp)
     overlap = hertz_max_overlap(r, s.density, s.youngs_modulus, s.poisson_ratio, v_imp)
-    t_c = cap_overlap = rupture = cutoff = reach = None
+    t_c = cap_overlap = rupture = cutoff = reach = f0 = co = None
+    # the bed the particles make (a particle_count may differ from the fill fraction)
+    v_mean = sum(f * math.pi * d**3 / 6.0 for d, f in zip(s.diameters, s.number_fractions))
+    fill = s.particle_count * v_mean / ((1.0 - BED_POROSITY) * math.pi
+                                        * (0.5 * s.drum_diameter) ** 2 * s.drum_length)
+    depth = bed_depth(s.drum_diameter, min(fill, 0.999))
     if s.wet:
         model = s.liquid
         theta = applied_contact_angle_rad(s.contact_angle_deg, s.contact_angle_compensation)
@@ -143,10 +186,16 @@ def time_scales(s: ScaledScene) -> TimeScales:
         vol = model.bridge_volume(r, r, s.liquid_content, s.liquid_content)
         rupture = float(model.rupture_distance(vol, theta))
         cutoff, reach = model.engine_cutoff_gaps(r, s.max_separation_ratio) or (None, None)
+        # the bed's typical particle (number-mean diameter) holds it together
+        d_mean = sum(d * f for d, f in zip(s.diameters, s.number_fractions))
+        f0_mean, _ = model.contact_force_and_stiffness(0.5 * d_mean, s.surface_tension, theta,
+                                                       s.liquid_content)
+        co = cohesion_number(f0_mean, d_mean, s.density, depth)
     radius = 0.5 * s.drum_diameter
     return TimeScales(
         rayleigh_time=s.rayleigh_time, impact_velocity=v_imp, hertz_time=t_h,
         hertz_overlap=overlap, capillary_time=t_c, capillary_overlap=cap_overlap,
         rupture_distance=rupture, bridge_cutoff=cutoff, neighbor_cutoff=reach, froude=s.froude,
         critical_rpm=60.0 / (2.0 * math.pi) * math.sqrt(GRAVITY / radius),
-        regime=regime(s.froude))
+        regime=regime(s.froude), bridge_force=f0 if f0 is None else float(f0),
+        bed_depth=depth, cohesion_number=co)
