@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Iterator, Sequence
 
 from rich.console import Console, Group
+from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
@@ -30,8 +31,9 @@ class Parser(argparse.ArgumentParser):
     """argparse with its refusals in ligwf's one-line form (sub-parsers inherit it)."""
 
     def error(self, message: str):  # noqa: D401 - argparse's hook
-        err_console.print(f"[bold red]ligwf: usage error:[/] {self.prog}: {message} "
-                          f"(see {self.prog} --help)", highlight=False)
+        err_console.print(f"[bold red]ligwf: usage error:[/] {escape(self.prog)}: "
+                          f"{escape(message)} "
+                          f"(see {escape(self.prog)} --help)", highlight=False)
         raise SystemExit(2)
 
 
@@ -128,7 +130,7 @@ def prepare_from_args(args: argparse.Namespace) -> Prepared:
     prepared = prepare_workflow(args.workflow, args.overrides, args.templates,
                                 args.allow_unstable)
     for line in prepared.warnings:
-        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
+        err_console.print(f"[yellow]ligwf: warning:[/] {escape(line)}", highlight=False)
     return prepared
 
 

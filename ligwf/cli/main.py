@@ -20,6 +20,7 @@ from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_workflo
 from ligwf.engine.plan import machine_cores, plan_study
 from ligwf.errors import LigwfError
 from ligwf.scene.regime import granulation_warning, original_numbers, regime_numbers
+from rich.markup import escape
 from rich.table import Table
 from ligwf.fsio import NOT_WRITABLE, not_writable
 from ligwf.study.pipeline import Interrupted, prepared_loads, write
@@ -115,13 +116,16 @@ def main(argv: list[str] | None = None) -> int:
         return int(args.func(args) or 0)
     except OSError as exc:  # a stage writing into a full or read-only folder: one line
         exc = not_writable(exc, Path.cwd()) if exc.errno in NOT_WRITABLE else exc
-        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
+        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {escape(str(exc))}",
+                          highlight=False)
         return 2
     except Interrupted as exc:         # Ctrl-C / SIGTERM: 130 / 143, as a shell would
-        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
+        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {escape(str(exc))}",
+                          highlight=False)
         return exc.exit_code
     except LigwfError as exc:
-        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {exc}", highlight=False)
+        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {escape(str(exc))}",
+                          highlight=False)
         return 2
 
 

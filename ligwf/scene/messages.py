@@ -136,6 +136,8 @@ def format_validation_error(exc: ValidationError, root: type[BaseModel], prefix:
             continue  # a collection emptied by its own invalid items: already reported
         value = err.get("input")
         msg = err["msg"].removeprefix("Value error, ").removeprefix("Assertion failed, ")
+        # a workflow has lists, not tuples (pydantic names the Python type)
+        msg = msg.replace("a valid tuple", "a list")
         item = (err.get("ctx") or {}).get("error")
         if isinstance(item, ItemProblem):
             loc, value, msg = loc + item.where, item.value, str(item)

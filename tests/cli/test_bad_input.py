@@ -142,6 +142,7 @@ CORPUS: list[Bad] = [
     Bad("out-under-file", ("--out",), setup="out-under-file"),
     Bad("mesh-cache-file", ("--mesh-cache",), setup="cache-file"),
     Bad("workflow-missing", ("no-such.yaml",), text=None, extra={"workflow": "no-such.yaml"}),
+    Bad("workflow-name-markup", ("wf[test].yaml",), extra={"workflow": "wf[test].yaml"}),
     Bad("workflow-directory", ("directory",), text=None, extra={"workflow": "."}),
     Bad("templates-missing", ("--templates", "nowhere"), options=("--templates", "nowhere")),
     # --- issue 21: tracebacks, hangs and silent accepts ---
