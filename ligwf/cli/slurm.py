@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Group
+from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
@@ -82,7 +83,7 @@ def _site_from_record(values: dict[str, Any]) -> SlurmSite:
 
 def _warn(lines: list[str]) -> None:
     for line in lines:
-        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
+        err_console.print(f"[yellow]ligwf: warning:[/] {escape(line)}", highlight=False)
 
 
 def _print_submitted(entries: list[dict]) -> None:
@@ -207,7 +208,7 @@ def cmd_status(args: argparse.Namespace) -> int:
     console.print(table)
     if data["scheduler_error"]:
         err_console.print(f"[yellow]Slurm not reachable, manifests only:[/] "
-                          f"{data['scheduler_error']}", highlight=False)
+                          f"{escape(str(data['scheduler_error']))}", highlight=False)
     for job in data["jobs"]:
         if job["kind"] != "array":
             console.print(f"{job['kind']} job {job['job_id']} (after {job.get('after')}): "
