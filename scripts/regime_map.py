@@ -40,7 +40,58 @@ def main(run_root: Path, out: Path) -> int:
     summary.to_csv(out / "controls.csv", index=False, float_format="%.4g")
     with pd.option_context("display.width", 250, "display.max_columns", 30):
         print(summary.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
+    figure(summary, all_rows, out / "regime_map.png")
     return 0
+
+
+def figure(summary: pd.DataFrame, rows: pd.DataFrame, path: Path,
+           definitions=("held_0.5s", "held_1s", "communities")) -> None:
+    """Regime map: share of the bed in granules and their persistence against St_v (wet
+    filled, cohesionless twin open; uniform beds circles, placed granules squares), and the
+    granule share against time of the placed beds."""
+    import matplotlib
+    matplotlib.use("Agg", force=True)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    colours = dict(zip(definitions, ("C0", "C1", "C3")))
+    for d in definitions:
+        sub = summary[summary["definition"] == d]
+        for _, r in sub.iterrows():
+            twin = "twin" in r["point"]
+            placed = r["point"].startswith("placed")
+            # a twin is drawn at its wet partner's St_v (its own is 1000x larger)
+            st = r["stokes_viscous"] / (1000.0 if twin else 1.0)
+            kw = dict(marker="s" if placed else "o", color=colours[d], ms=7,
+                      mfc="none" if twin else colours[d], ls="none")
+            axes[0].plot(st, r["share_10"], **kw)
+            axes[1].plot(st, r["persist_quarter"], **kw)
+        axes[0].plot([], [], "o", color=colours[d], label=d)
+    axes[0].plot([], [], "ko", mfc="none", label="cohesionless twin (at its wet St_v)")
+    axes[0].plot([], [], "ks", label="placed wet granules")
+    for ax, label in zip(axes[:2], ("bed volume in granules of >= 10 particles",
+                                    "pair persistence after a quarter revolution")):
+        ax.set_xscale("log")
+        ax.set_xlabel("viscous Stokes number St_v (CG1)")
+        ax.set_ylabel(label)
+        ax.set_ylim(-0.02, 1.02)
+        ax.grid(alpha=0.3)
+    axes[1].axhline(0.5, color="grey", ls=":", lw=1)
+    axes[0].legend(fontsize=8, loc="upper right")
+    ax = axes[2]
+    placed = rows[rows["point"].str.startswith("placed") & (rows["definition"] == definitions[0])]
+    for point, sub in placed.groupby("point"):
+        ax.plot(sub["time"], sub["share_10"], "-o" if "twin" not in point else "--o",
+                ms=3, label=point)
+    ax.set_xlabel("time since the drum started, s")
+    ax.set_ylabel(f"bed volume in granules ({definitions[0]})")
+    ax.set_title("placed wet granules: accretion and erosion")
+    ax.grid(alpha=0.3)
+    if len(placed):
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":

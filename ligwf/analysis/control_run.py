@@ -21,7 +21,7 @@ import pandas as pd
 
 from ligwf.analysis.case_granules import RunFacts
 from ligwf.analysis.controls import (adjusted_rand_index, bed_share, comovement, granule_count,
-                                     pair_persistence, volume_d50)
+                                     granule_sizes, pair_persistence, volume_d50)
 from ligwf.analysis.definitions import GranuleDefinition, identify_granules
 from ligwf.analysis.dumps import ContactFrame, read_contacts, read_particles
 from ligwf.analysis.frame_checks import plan_frames
@@ -124,6 +124,22 @@ def labeller(series: Series, kind: str, param) -> Callable[[int, bool, int], Ide
     return window_labels
 
 
+def growth_rates(labels: np.ndarray, later: np.ndarray | None, dt: float,
+                 min_particles: int = 10) -> dict[str, float]:
+    """Accretion and erosion rates, 1/s: the particles that join granules of >=
+    ``min_particles`` between t and t + dt (``accretion``) or leave them (``erosion``), per
+    particle in such granules at t and per second (nan without granules or a later frame)."""
+    if later is None:
+        return {"accretion_rate": np.nan, "erosion_rate": np.nan}
+    inside_t = granule_sizes(labels) >= min_particles
+    inside_u = granule_sizes(later) >= min_particles
+    n = int(inside_t.sum())
+    if n == 0:
+        return {"accretion_rate": np.nan, "erosion_rate": np.nan}
+    return {"accretion_rate": float((~inside_t & inside_u).sum()) / n / dt,
+            "erosion_rate": float((inside_t & ~inside_u).sum()) / n / dt}
+
+
 def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: float = 0.5,
                  stride: float = 0.1, short_dt: float = 0.05, comove_tau: float = 0.1,
                  determinism_frames: int = 2) -> pd.DataFrame:
@@ -163,6 +179,8 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
             for tag, dk in (("persist_short", d_short), ("persist_quarter", d_quarter)):
                 later = lab(k + dk)
                 row[tag] = pair_persistence(labels, later) if later is not None else np.nan
+                if tag == "persist_short":
+                    row.update(growth_rates(labels, later, dk * series.interval))
             if k + d_tau < len(series.frames):
                 cm = comovement(labels, series.frames[k].particles.positions,
                                 series.frames[k + d_tau].particles.positions, series.diameter,

@@ -46,3 +46,18 @@ def wet_sphere_centres(radius: float, inner_radius: float, length: float, fill: 
                 "lifter tips at its place); use a smaller radius or a larger fill_fraction")
         out.append((0.5 * length, u, v))
     return tuple(out)
+
+
+def wet_sphere_fields(scene) -> dict:
+    """The :class:`~ligwf.scene.scaling.ScaledScene` fields of placed liquid (none for a
+    uniformly wetted bed): the wet spheres (axial, across, vertical, radius) and their
+    liquid content."""
+    g = scene.liquid.wet_granules
+    if scene.liquid.placement != "granules" or g is None:
+        return {}
+    drum = scene.drum
+    inner = drum.radius - (drum.lifters.height if drum.lifters.count else 0.0)
+    centres = wet_sphere_centres(drum.radius, inner, drum.length, scene.process.fill_fraction,
+                                 g.count, g.radius)
+    return {"wet_spheres": tuple((*c, g.radius) for c in centres),
+            "wet_sphere_content": g.liquid_content}

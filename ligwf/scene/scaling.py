@@ -38,7 +38,7 @@ from enum import Enum
 
 from ligwf import liquids
 from ligwf.errors import ConfigError
-from ligwf.scene.placement import wet_sphere_centres
+from ligwf.scene.placement import wet_sphere_fields
 from ligwf.liquids.base import LiquidModel
 from ligwf.scene.model import GRAVITY, Scene
 from ligwf.scene.neighbour import fill_skin, turning_skin
@@ -276,8 +276,7 @@ class ScaledScene:
     wave_steps: int              # steps between insertion waves (time to fall one diameter)
     seeds: tuple[int, ...]       # per template, then the distribution, then per wave
     granules: bool
-    # placed liquid (liquid.placement: granules): (axial, across, vertical, radius) per wet
-    # sphere, m, and their liquid content; empty for a uniformly wetted bed
+    # placed liquid (ligwf.scene.placement): wet spheres (axial, across, vertical, r), m
     wet_spheres: tuple[tuple[float, float, float, float], ...] = ()
     wet_sphere_content: float = 0.0
 
@@ -319,8 +318,7 @@ class ScaledScene:
         """From :meth:`to_dict` (a case folder's stored scaled scene): lists back to tuples;
         a missing or unknown key is a TypeError, never a default."""
         out = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
-        if "wet_spheres" in out:
-            out["wet_spheres"] = tuple(tuple(w) for w in out["wet_spheres"])
+        out["wet_spheres"] = tuple(tuple(w) for w in out.get("wet_spheres", ()))
         return cls(**out)
 
     def to_dict(self) -> dict:
@@ -331,8 +329,6 @@ class ScaledScene:
         out["insertion_waves"] = list(self.insertion_waves)
         if not self.wet_spheres:                 # records of uniform beds stay as they were
             del out["wet_spheres"], out["wet_sphere_content"]
-        else:
-            out["wet_spheres"] = [list(w) for w in self.wet_spheres]
         return out
 
 
@@ -397,18 +393,6 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
         wave_steps=max(thermo_every, _steps(fall_time, dt) // thermo_every * thermo_every),
         seeds=replica_seeds(num.seed, replica, count=len(diameters) + 1 + len(waves)),
         granules=scene.analysis.granules,
-        **_wet_spheres(scene),
+        **wet_sphere_fields(scene),
     )
 
-
-def _wet_spheres(scene: Scene) -> dict:
-    """The ScaledScene fields of placed liquid (none for a uniformly wetted bed)."""
-    g = scene.liquid.wet_granules
-    if scene.liquid.placement != "granules" or g is None:
-        return {}
-    drum = scene.drum
-    inner = drum.radius - (drum.lifters.height if drum.lifters.count else 0.0)
-    centres = wet_sphere_centres(drum.radius, inner, drum.length, scene.process.fill_fraction,
-                                 g.count, g.radius)
-    return {"wet_spheres": tuple((*c, g.radius) for c in centres),
-            "wet_sphere_content": g.liquid_content}
