@@ -119,6 +119,8 @@ class GranuleAnalysis:
             if self._facts.case is None:
                 raise ConfigError(f"{self._facts.case_id}: pass the frames to analyse")
             frames = list(self._facts.plan.frames)
+        if self._facts.plan is None:
+            self._sequence = sorted(frames, key=lambda ff: ff.step)   # held windows of foreign dumps
         for ff in frames:
             self.results.append(self._single_frame(ff))
         self._conclude()
@@ -187,13 +189,10 @@ class GranuleAnalysis:
     def _held(self, ff: FrameFiles, particles: ParticleFrame, contacts: ContactFrame):
         """Granules of ``granules: held`` at ``ff``: the bridges present in every frame of
         [t, t + hold_time] (:func:`ligwf.analysis.persistent.persistent_labels`); the frames
-        after ``ff`` come from the run's frame plan, their bridge keys cached while the
-        frames are analysed in order."""
+        after ``ff`` come from the run's frame plan (foreign dumps: the frames given to
+        :meth:`run`), their bridge keys cached while the frames are analysed in order."""
         f = self._facts
-        if f.plan is None:
-            raise ConfigError(f"{f.case_id}: granules: held follows bridges over the run's "
-                              "frames; it needs a ligwf case (its frame plan)")
-        frames = list(f.plan.frames)
+        frames = list(f.plan.frames) if f.plan is not None else list(self._sequence)
         steps = [x.step for x in frames]
         k = steps.index(ff.step)
         interval = (steps[1] - steps[0]) * f.dt if len(steps) > 1 else float("inf")
