@@ -34,13 +34,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)
     wf = prepared.workflow
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
-    console.print(regime_table(prepared))
     for line in analysis_plan(prepared):
         console.print(line, highlight=False)
     cores, source = machine_cores(args.cores)
     schedule = plan_study(prepared_loads(prepared), cores)
     console.print(plan_table(schedule, f"rank plan for {cores} core(s) ({source}): what "
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
+    console.print(regime_table(prepared))
     return 0
 
 
