@@ -85,9 +85,10 @@ def test_sigterm_then_resume_from_forced_restart(tmp_path):
     proc = start_run(out, *LONGER)
     wait_for(lambda: "ligwf-phase production" in _read(case / "run.log"))
     os.kill(proc.pid, signal.SIGTERM)          # ligwf forwards it to the engine ranks
-    assert proc.wait(timeout=120) == 1
+    assert proc.wait(timeout=120) == 143       # 128 + SIGTERM, as a shell reports it
     m = read_manifest(case)
     assert m.status == "killed" and 0 < m.steps_done < m.total_steps
+    assert m.reason.startswith("interrupted by the user (SIGTERM)"), m.reason
     forced = list(case.glob("restart_forced_liggghts_*.data"))
     assert len(forced) == 1 and restart_step(forced[0]) == m.steps_done
     r = ligwf("run", str(WORKFLOW), "--out", str(out), *ONE_CASE, *LONGER)
