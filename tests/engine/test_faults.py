@@ -537,3 +537,32 @@ def test_disk_full_in_the_planned_ensemble_then_resumed_whole(tmp_path):
         r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS)
         assert r.returncode == 0, r.stdout[-3000:] + r.stderr
         assert_pair_complete(cases)
+
+
+def test_ctrl_c_of_ligwf_study_stops_before_the_analysis(tmp_path):
+    """`ligwf study` interrupted in production: forced restarts, both cases killed
+    'interrupted by the user', no analysis and no report, exit 130; `ligwf run` then
+    finishes both from their own restarts."""
+    from ligwf.engine.liggghts import FORCED_RESTART_RE
+
+    out = tmp_path / "study"
+    cases = [out / c for c in PAIR]
+    p = subprocess.Popen(ligwf_cmd("study", str(WORKFLOW), "--out", str(out), "--no-snapshots",
+                                   *PAIR_ARGS),
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    wait_for(lambda: all(in_phase(c, "ligwf-phase production", 0) for c in cases)
+             or p.poll() is not None, timeout=180, what="production in both")
+    os.kill(p.pid, signal.SIGINT)
+    assert p.wait(timeout=120) == 130
+    err = p.stderr.read()
+    assert "Interrupted: interrupted by the user (SIGINT)" in err and "Traceback" not in err
+    assert not (out / "analysis").exists() and not (out / "report").exists()
+    for case in cases:
+        m = read_manifest(case)
+        assert m.status == "killed" and m.reason.startswith("interrupted by the user (SIGINT)")
+        assert any(FORCED_RESTART_RE.match(f.name) for f in case.iterdir()), case.name
+        assert not engines_in(case)
+    r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS)
+    assert r.returncode == 0, r.stderr
+    assert_pair_complete(cases)
