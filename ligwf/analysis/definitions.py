@@ -50,9 +50,6 @@ METHODS = ("communities", "components", "held")
 #: CPM edge weights: the bridge's relative rupture work or its relative force
 WEIGHTS = ("energy", "force")
 VELOCITY_FRAMES = ("lab", "drum", "flow")
-#: thresholds switched on by the sensitivity table when the definition has them off
-NOMINAL_ANGLE_DEG = 30.0
-NOMINAL_RELATIVE_FORCE = 0.5
 #: the factors the sensitivity table moves each threshold by
 SENSITIVITY_FACTORS = (0.8, 1.25)
 
@@ -98,26 +95,45 @@ class GranuleDefinition:
         """The force (N) and angle part of the bond test."""
         return BondCriterion(self.min_bridge_force, self.max_velocity_angle_deg)
 
+    def setting(self) -> str:
+        """The definition in words, with the thresholds it uses (figure and table labels)."""
+        if self.method == "held":
+            return f"held, bridges through {self.hold_time:g} s"
+        parts = [self.method]
+        if self.method == "communities":
+            parts.append(f"resolution {self.resolution:g} ({self.weight} weight)")
+        if self.max_velocity_angle_deg < 180.0:
+            parts.append(f"angle {self.max_velocity_angle_deg:g} deg ({self.velocity_frame})")
+        if self.min_relative_force > 0:
+            parts.append(f"f_rel > {self.min_relative_force:g}")
+        if self.min_bridge_force > 0:
+            parts.append(f"F > {self.min_bridge_force:g} N")
+        return ", ".join(parts)
+
     def variants(self) -> list[tuple[str, "GranuleDefinition"]]:
-        """(label, definition) with each threshold moved by x0.8 and x1.25: the CPM
-        resolution, the velocity angle and the relative force. A threshold that is off
-        (angle 180 deg, relative force 0) is switched on at a nominal value (30 deg,
-        f_rel 0.5) moved by the same factors, so the table shows what it would change."""
-        out = [("as set", self)]
-        if self.method == "held":      # the one threshold it has: how long a bridge must hold
-            return out + [(f"hold {self.hold_time * fac:.3g} s",
-                           replace(self, hold_time=self.hold_time * fac))
-                          for fac in SENSITIVITY_FACTORS]
+        """(label, definition): the definition as set (its label states the setting), then
+        each threshold it USES moved by x0.8 and x1.25: the hold time of ``held``, the CPM
+        resolution of ``communities``, and the velocity angle, relative and absolute
+        bridge force where they are on. A definition with no threshold in use (components
+        of every bridge) has no variant."""
+        out = [(f"as set: {self.setting()}", self)]
         for fac in SENSITIVITY_FACTORS:
+            if self.method == "held":
+                out.append((f"hold {self.hold_time * fac:.3g} s",
+                             replace(self, hold_time=self.hold_time * fac)))
+                continue
             if self.method == "communities":
                 out.append((f"resolution x{fac:g}", replace(self, resolution=self.resolution * fac)))
-            angle = (self.max_velocity_angle_deg if self.max_velocity_angle_deg < 180.0
-                     else NOMINAL_ANGLE_DEG)
-            a = min(180.0, angle * fac)
-            out.append((f"angle {a:.3g} deg ({self.velocity_frame})",
-                        replace(self, max_velocity_angle_deg=a)))
-            f = self.min_relative_force or NOMINAL_RELATIVE_FORCE
-            out.append((f"f_rel > {f * fac:.3g}", replace(self, min_relative_force=f * fac)))
+            if self.max_velocity_angle_deg < 180.0:
+                a = min(180.0, self.max_velocity_angle_deg * fac)
+                out.append((f"angle {a:.3g} deg ({self.velocity_frame})",
+                            replace(self, max_velocity_angle_deg=a)))
+            if self.min_relative_force > 0:
+                f = self.min_relative_force * fac
+                out.append((f"f_rel > {f:.3g}", replace(self, min_relative_force=f)))
+            if self.min_bridge_force > 0:
+                f = self.min_bridge_force * fac
+                out.append((f"F > {f:.3g} N", replace(self, min_bridge_force=f)))
         return out
 
 

@@ -97,7 +97,7 @@ def kinetics_summary(kin: pd.DataFrame, n_boot: int, seed: int,
 
 def sensitivity_table(facts: RunFacts, frames: list[FrameFiles], definition: GranuleDefinition,
                       min_particles: int, implementation: str = "fast") -> pd.DataFrame:
-    """Per variant of ``definition`` (label first: ``as set``) the mean over ``frames`` of
+    """Per variant of ``definition`` (first: ``as set: <its setting>``) the mean over ``frames`` of
     granule count, d50 (m), largest granule and percolating share, and d50 relative to
     the definition as set."""
     rows = []
@@ -116,7 +116,8 @@ def sensitivity_table(facts: RunFacts, frames: list[FrameFiles], definition: Gra
                      "method": variant.method, "velocity_frame": variant.velocity_frame,
                      "resolution": variant.resolution,
                      "max_velocity_angle": variant.max_velocity_angle_deg,
-                     "min_relative_force": variant.min_relative_force, **mean})
+                     "min_relative_force": variant.min_relative_force,
+                     "hold_time": variant.hold_time, **mean})
     table = pd.DataFrame(rows)
     if not table.empty:
         table["d50_ratio"] = table["d50"] / table["d50"].iloc[0]

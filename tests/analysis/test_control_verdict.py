@@ -36,3 +36,17 @@ def test_persistence_against_a_twin_with_granules():
 def test_missing_numbers_fail_rather_than_pass():
     ok, _ = verdict({}, {}, "x")
     assert not ok
+
+
+def test_sensitivity_varies_only_the_thresholds_in_use_and_states_the_setting():
+    from ligwf.analysis.definitions import GranuleDefinition
+
+    labels = [lab for lab, _ in GranuleDefinition().variants()]
+    assert labels[0] == "as set: communities, resolution 0.002 (energy weight)"
+    assert labels[1:] == ["resolution x0.8", "resolution x1.25"]       # angle, f_rel are off
+    held = GranuleDefinition(method="held", hold_time=0.5).variants()
+    assert [lab for lab, _ in held] == ["as set: held, bridges through 0.5 s", "hold 0.4 s",
+                                        "hold 0.625 s"]
+    src = GranuleDefinition(method="components", max_velocity_angle_deg=30.0).variants()
+    assert [lab for lab, _ in src][1:] == ["angle 24 deg (lab)", "angle 37.5 deg (lab)"]
+    assert GranuleDefinition(method="components").variants()[1:] == []
