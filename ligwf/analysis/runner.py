@@ -308,7 +308,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
                    "steady_from_step": steady_from[c.case_id],
                    "steady_frames": int(steady_frames.get(c.case_id, 0))} for c in cases],
     }
-    commit(outputs, record)
+    commit(outputs, record, obsolete=GRANULE_OUTPUTS)    # e.g. no twins now: no controls.csv
     return record
 
 
@@ -364,7 +364,7 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
 #: Tables of a granule analysis: an analysis without granule data removes old ones.
 GRANULE_OUTPUTS = (layout.GRANULES_TABLE, layout.FRAMES_TABLE, layout.GSD_TABLE,
                    layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE, KINETICS_TABLE,
-                   KINETICS_SUMMARY_TABLE, SENSITIVITY_TABLE)
+                   KINETICS_SUMMARY_TABLE, SENSITIVITY_TABLE, layout.CONTROLS_TABLE)
 
 
 def commit(outputs: OutputSet, record: dict, obsolete: tuple[str, ...] = ()) -> None:
