@@ -91,7 +91,24 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
     return manifest, attempt
 
 
-_DUMP_STEP_RE = re.compile(r"_(\d+)\.vtu$")
+_DUMP_STEP_RE = re.compile(r"_(\d+)\.vt[ur]$")
+#: how every complete XML VTK file LIGGGHTS writes ends
+_VTK_END = b"</VTKFile>"
+
+
+def _dump_problem(path) -> str | None:
+    """Why a dump file is not whole (empty, or cut before its closing tag), None if it is."""
+    try:
+        size = path.stat().st_size
+        if size == 0:
+            return f"empty dump {path.name}"
+        with open(path, "rb") as fh:
+            fh.seek(max(0, size - 64))
+            if _VTK_END not in fh.read():
+                return f"truncated dump {path.name}"
+    except OSError as exc:
+        return f"unreadable dump {path.name} ({exc.strerror})"
+    return None
 
 
 def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | None:
@@ -100,8 +117,9 @@ def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | No
     A full disk (or a writer killed mid-file) leaves thermo rows missing from a screen and
     dump files empty; a run that resumes from a restart past the hole never writes them
     again. Holes: a thermo gap wider than ``thermo_every`` (restart at or before the row
-    before it), an empty file in ``post/`` or a missing particle dump at a step the run
-    has reached (restart before that step). None when the record is whole.
+    before it), an empty or truncated (no closing ``</VTKFile>``) file in ``post/`` or a
+    missing particle dump at a step the run has reached (restart before that step). None
+    when the record is whole.
     """
     holes: list[tuple[int, str]] = []
     every = case.scaled.thermo_every
@@ -117,8 +135,10 @@ def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | No
         for f in post.iterdir():
             names.add(f.name)
             m = _DUMP_STEP_RE.search(f.name)
-            if m and f.is_file() and f.stat().st_size == 0 and int(m.group(1)) <= reached:
-                holes.append((int(m.group(1)) - 1, f"empty dump {f.name}"))
+            if m and f.is_file() and int(m.group(1)) <= reached:
+                why = _dump_problem(f)
+                if why is not None:
+                    holes.append((int(m.group(1)) - 1, why))
         for step in case.expected_dump_steps(reached):
             if f"particles_{step}.vtu" not in names:
                 holes.append((step - 1, f"particle dump of step {step} missing"))

@@ -194,6 +194,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
         t_launch = time.time()
         tails: dict[int, tuple[LogTail, ThermoParser]] = {}
         ended: set[int] = set()
+        shown: set[int] = set()      # claims whose end the monitor has been told
         with open(ens_dir / "launch.log", "wb") as out:
             proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT,
                                     stdin=subprocess.DEVNULL, env=engine_env(),
@@ -227,6 +228,9 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                         ended.add(pos)
                         if m is not None:
                             outcome[name] = m.status
+                            if m.status != KILLED:      # a killed one is settled below
+                                shown.add(pos)
+                                monitor.end(name, m, plan_case(case))
                 if finished:
                     break
                 if stop.is_set() and not stop_sent:
@@ -270,7 +274,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                 progressed = True
             if m.status == KILLED:
                 retry.add(_key(case))
-            if pos not in ended or m.status == KILLED:
+            if pos not in shown:
                 monitor.end(case.path.name, m, plan_case(case))
         if not claims and proc.returncode:
             raise SimulationFailed(

@@ -96,3 +96,44 @@ def test_the_mesh_internal_error_is_classified_with_a_hint():
     assert status == FAILED and reason.startswith(line)
     assert "dt_rayleigh_fraction" in reason
     assert error_hint("ERROR: Unknown command: bogus") is None
+
+
+def test_a_hole_in_the_record_is_found_and_bounds_the_resume(tmp_path):
+    """record_hole on a rendered case with synthetic rows and dump files (what a full disk
+    leaves: a thermo gap, an empty or cut frame, a missing one)."""
+    import subprocess
+    import sys
+
+    from ligwf.engine.attempt import record_hole
+    from ligwf.engine.thermo import ThermoRow
+    from ligwf.study.case import CaseFolder
+
+    from helpers import ROOT
+
+    out = tmp_path / "study"
+    r = subprocess.run([sys.executable, "-m", "ligwf.cli.main", "render",
+                        str(ROOT / "tests" / "workflows" / "runner_tiny.yaml"), "--out", str(out),
+                        "--set", "sweep.rules=[weber]"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    case = CaseFolder.open(out / "cg3-weber-r0")
+    s = case.scaled
+    rows = [ThermoRow(step, {"step": float(step)}, "production") for step in
+            list(range(0, s.total_steps, s.thermo_every)) + [s.total_steps]]
+    steps = case.expected_dump_steps(s.total_steps)
+    for step in steps:
+        for kind in ("particles", "contacts"):
+            (case.path / "post" / f"{kind}_{step}.vtu").write_text(
+                '<VTKFile type="UnstructuredGrid">\n</VTKFile>\n')
+    assert record_hole(case, rows) is None
+    gap = rows[:10] + rows[12:]
+    assert record_hole(case, gap) == (rows[9].step, record_hole(case, gap)[1])
+    assert "thermo rows missing" in record_hole(case, gap)[1]
+    frame = case.path / "post" / f"contacts_{steps[1]}.vtu"
+    frame.write_text('<VTKFile type="UnstructuredGrid">\n<Piece')
+    assert record_hole(case, rows) == (steps[1] - 1, f"truncated dump {frame.name}")
+    frame.write_bytes(b"")
+    assert record_hole(case, rows) == (steps[1] - 1, f"empty dump {frame.name}")
+    (case.path / "post" / f"particles_{steps[0]}.vtu").unlink()
+    assert record_hole(case, rows)[0] == steps[0] - 1
+    # a frame past the step the run reached is not judged (it is written again)
+    assert record_hole(case, [r for r in rows if r.step < steps[0]]) is None
