@@ -25,14 +25,17 @@ def main(run_root: Path, out: Path) -> int:
     for point in sorted(p for p in run_root.iterdir() if (p / ".done").exists()):
         for case_dir in sorted(d for d in point.iterdir() if (d / "scene.json").exists()):
             t0 = time.perf_counter()
-            series = load_series(case_dir)
-            r = control_rows(series)
-            r.insert(0, "point", point.name)
+            cached = point / "controls_rows.csv"       # beside the run: measured once
+            if cached.is_file():
+                r = pd.read_csv(cached)
+            else:
+                r = control_rows(load_series(case_dir))
+                r.insert(0, "point", point.name)
+                r.to_csv(cached, index=False)
             rows.append(r)
             nums = regime_numbers(CaseFolder.open(case_dir).scaled)
             numbers.append({"point": point.name, **nums})
-            print(f"{point.name}: {len(series.frames)} frames, {time.perf_counter() - t0:.0f} s",
-                  flush=True)
+            print(f"{point.name}: {time.perf_counter() - t0:.0f} s", flush=True)
     all_rows = pd.concat(rows, ignore_index=True)
     all_rows.to_csv(out / "controls_rows.csv", index=False, float_format="%.4g")
     summary = summarise(all_rows.drop(columns=["point"]).assign(case_id=all_rows["point"]))
@@ -41,7 +44,61 @@ def main(run_root: Path, out: Path) -> int:
     with pd.option_context("display.width", 250, "display.max_columns", 30):
         print(summary.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     figure(summary, all_rows, out / "regime_map.png")
+    verdicts = pair_verdicts(summary)
+    verdicts.to_csv(out / "controls_verdict.csv", index=False, float_format="%.4g")
+    (out / "controls_verdict.md").write_text(markdown(verdicts))
     return 0
+
+
+#: each wet point and the cohesionless twin it is judged against: the twins (surface tension
+#: and viscosity / 1000) are all practically the same bed without cohesion (Bo_g ~ 0.001);
+#: each wet point takes the one of nearest viscosity and the same liquid placement
+TWIN_OF = {"wet_mu0.001": "twin_mu0.001", "wet_mu0.01": "twin_mu0.001",
+           "wet_mu0.1": "twin_mu0.3", "wet_mu0.3": "twin_mu0.3", "wet_mu0.3_lc0.05": "twin_mu0.3",
+           "wet_mu0.3_gamma0.072": "twin_mu0.3", "wet_mu0.3_gamma0.072_L2": "twin_mu0.3",
+           "placed_mu0.3": "placed_twin_mu0.3", "placed_mu0.001": "placed_twin_mu0.3"}
+
+
+def pair_verdicts(summary: pd.DataFrame) -> pd.DataFrame:
+    """Per wet point and definition: its measures, its twin's and the pre-registered verdict."""
+    from ligwf.analysis.control_verdict import criteria
+
+    by = {(r["point"], r["definition"]): r for _, r in summary.iterrows()}
+    rows = []
+    for (point, d), w in by.items():
+        t = by.get((TWIN_OF.get(point, ""), d))
+        if t is None:
+            continue
+        checks = criteria(w.to_dict(), t.to_dict())
+        rows.append({"point": point, "twin": TWIN_OF[point], "definition": d,
+                     "St_v": w["stokes_viscous"], "Bo_g": w["bond_granular"],
+                     "share_10": w["share_10"], "twin_share_10": t["share_10"],
+                     "persist_quarter": w["persist_quarter"],
+                     "twin_persist_quarter": t["persist_quarter"],
+                     "comove_ratio": w["comove_ratio"], "ari": min(
+                         v for v in (w.get("ari_seed", 1.0), w.get("ari_order", 1.0))
+                         if pd.notna(v)),
+                     "percolating": w["percolating"],
+                     **{c.name: c.passed for c in checks},
+                     "passes": all(c.passed for c in checks)})
+    return pd.DataFrame(rows)
+
+
+def markdown(v: pd.DataFrame) -> str:
+    crit = ["granules exist", "beats the twin", "survives", "moves together", "reproducible",
+            "no bed-spanning granule"]
+    head = ("| point | definition | St_v | Bo_g | share_10 wet / twin | persistence T/4 wet / twin"
+            " | co-movement | ARI | percolating | " + " | ".join(crit) + " | passes |")
+    lines = [head, "|" + "---|" * (9 + len(crit) + 1)]
+    f = lambda x: "–" if pd.isna(x) else f"{x:.3g}"
+    for _, r in v.iterrows():
+        lines.append(f"| {r['point']} | {r['definition']} | {f(r['St_v'])} | {f(r['Bo_g'])} | "
+                     f"{f(r['share_10'])} / {f(r['twin_share_10'])} | "
+                     f"{f(r['persist_quarter'])} / {f(r['twin_persist_quarter'])} | "
+                     f"{f(r['comove_ratio'])} | {f(r['ari'])} | {f(r['percolating'])} | "
+                     + " | ".join("yes" if r[c] else "no" for c in crit)
+                     + f" | {'**yes**' if r['passes'] else 'no'} |")
+    return "\n".join(lines) + "\n"
 
 
 def figure(summary: pd.DataFrame, rows: pd.DataFrame, path: Path,
