@@ -43,7 +43,8 @@ from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
 from ligwf.engine.health import FAILED, KILLED, log_errors
 from ligwf.engine.guard import (RANK_NAMES, STOP_GRACE_SECONDS, EngineProcess, engine_env,
                                 engine_tree, process, release, watch)
-from ligwf.engine.launch import Monitor, NullMonitor, interrupted_reason, signal_engine
+from ligwf.engine.launch import (Monitor, NullMonitor, interrupted_reason, signal_engine,
+                                 take_over)
 from ligwf.engine.restart_id import SETTLE_SECONDS
 from ligwf.engine.resume import SKIP, RestartFile, discard_restart, plan_case
 from ligwf.engine.site import EngineConfig
@@ -171,6 +172,8 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                                f"{group_size}")
     stop = stop or threading.Event()
     monitor = monitor or NullMonitor()
+    for case in cases:
+        take_over(case)     # a dead runner's engines and attempts (a no-op when there are none)
     todo = [c for c in cases if plan_case(c, retry_unstable).action != SKIP]
     by_key = {_key(c): c for c in todo}
     outcome: dict[str, str] = {}
