@@ -40,8 +40,13 @@ HARD_PARTICLE_MODULUS = 1e9
 #: closed drum at E = 5e9 Pa crashed the same way every time at 0.19 ("ERROR on proc 0:
 #: Internal error (./src/tri_mesh_I.h:109)": TriMesh::resolveTriSphereContactBary finds
 #: the contact point in no region of the triangle, i.e. the particle's position is nan --
-#: the integration had blown up) and completed at 0.16 (issue 21). Refused above 0.18,
-#: which is also where the soft-particle limit turns marginal.
+#: the integration had blown up) and completed at 0.16 (issue 21, LIGGGHTS_NOTES
+#: "Measured 2026-12-01"). A reconstruction of that scene (runner_tiny at CG2, closed,
+#: 320 particles, weber and bond, alone and in an ensemble) ran past step 272,000 at 0.19
+#: without the error, so the crash depends on the scene beyond dt and E; the engine
+#: checks no time-step limit there, only that the contact point is finite. Refused above
+#: 0.18, where the soft-particle limit turns marginal: a crash after hours costs more
+#: than 12 % more steps.
 DT_RAYLEIGH_LIMIT_HARD = 0.18
 #: dt / t_H limit: the same 20 % that check/timestep/gran applies to the Hertz time.
 DT_HERTZ_LIMIT = 0.2
