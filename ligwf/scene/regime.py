@@ -15,9 +15,11 @@ under Bond scaling (gamma, mu x n^2) Bo_g is invariant and St_v falls as 1/n. Th
 of the ORIGINAL (CG1) particles decide whether the bed granulates; ``ligwf check`` prints
 both.
 
-:data:`GRANULATING_ST_V` is the regime map's boundary on this engine's drums
-(docs/results/granule_definitions.md, "Regime map"): at St_v above it no definition found
-granules that beat the cohesionless twin.
+:data:`GRANULATING_ST_V` and :data:`GRANULATING_BOND` bound the one region of the regime map
+(docs/results/granule_definitions.md, "Regime map") where granules beat the cohesionless
+control: binder-like viscosity AND strong cohesion (St_v 0.35, Bo_g 3.4 on the demo drum).
+At St_v 0.35 with Bo_g 1.1, and at St_v 1-105 with Bo_g 1.1, no definition's granules
+survived a quarter revolution; nothing was mapped outside St_v 0.35-105 and Bo_g 1.1-3.4.
 """
 
 from __future__ import annotations
@@ -26,9 +28,10 @@ import math
 
 GRAVITY = 9.81
 
-#: St_v above which the regime map (CG1, docs/results/granule_definitions.md) found no
-#: granules beating the cohesionless control
-GRANULATING_ST_V = 3.0
+#: the regime map found granules beating the cohesionless control only at St_v <= this ...
+GRANULATING_ST_V = 0.5
+#: ... and Bo_g >= this (CG1 numbers; docs/results/granule_definitions.md)
+GRANULATING_BOND = 3.0
 
 
 def regime_numbers(s) -> dict[str, float]:
@@ -48,14 +51,15 @@ def regime_numbers(s) -> dict[str, float]:
 
 def granulation_warning(numbers: dict[str, float]) -> str | None:
     """A sentence when the regime map expects no granules at these CG1 numbers, else None."""
-    st = numbers["stokes_viscous"]
-    if numbers["bond_granular"] <= 0:
+    st, bo = numbers["stokes_viscous"], numbers["bond_granular"]
+    if bo <= 0:
         return "the bed is dry: there are no liquid bridges, hence no granules to analyse"
-    if st > GRANULATING_ST_V:
-        return (f"St_v = {st:.3g} > {GRANULATING_ST_V:g}: colliding wet particles rebound at "
-                "this viscosity; the regime map (docs/results/granule_definitions.md) found no "
-                "granules that beat a cohesionless control there, so a granule analysis will "
-                "measure the definition, not granulation (raise liquid.viscosity)")
+    if st > GRANULATING_ST_V or bo < GRANULATING_BOND:
+        return (f"St_v = {st:.3g}, Bo_g = {bo:.3g}: the regime map (docs/results/"
+                "granule_definitions.md) found granules that beat a cohesionless control only "
+                f"at St_v <= {GRANULATING_ST_V:g} with Bo_g >= {GRANULATING_BOND:g} (binder-like "
+                "viscosity and strong cohesion); here a granule analysis measures the "
+                "definition, not granulation (add sweep.controls: [cohesionless] to check)")
     return None
 
 

@@ -8,7 +8,7 @@ import pytest
 
 from ligwf.cli.main import main
 from ligwf.errors import ConfigError
-from ligwf.scene.regime import GRANULATING_ST_V, original_numbers, regime_numbers
+from ligwf.scene.regime import GRANULATING_BOND, GRANULATING_ST_V, original_numbers, regime_numbers
 from ligwf.scene.workflow import load_workflow
 
 from helpers import ROOT
@@ -21,7 +21,8 @@ def _case(overrides=()):
 
 
 def test_numbers_by_hand_and_under_both_rules():
-    cases = _case(["sweep.cg_levels=[1, 2]"])
+    cases = _case(["sweep.cg_levels=[1, 2]", "scene.liquid.viscosity=0.001",
+                   "scene.liquid.surface_tension=0.024"])
     cg1 = next(c for c in cases if c.cg == 1)
     n = regime_numbers(cg1.scaled())
     r, v = 0.75e-3, 2 * math.pi * 30 / 60 * 0.02      # 1.5 mm beads, 40 mm drum at 30 rpm
@@ -39,15 +40,21 @@ def test_numbers_by_hand_and_under_both_rules():
 
 
 def test_check_warns_where_the_map_expects_no_granules(capsys):
-    """Water-like viscosity (St_v ~ 105): warned; a binder-like one (St_v < the map's
-    boundary): not; a case without contact dumps: not (no granule analysis asked for)."""
-    assert main(["check", str(DEMO)]) == 0
-    err = capsys.readouterr().err
-    assert "granule analysis asked for, but St_v = 105" in err
-    mu = 2 * 0.105 / GRANULATING_ST_V            # St_v half the boundary
-    assert main(["check", str(DEMO), "--set", f"scene.liquid.viscosity={mu}"]) == 0
+    """Water-like viscosity (St_v ~ 105): warned; binder-like viscosity with weak cohesion
+    (St_v 0.35, Bo_g 1.1): warned; binder-like and strong (St_v 0.35, Bo_g 3.4, the map's
+    granulating point): not; a case without contact dumps: not (no granule analysis)."""
+    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.001",
+                 "--set", "scene.liquid.surface_tension=0.024"]) == 0
+    assert "granule analysis asked for, but St_v = 105, Bo_g = 1.13" in capsys.readouterr().err
+    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.3",
+                 "--set", "scene.liquid.surface_tension=0.024"]) == 0
+    assert "granule analysis asked for, but St_v = 0.349, Bo_g = 1.13" in capsys.readouterr().err
+    assert GRANULATING_BOND <= 3.39 and GRANULATING_ST_V >= 0.349
+    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.3",
+                 "--set", "scene.liquid.surface_tension=0.072"]) == 0
     assert "granule analysis asked for" not in capsys.readouterr().err
-    assert main(["check", str(DEMO), "--set", "scene.analysis.granules=false"]) == 0
+    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.001",
+                 "--set", "scene.analysis.granules=false"]) == 0
     assert "granule analysis asked for" not in capsys.readouterr().err
 
 
