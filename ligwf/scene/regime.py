@@ -83,3 +83,16 @@ def regime_warnings(rendered) -> list[str]:
         if msg and all(not w.endswith(msg) for w in out):
             out.append(f"{rc.case.case_id}: granule analysis asked for, but {msg}")
     return out
+
+
+def definition_warning(settings, rendered) -> list[str]:
+    """A warning when granules are analysed with a definition that never beat the
+    cohesionless control on the regime map (every one but ``held``)."""
+    if getattr(settings, "granules", "held") == "held":
+        return []
+    if not any(rc.scaled.granules for rc in rendered):
+        return []
+    return [f"analysis.granules: {settings.granules}: its granules never beat a cohesionless "
+            "control on the regime map (a CPM tiling / a bed-spanning cluster, in a twin without "
+            "cohesion as in the wet bed; docs/results/granule_definitions.md); granules: held "
+            "(with hold_time about half a revolution) is the definition that did"]

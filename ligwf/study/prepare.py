@@ -27,7 +27,7 @@ from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, ato
 from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
 from ligwf.engine.render import MESH_NAME, OUTPUT_DIRS, render
 from ligwf.scene.scaling import ScaledScene
-from ligwf.scene.regime import regime_warnings
+from ligwf.scene.regime import definition_warning, regime_warnings
 from ligwf.scene.stability import Preflight, check_rendered
 from ligwf.scene.workflow import Case, Workflow, comparison_warnings
 from ligwf.study.case import content_hash
@@ -118,7 +118,8 @@ def prepare(wf: Workflow, template_dirs: Iterable[str | Path] = (),
     rendered = render_workflow(wf, template_dirs)
     reports, warnings = check_rendered(rendered, allow_unstable)
     return Prepared(wf, rendered, reports,
-                    warnings + regime_warnings(rendered) + comparison_warnings(wf))
+                    warnings + regime_warnings(rendered) + comparison_warnings(wf)
+                    + definition_warning(wf.analysis, rendered))
 
 
 def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) -> Path:

@@ -79,3 +79,10 @@ def test_controls_refused_on_a_dry_scene_and_at_a_missing_level():
         _case(["sweep.controls=[cohesionless]", "sweep.control_cg_levels=[3]"])
     with pytest.raises(ConfigError, match="controls"):
         _case(["sweep.controls=[wet]"])
+
+
+def test_check_warns_when_the_definition_never_beat_the_control(capsys):
+    assert main(["check", str(DEMO), "--set", "analysis.granules=communities"]) == 0
+    assert "analysis.granules: communities: its granules never beat" in capsys.readouterr().err
+    assert main(["check", str(DEMO)]) == 0                     # the demo: held
+    assert "never beat" not in capsys.readouterr().err
