@@ -54,7 +54,8 @@ def regime_table(prepared) -> Table:
     for rc in prepared.rendered:
         own, cg1 = regime_numbers(rc.scaled), original_numbers(rc.case)
         control = any(k == "control" for k, _ in rc.case.varied)
-        verdict = ("control" if control else "no" if granulation_warning(cg1) else "yes")
+        closest = "closest point" in granulation_warning(cg1)
+        verdict = "control" if control else "closest (unproven)" if closest else "no"
         table.add_row(rc.case.case_id, *(f"{own[k]:.3g}" for k in
                                          ("stokes_viscous", "bond_granular", "capillary", "froude")),
                       f"{cg1['stokes_viscous']:.3g}", f"{cg1['bond_granular']:.3g}", verdict)

@@ -40,19 +40,26 @@ def test_numbers_by_hand_and_under_both_rules():
 
 
 def test_check_warns_where_the_map_expects_no_granules(capsys):
-    """Water-like viscosity (St_v ~ 105): warned; binder-like viscosity with weak cohesion
-    (St_v 0.35, Bo_g 1.1): warned; binder-like and strong (St_v 0.35, Bo_g 3.4, the map's
-    granulating point): not; a case without contact dumps: not (no granule analysis)."""
+    """No mapped regime passed every control criterion, so every granule analysis is
+    warned: water-like viscosity (St_v ~ 105) and binder-like viscosity with weak cohesion
+    (St_v 0.35, Bo_g 1.1) as 'no definition beat the control', the map's closest point
+    (St_v 0.35, Bo_g 3.4) as such; a case without contact dumps is not warned."""
     assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.001",
                  "--set", "scene.liquid.surface_tension=0.024"]) == 0
-    assert "granule analysis asked for, but St_v = 105, Bo_g = 1.13" in capsys.readouterr().err
+    out = capsys.readouterr()
+    assert "granule analysis asked for, but St_v = 105, Bo_g = 1.13: no granule definition" in out.err
+    row = next(line for line in out.out.splitlines() if line.startswith("│ cg1-none-r0 ")
+               and "105" in line)
+    assert row.rstrip().endswith("no │")
     assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.3",
                  "--set", "scene.liquid.surface_tension=0.024"]) == 0
-    assert "granule analysis asked for, but St_v = 0.349, Bo_g = 1.13" in capsys.readouterr().err
+    assert "St_v = 0.349, Bo_g = 1.13: no granule definition" in capsys.readouterr().err
     assert GRANULATING_BOND <= 3.39 and GRANULATING_ST_V >= 0.349
     assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.3",
                  "--set", "scene.liquid.surface_tension=0.072"]) == 0
-    assert "granule analysis asked for" not in capsys.readouterr().err
+    out = capsys.readouterr()
+    assert "St_v = 0.349, Bo_g = 3.39 is the regime map's closest point" in out.err
+    assert "closest (unproven)" in out.out
     assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.001",
                  "--set", "scene.analysis.granules=false"]) == 0
     assert "granule analysis asked for" not in capsys.readouterr().err
