@@ -273,7 +273,8 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                 m.attempts[-1].reason = m.reason
                 _record(case, m)
             outcome[case.path.name] = m.status
-            if m.status != KILLED or m.steps_done > before.get(_key(case), 0):
+            if (m.status != KILLED or m.steps_done > before.get(_key(case), 0)
+                    or m.reason.startswith("restart ")):   # a restart set aside is progress
                 progressed = True
             if m.status == KILLED:
                 retry.add(_key(case))
