@@ -206,11 +206,12 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
             figures.append((f"{case_id}: speed", figs.snapshot(
                 last.particles, mesh, axis, angle, "speed",
                 fig_dir / f"{case_id}_speed.png", f"{case_id} step {last.step}: speed [m/s]")))
-            labelled = study.analysis_dir / case_id / f"granules_{last.step}.vtu"
-            if trusted and labelled.is_file():
+            labelled = last_labelled(study.analysis_dir / case_id, last.step) if trusted else None
+            if labelled is not None:
+                step, path = labelled
                 figures.append((f"{case_id}: granules", figs.snapshot(
-                    labelled, mesh, axis, angle, "granule",
-                    fig_dir / f"{case_id}_granules.png", f"{case_id} step {last.step}: granule id")))
+                    path, mesh, axis, case.drum_angle(step), "granule",
+                    fig_dir / f"{case_id}_granules.png", f"{case_id} step {step}: granule id")))
 
     name = study.name
     md = "\n".join([
@@ -234,6 +235,20 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, problems,
                                                 controls_html(study.analysis_dir) if trusted else ""))
     return out
+
+
+def last_labelled(case_out: Path, up_to: int) -> tuple[int, Path] | None:
+    """(step, file) of the newest granule-labelled frame at or before ``up_to`` (the last
+    frames of a ``granules: held`` run have no granules: their hold window is open)."""
+    found = []
+    for p in case_out.glob("granules_*.vtu") if case_out.is_dir() else []:
+        try:
+            step = int(p.stem.split("_", 1)[1])
+        except ValueError:
+            continue
+        if step <= up_to:
+            found.append((step, p))
+    return max(found) if found else None
 
 
 class NothingToReport(LigwfError):
