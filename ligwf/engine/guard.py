@@ -20,7 +20,6 @@ nobody watches:
 
 from __future__ import annotations
 
-import json
 import os
 import signal
 import subprocess
@@ -136,7 +135,7 @@ def watch(launcher: subprocess.Popen, case_dirs=()) -> subprocess.Popen:
     watchdog stops the engine of a dead runner it gives their new restarts their
     identity sidecars (:mod:`ligwf.engine.restart_id`)."""
     root = process(launcher.pid)
-    return subprocess.Popen([sys.executable, "-m", "ligwf.engine.guard", str(launcher.pid),
+    return subprocess.Popen([sys.executable, "-m", "ligwf.engine.watchdog", str(launcher.pid),
                              str(root.start if root else 0), *map(str, case_dirs)],
                             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
                             stderr=subprocess.DEVNULL, start_new_session=True)
@@ -204,49 +203,3 @@ def stop_engines(procs: list[EngineProcess], grace: float = STOP_GRACE_SECONDS) 
     left = [p for p in procs if p.alive()]
     _signal(left, signal.SIGKILL)
     return bool(left)
-
-
-def stamp_lost(folders: list[str]) -> None:
-    """Identity sidecars for the restarts the dead runner's attempts wrote, in case folders
-    or the case folders an ensemble folder's claims name."""
-    from ligwf.engine.attempt import stamp_restarts
-    from ligwf.study.case import CaseFolder
-
-    cases: list[Path] = []
-    for folder in map(Path, folders):
-        claims = folder / "claims"
-        if claims.is_dir():
-            for p in claims.glob("*.json"):
-                try:
-                    cases.append(Path(json.loads(p.read_text())["case"]))
-                except (OSError, ValueError, KeyError, TypeError):
-                    pass
-        else:
-            cases.append(folder)
-    for path in cases:
-        try:
-            case = CaseFolder.open(path)
-            m = case.manifest()
-            if m is not None and m.attempts and m.attempts[-1].ended is None:
-                stamp_restarts(case, m.attempts[-1])
-        except Exception:  # noqa: BLE001 - the watchdog must never die before its engine
-            continue
-
-
-def main(argv: list[str]) -> int:
-    """The watchdog: ``python -m ligwf.engine.guard LAUNCHER_PID START [FOLDER ...]``.
-    Waits for the end of stdin, then stops the launcher's engine if it still runs and
-    stamps the restarts it left (:func:`stamp_lost`). A runner that released it normally
-    has recorded its attempts itself."""
-    root = EngineProcess(int(argv[0]), int(argv[1]), "launcher")
-    data = sys.stdin.buffer.read()  # returns when the runner closes the pipe or dies
-    if data.endswith(RELEASED):
-        return 0
-    if root.alive():
-        stop_engines(engine_tree(root.pid))
-    stamp_lost(argv[2:])
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
