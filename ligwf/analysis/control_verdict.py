@@ -87,5 +87,6 @@ def verdict(wet: dict, twin: dict, definition: str) -> tuple[bool, str]:
                       "pre-registered criterion: sizes and GSD errors below are findings")
     names = "; ".join(f"{c.name}: {c.detail}" for c in failed)
     return False, (f"granules ({definition}) do NOT beat the cohesionless control ({names}), "
-                   "so this definition measures the bed's tiling, not granules: no size "
-                   "limit or GSD error below is a finding")
+                   "so they are not shown to be granules (bodies that move together and "
+                   "survive, absent without cohesion): no size limit or GSD error below is a "
+                   "finding")
