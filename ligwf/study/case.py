@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -126,7 +127,22 @@ def folder_fingerprint(path: Path) -> dict:
     except (OSError, ValueError, AttributeError):
         scene = None
     record = path / DUMP_RECORD
-    return {"scene_hash": scene, "dump_record": file_digest(record) if record.is_file() else None}
+    return {"scene_hash": scene, "dump_record": _analysed_digest(record) if record.is_file() else None}
+
+
+#: the dumps an analysis reads (the engine's bounding-box files differ with the rank count)
+_ANALYSED_DUMP = re.compile(r"^(particles|contacts)_\d+\.vtu$")
+
+
+def _analysed_digest(record: Path) -> str:
+    """SHA-256 over the record's entries of the dumps an analysis reads (the whole file's
+    digest when it is unreadable, so a damaged record still differs)."""
+    try:
+        files = json.loads(record.read_text())["files"]
+        kept = {k: v for k, v in files.items() if _ANALYSED_DUMP.match(k)}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return file_digest(record)
+    return hashlib.sha256(json.dumps(kept, sort_keys=True).encode()).hexdigest()
 
 
 def granules_absent(scaled: ScaledScene) -> str | None:

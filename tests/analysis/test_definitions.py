@@ -21,6 +21,7 @@ from ligwf.analysis.bridge_law import relative_force
 from ligwf.analysis import gsd
 from ligwf.analysis.case_granules import RunFacts
 from ligwf.study.case import CaseFolder
+from helpers import tiled
 from wetdump import wet_study
 
 pytestmark = [pytest.mark.engine, pytest.mark.mpi]
@@ -131,29 +132,6 @@ def test_velocity_frames(real):
     assert plus < speed < minus
 
 
-def tiled(p, c, tiles: int, length: float):
-    """The periodic frame repeated ``tiles`` times along y; pairs across the boundary are
-    rewired to the neighbouring copy (ids of copy k: id + k * (max id))."""
-    n, big = len(p), int(p.ids.max())
-    pos = np.concatenate([p.positions + [0.0, k * length, 0.0] for k in range(tiles)])
-    out_p = replace(p, ids=np.concatenate([p.ids + k * big for k in range(tiles)]),
-                    types=np.tile(p.types, tiles), positions=pos,
-                    velocities=np.tile(p.velocities, (tiles, 1)), radii=np.tile(p.radii, tiles),
-                    liquid_content=None if p.liquid_content is None
-                    else np.tile(p.liquid_content, tiles))
-    a, b = p.index_of(c.id1), p.index_of(c.id2)
-    d = p.positions[b, 1] - p.positions[a, 1]
-    shift = np.round(d / length).astype(np.int64)      # b's nearest image is in copy k - shift
-    id1, id2 = [], []
-    for k in range(tiles):
-        id1.append(c.id1 + k * big)
-        id2.append(c.id2 + np.mod(k - shift, tiles) * big)
-    out_c = replace(c, id1=np.concatenate(id1), id2=np.concatenate(id2),
-                    delta=np.tile(c.delta, tiles))
-    assert n * tiles == len(out_p)
-    return out_p, out_c
-
-
 def test_default_gsd_is_invariant_to_tiling(real):
     """Acceptance (ii): tiling the frames 2x and 4x along the periodic axis moves the
     default definition's volume-weighted GSD by less than the width of its 95 % bootstrap
@@ -199,37 +177,3 @@ def test_default_gsd_is_invariant_to_tiling(real):
         change = np.abs(hists(tiles, range(5)).mean(axis=0) - base.mean(axis=0))
         assert np.all(change <= width + 1e-12), (tiles, change / width)
 
-
-def test_held_gsd_is_invariant_to_tiling(real):
-    """The held definition (components of the bridges present in every frame of a window)
-    on the real CG3 frames tiled 4x (12 diameters: the base, see above), then 2x and 4x
-    again: deterministic, so each copy holds the same granules and the volume-weighted GSD
-    of the non-percolating granules is the same to rounding (a granule that wrapped the
-    short box can only stop wrapping in a longer one; none does here, asserted)."""
-    from ligwf.analysis.persistent import Frame, bridge_keys, persistent_labels
-
-    scaled, liquid, motion, frames = real
-    L = 4 * scaled.drum_length
-    base = [tiled(p, c, 4, scaled.drum_length) for p, c in frames]
-    span = 3                                               # 4 consecutive frames
-
-    def hist(tiles):
-        out = []
-        for k in range(len(base) - span):
-            window = [(p, c) if tiles == 1 else tiled(p, c, tiles, L) for p, c in base[k:k + span + 1]]
-            wf = [Frame(p, c) for p, c in window]
-            ident = persistent_labels(wf, [bridge_keys(f, liquid) for f in wf],
-                                      replace(motion, length=L * tiles))
-            vol = np.bincount(ident.labels, weights=wf[0].particles.volumes)
-            members = np.bincount(ident.labels)
-            assert not ident.percolating.any()
-            keep = gsd.counted(members, ident.percolating, 2)
-            out.append(gsd.histogram(vol[keep], edges)[1])
-        return np.array(out)
-
-    v1 = float(frames[0][0].volumes.mean())
-    edges = gsd.log_edges(v1, 200 * v1, 5)
-    one = hist(1)
-    assert one.sum() > 0                                    # held granules, not singletons
-    for tiles in (2, 4):
-        np.testing.assert_allclose(hist(tiles), one, rtol=1e-9, atol=1e-12)

@@ -32,7 +32,7 @@ ANALYSIS = {"steady_after": 0.5, "granules": "communities", "min_bridge_force": 
             "flow_radius": 2.5, "resolution": 0.01, "community_weight": "force",
             "community_seed": 3, "bins_per_decade": 4,
             "min_particles": 3, "error_band": 0.2, "bootstrap": 50, "seed": 7,
-            "sensitivity_frames": 2, "gsd_volume": "primary"}
+            "sensitivity_frames": 2, "gsd_volume": "primary", "hold_time": 0.5}
 SETS = ["--set", "sweep.replicas=2", *[x for k, v in ANALYSIS.items()
                                        for x in ("--set", f"analysis.{k}={v}")]]
 #: a periodic slice shorter than one CG3 particle: the pre-flight refuses it
@@ -97,7 +97,7 @@ def test_local_and_slurm_give_identical_analysis(slurm_cluster, tmp_path, env):
     assert rec_local["definition"] == {
         "method": "communities", "velocity_frame": "drum", "max_velocity_angle_deg": 60.0,
         "min_bridge_force": 1.0e-9, "min_relative_force": 0.1, "resolution": 0.01, "seed": 3,
-        "flow_radius": 2.5, "weight": "force"}
+        "flow_radius": 2.5, "weight": "force", "hold_time": 0.5}
     assert rec_local["gsd"]["n_boot"] == 50 and rec_local["gsd"]["bins_per_decade"] == 4
     assert rec_local["gsd"]["error_band"] == 0.2
     cases = Study.open(local).cases
