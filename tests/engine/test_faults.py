@@ -294,8 +294,11 @@ def test_read_only_study_ends_in_one_line_per_command(tmp_path):
 
 #: two replicas of one case (different insertion seeds) on 2 cores: the rank plan puts
 #: them side by side in one mpirun -np 2 ensemble (no --np / --ensemble given)
+#: phases long enough that a relaunched attempt is still in the next phase when the test
+#: looks (with 0.3 / 0.6 s, a quiet machine ran a relaunch past settle and production
+#: between two looks, and the mpirun campaign failed in a clean-clone CI run)
 PAIR_ARGS = ["--cores", "2", "--set", "sweep.rules=[weber]", "--set", "sweep.replicas=2",
-             "--set", "scene.process.settle_time=0.3", "--set", "scene.process.run_time=0.6"]
+             "--set", "scene.process.settle_time=0.8", "--set", "scene.process.run_time=1.2"]
 PAIR = ("cg3-weber-r0", "cg3-weber-r1")
 PHASES = ("ligwf-phase fill 2", "ligwf-phase settle", "ligwf-phase production")
 #: what ends a ligwf run (the test starts it again); the others it survives by itself
