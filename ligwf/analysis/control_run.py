@@ -90,10 +90,13 @@ def _shuffled(c: ContactFrame, seed: int) -> ContactFrame:
     return replace(c, id1=c.id1[order], id2=c.id2[order], delta=c.delta[order])
 
 
-def labeller(series: Series, kind: str, param) -> Callable[[int, bool, int], Identification | None]:
+def labeller(series: Series, kind: str, param,
+             keys: dict[tuple[int, bool], np.ndarray] | None = None
+             ) -> Callable[[int, bool, int], Identification | None]:
     """granules(k, shuffled, seed): the granules at frame k (None when the window runs past
     the last frame); ``shuffled``: the contact rows in another order; ``seed``: the
-    optimiser seed (communities only)."""
+    optimiser seed (communities only). ``keys``: bridge keys per (frame, shuffled), shared
+    by every windowed definition of one series (each frame's bridges are found once)."""
     facts = series.facts
     motion = facts.motion
     if kind == "frame":
@@ -105,7 +108,7 @@ def labeller(series: Series, kind: str, param) -> Callable[[int, bool, int], Ide
         return frame_labels
     window, passage = param
     span = series.frames_in(window)
-    keys: dict[tuple[int, bool], np.ndarray] = {}
+    keys = {} if keys is None else keys
 
     def key(k: int, shuffled: bool) -> np.ndarray:
         if (k, shuffled) not in keys:
@@ -153,8 +156,9 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
     volumes = series.frames[0].particles.volumes
     axis, length = facts.periodic_axis, facts.box_length
     rows = []
+    shared_keys: dict[tuple[int, bool], np.ndarray] = {}
     for name, kind, param in candidates:
-        labels_of = labeller(series, kind, param)
+        labels_of = labeller(series, kind, param, shared_keys)
         cache: dict[int, Identification | None] = {}
 
         def lab(k: int) -> np.ndarray | None:
