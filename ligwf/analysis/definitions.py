@@ -84,7 +84,7 @@ class GranuleDefinition:
 
     @classmethod
     def of_settings(cls, s) -> "GranuleDefinition":
-        """The definition of a study's :class:`~ligwf.study.settings.AnalysisSettings`."""
+        """The definition of a study's :class:`~ligwf.scene.settings.AnalysisSettings`."""
         return cls(s.granules, s.velocity_frame, float(s.max_velocity_angle),
                    float(s.min_bridge_force), float(s.min_relative_force),
                    float(s.resolution), int(s.community_seed), float(s.flow_radius),

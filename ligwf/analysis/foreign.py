@@ -31,7 +31,7 @@ from ligwf.analysis.runner import (granule_definition, commit, frame_tables, gsd
                                    nothing_analysed, stage_tables)
 from ligwf.engine.liggghts import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
-from ligwf.study.settings import AnalysisSettings
+from ligwf.scene.settings import AnalysisSettings
 
 #: ``engine``: the angle as written into a LIGGGHTS 3.8.0 input (the engine applied
 #: 0.5 theta^2, see :mod:`ligwf.engine.liggghts`); ``scene``: the angle the engine applied

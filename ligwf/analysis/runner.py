@@ -24,7 +24,7 @@ the analysis fails on for any reason is a skipped frame (one bad frame never blo
 others). Otherwise the outputs are replaced as one set
 (:class:`~ligwf.analysis.outputs.OutputSet`). The science settings (bond criterion, GSD
 binning and bootstrap, steady window) come from the study
-(:class:`~ligwf.study.settings.AnalysisSettings`), so every path that analyses a study
+(:class:`~ligwf.scene.settings.AnalysisSettings`), so every path that analyses a study
 computes the same numbers. Granules are identified in every frame; the GSD uses the
 frames of each case's steady window only (the flow stage uses the same window).
 
@@ -76,7 +76,7 @@ from ligwf.analysis.outputs import OutputSet, new_token, study_provenance
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.study import layout
 from ligwf.study.case import granules_absent
-from ligwf.study.settings import AnalysisSettings
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.study import Study
 
 __all__ = ["AnalysisOptions", "GranuleAnalysis", "NothingAnalysed", "analyse"]

@@ -57,7 +57,7 @@ def register(subparsers) -> None:
 def cmd_analyse_dumps(args: argparse.Namespace) -> int:
     from ligwf.analysis.foreign import ForeignRun, analyse_dumps
     from ligwf.errors import ConfigError
-    from ligwf.study.settings import build_analysis_settings
+    from ligwf.scene.settings import build_analysis_settings
     from ligwf.yamlio import parse_yaml
 
     values = {}

@@ -10,7 +10,7 @@ sweep:
   replicas: {1: 1, 2: 3, 3: 3}   # or a single number for every CG level
   scene.process.rotation.rpm: [20, 30]   # any scene field as a list
   per_cg: {2: {process.run_time: 6.0}}    # scene fields for one CG level only
-analysis: {steady_after: 0.25, max_velocity_angle: 30}   # ligwf.study.settings
+analysis: {steady_after: 0.25, max_velocity_angle: 30}   # ligwf.scene.settings
 ```
 
 CLI overrides (``--set scene.drum.lifters.count=12``) are applied to the raw mapping before
@@ -35,7 +35,7 @@ from ligwf.yamlio import parse_yaml, read_yaml_mapping
 from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
 from ligwf.scene.messages import format_validation_error, short_repr
 from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene
-from ligwf.study.settings import AnalysisSettings, build_analysis_settings
+from ligwf.scene.settings import AnalysisSettings, build_analysis_settings
 
 _TOP_KEYS = {"name", "description", "scene", "sweep", "analysis"}
 #: replicas per CG level and cases per study ligwf prepares (a typo such as 300000 replicas

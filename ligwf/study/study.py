@@ -16,7 +16,7 @@ from pathlib import Path
 from ligwf.errors import ConfigError
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import ANALYSIS_DIR, REPORT_DIR, STUDY_FILE, is_case_folder, is_study_folder
-from ligwf.study.settings import AnalysisSettings, build_analysis_settings
+from ligwf.scene.settings import AnalysisSettings, build_analysis_settings
 
 
 @dataclass(frozen=True)

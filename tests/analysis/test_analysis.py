@@ -19,7 +19,7 @@ from ligwf.analysis.dumps import discover_frames, read_particles
 from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, NothingAnalysed, analyse
 from ligwf.cli.main import main
 from ligwf.study.case import CaseFolder
-from ligwf.study.settings import AnalysisSettings
+from ligwf.scene.settings import AnalysisSettings
 from wetdump import wet_study
 
 FAST = AnalysisOptions(settings=AnalysisSettings(bootstrap=100))

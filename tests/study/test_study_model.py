@@ -13,7 +13,7 @@ from ligwf.scene.workflow import load_workflow
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import Manifest
-from ligwf.study.settings import AnalysisSettings
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.study import Study, studies_below
 
 from helpers import DRUM
