@@ -2,7 +2,7 @@
 
 :class:`Liquid` is the law the engine applied in one case (the model of
 :mod:`ligwf.liquids`, the CG-scaled surface tension, the contact angle the engine actually
-used, see :mod:`ligwf.engine.liggghts`); the functions evaluate it on the pairs of a dumped
+used, see :mod:`ligwf.liquids.contact_angle`); the functions evaluate it on the pairs of a dumped
 frame with the model's numpy law (the reference the compiled kernels are tested against).
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 
 from ligwf import liquids
 from ligwf.analysis.dumps import ContactFrame, ParticleFrame
-from ligwf.engine.liggghts import applied_contact_angle_rad
+from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.liquids.base import LiquidModel
 from ligwf.scene.scaling import ScaledScene
 
@@ -25,7 +25,7 @@ class Liquid:
 
     model: str                  # a name of ligwf.liquids' registry
     surface_tension: float      # N/m, already CG-scaled
-    contact_angle_rad: float    # the angle the engine APPLIED (see ligwf.engine.liggghts)
+    contact_angle_rad: float    # the angle the engine APPLIED (see ligwf.liquids.contact_angle)
     liquid_content: float       # fraction of particle volume, used if a dump lacks it
 
     @property

@@ -29,12 +29,12 @@ from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.analysis.runner import (granule_definition, commit, frame_tables, gsd_settings,
                                    nothing_analysed, stage_tables)
-from ligwf.engine.liggghts import applied_contact_angle_rad
+from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.scene.settings import AnalysisSettings
 
 #: ``engine``: the angle as written into a LIGGGHTS 3.8.0 input (the engine applied
-#: 0.5 theta^2, see :mod:`ligwf.engine.liggghts`); ``scene``: the angle the engine applied
+#: 0.5 theta^2, see :mod:`ligwf.liquids.contact_angle`); ``scene``: the angle the engine applied
 #: (an engine with the upstream fix, or an input compensated as ligwf does).
 ANGLE_CONVENTIONS = ("engine", "scene")
 

@@ -1,11 +1,8 @@
 """The LIGGGHTS 3.8.0 facts ligwf works around, in one place.
 
-Contact angle (washino and easo, the Debian 3.8.0 release): the engine computes the
-effective angle of a pair as ``0.5 * theta_i * theta_j`` (radians) instead of the mean
-``0.5 * (theta_i + theta_j)`` (fixed upstream after the release). With 30 deg on both
-partners it applies about 7.9 deg. For one particle type an input angle
-``a = sqrt(2 theta)`` makes the engine apply ``theta``; ligwf writes that unless the scene
-says the engine has the fix (``numerics.contact_angle_compensation: false``).
+Contact angle: the 3.8.0 law of the capillary models (0.5 theta_i theta_j) and ligwf's
+compensation are :mod:`ligwf.liquids.contact_angle` (every layer that evaluates a bridge
+needs them).
 
 Restarts: SIGTERM makes the engine write ``restart_forced_liggghts_<step>.data`` in its
 working folder; the drum input writes periodic restarts alternately to two files (so a
@@ -18,54 +15,12 @@ through ctypes on an mpi4py sub-communicator by the ensemble worker.
 from __future__ import annotations
 
 import ctypes
-import math
 import os
 import re
 import struct
 from pathlib import Path
 
 from ligwf.engine.site import load_site
-from ligwf.liquids.base import InputAngle
-
-#: what the input's comment says when ligwf compensates the contact-angle bug
-CONTACT_ANGLE_NOTE = "LIGGGHTS 3.8.0 applies 0.5*a*a rad"
-
-
-def engine_contact_angle_deg(theta_deg: float, compensate: bool = True) -> float:
-    """Contact angle to write into the LIGGGHTS input so the engine applies ``theta_deg``.
-
-    LIGGGHTS 3.8.0 applies ``0.5 * a * a`` (radians) for an input angle ``a`` on both
-    partners. Solving ``0.5 a^2 = theta`` gives ``a = sqrt(2 theta)``, which stays within the
-    engine's accepted [0, 180] deg for every theta in [0, 180] deg. With ``compensate=False``
-    (an engine with the upstream fix) the angle is passed through.
-    """
-    if not compensate:
-        return theta_deg
-    return math.degrees(math.sqrt(2.0 * math.radians(theta_deg)))
-
-
-def engine_effective_angle_rad(theta_in_deg_i: float, theta_in_deg_j: float | None = None,
-                               product_bug: bool = True) -> float:
-    """Effective angle (radians) the engine applies for input angles of two partners."""
-    a = math.radians(theta_in_deg_i)
-    b = math.radians(theta_in_deg_j if theta_in_deg_j is not None else theta_in_deg_i)
-    return 0.5 * a * b if product_bug else 0.5 * (a + b)
-
-
-def input_angle(theta_deg: float, compensate: bool) -> InputAngle:
-    """The angle a liquid model writes for a scene angle ``theta_deg``, with its note."""
-    return InputAngle(engine_contact_angle_deg(theta_deg, compensate),
-                      CONTACT_ANGLE_NOTE if compensate else "")
-
-
-def applied_contact_angle_rad(theta_deg: float, compensated: bool,
-                              product_bug: bool = True) -> float:
-    """The angle (rad) the engine applied in a run whose scene angle is ``theta_deg``:
-    the scene's when ligwf compensated (or the engine has the fix), else 0.5 theta^2."""
-    if compensated or not product_bug:
-        return math.radians(theta_deg)
-    return engine_effective_angle_rad(theta_deg, product_bug=True)
-
 
 # --------------------------------------------------------------------------- restarts
 

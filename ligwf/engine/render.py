@@ -22,7 +22,7 @@ import jinja2
 
 from ligwf import __version__
 from ligwf.errors import RenderError
-from ligwf.engine.liggghts import input_angle
+from ligwf.liquids.contact_angle import input_angle
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.model import GRAVITY, unsafe_chars

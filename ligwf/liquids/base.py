@@ -51,7 +51,7 @@ class ScaledLiquid(Protocol):
 @dataclass(frozen=True)
 class InputAngle:
     """The contact angle to write into the input, deg, and a note when the engine needs it
-    to differ from the scene's (built by :mod:`ligwf.engine.liggghts`)."""
+    to differ from the scene's (built by :mod:`ligwf.liquids.contact_angle`)."""
 
     degrees: float
     note: str = ""

@@ -20,7 +20,7 @@ m = 4/3 pi r^3 rho, same material):
 * Capillary time scale (wet): t_c = sqrt(m* / k_b), with F_0 and k_b = |dF/ds| the bridge
   force and stiffness at contact, from the case's liquid model
   (``contact_force_and_stiffness`` of :mod:`ligwf.liquids`), at the angle the engine
-  applies (:mod:`ligwf.engine.liggghts`).
+  applies (:mod:`ligwf.liquids.contact_angle`).
 * Capillary overlap (wet): in contact the bridge force F_0 + k_b delta pulls the pair
   together against Hertz (4/3) E* sqrt(R*) delta^(3/2); the equilibrium delta is the
   static overlap a wet bed keeps. When the capillary pull grows faster than Hertz there is
@@ -42,7 +42,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ligwf.engine.liggghts import applied_contact_angle_rad
+from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.scene.model import GRAVITY
 from ligwf.scene.scaling import ScaledScene
 

@@ -13,7 +13,7 @@ import re
 import pytest
 
 from ligwf import liquids
-from ligwf.engine.liggghts import engine_effective_angle_rad
+from ligwf.liquids.contact_angle import engine_effective_angle_rad
 from ligwf.engine.render import render_bridge_probe
 from ligwf.scene.scaling import scale
 from ligwf.scene.workflow import load_workflow

@@ -1,4 +1,4 @@
-"""ligwf.engine.liggghts: the LIGGGHTS 3.8.0 contact-angle compensation."""
+"""ligwf.liquids.contact_angle: the LIGGGHTS 3.8.0 contact-angle law and its compensation."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from ligwf.engine.liggghts import engine_contact_angle_deg, engine_effective_angle_rad
+from ligwf.liquids.contact_angle import engine_contact_angle_deg, engine_effective_angle_rad
 
 
 def test_contact_angle_compensation():
