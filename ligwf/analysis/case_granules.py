@@ -27,6 +27,7 @@ from ligwf.analysis.definitions import GranuleDefinition, Motion, identify_granu
 from ligwf.analysis.granules import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.fsio import atomic_write_bytes
+from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 
 
@@ -166,7 +167,7 @@ class GranuleAnalysis:
                 bi, bj, bf = bonded_contacts(particles, contacts, f.liquid,
                                              self.definition.criterion)
                 extra["louvain"] = louvain_labels(len(particles), bi, bj, bf)
-            res.vtu = f"granules_{ff.step}.vtu"
+            res.vtu = layout.granule_frame(ff.step)
             write_particle_vtu(Path(self.vtu_dir) / res.vtu, particles, labels,
                                table["members"].to_numpy()[labels], extra)
         return res

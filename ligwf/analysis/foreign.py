@@ -32,6 +32,7 @@ from ligwf.analysis.runner import (granule_definition, commit, frame_tables, gsd
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.scene.settings import AnalysisSettings
+from ligwf.study import layout
 
 #: ``engine``: the angle as written into a LIGGGHTS 3.8.0 input (the engine applied
 #: 0.5 theta^2, see :mod:`ligwf.liquids.contact_angle`); ``scene``: the angle the engine applied
@@ -151,7 +152,7 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
         stage_tables(outputs, granules, table, gsd_df, summary)
         entries = [(r.time, r.vtu) for r in results if r.vtu]
         if entries:
-            outputs.write(f"{facts.case_id}/granules.pvd", pvd_text(entries).encode())
+            outputs.write(f"{facts.case_id}/{layout.GRANULE_SERIES}", pvd_text(entries).encode())
         record = {"dump_dir": str(dump_dir), "run": asdict(run),
                   "settings": settings.model_dump(mode="json"),
                   "definition": asdict(granule_definition(settings)),

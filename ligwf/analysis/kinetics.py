@@ -28,10 +28,6 @@ from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.dumps import FrameFiles
 from ligwf.analysis.gsd_tables import CaseLike, Condition
 
-#: File names of the kinetics and sensitivity tables in the analysis folder
-KINETICS_TABLE = "kinetics.csv"
-KINETICS_SUMMARY_TABLE = "kinetics_summary.csv"
-SENSITIVITY_TABLE = "sensitivity.csv"
 #: Per-frame quantities (see :func:`ligwf.analysis.gsd.frame_stats`)
 QUANTITIES = ("granules", "d10", "d50", "d90", "largest_granule", "granule_share",
               "percolating_share")

@@ -23,16 +23,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ligwf.errors import LigwfError
+from ligwf.study import layout
 from ligwf.study.case import file_digest, folder_fingerprint
 
-#: A per-case folder holding this file (or labelled frames) is a granule series of ours.
-SERIES_FILE = "granules.pvd"
-
-
 def is_series_dir(path: Path) -> bool:
-    """Whether ``path`` is a per-case granule series folder written by the analysis."""
-    return path.is_dir() and ((path / SERIES_FILE).is_file()
-                              or any(path.glob("granules_*.vtu")))
+    """Whether ``path`` is a per-case granule series folder written by the analysis (it
+    holds the series file or labelled frames)."""
+    return path.is_dir() and ((path / layout.GRANULE_SERIES).is_file()
+                              or any(path.glob(layout.GRANULE_FRAME_GLOB)))
 
 
 def new_token() -> str:

@@ -69,8 +69,7 @@ from ligwf.analysis.flow_run import steady_start_step
 from ligwf.analysis.gsd_pooling import pooling_table
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.study_controls import control_pairs, study_controls
-from ligwf.analysis.kinetics import (KINETICS_SUMMARY_TABLE, KINETICS_TABLE, SENSITIVITY_TABLE,
-                                     kinetics_summary, kinetics_table, sensitivity_table)
+from ligwf.analysis.kinetics import kinetics_summary, kinetics_table, sensitivity_table
 from ligwf.analysis.dumps import FrameFiles
 from ligwf.analysis.outputs import OutputSet, new_token, study_provenance
 from ligwf.errors import ConfigError, LigwfError
@@ -297,7 +296,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
         for c in cases:
             entries = [(r.time, r.vtu) for r in results if r.case_id == c.case_id and r.vtu]
             if entries:
-                outputs.write(f"{c.case_id}/granules.pvd", pvd_text(entries).encode())
+                outputs.write(f"{c.case_id}/{layout.GRANULE_SERIES}", pvd_text(entries).encode())
     steady_frames = steady.groupby("case_id")["step"].nunique() if len(steady) else {}
     plans: dict[str, FramePlan] = {f.case_id: f.plan for f in analysed}
     record = {
@@ -346,9 +345,9 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
     cases = [f.case for f in analysed]
     kin = kinetics_table(granules, cases, settings.min_particles,
                          VOLUME_COLUMNS[settings.gsd_volume])
-    outputs.write(KINETICS_TABLE, kin.to_csv(index=False).encode())
+    outputs.write(layout.KINETICS_TABLE, kin.to_csv(index=False).encode())
     summary = kinetics_summary(kin, settings.bootstrap, settings.seed)
-    outputs.write(KINETICS_SUMMARY_TABLE, summary.to_csv(index=False).encode())
+    outputs.write(layout.KINETICS_SUMMARY_TABLE, summary.to_csv(index=False).encode())
     if settings.sensitivity_frames == 0:
         return
     facts = next((f for f in analysed if f.cg == 1), analysed[0])
@@ -359,13 +358,13 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
     table = sensitivity_table(facts, [steady[int(k)] for k in pick],
                               granule_definition(settings), settings.min_particles,
                               implementation)
-    outputs.write(SENSITIVITY_TABLE, table.to_csv(index=False).encode())
+    outputs.write(layout.SENSITIVITY_TABLE, table.to_csv(index=False).encode())
 
 
 #: Tables of a granule analysis: an analysis without granule data removes old ones.
 GRANULE_OUTPUTS = (layout.GRANULES_TABLE, layout.FRAMES_TABLE, layout.GSD_TABLE,
-                   layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE, KINETICS_TABLE,
-                   KINETICS_SUMMARY_TABLE, SENSITIVITY_TABLE, layout.CONTROLS_TABLE)
+                   layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE, layout.KINETICS_TABLE,
+                   layout.KINETICS_SUMMARY_TABLE, layout.SENSITIVITY_TABLE, layout.CONTROLS_TABLE)
 
 
 def commit(outputs: OutputSet, record: dict, obsolete: tuple[str, ...] = ()) -> None:

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.kinetics import KINETICS_SUMMARY_TABLE, SENSITIVITY_TABLE
+from ligwf.study import layout
 
 KINETICS_PANELS = [("granules", "granules (count)"), ("d50", "d50 [mm]"),
                    ("largest_granule", "largest granule [bed share]"),
@@ -80,11 +80,11 @@ def sensitivity_figure(table: pd.DataFrame, out: Path) -> Path:
 def granule_figures(analysis_dir: Path, fig_dir: Path) -> list[tuple[str, Path]]:
     """(title, path) of the granule figures whose tables exist in ``analysis_dir``."""
     out = []
-    kin = _read(Path(analysis_dir) / KINETICS_SUMMARY_TABLE)
+    kin = _read(Path(analysis_dir) / layout.KINETICS_SUMMARY_TABLE)
     if not kin.empty:
-        out.append(("Granulation kinetics", kinetics_figure(kin, fig_dir / "granule_kinetics.png")))
-    sens = _read(Path(analysis_dir) / SENSITIVITY_TABLE)
+        out.append(("Granulation kinetics", kinetics_figure(kin, fig_dir / layout.FIGURE_KINETICS)))
+    sens = _read(Path(analysis_dir) / layout.SENSITIVITY_TABLE)
     if not sens.empty:
         out.append(("Granule definition sensitivity",
-                    sensitivity_figure(sens, fig_dir / "granule_sensitivity.png")))
+                    sensitivity_figure(sens, fig_dir / layout.FIGURE_SENSITIVITY)))
     return out

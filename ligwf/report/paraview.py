@@ -20,6 +20,7 @@ from ligwf.engine.mesh import axis_frame
 from ligwf.engine.render import MESH_NAME
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_text
+from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 
 
@@ -69,15 +70,15 @@ def case_collection(case: CaseFolder, analysis_dir: Path, out_dir: Path) -> Path
     labelled = analysis_dir / case.case_id
     for ff in frames:
         t = ff.step * s.dt
-        g = labelled / f"granules_{ff.step}.vtu"
+        g = labelled / layout.granule_frame(ff.step)
         particles = g if g.is_file() else ff.particles
         entries.append((t, 0, os.path.relpath(particles, out_dir)))
         pts = points @ rotation_matrix(s.axis, case.drum_angle(ff.step)).T
-        drum_file = case_out / f"drum_{ff.step}.vtu"
+        drum_file = case_out / layout.drum_frame(ff.step)
         tmp = drum_file.with_suffix(".tmp.vtu")
         meshio.write(tmp, meshio.Mesh(pts, [("triangle", tri)]), binary=True)
         os.replace(tmp, drum_file)
         entries.append((t, 1, os.path.relpath(drum_file, out_dir)))
-    path = out_dir / f"{case.case_id}.pvd"
+    path = out_dir / layout.paraview_collection(case.case_id)
     atomic_write_text(path, _pvd(entries))
     return path

@@ -172,24 +172,24 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     trusted = checked_analysis(study)
     flow = flow_study(study)
     nothing_to_report(study, flow)
-    fig_dir, pv_dir = out / "figures", out / "paraview"
+    fig_dir, pv_dir = out / layout.FIGURES_DIR, out / layout.PARAVIEW_DIR
     fig_dir.mkdir(parents=True, exist_ok=True)
     cases, conditions, _, profiles, floors = build_tables(study, granules=trusted)
     problems = study_problems(study)
-    atomic_write_text(out / "cases.csv", cases.to_csv(index=False))
-    atomic_write_text(out / "conditions.csv", conditions.to_csv(index=False))
-    atomic_write_text(out / "noise_floor.csv", floors.to_csv(index=False))
+    atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
+    atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
+    atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
 
     figures: list[tuple[str, Path]] = []
     if not conditions.empty:
-        figures.append(("Error vs run time", figs.pareto(conditions, fig_dir / "error_vs_runtime.png")))
+        figures.append(("Error vs run time", figs.pareto(conditions, fig_dir / layout.FIGURE_ERROR_VS_RUNTIME)))
         figures.append(("Velocity profiles", figs.velocity_profiles(cases, profiles,
-                                                                    fig_dir / "velocity_profiles.png")))
+                                                                    fig_dir / layout.FIGURE_VELOCITY_PROFILES)))
     gsd_path = study.analysis_dir / layout.GSD_TABLE
     if trusted and gsd_path.is_file() and gsd_path.stat().st_size > 1:
         gsd = pd.read_csv(gsd_path)
         if not gsd.empty:
-            figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / "gsd_overlay.png",
+            figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / layout.FIGURE_GSD_OVERLAY,
                                                                  study.analysis.gsd_volume)))
     if trusted:
         figures += granule_figures(study.analysis_dir, fig_dir)
@@ -205,13 +205,13 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
             axis, angle, mesh = case.scaled.axis, case.drum_angle(last.step), case.path / MESH_NAME
             figures.append((f"{case_id}: speed", figs.snapshot(
                 last.particles, mesh, axis, angle, "speed",
-                fig_dir / f"{case_id}_speed.png", f"{case_id} step {last.step}: speed [m/s]")))
+                fig_dir / layout.snapshot_figure(case_id, "speed"), f"{case_id} step {last.step}: speed [m/s]")))
             labelled = last_labelled(study.analysis_dir / case_id, last.step) if trusted else None
             if labelled is not None:
                 step, path = labelled
                 figures.append((f"{case_id}: granules", figs.snapshot(
                     path, mesh, axis, case.drum_angle(step), "granule",
-                    fig_dir / f"{case_id}_granules.png", f"{case_id} step {step}: granule id")))
+                    fig_dir / layout.snapshot_figure(case_id, "granules"), f"{case_id} step {step}: granule id")))
 
     name = study.name
     md = "\n".join([
@@ -228,11 +228,11 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         *(pooling_markdown(study.analysis_dir) if trusted else []),
         *problems.markdown(),
         "## Figures", "",
-        *[f"![{t}](figures/{p.name})" for t, p in figures], "",
+        *[f"![{t}]({layout.FIGURES_DIR}/{p.name})" for t, p in figures], "",
         "## ParaView", "",
-        *[f"- `paraview/{p.name}`" for p in pvds], ""])
-    atomic_write_text(out / "summary.md", md)
-    atomic_write_text(out / "index.html", _html(name, cases, conditions, figures, problems,
+        *[f"- `{layout.PARAVIEW_DIR}/{p.name}`" for p in pvds], ""])
+    atomic_write_text(out / layout.SUMMARY_REPORT, md)
+    atomic_write_text(out / layout.HTML_REPORT, _html(name, cases, conditions, figures, problems,
                                                 controls_html(study.analysis_dir) if trusted else ""))
     return out
 
@@ -241,12 +241,9 @@ def last_labelled(case_out: Path, up_to: int) -> tuple[int, Path] | None:
     """(step, file) of the newest granule-labelled frame at or before ``up_to`` (the last
     frames of a ``granules: held`` run have no granules: their hold window is open)."""
     found = []
-    for p in case_out.glob("granules_*.vtu") if case_out.is_dir() else []:
-        try:
-            step = int(p.stem.split("_", 1)[1])
-        except ValueError:
-            continue
-        if step <= up_to:
+    for p in case_out.glob(layout.GRANULE_FRAME_GLOB) if case_out.is_dir() else []:
+        step = layout.granule_frame_step(p.name)
+        if step is not None and step <= up_to:
             found.append((step, p))
     return max(found) if found else None
 
@@ -311,7 +308,7 @@ def _html(name, cases, conditions, figures, problems, controls: str = "") -> str
         if df.empty:
             return "<p>none</p>"
         return df.to_html(index=False, float_format=lambda v: f"{v:.3g}", na_rep="–", border=0)
-    imgs = "\n".join(f'<figure><img src="figures/{p.name}" alt="{html.escape(t)}">'
+    imgs = "\n".join(f'<figure><img src="{layout.FIGURES_DIR}/{p.name}" alt="{html.escape(t)}">'
                      f"<figcaption>{html.escape(t)}</figcaption></figure>" for t, p in figures)
     cols = [c for c, _ in CASE_COLUMNS]
     return f"""<!doctype html><html><head><meta charset="utf-8"><title>{html.escape(name)}</title>

@@ -10,11 +10,15 @@ A study folder (``ligwf render`` / ``run`` / ``study`` write it)::
     STUDY/<case_id>/dumps.json       size and SHA-256 of every file in post/ when the run
                                      ended done (written with the done manifest)
     STUDY/<case_id>/post/, restart/  the engine's dumps and restarts
-    STUDY/analysis/                  granule, GSD and flow tables
-    STUDY/report/                    the report folder
+    STUDY/analysis/                  granule, GSD, kinetics and flow tables, the steady
+                                     window, the analysis record, per case a granule series
+    STUDY/report/                    tables, summary.md, index.html, figures/, paraview/
 
-Only :mod:`ligwf.study` opens these files by name; every stage asks its objects
-(:class:`~ligwf.study.case.CaseFolder`, :class:`~ligwf.study.study.Study`).
+Every file name a stage writes is declared here and nowhere else: the study folder's
+files are opened by :mod:`ligwf.study` (every stage asks its objects,
+:class:`~ligwf.study.case.CaseFolder`, :class:`~ligwf.study.study.Study`); the analysis
+stage (:mod:`ligwf.analysis`) owns the files of ``analysis/`` and the report stage
+(:mod:`ligwf.report`) those of ``report/``, each writing them once.
 """
 
 from __future__ import annotations
@@ -41,17 +45,76 @@ ANALYSIS_DIR = "analysis"
 #: Study level: the report folder.
 REPORT_DIR = "report"
 
-# files in ANALYSIS_DIR
+# ---- files in ANALYSIS_DIR (written by the analysis stage, read by the report)
+#: what was analysed, from what, with which settings, and the digest of every table
 ANALYSIS_RECORD = "analysis.json"
 GRANULES_TABLE = "granules.parquet"
 FRAMES_TABLE = "frames.csv"
 GSD_TABLE = "gsd.csv"
 GSD_SUMMARY_TABLE = "gsd_summary.csv"
 GSD_POOLING_TABLE = "gsd_pooling.csv"
+#: the pooling table per condition and pool size (mean, min, max over pools)
+GSD_POOLING_SUMMARY_TABLE = "gsd_pooling_summary.csv"
+#: granule kinetics per case and frame, per condition with bands, definition sensitivity
+KINETICS_TABLE = "kinetics.csv"
+KINETICS_SUMMARY_TABLE = "kinetics_summary.csv"
+SENSITIVITY_TABLE = "sensitivity.csv"
+#: flow metrics per case (its steady window included)
 FLOW_TABLE = "flow.csv"
 #: granule controls: each wet case beside its cohesionless twin, per definition
 CONTROLS_TABLE = "controls.csv"
+#: the flow record: per case its steady window, per-frame series of every flow metric,
+#: profiles, velocity field and the frames it read (:mod:`ligwf.analysis.records.flow`)
 FLOW_PROFILES = "flow_profiles.json"
+#: per case ``ANALYSIS_DIR/<case_id>/``: the granule series (``.pvd``) of its labelled frames
+GRANULE_SERIES = "granules.pvd"
+#: glob of the labelled frames in a case's granule series folder
+GRANULE_FRAME_GLOB = "granules_*.vtu"
+
+
+def granule_frame(step: int) -> str:
+    """File name of the granule-labelled particles of one frame (in the case's folder)."""
+    return f"granules_{step}.vtu"
+
+
+def granule_frame_step(name: str) -> int | None:
+    """The step of a :func:`granule_frame` file name, None for any other name."""
+    stem, dot, ext = name.partition(".")
+    head, _, step = stem.partition("_")
+    if head != "granules" or ext != "vtu" or not step.isdigit():
+        return None
+    return int(step)
+
+
+# ---- files in REPORT_DIR (written by the report stage)
+CASES_REPORT = "cases.csv"
+CONDITIONS_REPORT = "conditions.csv"
+NOISE_FLOOR_REPORT = "noise_floor.csv"
+SUMMARY_REPORT = "summary.md"
+HTML_REPORT = "index.html"
+FIGURES_DIR = "figures"
+#: ParaView collections: ``PARAVIEW_DIR/<case_id>.pvd`` + ``PARAVIEW_DIR/<case_id>/drum_<step>.vtu``
+PARAVIEW_DIR = "paraview"
+FIGURE_ERROR_VS_RUNTIME = "error_vs_runtime.png"
+FIGURE_VELOCITY_PROFILES = "velocity_profiles.png"
+FIGURE_GSD_OVERLAY = "gsd_overlay.png"
+FIGURE_KINETICS = "granule_kinetics.png"
+FIGURE_SENSITIVITY = "granule_sensitivity.png"
+
+
+def snapshot_figure(case_id: str, coloured_by: str) -> str:
+    """File name of a case's snapshot figure (``coloured_by``: speed or granules)."""
+    return f"{case_id}_{coloured_by}.png"
+
+
+def paraview_collection(case_id: str) -> str:
+    """File name of a case's ParaView collection in ``PARAVIEW_DIR``."""
+    return f"{case_id}.pvd"
+
+
+def drum_frame(step: int) -> str:
+    """File name of the drum mesh turned to its position at ``step``."""
+    return f"drum_{step}.vtu"
 
 
 def is_study_folder(path: Path) -> bool:
