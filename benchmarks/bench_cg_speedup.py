@@ -32,7 +32,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.quiet import check_quiet  # noqa: E402
-from ligwf.engine.health import DONE  # noqa: E402
+from ligwf.study.manifest import DONE  # noqa: E402
 from ligwf.engine.launch import run_case  # noqa: E402
 from ligwf.engine.plan import case_load, machine_cores, plan_ranks  # noqa: E402
 from ligwf.engine.site import EngineConfig  # noqa: E402

@@ -48,8 +48,9 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.quiet import check_quiet  # noqa: E402
 from ligwf.engine.guard import engine_env  # noqa: E402
-from ligwf.engine.health import DONE  # noqa: E402
-from ligwf.engine.render import INPUT_NAME, grid_vars  # noqa: E402
+from ligwf.study.manifest import DONE  # noqa: E402
+from ligwf.engine.render import grid_vars  # noqa: E402
+from ligwf.study.layout import INPUT_NAME  # noqa: E402
 from ligwf.engine.site import EngineConfig  # noqa: E402
 from ligwf.engine.thermo import parse_screen  # noqa: E402
 from ligwf.scene.workflow import load_workflow  # noqa: E402

@@ -88,9 +88,10 @@ from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles 
 from ligwf.analysis.dumps_numba import first_of_each_pair  # noqa: E402
 from ligwf.analysis.vtu import read_vtu  # noqa: E402
 from ligwf.engine.guard import engine_env  # noqa: E402
-from ligwf.engine.health import DONE  # noqa: E402
+from ligwf.study.manifest import DONE  # noqa: E402
 from ligwf.engine.launch import run_case  # noqa: E402
-from ligwf.engine.render import MESH_NAME, grid_vars, shipped_template_dir  # noqa: E402
+from ligwf.engine.render import grid_vars, shipped_template_dir  # noqa: E402
+from ligwf.study.layout import MESH_NAME  # noqa: E402
 from ligwf.engine.resume import (RESUME_INPUT, render_resume, restart_files,  # noqa: E402
                                  resume_phase)
 from ligwf.engine.site import EngineConfig  # noqa: E402

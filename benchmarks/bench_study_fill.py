@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.quiet import check_quiet  # noqa: E402
-from ligwf.engine.health import DONE  # noqa: E402
+from ligwf.study.manifest import DONE  # noqa: E402
 from ligwf.engine.plan import machine_cores  # noqa: E402
 from ligwf.study.study import Study  # noqa: E402
 

@@ -13,15 +13,17 @@ import re
 
 from ligwf import __version__
 from ligwf.fsio import LOW_SPACE_BYTES, FolderNotWritable, atomic_write_text, space_left
-from ligwf.engine.guard import start_time
-from ligwf.engine.health import (DONE, FAILED, KILLED, RUNNING, UNSTABLE, Expectation, assess,
-                                 engine_signal, kinetic_energy_ceiling, verdict)
+from ligwf.engine.health import (Expectation, assess, engine_signal, kinetic_energy_ceiling,
+                                 verdict)
 from ligwf.engine.restart_id import CaseIdentity, stamp
 from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for, render_resume,
                                  rotate_screen)
-from ligwf.engine.thermo import ThermoRow, parse_screen, phase_group, rows_from_csv, rows_to_csv
+from ligwf.engine.thermo import parse_screen, phase_group
 from ligwf.scene.scaling import ScaledScene
 from ligwf.study.case import CaseFolder
+from ligwf.study.manifest import DONE, FAILED, KILLED, RUNNING, UNSTABLE
+from ligwf.study.processes import start_time
+from ligwf.study.thermo_table import ThermoRow, rows_from_csv, rows_to_csv
 from ligwf.study.layout import SCREEN_FILE
 from ligwf.study.manifest import Attempt, Manifest, now_iso, overwrite_manifest
 

@@ -40,9 +40,9 @@ from pathlib import Path
 
 from ligwf.engine.attempt import DISK_FULL, finish_attempt, restart_unreadable, stamp_restarts
 from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
-from ligwf.engine.health import FAILED, KILLED, log_errors
-from ligwf.engine.guard import (RANK_NAMES, STOP_GRACE_SECONDS, EngineProcess, engine_env,
-                                engine_tree, process, release, watch)
+from ligwf.engine.health import log_errors
+from ligwf.engine.guard import (RANK_NAMES, STOP_GRACE_SECONDS, engine_env, engine_tree, release,
+                                watch)
 from ligwf.engine.launch import (Monitor, NullMonitor, interrupted_reason, signal_engine,
                                  take_over)
 from ligwf.engine.restart_id import SETTLE_SECONDS
@@ -52,7 +52,8 @@ from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.errors import SimulationFailed
 from ligwf.fsio import FolderNotWritable, atomic_write_json
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import Manifest, overwrite_manifest
+from ligwf.study.manifest import FAILED, KILLED, Manifest, overwrite_manifest
+from ligwf.study.processes import EngineProcess, process
 
 ENSEMBLE_DIR = ".ensemble"
 

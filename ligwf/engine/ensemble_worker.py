@@ -35,12 +35,13 @@ import time
 from pathlib import Path
 
 from ligwf.engine.attempt import DISK_FULL, begin_attempt, finish_attempt, restart_unreadable
-from ligwf.engine.guard import ENSEMBLE_RANK_NAME, process
-from ligwf.engine.health import KILLED
+from ligwf.engine.guard import ENSEMBLE_RANK_NAME
 from ligwf.engine.liggghts import Liggghts
 from ligwf.fsio import atomic_write_json
 from ligwf.engine.resume import FRESH, RESUME, SKIP, discard_restart, input_for, plan_case
 from ligwf.study.case import CaseFolder
+from ligwf.study.manifest import KILLED
+from ligwf.study.processes import process
 
 QUEUE_FILE = "queue.json"
 _libc = ctypes.CDLL(None)

@@ -25,8 +25,9 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass
 from pathlib import Path
+
+from ligwf.study.processes import EngineProcess, process
 
 #: the process name an MPI-ensemble rank gives itself (``python -m
 #: ligwf.engine.ensemble_worker`` sets it with prctl, so it can be found like ``liggghts``)
@@ -48,57 +49,6 @@ def engine_env() -> dict[str, str]:
     env = dict(os.environ)
     env.setdefault("OMPI_MCA_odls_base_sigkill_timeout", str(MPI_KILL_DELAY))
     return env
-
-
-@dataclass(frozen=True)
-class EngineProcess:
-    """A process by pid and kernel start time (clock ticks since boot), so a pid the kernel
-    has since given to another process is not mistaken for the engine."""
-
-    pid: int
-    start: int
-    name: str = ""
-
-    def alive(self) -> bool:
-        return start_time(self.pid) == self.start
-
-    def to_dict(self) -> dict:
-        return {"pid": self.pid, "start": self.start, "name": self.name}
-
-    @classmethod
-    def from_dict(cls, d: dict) -> "EngineProcess":
-        return cls(int(d["pid"]), int(d["start"]), str(d.get("name", "")))
-
-
-def start_time(pid: int) -> int | None:
-    """Start time of ``pid`` (field 22 of /proc/<pid>/stat), None when it does not exist
-    or has ended (a zombie, state Z or X, waiting for its parent to reap it, is no
-    process that runs: never a live runner or engine)."""
-    try:
-        with open(f"/proc/{pid}/stat", "rb") as fh:
-            stat = fh.read().decode(errors="replace")
-    except OSError:
-        return None
-    # the command name (field 2) may hold spaces and parentheses: split after the last ')'
-    fields = stat[stat.rfind(")") + 2:].split()
-    if fields and fields[0] in ("Z", "X"):
-        return None
-    try:
-        return int(fields[19])
-    except (IndexError, ValueError):
-        return None
-
-
-def process(pid: int) -> EngineProcess | None:
-    """``pid`` with its start time and name, None when it is gone."""
-    start = start_time(pid)
-    if start is None:
-        return None
-    try:
-        name = Path(f"/proc/{pid}/comm").read_text().strip()
-    except OSError:
-        name = ""
-    return EngineProcess(pid, start, name)
 
 
 def descendants(pid: int) -> list[int]:

@@ -17,13 +17,8 @@ import re
 from dataclasses import dataclass
 from typing import Iterable, Sequence
 
-from ligwf.engine.thermo import ThermoRow
-
-#: Case states a manifest can hold.
-DONE, FAILED, UNSTABLE, KILLED, RUNNING = "done", "failed", "unstable", "killed", "running"
-STATUSES = (DONE, FAILED, UNSTABLE, KILLED, RUNNING)
-#: Shown for a case without a (readable) manifest: not run yet. Never written to one.
-MISSING = "missing"
+from ligwf.study.manifest import DONE, FAILED, KILLED, UNSTABLE
+from ligwf.study.thermo_table import ThermoRow
 
 #: Issue kinds that make a case ``failed`` (the engine stopped on an error) rather than
 #: ``unstable`` (it ran, but the physics went wrong).

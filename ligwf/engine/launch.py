@@ -28,17 +28,19 @@ from ligwf.engine.attempt import (DISK_FULL, begin_attempt, close_lost_attempt, 
                                   finish_attempt, history, merge_rows, restart_unreadable,
                                   stamp_restarts)
 from ligwf.engine.restart_id import SETTLE_SECONDS, CaseIdentity, stamp
-from ligwf.engine.guard import (STOP_GRACE_SECONDS, EngineProcess, descendants, engine_env,
-                                engine_tree, live_engines, release, stop_engines, watch)
-from ligwf.engine.health import KILLED, RUNNING, Expectation, physics_issues
+from ligwf.engine.guard import (STOP_GRACE_SECONDS, descendants, engine_env, engine_tree,
+                                live_engines, release, stop_engines, watch)
+from ligwf.engine.health import Expectation, physics_issues
 from ligwf.engine.render import grid_vars
 from ligwf.engine.resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, plan_case
 from ligwf.engine.site import EngineConfig
-from ligwf.engine.thermo import LogTail, ThermoParser, ThermoRow
+from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.fsio import NOT_WRITABLE, FolderNotWritable, not_writable
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import SCREEN_FILE
-from ligwf.study.manifest import Manifest, case_lock, runner_alive
+from ligwf.study.manifest import KILLED, RUNNING, Manifest, case_lock, runner_alive
+from ligwf.study.processes import EngineProcess
+from ligwf.study.thermo_table import ThermoRow
 
 class Monitor(Protocol):
     """Receives live progress of the cases a runner works on (local runs and ensembles

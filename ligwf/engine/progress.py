@@ -14,11 +14,11 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskID, Text
                            TimeRemainingColumn)
 from rich.table import Table
 
-from ligwf.engine.health import DONE, FAILED, KILLED, MISSING, RUNNING, UNSTABLE
 from ligwf.engine.resume import Plan
 from ligwf.engine.thermo import ThermoParser
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import Manifest, effective_status
+from ligwf.study.manifest import (DONE, FAILED, KILLED, MISSING, RUNNING, UNSTABLE, Manifest,
+                                  effective_status)
 
 _STATUS_STYLE = {DONE: "green", FAILED: "red", UNSTABLE: "yellow", KILLED: "magenta",
                  RUNNING: "cyan"}

@@ -26,11 +26,8 @@ from ligwf.liquids.contact_angle import input_angle
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.model import GRAVITY, unsafe_chars
+from ligwf.study.layout import INPUT_NAME, MESH_NAME
 
-#: Name of the main input file in a case folder.
-INPUT_NAME = "in.liggghts"
-#: Name of the drum mesh in a case folder (the input refers to it by this name).
-MESH_NAME = "drum.stl"
 #: Sub-folders the input writes into (the case writer creates them).
 OUTPUT_DIRS = ("post", "restart")
 

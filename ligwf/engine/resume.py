@@ -29,12 +29,11 @@ from pathlib import Path
 
 from ligwf.engine.liggghts import FORCED_RESTART_RE, PERIODIC_RESTARTS, restart_step
 from ligwf.engine.restart_id import SIDECAR_SUFFIX, CaseIdentity, remove_sidecar, why_not_own
-from ligwf.engine.health import DONE, FAILED, RUNNING, UNSTABLE
-from ligwf.engine.render import INPUT_NAME, OUTPUT_DIRS, render_template, template_context
+from ligwf.engine.render import OUTPUT_DIRS, render_template, template_context
 from ligwf.scene.scaling import ScaledScene
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import MANIFEST_FILE, SCREEN_FILE, THERMO_FILE
-from ligwf.study.manifest import effective_status
+from ligwf.study.layout import INPUT_NAME, MANIFEST_FILE, SCREEN_FILE, THERMO_FILE
+from ligwf.study.manifest import DONE, FAILED, RUNNING, UNSTABLE, effective_status
 
 #: Input file of a resumed attempt (next to ``in.liggghts``).
 RESUME_INPUT = "resume.in.liggghts"

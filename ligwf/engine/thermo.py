@@ -13,12 +13,11 @@ read of a finished run (:func:`parse_screen`).
 
 from __future__ import annotations
 
-import csv
-import io
-import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from ligwf.study.thermo_table import ThermoRow
 
 #: Thermo column names as LIGGGHTS prints them -> ligwf's names (SI units).
 COLUMN_NAMES = {
@@ -41,18 +40,6 @@ _LOOP_RE = re.compile(r"^Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) ste
 def phase_group(marker: str) -> str:
     """Phase a marker belongs to for timing: ``fill 2`` -> ``fill``; ``settle``; ``production``."""
     return marker.split()[0] if marker else "setup"
-
-
-@dataclass(frozen=True)
-class ThermoRow:
-    """One thermo line: the step, the values by ligwf column name, and its phase."""
-
-    step: int
-    values: dict[str, float]
-    phase: str
-
-    def get(self, name: str, default: float = math.nan) -> float:
-        return self.values.get(name, default)
 
 
 @dataclass
@@ -202,59 +189,3 @@ class LogTail:
             lines.append(self._partial.decode("utf-8", errors="replace"))
             self._partial = b""
         return lines
-
-
-#: Columns of the thermo table written next to each run (``thermo.csv``).
-TABLE_COLUMNS = ("step", "time", "atoms", "ke", "rke", "dt_rayleigh", "dt_hertz", "cpu")
-
-
-def rows_to_csv(rows: list[ThermoRow]) -> str:
-    """Thermo rows as CSV text: the columns of :data:`TABLE_COLUMNS` plus the phase."""
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(list(TABLE_COLUMNS) + ["phase"])
-    for row in rows:
-        writer.writerow([row.step] + [repr(row.get(c)) for c in TABLE_COLUMNS[1:]] + [row.phase])
-    return buf.getvalue()
-
-
-def rows_from_csv(text: str) -> list[ThermoRow]:
-    """Inverse of :func:`rows_to_csv`."""
-    reader = csv.DictReader(io.StringIO(text))
-    rows = []
-    for rec in reader:
-        phase = rec.pop("phase", "")
-        step = int(rec.pop("step"))
-        values = {k: float(v) for k, v in rec.items()}
-        values["step"] = float(step)
-        rows.append(ThermoRow(step=step, values=values, phase=phase))
-    return rows
-
-
-#: Columns every thermo row of a finished run must hold as finite numbers.
-REQUIRED_FINITE = ("time", "atoms", "ke")
-
-
-def table_problem(rows: list[ThermoRow], thermo_every: int) -> str | None:
-    """Why a finished run's thermo rows cannot be its own (None: they are plausible).
-
-    The runner writes one row every ``thermo_every`` steps (and at the end of each
-    ``run`` command), steps rising strictly from the first row on; a done run never
-    printed nan (its health check would have stopped it). So a nan or missing number, a
-    step repeated or going back, or a gap wider than ``thermo_every`` means the table was
-    edited, merged wrongly or lost rows.
-    """
-    prev = None
-    for k, row in enumerate(rows):
-        bad = [c for c in REQUIRED_FINITE if not math.isfinite(row.get(c))]
-        if bad:
-            return f"row {k + 1} (step {row.step}) has no finite {', '.join(bad)} (nan or missing)"
-        if prev is not None:
-            if row.step <= prev:
-                return (f"step {row.step} follows step {prev} (rows duplicated or out of "
-                        "order)")
-            if row.step - prev > thermo_every:
-                return (f"rows missing between steps {prev} and {row.step} (the run writes "
-                        f"one every {thermo_every} steps)")
-        prev = row.step
-    return None

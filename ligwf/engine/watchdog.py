@@ -14,8 +14,9 @@ import sys
 from pathlib import Path
 
 from ligwf.engine.attempt import stamp_restarts
-from ligwf.engine.guard import RELEASED, EngineProcess, engine_tree, stop_engines
+from ligwf.engine.guard import RELEASED, engine_tree, stop_engines
 from ligwf.study.case import CaseFolder
+from ligwf.study.processes import EngineProcess
 
 
 def stamp_lost(folders: list[str]) -> None:

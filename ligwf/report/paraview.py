@@ -17,7 +17,7 @@ import numpy as np
 
 from ligwf.analysis.frame_checks import plan_frames
 from ligwf.engine.mesh import axis_frame
-from ligwf.engine.render import MESH_NAME
+from ligwf.study.layout import MESH_NAME
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_text
 from ligwf.study import layout

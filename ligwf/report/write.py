@@ -24,7 +24,7 @@ from ligwf.analysis.gsd_pooling import pooling_summary
 from ligwf.analysis.outputs import StaleAnalysis, damaged_outputs, provenance_mismatch
 from ligwf.analysis.flow_run import flow_study
 from ligwf.analysis.steady import is_auto
-from ligwf.engine.render import MESH_NAME
+from ligwf.study.layout import MESH_NAME
 from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs

@@ -27,10 +27,9 @@ from pathlib import Path, PurePosixPath
 from typing import Callable, Iterable, Mapping, Sequence
 
 from ligwf import __version__
-from ligwf.engine.health import FAILED, KILLED, MISSING, RUNNING, UNSTABLE
 from ligwf.errors import ConfigError, SubmitError
 from ligwf.fsio import atomic_write_json, atomic_write_text
-from ligwf.study.manifest import read_manifest
+from ligwf.study.manifest import FAILED, KILLED, MISSING, RUNNING, UNSTABLE, read_manifest
 from ligwf.study.study import Study
 from ligwf.slurm.budget import nodes_for
 from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_parsable,

@@ -22,16 +22,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ligwf.engine.health import DONE
-from ligwf.engine.render import INPUT_NAME, MESH_NAME
-from ligwf.engine.thermo import rows_from_csv, table_problem
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json
 from ligwf.scene.model import Scene
 from ligwf.scene.scaling import ScaledScene, scale
-from ligwf.study.layout import (DUMP_RECORD, MANIFEST_FILE, POST_DIR, SCENE_FILE, SCREEN_FILE,
-                                THERMO_FILE)
-from ligwf.study.manifest import Manifest, read_manifest, write_manifest
+from ligwf.study.layout import (DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME, POST_DIR,
+                                SCENE_FILE, SCREEN_FILE, THERMO_FILE)
+from ligwf.study.manifest import DONE, Manifest, read_manifest, write_manifest
+from ligwf.study.thermo_table import rows_from_csv, table_problem
 
 
 def file_digest(path: Path) -> str:

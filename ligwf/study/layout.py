@@ -39,6 +39,10 @@ THERMO_FILE = "thermo.csv"
 DUMP_RECORD = "dumps.json"
 #: Case level: the engine's dump folder.
 POST_DIR = "post"
+#: Case level: the main LIGGGHTS input (the renderer writes it).
+INPUT_NAME = "in.liggghts"
+#: Case level: the drum mesh (the input refers to it by this name).
+MESH_NAME = "drum.stl"
 
 #: Study level: outputs of the analysis stage.
 ANALYSIS_DIR = "analysis"

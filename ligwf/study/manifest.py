@@ -26,10 +26,14 @@ from typing import Any, Iterator
 
 from ligwf.errors import ConfigError
 from ligwf.fsio import NOT_WRITABLE, atomic_write_json, not_writable, overwrite_in_place
-from ligwf.engine.guard import EngineProcess, start_time
-from ligwf.engine.health import KILLED, RUNNING, STATUSES
 from ligwf.study.layout import MANIFEST_FILE, SCREEN_FILE
+from ligwf.study.processes import EngineProcess, start_time
 
+#: Case states a manifest can hold.
+DONE, FAILED, UNSTABLE, KILLED, RUNNING = "done", "failed", "unstable", "killed", "running"
+STATUSES = (DONE, FAILED, UNSTABLE, KILLED, RUNNING)
+#: Shown for a case without a (readable) manifest: not run yet. Never written to one.
+MISSING = "missing"
 
 #: Case level: locked (flock) by the one runner working on the case. The kernel drops the
 #: lock when that process dies, however it dies, so a stale lock cannot block a case.

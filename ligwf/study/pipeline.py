@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Callable, Iterable, Sequence
 
 from ligwf.engine.ensemble import run_ensemble
-from ligwf.engine.health import DONE
 from ligwf.engine.launch import Monitor, run_case, take_over
 from ligwf.engine.plan import (CaseLoad, Phase, Schedule, case_load, override_schedule,
                                plan_study)
@@ -40,7 +39,7 @@ from ligwf.engine.site import EngineConfig
 from ligwf.errors import LigwfError
 from ligwf.scene.workflow import load_workflow
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import case_busy, case_lock
+from ligwf.study.manifest import DONE, case_busy, case_lock
 from ligwf.study.prepare import Prepared, prepare, write_study
 from ligwf.study.study import Study
 

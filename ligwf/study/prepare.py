@@ -25,13 +25,13 @@ from ligwf.errors import ConfigError
 from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, atomic_write_text,
                         not_writable)
 from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
-from ligwf.engine.render import MESH_NAME, OUTPUT_DIRS, render
+from ligwf.engine.render import OUTPUT_DIRS, render
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.regime import definition_warning, regime_warnings
 from ligwf.scene.stability import Preflight, check_rendered
 from ligwf.scene.workflow import Case, Workflow, comparison_warnings
 from ligwf.study.case import content_hash
-from ligwf.study.layout import SCENE_FILE, STUDY_FILE
+from ligwf.study.layout import MESH_NAME, SCENE_FILE, STUDY_FILE
 from ligwf.study.study import Study
 
 

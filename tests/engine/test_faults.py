@@ -25,8 +25,8 @@ from pathlib import Path
 import meshio
 import pytest
 
-from ligwf.engine.thermo import rows_from_csv
 from ligwf.study.manifest import read_manifest
+from ligwf.study.thermo_table import rows_from_csv
 
 from helpers import ROOT  # noqa: E402
 
@@ -324,7 +324,8 @@ def in_phase(case: Path, marker: str, after: int) -> bool:
 
 
 def mpirun_of(proc: subprocess.Popen) -> int:
-    from ligwf.engine.guard import descendants, process
+    from ligwf.engine.guard import descendants
+    from ligwf.study.processes import process
     found = [p for p in descendants(proc.pid) if (q := process(p)) and q.name == "mpirun"]
     assert found, "no mpirun below ligwf"
     return found[0]

@@ -9,11 +9,11 @@ import os
 import struct
 import time
 
-from ligwf.engine.guard import start_time
-from ligwf.engine.health import FAILED, HealthIssue, error_hint, verdict
+from ligwf.engine.health import HealthIssue, error_hint, verdict
 from ligwf.engine.liggghts import restart_step
 from ligwf.engine.restart_id import CaseIdentity, sidecar, stamp, why_not_own
-from ligwf.study.manifest import Manifest, pid_alive, runner_alive
+from ligwf.study.manifest import FAILED, Manifest, pid_alive, runner_alive
+from ligwf.study.processes import start_time
 
 MINE = CaseIdentity("cg3-weber-r0", "a" * 64, 0, (10007, 10009))
 OTHER_REPLICA = CaseIdentity("cg3-weber-r1", "a" * 64, 1, (20011, 20021))
@@ -105,7 +105,7 @@ def test_a_hole_in_the_record_is_found_and_bounds_the_resume(tmp_path):
     import sys
 
     from ligwf.engine.attempt import record_hole
-    from ligwf.engine.thermo import ThermoRow
+    from ligwf.study.thermo_table import ThermoRow
     from ligwf.study.case import CaseFolder
 
     from helpers import ROOT

@@ -12,7 +12,8 @@ from ligwf.engine.health import (Expectation, assess, atom_loss, insertion_short
                           log_warnings, non_finite, verdict)
 from ligwf.study.manifest import Manifest, read_manifest, write_manifest
 from ligwf.engine.resume import resume_phase
-from ligwf.engine.thermo import ThermoRow, parse_screen, rows_from_csv, rows_to_csv
+from ligwf.engine.thermo import parse_screen
+from ligwf.study.thermo_table import ThermoRow, rows_from_csv, rows_to_csv
 
 # A screen in the shape LIGGGHTS 3.8.0 prints it (header, rows, "Loop time", markers).
 SCREEN = """LIGGGHTS (Version LIGGGHTS-PUBLIC 3.8.0, compiled 2022-01-26-19:42:32 by buildd, git commit unknown)
