@@ -37,7 +37,7 @@ from ligwf.engine.launch import run_case  # noqa: E402
 from ligwf.engine.plan import case_load, machine_cores, plan_ranks  # noqa: E402
 from ligwf.engine.site import EngineConfig  # noqa: E402
 from ligwf.scene.workflow import load_workflow  # noqa: E402
-from ligwf.study.prepare import render_workflow, write_study  # noqa: E402
+from ligwf.pipeline.prepare import render_workflow, write_study  # noqa: E402
 
 TARGETS = {2.0: 15.0, 3.0: 60.0}
 PHASES = ("fill", "settle", "production")

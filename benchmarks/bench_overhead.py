@@ -56,7 +56,7 @@ from ligwf.engine.thermo import parse_screen  # noqa: E402
 from ligwf.scene.workflow import load_workflow  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 from ligwf.study.layout import SCREEN_FILE  # noqa: E402
-from ligwf.study.prepare import render_workflow, write_study  # noqa: E402
+from ligwf.pipeline.prepare import render_workflow, write_study  # noqa: E402
 from ligwf.study.study import Study  # noqa: E402
 from ligwf.yamlio import read_yaml_mapping  # noqa: E402
 

@@ -98,7 +98,7 @@ from ligwf.engine.site import EngineConfig  # noqa: E402
 from ligwf.scene.workflow import load_workflow  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 from ligwf.study.layout import SCREEN_FILE  # noqa: E402
-from ligwf.study.prepare import render_workflow, write_study  # noqa: E402
+from ligwf.pipeline.prepare import render_workflow, write_study  # noqa: E402
 
 WORKFLOW = ROOT / "workflows" / "we_vs_bo.yaml"
 LOG_FILE = "log.liggghts"            # the -log name of EngineConfig.command

@@ -1,5 +1,8 @@
 """The structure the architecture promises (docs/architecture.md), checked on the code itself.
 
+* the packages form layers that point one way (:data:`LAYERS`, bottom first): a module
+  imports only modules of its own layer or of layers below it, counting imports inside
+  functions and under ``TYPE_CHECKING`` too; every module belongs to exactly one layer;
 * no import cycle between ligwf modules, counting imports inside functions too, and no
   dynamic import (``importlib.import_module`` / ``__import__``) hiding one;
 * every module under 400 lines (split by topic before that);
@@ -71,6 +74,66 @@ def import_graph() -> nx.DiGraph:
             if not module or not target.startswith(module + ".") or not path.name == "__init__.py":
                 g.add_edge(module, target)
     return g
+
+
+#: The layers, bottom first: each lists the packages / modules it holds (a name covers the
+#: modules below it). A module may import its own layer and the layers below, never above.
+LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("base", ("ligwf", "ligwf.errors", "ligwf.fsio", "ligwf.yamlio", "ligwf.numba_cache")),
+    ("liquids", ("ligwf.liquids",)),
+    ("scene", ("ligwf.scene",)),
+    ("folder model", ("ligwf.study",)),
+    ("engine", ("ligwf.engine",)),
+    ("analysis", ("ligwf.analysis",)),
+    ("report", ("ligwf.report",)),
+    ("scheduler", ("ligwf.scheduler", "ligwf.slurm")),
+    ("pipeline", ("ligwf.pipeline",)),
+    ("cli", ("ligwf.cli",)),
+)
+
+
+def layer_of(module: str, layers=LAYERS) -> int | None:
+    """Index in ``layers`` of the layer holding ``module`` (the longest matching name)."""
+    best, length = None, -1
+    for number, (_, names) in enumerate(layers):
+        for name in names:
+            covers = module == name or (name != "ligwf" and module.startswith(name + "."))
+            if covers and len(name) > length:
+                best, length = number, len(name)
+    return best
+
+
+def up_edges(graph: nx.DiGraph, layers=LAYERS) -> list[str]:
+    """Every import from a layer into a layer above it, as ``a -> b (layer < layer)``."""
+    found = []
+    for a, b in sorted(graph.edges()):
+        la, lb = layer_of(a, layers), layer_of(b, layers)
+        if la is not None and lb is not None and lb > la:
+            found.append(f"{a} -> {b} ({layers[la][0]} imports {layers[lb][0]})")
+    return found
+
+
+def test_every_module_has_a_layer():
+    homeless = [m for m in MODULES if layer_of(m) is None]
+    assert not homeless, f"modules in no layer (add them to LAYERS): {homeless}"
+
+
+def test_layers_point_one_way():
+    edges = up_edges(import_graph())
+    assert not edges, ("imports from a lower layer into a higher one (move the code to the "
+                       "layer it belongs to):\n" + "\n".join(edges))
+
+
+def test_the_layer_check_sees_an_up_edge_inside_a_function(tmp_path):
+    """The checker itself: a function-level import of a higher layer is an up-edge, one of
+    the same layer or a lower one is not."""
+    src = tmp_path / "fake.py"
+    src.write_text("from ligwf.study.manifest import DONE\n\n"
+                   "def f():\n    from ligwf.pipeline.run import run_study\n")
+    g = nx.DiGraph()
+    g.add_edges_from(("ligwf.engine.fake", t) for t in _imports("ligwf.engine.fake", src))
+    assert up_edges(g) == ["ligwf.engine.fake -> ligwf.pipeline.run (engine imports pipeline)"]
+    assert layer_of("ligwf.scene.settings") == 2 and layer_of("ligwf") == 0
 
 
 def test_no_import_cycle():

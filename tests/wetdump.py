@@ -12,7 +12,7 @@ import shutil
 from pathlib import Path
 
 from helpers import DRUM, run_liggghts
-from ligwf.study.prepare import render_workflow, write_study
+from ligwf.pipeline.prepare import render_workflow, write_study
 from ligwf.scene.workflow import load_workflow
 
 _CACHE: dict[str, Path] = {}

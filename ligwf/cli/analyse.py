@@ -38,7 +38,7 @@ def register(subparsers) -> None:
 
 def cmd_analyse(args: argparse.Namespace) -> int:
     from ligwf.analysis.runner import AnalysisOptions, _mpi_comm
-    from ligwf.study.pipeline import analyse_study
+    from ligwf.pipeline.post import analyse_study
     from ligwf.study.study import Study
 
     options = AnalysisOptions(implementation="reference" if args.reference else "fast",

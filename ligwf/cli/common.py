@@ -1,6 +1,6 @@
 """What every ligwf sub-command shares: consoles, the workflow arguments, the pre-flight
 warnings, the case table and the stop-on-signal event. Holds no pipeline logic (that is
-:mod:`ligwf.study.pipeline`)."""
+:mod:`ligwf.pipeline`)."""
 
 from __future__ import annotations
 
@@ -20,8 +20,7 @@ from rich.table import Table
 from rich.text import Text
 
 from ligwf.engine.plan import MAX_RANKS, CasePlan, Schedule, particle_steps
-from ligwf.study.pipeline import prepare_workflow
-from ligwf.study.prepare import Prepared
+from ligwf.pipeline.prepare import Prepared, prepare_workflow
 
 console = Console(width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True, soft_wrap=True)

@@ -1,9 +1,9 @@
 """Command line: ``ligwf render``, ``ligwf check`` and every stage's sub-commands.
 
 Every command validates the whole workflow, renders every case in memory and runs the
-stability pre-flight before it writes anything (:func:`ligwf.study.pipeline.prepare_workflow`),
+stability pre-flight before it writes anything (:func:`ligwf.pipeline.prepare.prepare_workflow`),
 so a bad value is reported with its field and allowed range and nothing is left half-done.
-The CLI only parses arguments: the pipeline is :mod:`ligwf.study.pipeline`.
+The CLI only parses arguments and prints: the pipeline is :mod:`ligwf.pipeline`.
 """
 
 from __future__ import annotations
@@ -13,21 +13,21 @@ import sys
 from pathlib import Path
 
 from ligwf import __version__
-from ligwf.cli import analyse, analyse_dumps, report, run, slurm, stability
+from ligwf.cli import analyse, analyse_dumps, report, run, slurm, stability, study
 from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_workflow_args,
                               case_table, console, err_console, folder_to_write, plan_table,
                               prepare_from_args)
-from ligwf.engine.plan import machine_cores, plan_study
 from ligwf.errors import LigwfError
 from ligwf.scene.regime import granulation_warning, original_numbers, regime_numbers
 from rich.markup import escape
 from rich.table import Table
 from ligwf.fsio import NOT_WRITABLE, not_writable
-from ligwf.study.pipeline import Interrupted, prepared_loads, write
+from ligwf.pipeline.prepare import write
+from ligwf.pipeline.run import Interrupted, planned_schedule, run_settings
 from ligwf.study.case import granules_absent
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
-COMMAND_MODULES = (run, slurm, analyse, analyse_dumps, stability, report)
+COMMAND_MODULES = (run, slurm, analyse, analyse_dumps, stability, report, study)
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -36,9 +36,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
     for line in analysis_plan(prepared):
         console.print(line, highlight=False)
-    cores, source = machine_cores(args.cores)
-    schedule = plan_study(prepared_loads(prepared), cores)
-    console.print(plan_table(schedule, f"rank plan for {cores} core(s) ({source}): what "
+    settings = run_settings(cores=args.cores)
+    schedule = planned_schedule(prepared, settings)
+    console.print(plan_table(schedule, f"rank plan for {settings.cores} core(s) "
+                             f"({settings.cores_source}): what "
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     console.print(regime_table(prepared))
     return 0

@@ -8,7 +8,8 @@ ranks, longest first, on the cores of this machine or allocation (``--cores`` to
 otherwise); the plan is printed before the run. ``--np K`` runs every case on K ranks one
 after the other, ``--ensemble P`` all of them in one ``mpirun -np P`` (groups of ``--np``,
 default 1), as before. Running the same command again resumes (see
-:mod:`ligwf.engine.resume`).
+:mod:`ligwf.engine.resume`). The chain is :mod:`ligwf.pipeline.run`; this module parses
+and prints.
 ``run-case`` runs case number I of a rendered study folder with the same runner (what a
 Slurm array task calls).
 """
@@ -16,57 +17,46 @@ Slurm array task calls).
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, console,
                               folder_to_write, plan_table, prepare_from_args, rank_count,
                               stop_on_signals)
-from ligwf.engine.plan import machine_cores
 from ligwf.engine.progress import RichMonitor, summary_table
-from ligwf.engine.site import EngineConfig
-from ligwf.study.pipeline import RunSettings, cases_to_run, run_study, study_schedule, write
+from ligwf.pipeline.run import StudyRun, run_case_of, run_settings, start_run
 from ligwf.study.study import Study
 
 
-def run_settings(args: argparse.Namespace, cores: int = 1) -> RunSettings:
-    """The run settings of ``args``: planned on ``cores`` cores unless ``--np`` or
-    ``--ensemble`` was given (``--ensemble`` alone keeps groups of one rank)."""
-    ensemble = getattr(args, "ensemble", 0)
-    nprocs = args.np if args.np is not None else (1 if ensemble else None)
-    return RunSettings(nprocs=nprocs, ensemble=ensemble, retry_unstable=args.retry_unstable,
-                       template_dirs=tuple(getattr(args, "templates", ())), cores=cores)
-
-
-def prepare_and_run(args: argparse.Namespace) -> tuple[Study, bool]:
-    """Prepare (pre-flight first), write, show the rank plan and run a workflow with live
-    progress; returns the study and whether every case is done (``run`` and ``study``)."""
+def start_from_args(args: argparse.Namespace) -> StudyRun:
+    """Prepare (pre-flight first), write and schedule the workflow of ``args``, and print
+    the rank plan (``run`` and ``study``)."""
     prepared = prepare_from_args(args)
-    cores, source = machine_cores(args.cores)
-    settings = run_settings(args, cores)
-    engine = EngineConfig.from_site()   # a bad site setting is refused before writing
-    study = write(prepared, args.out, args.mesh_cache)
-    schedule = study_schedule(cases_to_run(study.cases, settings.retry_unstable), settings)
-    title = (f"rank plan for {cores} core(s) ({source})" if settings.planned
-             else "ranks as asked (--np / --ensemble)")
-    console.print(plan_table(schedule, title))
+    settings = run_settings(args.np, args.ensemble, args.cores, args.retry_unstable,
+                            args.templates)
+    run = start_run(prepared, args.out, settings, args.mesh_cache)
+    title = (f"rank plan for {settings.cores} core(s) ({settings.cores_source})"
+             if settings.planned else "ranks as asked (--np / --ensemble)")
+    console.print(plan_table(run.schedule, title))
+    return run
+
+
+def run_with_progress(run: StudyRun, args: argparse.Namespace) -> bool:
+    """Run a started study with live progress, then print its case table."""
     with stop_on_signals() as stop, RichMonitor(console) as monitor:
-        done = run_study(study, study.cases, engine, settings, monitor, stop)
-    console.print(summary_table(study.cases, f"{study.name}: {args.out}"))
-    return study, done
+        done = run.run(monitor, stop)
+    console.print(summary_table(run.study.cases, f"{run.study.name}: {args.out}"))
+    return done
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    return 0 if prepare_and_run(args)[1] else 1
+    return 0 if run_with_progress(start_from_args(args), args) else 1
 
 
 def cmd_run_case(args: argparse.Namespace) -> int:
     study = Study.open(args.study)
     case = study.case(args.index)
-    args.np = args.np or int(os.environ.get("SLURM_NTASKS", "1"))
     with stop_on_signals() as stop, RichMonitor(console) as monitor:
-        done = run_study(study, [case], EngineConfig.from_site(), run_settings(args), monitor,
-                         stop)
+        done = run_case_of(study, case, args.np, args.retry_unstable, monitor, stop)
     console.print(summary_table([case], f"case {args.index}"))
     return 0 if done else 1
 

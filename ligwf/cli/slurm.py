@@ -5,7 +5,7 @@ and the stability pre-flight (``--allow-unstable`` overrides it) before anything
 written or submitted -- writes the same folders, one array script with one task per case
 (each runs ``ligwf run-case STUDY --index I``, the local runner with its manifests, health
 checks and resume) plus an analysis job that depends on the array (``afterany``) and runs
-the same post-processing as ``ligwf study`` (:data:`ligwf.study.pipeline.POSTPROCESS_COMMANDS`,
+the same post-processing as ``ligwf study`` (:data:`ligwf.pipeline.post.POSTPROCESS_COMMANDS`,
 with the analysis settings stored in the study), and submits both. Each case's ranks
 (``--ntasks`` of its array task) come from the rank plan (:mod:`ligwf.engine.plan`: particle
 count and axial slab rule, at most ``--cores`` if given): one array per rank count, the
@@ -38,16 +38,14 @@ from rich.text import Text
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_table,
                               console, duration, err_console, folder_to_write, positive_int,
                               prepare_from_args, rank_count)
-from ligwf.engine.plan import CasePlan, case_load, fixed_ranks, plan_ranks
-from ligwf.errors import SubmitError
+from ligwf.engine.plan import CasePlan
+from ligwf.pipeline.prepare import prepared_loads
+from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_submit
 from ligwf.slurm.budget import (PlanRow, hours_minutes, over_time_warning, plan_rows,
                                 slab_note, slurm_time_seconds)
-from ligwf.slurm.jobs import (PlannedJob, active_tasks, cases_to_resubmit, dry_run_text,
-                              next_round, plan_jobs, read_record, recorded_plan, recorded_site,
-                              require_scheduler, study_status, submit_jobs)
+from ligwf.slurm.jobs import PlannedJob, recorded_site, study_status
+from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
-from ligwf.study.pipeline import POSTPROCESS_COMMANDS, prepared_loads, write
-from ligwf.study.study import Study
 
 
 def add_site_args(p: argparse.ArgumentParser) -> None:
@@ -146,21 +144,15 @@ def cmd_submit(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)      # pre-flight before anything is written
     wf, rendered = prepared.workflow, prepared.rendered
     site = site_from_args(args, load_slurm_site())
-    steps = [] if args.no_analysis else list(POSTPROCESS_COMMANDS)
-    out: Path = args.out.resolve()
-    round_no = next_round(out) if (out / "slurm").is_dir() else 1
-    loads = prepared_loads(prepared)
+    scheduler = SlurmScheduler(site)
+    fixed = args.ntasks is not None or ntasks_configured()   # every case on site.ntasks ranks
+    submission = plan_submission(prepared, args.out.resolve(), scheduler, args.cores,
+                                 site.ntasks if fixed else None, not args.no_analysis)
+    plans, jobs = submission.schedule.cases, list(submission.jobs)
+    title = ("rank plan" + (f" (at most {args.cores} per case)" if args.cores else "")
+             if submission.planned else "ranks as asked (--ntasks / site ntasks)")
     groups = [(rc.scaled.cg, rc.scaled.rule) for rc in rendered]    # replicas share a row
-    if args.ntasks is not None or ntasks_configured():   # every case on site.ntasks ranks
-        plans, ranks = fixed_ranks(loads, site.ntasks, "--ntasks"), None
-        title = "ranks as asked (--ntasks / site ntasks)"
-    else:
-        plans = tuple(plan_ranks(load, args.cores) for load in loads)
-        ranks = {rc.case.index: p.ranks for rc, p in zip(rendered, plans)}
-        title = "rank plan" + (f" (at most {args.cores} per case)" if args.cores else "")
-    jobs = plan_jobs(out, wf.name, site, [rc.case.index for rc in rendered], steps, round_no,
-                     ranks, args.cores)
-    rows = plan_rows(loads, plans, groups, site.cores_per_node)
+    rows = plan_rows(prepared_loads(prepared), plans, groups, site.cores_per_node)
     plan_view = slurm_plan_table(rows, title, site.time, plan_caption(plans, jobs, rows, site))
     limit = slurm_time_seconds(site.time)
     over_time = [over_time_warning(row, site.time) for row in rows if row.exceeds(limit)]
@@ -168,20 +160,13 @@ def cmd_submit(args: argparse.Namespace) -> int:
         console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
         console.print(plan_view)
         _warn(over_time)
-        print(dry_run_text(jobs))
+        print(scheduler.dry_run_text(jobs))
         return 0
-    require_scheduler()
-    if read_record(out):
-        busy = active_tasks(study_status(out).cases)
-        if busy:
-            raise SubmitError(f"{out} still has {len(busy)} queued or running case(s) "
-                              f"({', '.join(c.job or '?' for c in busy[:5])}); wait, scancel "
-                              "them, or use 'ligwf slurm resubmit'")
-    write(prepared, out, args.mesh_cache)
-    console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) -> {out}"))
+    write_for_submit(prepared, submission, scheduler, args.mesh_cache)
+    console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) -> {submission.out}"))
     console.print(plan_view)
     _warn(over_time)
-    _print_submitted(submit_jobs(out, jobs, site))
+    _print_submitted(submission.submit(scheduler))
     return 0
 
 
@@ -219,35 +204,27 @@ def cmd_status(args: argparse.Namespace) -> int:
 
 def cmd_resubmit(args: argparse.Namespace) -> int:
     study_dir: Path = args.study_dir.resolve()
-    study = Study.open(study_dir)
     recorded = recorded_site(study_dir)
     base = _site_from_record(recorded) if recorded else load_slurm_site()
-    site = site_from_args(args, base)
-    st = study_status(study_dir)
-    indices = cases_to_resubmit(st.cases, args.include_unstable)
-    busy = active_tasks(st.cases)
-    if busy:
-        console.print(f"{len(busy)} case(s) still queued or running, not resubmitted: "
-                      + ", ".join(c.job or "?" for c in busy))
-    if not indices:
+    scheduler = SlurmScheduler(site_from_args(args, base))
+    # a planned submission is planned again (same core limit unless --cores says otherwise)
+    plan = scheduler.recorded_plan(study_dir) if args.ntasks is None else None
+    again = plan_resubmission(study_dir, scheduler, args.include_unstable, args.cores,
+                              planned=plan is not None, recorded_cores=(plan or {}).get("cores"),
+                              analysis=not args.no_analysis)
+    if again.busy:
+        console.print(f"{len(again.busy)} case(s) still queued or running, not resubmitted: "
+                      + ", ".join(c.job or "?" for c in again.busy))
+    if not again.indices:
         console.print("nothing to resubmit: every case is done, unstable or still queued")
         return 0
-    steps = [] if args.no_analysis else list(POSTPROCESS_COMMANDS)
-    # a planned submission is planned again (same core limit unless --cores says otherwise)
-    plan = recorded_plan(study_dir) if args.ntasks is None else None
-    cores = args.cores if args.cores is not None else (plan or {}).get("cores")
-    ranks = None if plan is None else {
-        c.index: plan_ranks(case_load(c.path.name, c.scaled), cores).ranks
-        for c in study.cases if c.index in indices}
-    jobs = plan_jobs(study_dir, study.name, site, indices, steps,
-                     next_round(study_dir), ranks, cores)
-    console.print(f"resubmitting {len(indices)} case(s): "
+    console.print(f"resubmitting {len(again.indices)} case(s): "
                   + ", ".join(f"{c.index} {c.case_id} ({c.manifest})"
-                              for c in st.cases if c.index in indices))
+                              for c in again.cases if c.index in again.indices))
     if args.dry_run:
-        print(dry_run_text(jobs))
+        print(scheduler.dry_run_text(list(again.jobs)))
         return 0
-    _print_submitted(submit_jobs(study_dir, jobs, site))
+    _print_submitted(again.submit(scheduler))
     return 0
 
 

@@ -1,7 +1,7 @@
 """``ligwf stability-report STUDY_DIR`` and ``ligwf stability-suite SUITE --out DIR``.
 
 (The pre-flight every workflow command runs before writing is part of preparing a study,
-:func:`ligwf.study.prepare.prepare`.)
+:func:`ligwf.pipeline.prepare.prepare`.)
 """
 
 from __future__ import annotations
@@ -72,8 +72,7 @@ def cmd_stability_report(args: argparse.Namespace) -> int:
 def cmd_stability_suite(args: argparse.Namespace) -> int:
     """Render every variant of a stress suite (refused cases included: that is the point)."""
     from ligwf.scene.stability_suite import load_suite
-    from ligwf.study.pipeline import write
-    from ligwf.study.prepare import prepare
+    from ligwf.pipeline.prepare import prepare, write
 
     suite = load_suite(args.suite)
     for variant, wf in suite.items():

@@ -28,6 +28,11 @@ The cost of a case is its particle-steps (particles x steps, what ``ligwf check`
 wall-time estimates use the rates below and are only as good as those measurements.
 ``--np`` / ``--ensemble`` bypass the planner: :func:`override_schedule` describes what
 they do (today's meaning) so ``check`` and ``run`` can show it the same way.
+
+On a batch scheduler every case runs in an allocation of its own (an array task):
+:func:`allocation_schedule` gives each case its ranks by the same :func:`plan_ranks` (the
+cores per case, if capped, instead of the machine's) and one phase per rank count, each
+phase one array of side-by-side allocations.
 """
 
 from __future__ import annotations
@@ -237,6 +242,26 @@ def plan_study(loads: Sequence[CaseLoad], cores: int,
                             list_schedule_seconds([p.estimated_seconds for p in members],
                                                   groups)))
     return Schedule(cores, plans, tuple(phases), planned=True)
+
+
+def allocation_schedule(loads: Sequence[CaseLoad], cores_per_case: int | None = None,
+                        fixed: tuple[int, str] | None = None) -> Schedule:
+    """How a batch scheduler runs the cases, each in an allocation of its own: ranks per
+    case from :func:`plan_ranks` with at most ``cores_per_case`` (None: no core limit
+    beyond the slab and particle rules), or every case on ``fixed = (ranks, option)``
+    ranks because that option says so. One phase per rank count, widest first, its cases
+    in study order, each its own group (the scheduler runs them side by side as the
+    cluster allows; ``ensemble`` False). ``cores``: the ranks of all cases at once."""
+    _unique_names(loads)
+    plans = (fixed_ranks(loads, *fixed) if fixed is not None
+             else tuple(plan_ranks(l, cores_per_case) for l in loads))
+    phases = []
+    for ranks in sorted({p.ranks for p in plans}, reverse=True):
+        members = tuple(p for p in plans if p.ranks == ranks)
+        phases.append(Phase(ranks, len(members), tuple(p.name for p in members), False,
+                            max(p.estimated_seconds for p in members)))
+    return Schedule(max(1, sum(p.ranks for p in plans)), plans, tuple(phases),
+                    planned=fixed is None)
 
 
 def fixed_ranks(loads: Sequence[CaseLoad], ranks: int, bound: str) -> tuple[CasePlan, ...]:

@@ -301,7 +301,7 @@ def enforce(reports: list[Preflight], allow_unstable: bool = False) -> list[str]
 
 
 def check_rendered(rendered, allow_unstable: bool = False) -> tuple[list[Preflight], list[str]]:
-    """Pre-flight of rendered cases (``ligwf.study.prepare.RenderedCase``); see :func:`enforce`."""
+    """Pre-flight of rendered cases (``ligwf.pipeline.prepare.RenderedCase``); see :func:`enforce`."""
     reports = [preflight(rc.scaled, rc.case.case_id,
                          explicit_dt=getattr(rc.case.scene.numerics, "dt", None) is not None)
                for rc in rendered]

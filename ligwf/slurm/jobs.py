@@ -29,7 +29,7 @@ from typing import Callable, Iterable, Mapping, Sequence
 from ligwf import __version__
 from ligwf.errors import ConfigError, SubmitError
 from ligwf.fsio import atomic_write_json, atomic_write_text
-from ligwf.study.manifest import FAILED, KILLED, MISSING, RUNNING, UNSTABLE, read_manifest
+from ligwf.study.manifest import MISSING, read_manifest
 from ligwf.study.study import Study
 from ligwf.slurm.budget import nodes_for
 from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_parsable,
@@ -39,10 +39,6 @@ from ligwf.slurm.script import (LOG_DIR, SLURM_DIR, ScriptContext, analysis_scri
 from ligwf.slurm.site import SlurmSite
 
 RECORD_FILE = "slurm/jobs.json"
-#: Manifest states worth running again: the runner resumes killed cases from their restart.
-#: ``unstable`` is left out by default: the same input and seed would fail the same way.
-RETRY_STATES = frozenset({FAILED, KILLED, RUNNING, MISSING})
-
 Runner = Callable[[Sequence[str]], subprocess.CompletedProcess]
 
 
@@ -319,20 +315,3 @@ def study_status(study_dir: Path, run: Runner = run_command, user: str | None = 
             entry["state"] = states.get((str(sub["job_id"]), None))
         jobs.append(entry)
     return StudyStatus(cases, jobs, scheduler_error)
-
-
-def cases_to_resubmit(cases: Iterable[CaseStatus], include_unstable: bool = False) -> list[int]:
-    """Indices of cases that are not done and not queued: missing, failed, killed, stale.
-
-    A manifest still saying ``running`` while Slurm no longer runs the task means the task
-    died without the runner finishing its manifest (e.g. SIGKILL at the time limit).
-    """
-    retry = set(RETRY_STATES)
-    if include_unstable:
-        retry.add(UNSTABLE)
-    return sorted(c.index for c in cases if not c.queued and c.manifest in retry)
-
-
-def active_tasks(cases: Iterable[CaseStatus]) -> list[CaseStatus]:
-    """Cases whose latest task is still pending or running."""
-    return [c for c in cases if c.queued]

@@ -103,12 +103,13 @@ def test_check_plans_for_the_cores_of_a_slurm_allocation(tmp_path, monkeypatch, 
 ])
 def test_run_plans_unless_np_or_ensemble_is_given(tmp_path, argv, planned, nprocs, ensemble):
     from ligwf.cli.main import build_parser
-    from ligwf.cli.run import run_settings
+    from ligwf.pipeline.run import run_settings
 
     for command in ("run", "study"):
         args = build_parser().parse_args([command, str(DRUM), "--out", str(tmp_path / "s"),
-                                          *argv])
-        settings = run_settings(args, cores=2)
+                                          *argv, "--cores", "2"])
+        settings = run_settings(args.np, args.ensemble, args.cores, args.retry_unstable,
+                                args.templates)
         assert (settings.planned, settings.nprocs, settings.ensemble, settings.cores) == (
             planned, nprocs, ensemble, 2)
 

@@ -7,7 +7,7 @@ import re
 import meshio
 import pytest
 
-from ligwf.study.prepare import render_workflow, write_study
+from ligwf.pipeline.prepare import render_workflow, write_study
 
 from helpers import DRUM, WET_POLY, run_liggghts
 from ligwf.scene.workflow import load_workflow

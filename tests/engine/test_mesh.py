@@ -110,7 +110,7 @@ def test_cache_is_keyed_by_sag(tmp_path):
 
 def test_every_cg_level_of_a_study_shares_one_mesh(tmp_path):
     from ligwf.scene.workflow import load_workflow
-    from ligwf.study.prepare import render_workflow
+    from ligwf.pipeline.prepare import render_workflow
 
     from helpers import ROOT
     wf = load_workflow(ROOT / "workflows" / "we_vs_bo.yaml", [])

@@ -10,7 +10,7 @@ import pytest
 
 from ligwf.scene.stability import MARGINAL, OK, REFUSED, UnstableCase, preflight
 from ligwf.scene.workflow import load_workflow
-from ligwf.study.prepare import prepare
+from ligwf.pipeline.prepare import prepare
 
 from helpers import ROOT  # noqa: E402
 

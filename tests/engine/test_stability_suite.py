@@ -13,7 +13,7 @@ import pytest
 from ligwf.cli.main import main
 from ligwf.engine.launch import run_case
 from ligwf.scene.stability import REFUSED
-from ligwf.study.prepare import prepare, write_study
+from ligwf.pipeline.prepare import prepare, write_study
 from ligwf.report.stability import report_study
 from ligwf.scene.stability_suite import load_suite
 

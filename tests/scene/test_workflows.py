@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from ligwf.study.prepare import render_workflow
+from ligwf.pipeline.prepare import render_workflow
 from ligwf.scene.stability import REFUSED, preflight
 from ligwf.scene.workflow import load_workflow
 

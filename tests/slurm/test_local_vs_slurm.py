@@ -1,5 +1,5 @@
 """One workflow, two paths: ``ligwf study`` locally and ``ligwf slurm submit`` on a real
-single-node Slurm run the same pipeline (:mod:`ligwf.study.pipeline`).
+single-node Slurm run the same pipeline (:mod:`ligwf.pipeline`).
 
 The workflow's ``analysis:`` settings differ from every default; both paths must refuse
 the same unsafe case before writing anything, store the same settings in the study, and
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from ligwf.study.pipeline import POSTPROCESS_COMMANDS, postprocess
+from ligwf.pipeline.post import POSTPROCESS_COMMANDS, postprocess
 from ligwf.study.study import Study
 
 from test_slurm_integration import _logs, wait_until_idle

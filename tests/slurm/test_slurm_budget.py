@@ -16,7 +16,7 @@ from ligwf.slurm.budget import (hours_minutes, nodes_for, over_time_warning, pla
 from ligwf.slurm.jobs import plan_jobs
 from ligwf.slurm.script import ScriptContext, array_script
 from ligwf.slurm.site import SlurmSite, load_slurm_site
-from ligwf.study.pipeline import prepare_workflow, prepared_loads
+from ligwf.pipeline.prepare import prepare_workflow, prepared_loads
 
 PAPER = ROOT / "workflows" / "paper_scale.yaml"
 #: paper_scale.yaml reduced to its CG1 case (360,000 particles of 1 mm, 60 mm periodic axis)

@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from ligwf.errors import ConfigError
-from ligwf.slurm.jobs import (CaseStatus, append_record, cases_to_resubmit, dry_run_text, job_name,
-                         next_round, plan_jobs, read_record, recorded_plan, recorded_site,
-                         submit_jobs)
+from ligwf.scheduler import cases_to_resubmit
+from ligwf.slurm.jobs import (CaseStatus, append_record, dry_run_text, job_name, next_round,
+                              plan_jobs, read_record, recorded_plan, recorded_site, submit_jobs)
 from ligwf.slurm.site import SlurmSite
 
 from helpers import DRUM

@@ -1,23 +1,15 @@
-"""The pipeline of a study, assembled once: prepare -> run -> analyse -> report.
+"""The run stage of the pipeline: write a prepared study, schedule its cases, run them.
 
-Every path goes through these functions, so they cannot drift apart:
-
-* ``ligwf study`` = :func:`prepare_workflow` + :func:`write` + :func:`run_study` +
-  :func:`postprocess`;
-* ``ligwf run`` / ``run-case`` = the first three / :func:`run_study` on one case;
-* ``ligwf slurm submit`` = :func:`prepare_workflow` (pre-flight before anything is
-  written or submitted) + :func:`write`; its array tasks run ``ligwf run-case`` and its
-  analysis job runs :data:`POSTPROCESS_COMMANDS`, which are :func:`analyse_study` and
-  :func:`report_study`: the two steps of :func:`postprocess`.
-
-The science of the post-processing (steady window, bond criterion, GSD settings) is read
-from the study (:attr:`ligwf.study.study.Study.analysis`, stored from the workflow's
-``analysis:`` block), never passed in, so the local and the Slurm path compute the same
-tables. What callers choose is only how things run (ranks, ensembles, outputs).
+* ``ligwf run`` = :func:`~ligwf.pipeline.prepare.prepare_workflow` + :func:`start_run`
+  (write the folders, schedule the cases) + :meth:`StudyRun.run`;
+* ``ligwf run-case`` (a Slurm array task) = :func:`run_case_of` on one case of a written
+  study, on ``--np`` or the allocation's ``SLURM_NTASKS`` ranks;
+* ``ligwf study`` = the same as ``run``, then :func:`ligwf.pipeline.post.postprocess`.
 
 How the cases run: by default the planner (:mod:`ligwf.engine.plan`) gives each case its
 ranks and packs the cases onto the cores (:func:`study_schedule`); ``--np`` /
-``--ensemble`` override it with their old meaning.
+``--ensemble`` override it with their old meaning. What callers choose is only how things
+run (ranks, ensembles, cores), never what is computed.
 """
 
 from __future__ import annotations
@@ -28,20 +20,19 @@ import threading
 from contextlib import ExitStack
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable, Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 from ligwf.engine.ensemble import run_ensemble
 from ligwf.engine.launch import Monitor, run_case, take_over
-from ligwf.engine.plan import (CaseLoad, Phase, Schedule, case_load, override_schedule,
-                               plan_study)
+from ligwf.engine.plan import Phase, Schedule, case_load, machine_cores, override_schedule, plan_study
 from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig
 from ligwf.errors import LigwfError
-from ligwf.scene.workflow import load_workflow
+from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import DONE, case_busy, case_lock
-from ligwf.study.prepare import Prepared, prepare, write_study
 from ligwf.study.study import Study
+
 
 class Interrupted(LigwfError):
     """The run was stopped on request (Ctrl-C, SIGTERM): the engines wrote their forced
@@ -56,16 +47,8 @@ class Interrupted(LigwfError):
                          "resumes them")
 
 
-if TYPE_CHECKING:  # the analysis and report stages load numba / matplotlib: imported on use
-    from ligwf.analysis.runner import AnalysisOptions
-
 #: Seconds between looks at cases another runner holds (see :func:`run_study`).
 WAIT_SECONDS = 1.0
-
-#: The ligwf sub-commands the Slurm analysis job runs over the study, in order: the CLI
-#: faces of :func:`analyse_study` and :func:`report_study`, i.e. :func:`postprocess`.
-POSTPROCESS_COMMANDS = ("analyse", "report")
-
 
 @dataclass(frozen=True)
 class RunSettings:
@@ -81,34 +64,29 @@ class RunSettings:
     retry_unstable: bool = False
     template_dirs: tuple[Path, ...] = ()
     cores: int = 1                  # cores a planned run fills
+    cores_source: str = "given"     # where ``cores`` came from (engine.plan.available_cores)
 
     @property
     def planned(self) -> bool:
         return self.nprocs is None and not self.ensemble
 
 
-def prepare_workflow(workflow: Path, overrides: Sequence[str] = (),
-                     template_dirs: Iterable[Path] = (), allow_unstable: bool = False) -> Prepared:
-    """Load and validate a workflow, render every case in memory and pre-flight it
-    (UnstableCase on a refusal unless ``allow_unstable``). Writes nothing."""
-    return prepare(load_workflow(workflow, list(overrides)), tuple(template_dirs),
-                   allow_unstable)
-
-
-def write(prepared: Prepared, out: Path, mesh_cache: Path | None = None) -> Study:
-    """Write the prepared study folder (identical cases are rewritten byte for byte, so
-    their outputs stay and a re-run resumes)."""
-    return write_study(prepared.workflow, prepared.rendered, out, mesh_cache)
+def run_settings(nprocs: int | None = None, ensemble: int = 0, cores: int | None = None,
+                 retry_unstable: bool = False,
+                 template_dirs: Iterable[Path] = ()) -> RunSettings:
+    """How ``ligwf run`` / ``study`` run: planned on the cores of this machine or
+    allocation (``cores`` to say otherwise, :func:`ligwf.engine.plan.machine_cores`) unless
+    ``nprocs`` or ``ensemble`` is given (``ensemble`` alone keeps groups of one rank)."""
+    count, source = machine_cores(cores)
+    if nprocs is None and ensemble:
+        nprocs = 1
+    return RunSettings(nprocs=nprocs, ensemble=ensemble, retry_unstable=retry_unstable,
+                       template_dirs=tuple(template_dirs), cores=count, cores_source=source)
 
 
 def all_done(cases: Iterable[CaseFolder]) -> bool:
     """Whether every case's manifest says done."""
     return all((m := c.manifest()) is not None and m.status == DONE for c in cases)
-
-
-def prepared_loads(prepared: Prepared) -> list[CaseLoad]:
-    """The planner's view of every prepared case (named as its case folder will be)."""
-    return [case_load(rc.case.case_id, rc.scaled) for rc in prepared.rendered]
 
 
 def cases_to_run(cases: Iterable[CaseFolder], retry_unstable: bool = False) -> list[CaseFolder]:
@@ -213,25 +191,44 @@ def _ensemble_phase(study: Study, members: list[CaseFolder], phase: Phase, label
         one(case, phase.ranks)
 
 
-def analyse_study(path: Path, out: Path | None = None,
-                  options: "AnalysisOptions | None" = None, comm=None) -> dict | None:
-    """Granules, frame and GSD tables of a study (or one case folder) with the study's
-    analysis settings; ``options`` only say how it runs. Returns the analysis record on
-    rank 0 (None on other MPI ranks)."""
-    from ligwf.analysis.runner import AnalysisOptions, analyse
+@dataclass(frozen=True)
+class StudyRun:
+    """A written study about to run: its folder, the schedule of the cases still to run
+    (what the CLI prints before the engines start), the engine and the run settings."""
 
-    return analyse(path, out, options or AnalysisOptions(), comm)
+    study: Study
+    schedule: Schedule
+    engine: EngineConfig
+    settings: RunSettings
+
+    def run(self, monitor: Monitor | None = None, stop: threading.Event | None = None) -> bool:
+        """Run every case of the study (:func:`run_study`); whether all of them are done."""
+        return run_study(self.study, self.study.cases, self.engine, self.settings, monitor,
+                         stop)
 
 
-def report_study(path: Path, out: Path | None = None, snapshots: bool = True) -> Path:
-    """Flow metrics (the study's steady window) and the report folder; returns it."""
-    from ligwf.report.write import write_report
+def start_run(prepared: Prepared, out: Path, settings: RunSettings,
+              mesh_cache: Path | None = None) -> StudyRun:
+    """Write a prepared study (the pre-flight is behind it) and schedule the cases that
+    are not finished. The site's engine settings are read first: a bad one is refused
+    before anything is written."""
+    engine = EngineConfig.from_site()
+    study = write(prepared, out, mesh_cache)
+    schedule = study_schedule(cases_to_run(study.cases, settings.retry_unstable), settings)
+    return StudyRun(study, schedule, engine, settings)
 
-    return write_report(Study.open(path), out, snapshots=snapshots)
+
+def run_case_of(study: Study, case: CaseFolder, nprocs: int | None = None,
+                retry_unstable: bool = False, monitor: Monitor | None = None,
+                stop: threading.Event | None = None) -> bool:
+    """Run one case of a written study (what a scheduler's array task does) on ``nprocs``
+    ranks, default the allocation's ``SLURM_NTASKS``, else 1. Whether it is done."""
+    ranks = nprocs or int(os.environ.get("SLURM_NTASKS", "1"))
+    return run_study(study, [case], EngineConfig.from_site(),
+                     RunSettings(nprocs=ranks, retry_unstable=retry_unstable), monitor, stop)
 
 
-def postprocess(path: Path, snapshots: bool = True) -> tuple[dict | None, Path]:
-    """Analyse, then report, a study with its stored settings: what ``ligwf study`` does
-    after the run and what the Slurm analysis job does (:data:`POSTPROCESS_COMMANDS`)."""
-    record = analyse_study(path)
-    return record, report_study(path, snapshots=snapshots)
+def planned_schedule(prepared: Prepared, settings: RunSettings) -> Schedule:
+    """The rank plan of every prepared case on ``settings.cores`` cores: what ``ligwf
+    run`` / ``study`` do without ``--np`` / ``--ensemble`` (``ligwf check`` prints it)."""
+    return plan_study(prepared_loads(prepared), settings.cores)

@@ -8,11 +8,11 @@ import threading
 
 import pytest
 
-import ligwf.study.pipeline as pipeline
+import ligwf.pipeline.run as pipeline
 from ligwf.engine.site import EngineConfig
+from ligwf.pipeline.prepare import prepare_workflow, write
+from ligwf.pipeline.run import RunSettings, cases_to_run, run_study, study_schedule
 from ligwf.study.manifest import case_lock
-from ligwf.study.pipeline import (RunSettings, cases_to_run, prepare_workflow, run_study,
-                                  study_schedule, write)
 
 from helpers import DRUM
 

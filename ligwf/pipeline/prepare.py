@@ -1,9 +1,10 @@
 """Prepare a study: validate, scale, render, pre-flight (all in memory), then write.
 
-:func:`prepare` is the first step of every path that starts from a workflow (``check``,
+:func:`prepare_workflow` (a workflow file and its ``--set`` overrides) / :func:`prepare`
+(a loaded workflow) is the first step of every path that starts from a workflow (``check``,
 ``render``, ``run``, ``study``, ``slurm submit``): every case is scaled and rendered and
 the stability pre-flight runs before anything is written, so a bad value or an unsafe case
-is refused with nothing half-done. :func:`write_study` then writes the study record (the
+is refused with nothing half-done. :func:`write` (:func:`write_study`) then writes the study record (the
 workflow, its analysis settings, the case list) and one folder per case with the input,
 the drum mesh (from the mesh cache), the scene record (original and scaled parameters plus
 a content hash) and the empty output folders the input writes into (names:
@@ -18,18 +19,19 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterable
+from typing import Iterable, Sequence
 
 from ligwf import __version__
 from ligwf.errors import ConfigError
 from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, atomic_write_text,
                         not_writable)
 from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
+from ligwf.engine.plan import CaseLoad, case_load
 from ligwf.engine.render import OUTPUT_DIRS, render
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.regime import definition_warning, regime_warnings
 from ligwf.scene.stability import Preflight, check_rendered
-from ligwf.scene.workflow import Case, Workflow, comparison_warnings
+from ligwf.scene.workflow import Case, Workflow, comparison_warnings, load_workflow
 from ligwf.study.case import content_hash
 from ligwf.study.layout import MESH_NAME, SCENE_FILE, STUDY_FILE
 from ligwf.study.study import Study
@@ -162,3 +164,22 @@ def write_study(wf: Workflow, rendered: list[RenderedCase], out_dir: Path,
                    "scene_hash": rc.scene_hash} for rc in rendered],
     })
     return Study.open(out_dir)
+
+
+def prepare_workflow(workflow: Path, overrides: Sequence[str] = (),
+                     template_dirs: Iterable[Path] = (), allow_unstable: bool = False) -> Prepared:
+    """Load and validate a workflow, render every case in memory and pre-flight it
+    (UnstableCase on a refusal unless ``allow_unstable``). Writes nothing."""
+    return prepare(load_workflow(workflow, list(overrides)), tuple(template_dirs),
+                   allow_unstable)
+
+
+def write(prepared: Prepared, out: Path, mesh_cache: Path | None = None) -> Study:
+    """Write the prepared study folder (identical cases are rewritten byte for byte, so
+    their outputs stay and a re-run resumes)."""
+    return write_study(prepared.workflow, prepared.rendered, out, mesh_cache)
+
+
+def prepared_loads(prepared: Prepared) -> list[CaseLoad]:
+    """The planner's view of every prepared case (named as its case folder will be)."""
+    return [case_load(rc.case.case_id, rc.scaled) for rc in prepared.rendered]

@@ -1,0 +1,121 @@
+"""The pipeline on a batch scheduler: prepare, plan the ranks, write, submit.
+
+``ligwf slurm submit`` = :func:`~ligwf.pipeline.prepare.prepare_workflow` (the same
+validation, rendering and pre-flight as ``ligwf study``, before anything is written or
+submitted) + :func:`plan_submission` + :func:`write_for_submit` +
+:meth:`Submission.submit`; ``ligwf slurm resubmit`` =
+:func:`plan_resubmission` + :meth:`Resubmission.submit`. The ranks of every case come from
+the same planner as a local run (:func:`ligwf.engine.plan.allocation_schedule`: each case
+in an allocation of its own, at most ``cores`` ranks if given), or ``--ntasks`` / the
+site's fixed task count; the scheduler (:class:`ligwf.scheduler.Scheduler`) builds one
+array per rank count and the follow-up job runs :data:`POSTPROCESS_COMMANDS`, the
+post-processing of ``ligwf study``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+from ligwf.engine.plan import Schedule, allocation_schedule, case_load
+from ligwf.errors import SubmitError
+from ligwf.pipeline.post import POSTPROCESS_COMMANDS
+from ligwf.pipeline.prepare import Prepared, prepared_loads, write
+from ligwf.scheduler import BatchJob, CaseView, Scheduler, active_tasks, cases_to_resubmit
+from ligwf.study.study import Study
+
+
+def submission_schedule(loads, cores: int | None, ntasks: int | None) -> Schedule:
+    """The ranks of every case on a scheduler: the rank plan (at most ``cores`` ranks a
+    case), or every case on ``ntasks`` ranks (``--ntasks`` / the site's ntasks)."""
+    fixed = (ntasks, "--ntasks") if ntasks is not None else None
+    return allocation_schedule(loads, cores, fixed)
+
+
+@dataclass(frozen=True)
+class Submission:
+    """What a submit will do: the study folder, the rank schedule and the scripts."""
+
+    out: Path
+    schedule: Schedule
+    jobs: tuple[BatchJob, ...]
+
+    @property
+    def planned(self) -> bool:
+        return self.schedule.planned
+
+    def submit(self, scheduler: Scheduler) -> list[dict]:
+        """Submit the scripts of a written study (:func:`write_for_submit`); the recorded
+        entries."""
+        return scheduler.submit(self.out, self.jobs)
+
+
+def plan_submission(prepared: Prepared, out: Path, scheduler: Scheduler, cores: int | None,
+                    ntasks: int | None, analysis: bool = True) -> Submission:
+    """The schedule and scripts of a first submission of ``prepared`` into ``out`` (pure
+    apart from reading an earlier submission record to number the scripts)."""
+    schedule = submission_schedule(prepared_loads(prepared), cores, ntasks)
+    ranks = None if not schedule.planned else {
+        rc.case.index: schedule.ranks_of(rc.case.case_id) for rc in prepared.rendered}
+    steps = list(POSTPROCESS_COMMANDS) if analysis else []
+    jobs = scheduler.plan_jobs(out, prepared.workflow.name,
+                               [rc.case.index for rc in prepared.rendered], ranks, steps,
+                               scheduler.next_round(out), cores)
+    return Submission(out, schedule, tuple(jobs))
+
+
+def write_for_submit(prepared: Prepared, submission: Submission, scheduler: Scheduler,
+                     mesh_cache: Path | None = None) -> Study:
+    """Check the scheduler's commands, refuse while an earlier submission of the study
+    still runs, then write the study folder (:meth:`Submission.submit` submits it)."""
+    scheduler.require()
+    out = submission.out
+    if scheduler.recorded(out):
+        busy = active_tasks(scheduler.status(out).cases)
+        if busy:
+            raise SubmitError(f"{out} still has {len(busy)} queued or running case(s) "
+                              f"({', '.join(c.job or '?' for c in busy[:5])}); wait, scancel "
+                              f"them, or use 'ligwf {scheduler.name} resubmit'")
+    return write(prepared, out, mesh_cache)
+
+
+@dataclass(frozen=True)
+class Resubmission:
+    """The cases a resubmit runs again, the ones still queued, and the scripts."""
+
+    study_dir: Path
+    cases: tuple[CaseView, ...]        # every case with its status
+    indices: tuple[int, ...]          # the ones to run again
+    busy: tuple[CaseView, ...]         # still queued or running: left alone
+    jobs: tuple[BatchJob, ...]
+
+    def submit(self, scheduler: Scheduler) -> list[dict]:
+        return scheduler.submit(self.study_dir, self.jobs)
+
+
+def plan_resubmission(study_dir: Path, scheduler: Scheduler, include_unstable: bool,
+                      cores: int | None, planned: bool, recorded_cores: int | None = None,
+                      analysis: bool = True) -> Resubmission:
+    """The cases that are missing, failed or killed (``include_unstable``: unstable too)
+    and not queued, with their scripts. ``planned``: a planned submission is planned
+    again, on ``cores`` or else the cores it was planned on (``recorded_cores``);
+    otherwise every case gets the site's fixed task count."""
+    study = Study.open(study_dir)
+    st = scheduler.status(study_dir)
+    indices = cases_to_resubmit(st.cases, include_unstable)
+    busy = active_tasks(st.cases)
+    jobs: Sequence[BatchJob] = ()
+    plan_cores = cores if cores is not None else recorded_cores
+    if indices:
+        again = [c for c in study.cases if c.index in indices]
+        ranks = None
+        if planned:
+            schedule = submission_schedule([case_load(c.path.name, c.scaled) for c in again],
+                                           plan_cores, None)
+            ranks = {c.index: schedule.ranks_of(c.path.name) for c in again}
+        steps = list(POSTPROCESS_COMMANDS) if analysis else []
+        jobs = scheduler.plan_jobs(study_dir, study.name, indices, ranks, steps,
+                                   scheduler.next_round(study_dir), plan_cores)
+    return Resubmission(Path(study_dir), tuple(st.cases), tuple(indices), tuple(busy),
+                        tuple(jobs))

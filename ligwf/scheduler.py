@@ -1,0 +1,120 @@
+"""The batch-scheduler interface: what ligwf asks of Slurm (or PBS, LSF, ...).
+
+A scheduler runs a written study as job arrays: one task per case (each runs ``ligwf
+run-case STUDY --index I``, the local runner with its manifests, health checks and
+resume), one array per rank count of the rank plan (the phases of
+:func:`ligwf.engine.plan.allocation_schedule`), and a follow-up job after all of them
+that runs the pipeline's post-processing commands. Four things differ between
+schedulers, and a :class:`Scheduler` implements them:
+
+* **script building** (:meth:`Scheduler.plan_jobs`, pure): the batch scripts and what
+  each one covers; :meth:`Scheduler.dry_run_text` shows them without submitting;
+* **submit** (:meth:`Scheduler.submit`): write the scripts, submit them in order (the
+  follow-up job depends on the arrays), record every submission in the study folder;
+* **status** (:meth:`Scheduler.status`): each case's manifest beside the scheduler's view
+  of its latest task (:class:`StudyStatus`);
+* **cancel** (:meth:`Scheduler.cancel`): stop the study's queued and running jobs (array
+  tasks get the scheduler's signal, so the runner writes forced restarts and marks the
+  case ``killed``; a resubmit resumes it).
+
+The case's outcome is always its manifest: the scheduler only says whether a task is still
+queued or running. The Slurm implementation is :class:`ligwf.slurm.scheduler.SlurmScheduler`;
+the pipeline (:mod:`ligwf.pipeline.submit`) chains preparation, rank plan and scheduler.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Iterable, Mapping, Protocol, Sequence
+
+from ligwf.study.manifest import FAILED, KILLED, MISSING, RUNNING, UNSTABLE
+
+#: Manifest states worth running again: the runner resumes killed cases from their restart.
+#: ``unstable`` is left out by default: the same input and seed would fail the same way.
+RETRY_STATES = frozenset({FAILED, KILLED, RUNNING, MISSING})
+
+
+class CaseView(Protocol):
+    """What the pipeline reads of one case's status (the Slurm one: its ``CaseStatus``)."""
+
+    index: int
+    case_id: str
+    manifest: str           # the manifest status, or MISSING
+    job: str | None         # the scheduler's id of its latest task
+
+    @property
+    def queued(self) -> bool:
+        """Still pending or running (it will write its manifest itself)."""
+
+
+class StudyStatus(Protocol):
+    """Every case's status, the recorded jobs (with their state) and, in tolerant mode,
+    why the scheduler's view is missing."""
+
+    cases: list
+    jobs: list[dict]
+    scheduler_error: str | None
+
+
+def cases_to_resubmit(cases: Iterable[CaseView], include_unstable: bool = False) -> list[int]:
+    """Indices of cases that are not done and not queued: missing, failed, killed, stale.
+
+    A manifest still saying ``running`` while the scheduler no longer runs the task means the
+    task died without the runner finishing its manifest (e.g. SIGKILL at the time limit).
+    """
+    retry = set(RETRY_STATES)
+    if include_unstable:
+        retry.add(UNSTABLE)
+    return sorted(c.index for c in cases if not c.queued and c.manifest in retry)
+
+
+def active_tasks(cases: Iterable[CaseView]) -> list[CaseView]:
+    """Cases whose latest task is still pending or running."""
+    return [c for c in cases if c.queued]
+
+
+class BatchJob(Protocol):
+    """A planned script: its kind (``array`` or the follow-up ``analysis``), where it is
+    written, its text and the case indices it covers."""
+
+    kind: str
+    script_path: Path
+    script_text: str
+    indices: tuple[int, ...]
+
+
+class Scheduler(Protocol):
+    """A batch scheduler ligwf submits studies to (see the module docstring)."""
+
+    #: the name shown to users and recorded with the submissions (``slurm``)
+    name: str
+
+    def require(self) -> None:
+        """SubmitError unless the scheduler's commands are reachable (checked before
+        anything is written)."""
+
+    def plan_jobs(self, study_dir: Path, study_name: str, indices: Iterable[int],
+                  ranks: Mapping[int, int] | None, post_steps: Sequence[str], round_no: int,
+                  plan_cores: int | None = None) -> Sequence[BatchJob]:
+        """The scripts of one submission round (pure): one array per rank count of
+        ``ranks`` (case index -> MPI ranks; None: the site's fixed task count) and, with
+        ``post_steps``, the follow-up job running ``ligwf <step> STUDY`` for each."""
+
+    def dry_run_text(self, jobs: Sequence[BatchJob]) -> str:
+        """Every script and the command that would submit it."""
+
+    def submit(self, study_dir: Path, jobs: Sequence[BatchJob]) -> list[dict]:
+        """Write and submit ``jobs`` in order, recording each; the new record entries."""
+
+    def status(self, study_dir: Path, tolerant: bool = False) -> StudyStatus:
+        """Every case's manifest beside the scheduler's view of its latest task
+        (``tolerant``: an unreachable scheduler leaves its view empty and says why)."""
+
+    def cancel(self, study_dir: Path) -> list[str]:
+        """Cancel the study's jobs that are still queued or running; their ids."""
+
+    def next_round(self, study_dir: Path) -> int:
+        """1 + the submission rounds recorded in the study folder so far."""
+
+    def recorded(self, study_dir: Path) -> bool:
+        """Whether the study folder records a submission of this scheduler."""
