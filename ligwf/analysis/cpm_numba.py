@@ -24,10 +24,10 @@ on real engine dumps, in units of the total edge weight).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from ligwf.numba_cache import cached_jit
 
-@njit(cache=True)
+@cached_jit()
 def _csr(n, i, j, w):
     """Symmetric CSR adjacency (indptr, indices, weights) of undirected edges (i, j, w);
     self-loops dropped (they add the same constant to every partition's quality)."""
@@ -53,7 +53,7 @@ def _csr(n, i, j, w):
     return indptr, indices, weights
 
 
-@njit(cache=True)
+@cached_jit()
 def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, init):
     """Louvain local moving from the partition ``init`` (ids < n); returns (community per
     node, moves made). A node moves only for a strictly larger gain (relative tolerance
@@ -123,7 +123,7 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
     return comm, total_moves
 
 
-@njit(cache=True)
+@cached_jit()
 def _renumber(comm):
     """Communities numbered 0..K-1 in order of first appearance; returns (labels, K)."""
     n = len(comm)
@@ -139,7 +139,7 @@ def _renumber(comm):
     return out, k
 
 
-@njit(cache=True)
+@cached_jit()
 def _aggregate(indptr, indices, weights, node_w, labels, k):
     """The graph of communities: node weights summed, edges between communities summed
     (each undirected edge once), internal edges dropped. Returns (i, j, w, node_w)."""
@@ -183,13 +183,13 @@ def _aggregate(indptr, indices, weights, node_w, labels, k):
     return out_i[:q + 1], out_j[:q + 1], out_w[:q + 1], nw
 
 
-@njit(cache=True)
+@cached_jit()
 def seed_orders(seed):
     """Seed the generator of :func:`level_order` (numba's own, separate from numpy's)."""
     np.random.seed(seed)
 
 
-@njit(cache=True)
+@cached_jit()
 def level_order(size, level_no):
     """Node order of one level's local moving. The particle graph (level 0) is visited in
     id order from a seeded start: neighbouring ids are mostly neighbouring particles, and a
@@ -201,7 +201,7 @@ def level_order(size, level_no):
     return np.random.permutation(size)
 
 
-@njit(cache=True)
+@cached_jit()
 def _levels(n, i, j, w, node_w, gamma, start, max_passes, max_levels):
     """One Louvain run: local moving on the graph from partition ``start``, then on the
     aggregated graphs from singletons, until a level moves nothing."""
@@ -225,7 +225,7 @@ def _levels(n, i, j, w, node_w, gamma, start, max_passes, max_levels):
     return _renumber(labels)[0]
 
 
-@njit(cache=True)
+@cached_jit()
 def louvain_cpm(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50, max_levels=20):
     """Community per node (0..K-1 in order of first appearance) maximising CPM with
     resolution ``gamma`` by Louvain; node orders drawn from ``seed``. ``iterations``: the
@@ -241,7 +241,7 @@ def louvain_cpm(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50, ma
     return labels
 
 
-@njit(cache=True)
+@cached_jit()
 def cpm_quality_compiled(labels, i, j, w, node_w, gamma):
     """CPM quality of a partition, sum of W_in(c) - gamma N_c^2 / 2, in one compiled loop
     (the value the fast path reports; the numpy version in ligwf.analysis.communities is

@@ -10,14 +10,14 @@ the caller falls back to the standard library / numpy path, so results never dif
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from ligwf.numba_cache import cached_jit
 _ALPHABET = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/"
 _TABLE = np.full(256, -1, np.int16)
 _TABLE[np.frombuffer(_ALPHABET, np.uint8)] = np.arange(64)
 
 
-@njit(cache=True)
+@cached_jit()
 def _decode(text, table, out, pad):
     n = len(text)
     while n > 0 and text[n - 1] == 61:          # trailing '=' padding
@@ -69,7 +69,7 @@ def decode_base64(text: bytes, header_size: int) -> np.ndarray | None:
     return out[pad:end]
 
 
-@njit(cache=True)
+@cached_jit()
 def _first_of_each_pair(lo, hi, max_id):
     m = len(lo)
     start = np.zeros(max_id + 2, np.int64)

@@ -13,22 +13,28 @@ goes further and decides the bonds, merges the granules and unwraps them across 
 periodic axis in one call: the unwrapping rides on the union-find (image counts), so no
 second search over the bonds is needed.
 
-``cache=True`` stores the machine code next to this file (``__pycache__``), so the
-compilation is paid once per installation, not once per process; except for the two
-kernels taking a model's law (:func:`bond_kernel`, :func:`bond_components`): numba keys
-them by the function objects, which differ in every process, so a cache would never hit
-and would grow by a file per run. They are compiled once per process and model (about a
-second each, outside the per-frame time); call :func:`warm_up` before timing anything.
+``cache=True`` stores the machine code next to this file (``__pycache__``, or where
+:mod:`ligwf.numba_cache` finds a writable place), so the compilation is paid once per
+installation, not once per process and MPI rank. The kernels that evaluate a model's law
+(:func:`bond_kernel`, :func:`bond_components`, :func:`rupture_work`) take the law's
+functions as arguments, but the compiled code does not: for each law they dispatch to a
+kernel of their own, compiled with the law's functions as globals
+(:func:`ligwf.numba_cache.specialised`) and cached under a name carrying a digest of the
+law's source files (a kernel taking functions as arguments could never be cached: numba
+keys it by the function objects, new in every process). :func:`warm_up` compiles or loads
+them; call it before timing anything.
 """
 
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 import numpy as np
 from numba import njit
 
 from ligwf import liquids
+from ligwf.numba_cache import cached_jit, law_digest, specialised
 from ligwf.liquids.base import LiquidModel
 
 
@@ -106,29 +112,39 @@ def _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
     return count
 
 
-@njit(error_model="numpy")
+# _bond_kernel, _bond_components and _rupture_work are never compiled as written: their
+# globals VOLUME, WITHIN_RUPTURE and FORCE exist only in the copies _for_law compiles per law.
+def _bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
+                 cos_max, min_force):
+    """:func:`bond_kernel` for the law bound to ``VOLUME``, ``WITHIN_RUPTURE``, ``FORCE``
+    (compiled per law by :func:`_for_law`)."""
+    m = len(id1)
+    out_i = np.empty(m, np.int64)
+    out_j = np.empty(m, np.int64)
+    out_f = np.empty(m, np.float64)
+    out_k = np.empty(m, np.int64)
+    count = _scan(VOLUME, WITHIN_RUPTURE, FORCE, id1, id2, id_offset, velocities, radii,
+                  content, delta, gamma, theta, cos_max, min_force, True, out_i, out_j, out_f,
+                  out_k)
+    return count, out_i, out_j, out_f, out_k
+
+
 def bond_kernel(id1, id2, id_offset, velocities, radii, content, delta, volume,
                 within_rupture, force, gamma, theta, cos_max, min_force):
     """One pass over the contacts: the bond test of :func:`_bond` for each.
 
     Particle rows are ``id1 - id_offset`` and ``id2 - id_offset`` (the ids themselves when
     the caller already mapped them, with offset 0). ``content``: liquid content per
-    particle (fraction of its volume). Returns
+    particle (fraction of its volume). ``volume``, ``within_rupture``, ``force``: the
+    model's law (:func:`law`). Returns
     (count, i, j, force, contact row) with the bonded pairs in the first ``count`` entries,
     or count = -1 - k when contact k refers to a row outside the frame.
     """
-    m = len(id1)
-    out_i = np.empty(m, np.int64)
-    out_j = np.empty(m, np.int64)
-    out_f = np.empty(m, np.float64)
-    out_k = np.empty(m, np.int64)
-    count = _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
-                  content, delta, gamma, theta, cos_max, min_force, True, out_i, out_j, out_f,
-                  out_k)
-    return count, out_i, out_j, out_f, out_k
+    return _for_law(_bond_kernel, VOLUME=volume, WITHIN_RUPTURE=within_rupture, FORCE=force)(
+        id1, id2, id_offset, velocities, radii, content, delta, gamma, theta, cos_max,
+        min_force)
 
 
-@njit(error_model="numpy")
 def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volume,
                     within_rupture, force, gamma, theta, cos_max, min_force, force_needed, y,
                     length):
@@ -150,12 +166,22 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volu
     labels, y unwrapped, percolating per granule, granule count); count = -1 - k when
     contact k refers to a row outside the frame.
     """
+    return _for_law(_bond_components, VOLUME=volume, WITHIN_RUPTURE=within_rupture,
+                    FORCE=force)(
+        id1, id2, id_offset, velocities, radii, content, delta, gamma, theta, cos_max,
+        min_force, force_needed, y, length)
+
+
+def _bond_components(id1, id2, id_offset, velocities, radii, content, delta, gamma, theta,
+                     cos_max, min_force, force_needed, y, length):
+    """:func:`bond_components` for the law bound to ``VOLUME``, ``WITHIN_RUPTURE``,
+    ``FORCE`` (compiled per law by :func:`_for_law`)."""
     m = len(id1)
     n = len(radii)
     out_i = np.empty(m, np.int64)
     out_j = np.empty(m, np.int64)
     out_f = np.empty(m, np.float64)
-    count = _scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
+    count = _scan(VOLUME, WITHIN_RUPTURE, FORCE, id1, id2, id_offset, velocities, radii,
                   content, delta, gamma, theta, cos_max, min_force, force_needed, out_i, out_j,
                   out_f, np.empty(m, np.int64))
     if count < 0:
@@ -165,7 +191,7 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volu
     return count, out_i, out_j, out_f, labels, unwrapped, percolating, n_granules
 
 
-@njit(cache=True, error_model="numpy")
+@cached_jit(error_model="numpy")
 def components_images(n, i, j, count, y, length):
     """Connected components of the first ``count`` pairs (i, j) of n particles with their
     unwrapping along the periodic axis and percolation test (the union-find pass of
@@ -243,7 +269,7 @@ def components_images(n, i, j, count, y, length):
     return labels, unwrapped, percolating[:n_granules], n_granules
 
 
-@njit(cache=True, inline="always")
+@cached_jit(inline="always")
 def _find(parent, x):
     while parent[x] != x:
         parent[x] = parent[parent[x]]      # path halving
@@ -251,7 +277,7 @@ def _find(parent, x):
     return x
 
 
-@njit(cache=True)
+@cached_jit()
 def union_find_labels(n, i, j):
     """Connected components by union-find; labels numbered in order of first member, so
     granule 0 holds particle 0, granule 1 the first particle not in granule 0, and so on."""
@@ -275,7 +301,7 @@ def union_find_labels(n, i, j):
     return labels
 
 
-@njit(cache=True, error_model="numpy")
+@cached_jit(error_model="numpy")
 def granule_sums(labels, n_granules, radii, positions, axis, axis_values):
     """Members, volume (m^3), volume-weighted position sums (m^4) and first member (row)
     per granule, in one pass (the same sums, in the same order, as numpy.bincount).
@@ -296,22 +322,45 @@ def granule_sums(labels, n_granules, radii, positions, axis, axis_values):
     return members, volume, moment, first
 
 
-@njit(error_model="numpy")
-def rupture_work(r_i, r_j, lo, hi, vol, force, gamma, theta, nodes, weights):
-    """Work, J, the bridge of each pair still does between gap ``lo`` and its rupture gap
-    ``hi`` (m): Gauss-Legendre quadrature of the model's numba ``force`` at ``nodes`` /
-    ``weights`` on [-1, 1] (the same nodes as the numpy reference,
-    :func:`ligwf.analysis.bridge_law.relative_energy`)."""
+def _rupture_work(r_i, r_j, lo, hi, vol, gamma, theta, nodes, weights):
+    """:func:`rupture_work` for the law bound to ``FORCE`` (compiled per law by
+    :func:`_for_law`)."""
     cos_theta, sin_theta = math.cos(theta), math.sin(theta)
     out = np.empty(len(r_i), np.float64)
     for k in range(len(r_i)):
         half, mid = 0.5 * (hi[k] - lo[k]), 0.5 * (hi[k] + lo[k])
         total = 0.0
         for q in range(len(nodes)):
-            total += weights[q] * force(r_i[k], r_j[k], mid + half * nodes[q], gamma, theta,
+            total += weights[q] * FORCE(r_i[k], r_j[k], mid + half * nodes[q], gamma, theta,
                                         cos_theta, sin_theta, vol[k])
         out[k] = half * total
     return out
+
+
+def rupture_work(r_i, r_j, lo, hi, vol, force, gamma, theta, nodes, weights):
+    """Work, J, the bridge of each pair still does between gap ``lo`` and its rupture gap
+    ``hi`` (m): Gauss-Legendre quadrature of the model's numba ``force`` at ``nodes`` /
+    ``weights`` on [-1, 1] (the same nodes as the numpy reference,
+    :func:`ligwf.analysis.bridge_law.relative_energy`)."""
+    return _for_law(_rupture_work, FORCE=force)(r_i, r_j, lo, hi, vol, gamma, theta, nodes,
+                                                weights)
+
+
+_COMPILED: dict[tuple, Callable] = {}
+
+
+def _for_law(kernel, **law) -> Callable:
+    """``kernel`` compiled with the law's numba functions ``law`` bound to its global names
+    (``VOLUME``, ``WITHIN_RUPTURE``, ``FORCE``): built once per process and law, compiled
+    once per installation (:func:`ligwf.numba_cache.specialised`)."""
+    key = (kernel, *law.items())
+    compiled = _COMPILED.get(key)
+    if compiled is None:
+        model = law["FORCE"].py_func.__module__.rsplit(".", 1)[-1]   # readable cache names
+        compiled = specialised(kernel, f"{model}_{law_digest(*law.values())}",
+                               {"error_model": "numpy"}, **law)
+        _COMPILED[key] = compiled
+    return compiled
 
 
 def warm_up(models: tuple[str, ...] | None = None) -> None:

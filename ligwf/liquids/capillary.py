@@ -12,10 +12,10 @@ The models differ in their force law and bridge volume only (:mod:`ligwf.liquids
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from ligwf.liquids.base import InputAngle, Line, LiquidBlock, LiquidModel, ScaledLiquid, \
     comment
+from ligwf.numba_cache import cached_jit
 
 #: the properties both capillary cohesion models read (LIGGGHTS 3.8.0 source)
 CAPILLARY_PROPERTIES = ("surfaceLiquidContentInitial", "surfaceTension", "fluidViscosity",
@@ -28,7 +28,7 @@ def rupture_distance(bridge_volume, theta_rad):
     return (1.0 + 0.5 * theta_rad) * np.cbrt(bridge_volume)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@cached_jit(inline="always", error_model="numpy")
 def within_rupture(gap, vol, theta):
     """``gap < (1 + theta/2) vol^(1/3)`` (:func:`rupture_distance`) decided without the cube
     root where the cubes differ by more than any rounding could (1e-10 relative); the few

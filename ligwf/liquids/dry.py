@@ -7,22 +7,22 @@ finds no bonds (every particle is its own granule).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from ligwf.liquids.base import Kernels, LiquidModel
+from ligwf.numba_cache import cached_jit
 
 
-@njit(cache=True, inline="always")
+@cached_jit(inline="always")
 def _volume(ri, rj, lvi, lvj):
     return 0.0
 
 
-@njit(cache=True, inline="always")
+@cached_jit(inline="always")
 def _never(gap, vol, theta):
     return False
 
 
-@njit(cache=True, inline="always")
+@cached_jit(inline="always")
 def _force(ri, rj, gap, gamma, theta, cos_theta, sin_theta, vol):
     return 0.0
 

@@ -12,10 +12,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ligwf.liquids.base import Kernels, sphere_volume
 from ligwf.liquids.capillary import CapillaryModel, within_rupture
+from ligwf.numba_cache import cached_jit
 
 
 def bridge_volume(r_i, r_j, content_i, content_j):
@@ -38,7 +38,7 @@ def _fit(vol, r2, theta_rad):
     return a, b, c
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@cached_jit(inline="always", error_model="numpy")
 def _volume(ri, rj, lvi, lvj):
     """:func:`bridge_volume` from each partner's liquid volume (m^3), m^3."""
     s = ri + rj
@@ -47,7 +47,7 @@ def _volume(ri, rj, lvi, lvj):
     return lvi * cap_i + lvj * cap_j
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@cached_jit(inline="always", error_model="numpy")
 def _force(ri, rj, gap, gamma, theta, cos_theta, sin_theta, vol):
     """:meth:`Easo.capillary_force` for one pair within rupture, N."""
     r2 = max(ri, rj)

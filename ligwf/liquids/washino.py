@@ -11,10 +11,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
 
 from ligwf.liquids.base import Kernels, sphere_volume
 from ligwf.liquids.capillary import CapillaryModel, within_rupture
+from ligwf.numba_cache import cached_jit
 
 #: LIGGGHTS' default fraction of the two particles' liquid that forms a washino bridge
 #: (``lbVolumeFraction``, used unless ``modifyLbVolume`` is switched on).
@@ -26,13 +26,13 @@ def bridge_volume(r_i, r_j, content_i, content_j, fraction: float = BRIDGE_VOLUM
     return fraction * (sphere_volume(r_i) * content_i + sphere_volume(r_j) * content_j)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@cached_jit(inline="always", error_model="numpy")
 def _volume(ri, rj, lvi, lvj):
     """:func:`bridge_volume` from each partner's liquid volume (m^3), m^3."""
     return BRIDGE_VOLUME_FRACTION * (lvi + lvj)
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@cached_jit(inline="always", error_model="numpy")
 def _force(ri, rj, gap, gamma, theta, cos_theta, sin_theta, vol):
     """:meth:`Washino.capillary_force` for one pair within rupture, N."""
     r_eff = ri * rj / (ri + rj)
