@@ -1,4 +1,4 @@
-"""``ligwf slurm submit | status | resubmit``: run a study as Slurm job arrays.
+"""``ligwf slurm submit | status | resubmit | cancel``: run a study as Slurm job arrays.
 
 ``submit`` prepares the workflow exactly as ``ligwf study`` does -- validation, rendering
 and the stability pre-flight (``--allow-unstable`` overrides it) before anything is
@@ -18,7 +18,9 @@ particles, steps, ranks and what bound them, nodes, the estimated wall time agai
 ``--dry-run`` prints the plan, the scripts and the sbatch commands and writes nothing.
 ``status`` joins the runner's manifests with squeue/scontrol; ``resubmit`` submits new
 arrays with exactly the cases that are missing, failed or killed (a planned submission is
-planned again).
+planned again); ``cancel`` scancels the study's queued and running jobs (the runners write
+forced restarts, so ``resubmit`` resumes them). The chain is :mod:`ligwf.pipeline.submit`
+over :class:`ligwf.slurm.scheduler.SlurmScheduler`; this module parses and prints.
 """
 
 from __future__ import annotations
@@ -228,8 +230,22 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_cancel(args: argparse.Namespace) -> int:
+    study_dir: Path = args.study_dir.resolve()
+    recorded = recorded_site(study_dir)
+    scheduler = SlurmScheduler(_site_from_record(recorded) if recorded else load_slurm_site())
+    ids = scheduler.cancel(study_dir)
+    if not ids:
+        console.print("nothing to cancel: no job of this study is queued or running")
+        return 0
+    console.print(f"cancelled job(s) {', '.join(ids)}: running cases write their forced "
+                  f"restarts and are marked killed; 'ligwf slurm resubmit {args.study_dir}' "
+                  "resumes them")
+    return 0
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
-    """Add ``ligwf slurm submit|status|resubmit`` to the top-level parser."""
+    """Add ``ligwf slurm submit|status|resubmit|cancel`` to the top-level parser."""
     slurm = subparsers.add_parser("slurm", help="run a study as Slurm job arrays")
     sub = slurm.add_subparsers(dest="slurm_command", required=True)
 
@@ -253,3 +269,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                    help="also rerun cases the health checks marked unstable")
     add_site_args(p)
     p.set_defaults(func=cmd_resubmit)
+
+    p = sub.add_parser("cancel", help="scancel the study's queued and running jobs (the "
+                                      "cases resume on 'ligwf slurm resubmit')")
+    p.add_argument("study_dir", type=Path, help="study folder")
+    p.set_defaults(func=cmd_cancel)
