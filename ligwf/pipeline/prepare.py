@@ -4,10 +4,10 @@
 (a loaded workflow) is the first step of every path that starts from a workflow (``check``,
 ``render``, ``run``, ``study``, ``slurm submit``): every case is scaled and rendered and
 the stability pre-flight runs before anything is written, so a bad value or an unsafe case
-is refused with nothing half-done. :func:`write` (:func:`write_study`) then writes the study record (the
-workflow, its analysis settings, the case list) and one folder per case with the input,
-the drum mesh (from the mesh cache), the scene record (original and scaled parameters plus
-a content hash) and the empty output folders the input writes into (names:
+is refused with nothing half-done. :func:`write` (:func:`write_study`) then writes the
+study record (the workflow, its analysis settings, the case list) and one folder per case
+with the input, the drum mesh (from the mesh cache), the scene record (original and scaled
+parameters plus a content hash) and the empty output folders the input writes into (names:
 :mod:`ligwf.study.layout`). Every file is written atomically.
 
 The content hash covers the scaled parameters, the rendered input and the mesh, so a

@@ -24,7 +24,8 @@ from typing import Callable, Iterable, Sequence
 
 from ligwf.engine.ensemble import run_ensemble
 from ligwf.engine.launch import Monitor, run_case, take_over
-from ligwf.engine.plan import Phase, Schedule, case_load, machine_cores, override_schedule, plan_study
+from ligwf.engine.plan import (Phase, Schedule, case_load, machine_cores, override_schedule,
+                               plan_study)
 from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig
 from ligwf.errors import LigwfError
