@@ -71,19 +71,12 @@ def cmd_stability_report(args: argparse.Namespace) -> int:
 
 def cmd_stability_suite(args: argparse.Namespace) -> int:
     """Render every variant of a stress suite (refused cases included: that is the point)."""
-    from ligwf.scene.stability_suite import load_suite
-    from ligwf.pipeline.prepare import prepare, write
+    from ligwf.pipeline.suite import write_suite
 
-    suite = load_suite(args.suite)
-    for variant, wf in suite.items():
-        prepared = prepare(wf, args.templates, allow_unstable=True)
-        write(prepared, args.out / variant, args.mesh_cache)
+    for variant, prepared in write_suite(args.suite, args.out, args.templates, args.mesh_cache):
         for rc, rep in zip(prepared.rendered, prepared.preflight):
             console.print(f"{variant}/{rc.case.case_id}: pre-flight {rep.verdict}",
                           highlight=False)
-    (args.out).mkdir(parents=True, exist_ok=True)
-    atomic_write_json(args.out / "suite.json", {"suite": str(args.suite),
-                                                "variants": list(suite)})
     return 0
 
 
