@@ -17,7 +17,9 @@ a notebook calls the same functions::
 * :mod:`~ligwf.pipeline.post` analyses and reports a study with its stored settings;
 * :mod:`~ligwf.pipeline.submit` runs a study through a batch scheduler
   (:class:`ligwf.scheduler.Scheduler`, Slurm: :mod:`ligwf.slurm`), with the same
-  preparation and the same planner.
+  preparation and the same planner;
+* :mod:`~ligwf.pipeline.suite` writes the stability stress suite (every variant, refused
+  cases included).
 
 It is the top of the stages (docs/architecture.md, enforced by tests/test_architecture.py):
 it imports every stage, no stage imports it.
