@@ -25,7 +25,7 @@ the pipeline (:mod:`ligwf.pipeline.submit`) chains preparation, rank plan and sc
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Iterable, Mapping, Protocol, Sequence
+from typing import Iterable, Mapping, Protocol, Sequence, runtime_checkable
 
 from ligwf.study.manifest import FAILED, KILLED, MISSING, RUNNING, UNSTABLE
 
@@ -83,6 +83,7 @@ class BatchJob(Protocol):
     indices: tuple[int, ...]
 
 
+@runtime_checkable
 class Scheduler(Protocol):
     """A batch scheduler ligwf submits studies to (see the module docstring)."""
 

@@ -32,7 +32,8 @@ def _arrays(submission) -> list[tuple[tuple[int, ...], int]]:
 @pytest.mark.parametrize("cores", [2, 3])
 def test_slurm_ranks_are_the_local_rank_plan_and_each_phase_is_one_array(tmp_path, cores):
     prepared = prepare_workflow(DRUM, WITH_BIG)
-    scheduler: Scheduler = SlurmScheduler(SITE)
+    scheduler = SlurmScheduler(SITE)
+    assert isinstance(scheduler, Scheduler)     # every operation of the interface is there
     sub = plan_submission(prepared, tmp_path / "s", scheduler, cores, None)
     local = plan_study(prepared_loads(prepared), cores)
     assert [(c.name, c.ranks, c.bound) for c in sub.schedule.cases] == [
