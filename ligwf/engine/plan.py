@@ -168,7 +168,8 @@ class Phase:
 
     ``ensemble``: all in ONE ``mpirun`` of ``groups x ranks`` ranks, each group claiming
     the next case of ``cases`` (:func:`ligwf.engine.ensemble.run_ensemble`); otherwise one
-    case after the other under ``mpirun -np ranks``.
+    case after the other under ``mpirun -np ranks`` (on a batch scheduler,
+    :func:`allocation_schedule`: every case its own group in an allocation of its own).
     """
 
     ranks: int
