@@ -8,7 +8,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ligwf.engine.plan import (MIN_PARTICLES_PER_RANK, CaseLoad, available_cores, case_load,
+from ligwf.engine.plan import (MIN_PARTICLES_PER_RANK, CaseLoad, allocation_schedule,
+                               available_cores, case_load,
                                estimated_seconds, fixed_ranks, list_schedule_seconds,
                                override_schedule, particle_steps, plan_ranks, plan_study,
                                rank_limits)
@@ -142,6 +143,28 @@ def test_list_schedule_matches_hand_worked_answers():
     assert list_schedule_seconds([3, 2, 2, 1], 2) == 4
     assert list_schedule_seconds([5, 1, 1, 1], 2) == 5
     assert list_schedule_seconds([1, 1, 1], 1) == 3
+
+
+# ------------------------------------------------------------- one allocation per case
+
+def test_allocation_schedule_gives_each_case_the_plan_ranks_one_phase_per_rank_count():
+    loads = [load("small", particles=100), load("big", particles=12_000, length=0.018),
+             load("big2", particles=12_000, length=0.018), load("tiny", particles=50)]
+    sched = allocation_schedule(loads, cores_per_case=None)
+    assert [(c.name, c.ranks) for c in sched.cases] == [
+        (l.name, plan_ranks(l, None).ranks) for l in loads]
+    assert sched.planned and sched.cores == sum(c.ranks for c in sched.cases)
+    # widest first, study order inside a phase, every case its own allocation (no ensemble)
+    assert [(ph.ranks, ph.groups, ph.cases, ph.ensemble) for ph in sched.phases] == [
+        (4, 2, ("big", "big2"), False), (1, 2, ("small", "tiny"), False)]
+    capped = allocation_schedule(loads, cores_per_case=2)
+    assert [(c.ranks, c.bound) for c in capped.cases][1] == (2, "cores")
+    fixed = allocation_schedule(loads, fixed=(3, "--ntasks"))
+    assert not fixed.planned and {(c.ranks, c.bound) for c in fixed.cases} == {(3, "--ntasks")}
+    assert [(ph.ranks, ph.cases) for ph in fixed.phases] == [(3, ("small", "big", "big2",
+                                                                   "tiny"))]
+    with pytest.raises(ConfigError, match="each case must appear once"):
+        allocation_schedule([load("a"), load("a")])
 
 
 # ---------------------------------------------------------------------------- overrides
