@@ -51,6 +51,7 @@ import pandas as pd
 from ligwf.analysis import gsd
 from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
 from ligwf.fsio import atomic_write_bytes, atomic_write_text
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 
 GROUP = "gsd_cg"
@@ -312,11 +313,11 @@ def main(argv=None) -> int:
     flow = pd.concat([p[2] for p in parts], ignore_index=True)
     wet_g = g[~g.case_id.map(is_twin)]
     wet_cases = [c for c in cases if not is_twin(c.case_id)]
-    min_particles = gsd.DEFAULT_MIN_PARTICLES
+    min_particles = AnalysisSettings().min_particles
     args.out.mkdir(parents=True, exist_ok=True)
     limits, dists = [], []
     for volume, column in gsd.VOLUME_COLUMNS.items():
-        settings = gsd.GsdSettings(n_boot=args.boot, volume_column=column, seed=args.seed)
+        settings = AnalysisSettings(bootstrap=args.boot, gsd_volume=volume, seed=args.seed)
         t = pooling_table(wet_g, wet_cases, settings)
         limits.append(pooling_summary(t).assign(volume=volume))
         d = verdicts(distance_table(wet_g, wet_cases, column, args.boot, min_particles, args.seed))

@@ -34,6 +34,7 @@ from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.frame_checks import plan_frames
 from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
 from ligwf.fsio import atomic_write_text
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.study import Study
 
 DEFINITIONS = {
@@ -99,8 +100,7 @@ def main(argv=None) -> int:
         d.insert(0, "definition", name)
         defs.append(d)
         for volume in ("physical", "primary"):
-            col = gsd.VOLUME_COLUMNS[volume]
-            t = pooling_table(g, cases, gsd.GsdSettings(n_boot=args.boot, volume_column=col))
+            t = pooling_table(g, cases, AnalysisSettings(bootstrap=args.boot, gsd_volume=volume))
             t.insert(0, "volume", volume)
             t.insert(0, "definition", name)
             pooled.append(t)

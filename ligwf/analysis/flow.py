@@ -26,6 +26,7 @@ Over frames: mean and standard deviation of each scalar, the share of rigid fram
 velocity field on a grid of the cross-section averaged over frames.
 Granule-derived quantities (largest granule fraction, share of frames in which one
 granule holds > 99 % of the bed) come from the granule stage and are merged by the report.
+The report's flow metrics are registered in :mod:`ligwf.analysis.flow_metrics`.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ligwf.analysis.dumps import ParticleFrame
+from ligwf.analysis.records.statistics import relative_l2
 from ligwf.analysis.surface import fit_surface
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
@@ -249,17 +251,6 @@ def velocity_field(frames: list[ParticleFrame], geo: DrumGeometry, cells: int = 
         mv = np.where(cnt > 0, sv / cnt, np.nan)
     c = 0.5 * (edges[:-1] + edges[1:])
     return c, c, mu, mv
-
-
-def relative_l2(v_ref: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """||v - v_ref|| / ||v_ref|| over the last axis (profile bins), on the bins both fill;
-    broadcasts over leading axes (bootstrap draws). nan where no bin is common."""
-    v_ref, v = np.asarray(v_ref, float), np.asarray(v, float)
-    ok = np.isfinite(v_ref) & np.isfinite(v)
-    diff = np.sqrt(np.sum(np.where(ok, (v - v_ref) ** 2, 0.0), axis=-1))
-    norm = np.sqrt(np.sum(np.where(ok, v_ref**2, 0.0), axis=-1))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(norm > 0, diff / np.where(norm > 0, norm, 1.0), np.nan)
 
 
 def profile_l2_error(s_ref: list[float], v_ref: list[float], s: list[float], v: list[float]) -> float:

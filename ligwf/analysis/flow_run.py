@@ -1,39 +1,38 @@
-"""Flow stage over a study: flow metrics of every usable case -> the flow tables.
+"""Flow stage of the analysis: per usable case its steady window and flow metrics.
 
-Only usable cases count (manifest ``done`` for the scene the folder holds: the same rule
-as the granule analysis, :meth:`ligwf.study.study.Study.usable_cases`). Only the steady
-part of the production phase counts: frames from the study's ``steady_after`` on (a
-fraction of the production time, the same window the GSD uses,
+Run by :func:`ligwf.analysis.runner.analyse` (``ligwf analyse``) once per case, before
+the granule tables are written: the steady window found here is the one the GSD, the
+kinetics, the controls and the report use (computed once, from one read of the
+production frames). Only the steady part of the production phase counts: frames from the
+study's ``steady_after`` on (a fraction of the production time,
 :meth:`ligwf.study.case.CaseFolder.steady_start_step`; or ``auto``: from the bed's
-measured spin-up, :mod:`ligwf.analysis.steady`, computed on every production frame). Frames are checked as the
-granule analysis checks them (:mod:`ligwf.analysis.frame_checks`: expected steps, dump
-record, particle count, ids, radii, drum); refused and missing ones are listed per case
-with their reasons, never used. Outputs, written atomically
-into the study's analysis folder (names in :mod:`ligwf.study.layout`):
+measured spin-up, :mod:`ligwf.analysis.steady`, on every production frame). Frames are
+checked as the granule analysis checks them (:mod:`ligwf.analysis.frame_checks`:
+expected steps, dump record, particle count, ids, radii, drum); refused and missing ones
+are listed per case with their reasons, never used. Every series registered in
+:mod:`ligwf.analysis.flow_metrics` is evaluated on every checked production frame.
 
-* flow table: one row per case with the :class:`~ligwf.analysis.flow.FlowSummary` scalars;
-* flow profiles: per case the mean and std velocity profile on the normalised depth
-  below the free surface, the per-frame series of the steady window (angle, rigid
-  fraction, rms speed, profiles: what the report's block-bootstrap intervals resample),
-  the steady window used, and the mean velocity field on a grid of the cross-section.
+Outputs (staged with the granule tables, names in :mod:`ligwf.study.layout`): the flow
+table (one row per case: steady window, the :class:`~ligwf.analysis.flow.FlowSummary`
+scalars and the value of every registered metric) and the flow record
+(:class:`~ligwf.analysis.records.flow.FlowRecord`).
 """
 
 from __future__ import annotations
 
-from pathlib import Path
+import os
 
 import numpy as np
 import pandas as pd
 
+from ligwf.analysis import flow_metrics
 from ligwf.analysis.dumps import read_particles
 from ligwf.analysis.flow import DrumGeometry, frame_flow, summarise, velocity_field
 from ligwf.analysis.frame_checks import check_particles, plan_frames
+from ligwf.analysis.records.flow import CaseFlow, FlowRecord
 from ligwf.analysis.steady import auto_fraction, is_auto
 from ligwf.errors import ConfigError, DumpReadError
-from ligwf.fsio import atomic_write_json, atomic_write_text
-from ligwf.study import layout
 from ligwf.study.case import CaseFolder
-from ligwf.study.study import Study
 
 
 def steady_fraction(case: CaseFolder, steady_after, flows: list) -> float:
@@ -49,13 +48,12 @@ def steady_fraction(case: CaseFolder, steady_after, flows: list) -> float:
                          case.production_start_step * dt, case.scaled.run_steps * dt)
 
 
-def _production_frames(case: CaseFolder) -> tuple[list, list, list[dict]]:
-    """Checked particle frames of the production phase, their flows, and the frames
-    refused or missing (``{"step", "reason"}``)."""
+def _production_frames(case: CaseFolder, plan) -> tuple[list, list, list, list[dict]]:
+    """Checked particle frames of the production phase, their flows, their registered
+    series, and the frames refused or missing (``{"step", "reason"}``)."""
     geo = DrumGeometry.from_scaled(case.scaled)
     production = case.production_start_step
-    plan = plan_frames(case)
-    frames, flows = [], []
+    frames, flows, series = [], [], []
     problems = [p for p in plan.problems if p["step"] >= production]
     for ff in plan.frames:
         if ff.step < production:
@@ -69,85 +67,104 @@ def _production_frames(case: CaseFolder) -> tuple[list, list, list[dict]]:
             continue
         try:
             flow = frame_flow(frame, geo)
+            values = flow_metrics.frame_series(frame, geo, flow)
         except (MemoryError, KeyboardInterrupt):
             raise
         except Exception as exc:   # a frame that passed its checks and still breaks a metric
             problems.append({"step": ff.step, "reason": f"{ff.particles}: flow metrics failed "
                              f"on this frame ({type(exc).__name__}: {exc})"})
             continue
-        frames.append(frame)
+        frames.append((frame, ff))
         flows.append(flow)
-    return frames, flows, problems
+        series.append(values)
+    return frames, flows, series, problems
 
 
-def steady_start_step(case: CaseFolder, steady_after) -> int:
-    """First step of the case's steady window: the fixed fraction of production, or for
-    ``auto`` the measured spin-up (reads the production frames: the granule stage asks
-    this before the flow stage has run)."""
-    if not is_auto(steady_after):
-        return case.steady_start_step(float(steady_after))
-    _, flows, _ = _production_frames(case)
-    return case.steady_start_step(steady_fraction(case, steady_after, flows))
+def _listed(v) -> list | float:
+    return [float(x) for x in np.ravel(v)] if np.ndim(v) else float(v)
 
 
-def case_flow(case: CaseFolder, steady_after) -> tuple[dict, dict, list[str]]:
-    """(summary row, profiles, skipped-frame notes) of one case folder; DumpReadError when
-    no frame of the steady window is usable, ConfigError when its dump record is unreadable."""
-    geo = DrumGeometry.from_scaled(case.scaled)
-    frames, all_flows, problems = _production_frames(case)
+def case_flow(case: CaseFolder, steady_after) -> tuple[CaseFlow, list[str]]:
+    """The flow of one case folder and its skipped-frame notes (the steady window's); the
+    record is ``measured`` only when a frame of the window was usable (else the one note
+    says why). ConfigError when its dump record is unreadable."""
+    plan = plan_frames(case)
+    frames, all_flows, all_series, problems = _production_frames(case, plan)
     fraction = steady_fraction(case, steady_after, all_flows)
     first = case.steady_start_step(fraction)
+    rel = {ff.step: os.path.relpath(ff.particles, case.path) for ff in plan.frames}
+    head = dict(case_id=case.case_id, cg=case.cg, rule=case.rule, replica=case.replica,
+                group=case.group, steady_fraction=fraction, steady_from_step=first,
+                frames=tuple(sorted(rel.items())),
+                snapshot=(frames[-1][1].step, rel[frames[-1][1].step]) if frames else None,
+                read_steps=tuple(ff.step for _, ff in frames))
     skipped = [p["reason"] for p in problems if p["step"] >= first]
-    steady = [k for k, f in enumerate(frames) if f.step >= first]
+    steady = [k for k, (f, _) in enumerate(frames) if f.step >= first]
     if not steady:
-        raise DumpReadError(f"{case.path}: no readable particle dump in the steady part "
-                            f"(steps >= {first:.0f})"
-                            + (f"; first refused: {problems[-1]['reason']}" if problems else ""))
-    flows = [all_flows[k] for k in steady]
-    summ = summarise(flows)
-    cu, cv, mu, mv = velocity_field([frames[k] for k in steady], geo)
-    row = {"case_id": case.case_id, "cg": case.cg, "rule": case.rule,
-           "replica": case.replica, "group": case.group, "steady_fraction": fraction,
-           "steady_from_step": first, **summ.scalars()}
-
-    def clean(values) -> list:
-        return [float(x) if np.isfinite(x) else None for x in values]
-
-    prof = {"s": summ.profile_s, "v_mean": summ.profile_v_mean, "v_std": summ.profile_v_std,
-            "field_u": cu.tolist(), "field_v": cv.tolist(),
-            "field_vel_u": np.where(np.isfinite(mu), mu, None).tolist(),
-            "field_vel_v": np.where(np.isfinite(mv), mv, None).tolist(),
-            "steady_fraction": fraction, "steady_from_step": first,
-            "angle_series": clean(f.angle_of_repose for f in flows),
-            "rigid_series": clean(f.rigid_fraction for f in flows),
-            "rms_series": clean(f.rms_speed for f in flows),
-            "v_frames": [clean(f.profile_v) for f in flows],
-            "time_series": [f.time for f in flows],
-            "production_times": [f.time for f in all_flows],
-            "production_angles": clean(f.angle_of_repose for f in all_flows),
-            "production_kinetic": clean(f.kinetic_energy for f in all_flows)}
-    return row, prof, skipped
+        return CaseFlow(**head), [
+            f"{case.path}: no readable particle dump in the steady part (steps >= "
+            f"{first:.0f})" + (f"; first refused: {problems[-1]['reason']}" if problems else "")]
+    return measured_flow(head, [frames[k][0] for k in steady], all_flows, all_series, steady,
+                         DrumGeometry.from_scaled(case.scaled)), skipped
 
 
-def flow_study(study: Study, out_dir: Path | None = None) -> pd.DataFrame:
-    """Flow metrics of every usable case of ``study``; writes the flow tables."""
-    out_dir = Path(out_dir) if out_dir else study.analysis_dir
-    steady_after = study.analysis.steady_after
-    cases, skipped_cases = study.usable_cases()
-    rows, profiles, notes = [], {}, {}
+def measured_flow(head: dict, steady_frames: list, flows: list, series: list[dict],
+                  steady: list[int], geo: DrumGeometry) -> CaseFlow:
+    """The :class:`CaseFlow` of a case (``head``: its identity and window fields) from its
+    production frames' flows and registered series, ``steady`` indexing the window's
+    frames (``steady_frames`` their particle frames, for the velocity field)."""
+    window = [flows[k] for k in steady]
+    summ = summarise(window)
+    cu, cv, mu, mv = velocity_field(steady_frames, geo)
+    kept = {name: [_listed(series[k][name]) for k in steady] for name in flow_metrics.SERIES}
+    values = {m.name: m.value(kept[m.series])
+              for m in flow_metrics.METRICS.values() if not m.is_error}
+    return CaseFlow(
+        **head, values=values, series=kept, times=[f.time for f in window],
+        profile_s=summ.profile_s, profile_v_mean=summ.profile_v_mean,
+        profile_v_std=summ.profile_v_std, field_u=cu.tolist(), field_v=cv.tolist(),
+        field_vel_u=mu.tolist(), field_vel_v=mv.tolist(),
+        production_times=[f.time for f in flows],
+        production_angles=[f.angle_of_repose for f in flows],
+        production_kinetic=[f.kinetic_energy for f in flows],
+        summary=summ.scalars())
+
+
+def flow_cases(cases: list[CaseFolder], steady_after) -> tuple[dict[str, CaseFlow],
+                                                              dict[str, list[str]]]:
+    """(flow per case, skipped-frame notes per case) of ``cases``; a case whose dump
+    record is unreadable is left out with its reason as the note."""
+    out, notes = {}, {}
     for c in cases:
         try:
-            row, prof, skipped = case_flow(c, steady_after)
-        except (DumpReadError, ConfigError) as exc:
+            flow, skipped = case_flow(c, steady_after)
+        except ConfigError as exc:
             notes[c.case_id] = [str(exc)]
             continue
-        rows.append(row)
-        profiles[c.case_id] = prof
+        out[c.case_id] = flow
         if skipped:
             notes[c.case_id] = skipped
-    df = pd.DataFrame(rows)
-    atomic_write_text(out_dir / layout.FLOW_TABLE, df.to_csv(index=False))
-    atomic_write_json(out_dir / layout.FLOW_PROFILES, {"steady_after": steady_after,
-                                                      "profiles": profiles, "skipped_frames": notes,
-                                                      "skipped_cases": skipped_cases})
-    return df
+    return out, notes
+
+
+def flow_record(flows: dict[str, CaseFlow], notes: dict[str, list[str]], steady_after,
+                skipped_cases: list[dict]) -> FlowRecord:
+    """The flow record of a study's cases (with the specifications of the registered
+    metrics)."""
+    return FlowRecord(steady_after=steady_after,
+                      metrics=tuple(flow_metrics.METRICS.values()), cases=dict(flows),
+                      skipped_frames=dict(notes), skipped_cases=list(skipped_cases))
+
+
+def flow_table(record: FlowRecord) -> pd.DataFrame:
+    """One row per measured case: identity, steady window, the flow summary's scalars and
+    every registered metric's value not already among them."""
+    rows = []
+    for c in record.measured():
+        row = {"case_id": c.case_id, "cg": c.cg, "rule": c.rule, "replica": c.replica,
+               "group": c.group, "steady_fraction": c.steady_fraction,
+               "steady_from_step": c.steady_from_step, **c.summary}
+        for name, v in c.values.items():
+            row.setdefault(name, v)
+        rows.append(row)
+    return pd.DataFrame(rows)

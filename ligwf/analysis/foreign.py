@@ -27,7 +27,7 @@ from ligwf.analysis.dumps import FrameFiles, read_particles
 from ligwf.analysis.granules import AXES, Liquid
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.outputs import OutputSet, new_token
-from ligwf.analysis.runner import (granule_definition, commit, frame_tables, gsd_settings,
+from ligwf.analysis.runner import (granule_definition, commit, frame_tables,
                                    nothing_analysed, stage_tables)
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
@@ -148,7 +148,7 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
             raise nothing_analysed(dump_dir, [], skipped)
         case = ForeignCase(facts.case_id, facts.cg)
         gsd_df, summary = gsd_tables(granules[granules["step"] >= steady_from_step], [case],
-                                     gsd_settings(settings))
+                                     settings)
         stage_tables(outputs, granules, table, gsd_df, summary)
         entries = [(r.time, r.vtu) for r in results if r.vtu]
         if entries:
@@ -156,7 +156,7 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
         record = {"dump_dir": str(dump_dir), "run": asdict(run),
                   "settings": settings.model_dump(mode="json"),
                   "definition": asdict(granule_definition(settings)),
-                  "gsd": asdict(gsd_settings(settings)), "steady_from_step": steady_from_step,
+                  "steady_from_step": steady_from_step,
                   "checked_against_scene": False,
                   "cases": [{"case_id": facts.case_id, "cg": facts.cg, "frames": len(frames),
                              "analysed": index.get(facts.case_id, 0)}],

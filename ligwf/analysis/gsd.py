@@ -18,7 +18,7 @@ Time averages are means of the per-frame distributions. Confidence bands come fr
 hierarchical bootstrap: resample replicas, then frames within each drawn replica in moving
 blocks (frames are dump_interval apart and correlated over a few frames: the block is 2x
 the measured autocorrelation time of the replica's series, the largest over its columns,
-:func:`ligwf.analysis.intervals.block_length`; treating frames as independent made bands
+:func:`ligwf.analysis.records.intervals.block_length`; treating frames as independent made bands
 1.4-2.2x too narrow). With one replica only frames are resampled. Every random draw comes from one seeded generator, so results are
 reproducible and identical in serial and MPI runs.
 
@@ -34,14 +34,11 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 
-#: Default smallest granule (particles) in the GSD: a single particle is not a granule.
-DEFAULT_MIN_PARTICLES = 2
-#: Default relative per-bin error of CG-n against CG1 that locates the size limit.
-DEFAULT_ERROR_BAND = 0.15
+from ligwf.scene.settings import AnalysisSettings
+
 #: Bins holding less than this share of the CG1 granule volume are too sparsely sampled
 #: for a relative error (a handful of granules): they do not move the located limit.
 MIN_BIN_SHARE = 0.01
@@ -51,33 +48,14 @@ MIN_BIN_SHARE = 0.01
 VOLUME_COLUMNS = {"physical": "volume", "primary": "primary_volume"}
 
 
-@dataclass(frozen=True)
-class GsdSettings:
-    """Binning, size-limit and bootstrap settings of the GSD stage."""
+#: confidence of the GSD bootstrap bands (the binning, bootstrap draws, seed, size-limit
+#: band and smallest granule are the study's AnalysisSettings, read as they are)
+CONFIDENCE = 0.95
 
-    bins_per_decade: int = 5
-    min_particles: int = DEFAULT_MIN_PARTICLES
-    n_boot: int = 1000
-    confidence: float = 0.95
-    seed: int = 12345
-    error_band: float = DEFAULT_ERROR_BAND
-    #: granule-table column binned: "volume" (physical, m^3) or "primary_volume" (/ n^3)
-    volume_column: str = "volume"
 
-    def __post_init__(self) -> None:
-        if self.volume_column not in VOLUME_COLUMNS.values():
-            raise ValueError(f"volume_column = {self.volume_column!r}: use "
-                             f"{' or '.join(VOLUME_COLUMNS.values())}")
-        if self.bins_per_decade < 1:
-            raise ValueError(f"bins_per_decade = {self.bins_per_decade}: must be >= 1")
-        if self.min_particles < 1:
-            raise ValueError(f"min_particles = {self.min_particles}: must be >= 1")
-        if self.n_boot < 1:
-            raise ValueError(f"n_boot = {self.n_boot}: must be >= 1")
-        if not self.error_band > 0.0:
-            raise ValueError(f"error_band = {self.error_band}: must be > 0")
-        if not 0.0 < self.confidence < 1.0:
-            raise ValueError(f"confidence = {self.confidence}: allowed range (0, 1)")
+def volume_column(settings: AnalysisSettings) -> str:
+    """The granule-table column the GSD of ``settings`` bins (its ``gsd_volume``)."""
+    return VOLUME_COLUMNS[settings.gsd_volume]
 
 
 def log_edges(v_min: float, v_max: float, per_decade: int) -> np.ndarray:
@@ -150,9 +128,9 @@ def located_limit(edges: np.ndarray, cg: np.ndarray, ref: np.ndarray, error_band
 
 def block_lengths(per_frame: np.ndarray, replicas: np.ndarray) -> list[int]:
     """Moving-block length per replica (in ``np.unique`` order): the largest
-    :func:`~ligwf.analysis.intervals.block_length` over the columns of its frames (rows in
+    :func:`~ligwf.analysis.records.intervals.block_length` over the columns of its frames (rows in
     time order)."""
-    from ligwf.analysis.intervals import block_length
+    from ligwf.analysis.records.intervals import block_length
 
     per_frame = np.asarray(per_frame, dtype=float).reshape(len(replicas), -1)
     return [max(block_length(col) for col in per_frame[replicas == r].T)
@@ -163,7 +141,7 @@ def _resample_indices(replicas: np.ndarray, rng: np.random.Generator,
                       blocks: list[int] | None = None) -> np.ndarray:
     """One hierarchical bootstrap draw: replicas with replacement, then frames in each in
     moving blocks of ``blocks[k]`` frames (1: frames independently)."""
-    from ligwf.analysis.intervals import block_indices
+    from ligwf.analysis.records.intervals import block_indices
 
     groups = [np.nonzero(replicas == r)[0] for r in np.unique(replicas)]
     blocks = blocks or [1] * len(groups)

@@ -28,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis import gsd as gsdmod
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.analysis.gsd_tables import CaseLike, Condition
 
 #: Columns of the pooling table (one row per condition, pool size and pool).
@@ -82,13 +83,13 @@ def _frame_hists(g: pd.DataFrame, edges: np.ndarray, column: str, min_particles:
     return np.asarray(hists, dtype=float).reshape(-1, len(edges) - 1), np.asarray(reps)
 
 
-def _compare(edges, pool_h, pool_r, ref_h, ref_r, settings: gsdmod.GsdSettings,
+def _compare(edges, pool_h, pool_r, ref_h, ref_r, settings: AnalysisSettings,
              rng: np.random.Generator) -> dict[str, float]:
     """Limits and side errors of one pool against its reference, with bootstrap bands."""
-    conf, band = settings.confidence, settings.error_band
+    conf, band = gsdmod.CONFIDENCE, settings.error_band
     cg, ref = pool_h.mean(axis=0), ref_h.mean(axis=0)
-    cg_d = gsdmod.bootstrap_means(pool_h, pool_r, settings.n_boot, rng)
-    ref_d = gsdmod.bootstrap_means(ref_h, ref_r, settings.n_boot, rng)
+    cg_d = gsdmod.bootstrap_means(pool_h, pool_r, settings.bootstrap, rng)
+    ref_d = gsdmod.bootstrap_means(ref_h, ref_r, settings.bootstrap, rng)
     out: dict[str, float] = {}
     for name, locate, below_of in (
             ("upper", upper_limit, _below_upper),
@@ -108,14 +109,14 @@ def _compare(edges, pool_h, pool_r, ref_h, ref_r, settings: gsdmod.GsdSettings,
 
 
 def pooling_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
-                  settings: gsdmod.GsdSettings, ks: Sequence[int] = (1, 2, 4)) -> pd.DataFrame:
+                  settings: AnalysisSettings, ks: Sequence[int] = (1, 2, 4)) -> pd.DataFrame:
     """One row per CG-n condition, pool size K in ``ks`` (<= its replica count) and pool,
     plus the CG1 noise-floor rows (each CG1 replica against the other CG1 replicas).
     ``granules``: the granule table of the frames to use (the steady window), binned on
     the edges of the whole table (one binning for every pool)."""
     if granules.empty:
         return pd.DataFrame(columns=POOLING_COLUMNS)
-    col = settings.volume_column
+    col = gsdmod.volume_column(settings)
     use = gsdmod.counted(granules["members"], granules["percolating"].to_numpy(bool),
                          settings.min_particles)
     v_all = granules[col][use] if use.any() else granules[col]

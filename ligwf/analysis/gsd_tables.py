@@ -20,6 +20,7 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis import gsd as gsdmod
+from ligwf.scene.settings import AnalysisSettings
 
 
 class CaseLike(Protocol):
@@ -89,7 +90,7 @@ def _per_condition(g: pd.DataFrame, cases: Sequence[CaseLike], edges: np.ndarray
 
 
 def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
-               settings: gsdmod.GsdSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
+               settings: AnalysisSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
     """``gsd.csv`` and ``gsd_summary.csv`` contents from the granule table of the frames
     to use (tables with their columns and no row when there is none: a steady window
     without frames is a result, and the files keep their header)."""
@@ -97,7 +98,7 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
         return pd.DataFrame(columns=GSD_COLUMNS), pd.DataFrame(columns=SUMMARY_COLUMNS)
     g = granules
     use = gsdmod.counted(g["members"], g["percolating"].to_numpy(bool), settings.min_particles)
-    col = settings.volume_column
+    col = gsdmod.volume_column(settings)
     v_all = g[col][use] if use.any() else g[col]
     edges = gsdmod.log_edges(float(v_all.min()), float(v_all.max()), settings.bins_per_decade)
     rng = np.random.default_rng(settings.seed)
@@ -105,15 +106,15 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
     rows, summary = [], []
     conds = sorted(per_cond, key=lambda c: (c.group, c.cg, c.rule))
     ref_of = {c.group: c for c in conds if c.cg == 1}
-    conf, nb = settings.confidence, len(edges) - 1
+    conf, nb = gsdmod.CONFIDENCE, len(edges) - 1
     for cond in conds:
         d = per_cond[cond]
         rep = np.asarray(d["rep"])
         num, vol, scalars = np.asarray(d["num"]), np.asarray(d["vol"]), np.asarray(d["sc"])
-        num_lo, num_hi = gsdmod.band(gsdmod.bootstrap_means(num, rep, settings.n_boot, rng), conf)
-        vol_draws = gsdmod.bootstrap_means(vol, rep, settings.n_boot, rng)
+        num_lo, num_hi = gsdmod.band(gsdmod.bootstrap_means(num, rep, settings.bootstrap, rng), conf)
+        vol_draws = gsdmod.bootstrap_means(vol, rep, settings.bootstrap, rng)
         vol_lo, vol_hi = gsdmod.band(vol_draws, conf)
-        sc_lo, sc_hi = gsdmod.band(gsdmod.bootstrap_means(scalars, rep, settings.n_boot, rng), conf)
+        sc_lo, sc_hi = gsdmod.band(gsdmod.bootstrap_means(scalars, rep, settings.bootstrap, rng), conf)
         mean_vol = vol.mean(axis=0)
         ref = ref_of.get(cond.group) if cond.cg != 1 else None
         rel = rel_lo = rel_hi = ref_vol = np.full(nb, np.nan)
@@ -125,7 +126,7 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
             r = per_cond[ref]
             ref_vol = np.asarray(r["vol"]).mean(axis=0)
             ref_draws = gsdmod.bootstrap_means(np.asarray(r["vol"]), np.asarray(r["rep"]),
-                                               settings.n_boot, rng)
+                                               settings.bootstrap, rng)
             rel = gsdmod.relative_error(mean_vol, ref_vol)
             rel_lo, rel_hi = gsdmod.band(gsdmod.relative_error(vol_draws, ref_draws), conf)
             limit = float(gsdmod.located_limit(edges, mean_vol, ref_vol, settings.error_band))

@@ -27,6 +27,7 @@ from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts
 from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.dumps import FrameFiles
 from ligwf.analysis.gsd_tables import CaseLike, Condition
+from ligwf.scene.settings import AnalysisSettings
 
 #: Per-frame quantities (see :func:`ligwf.analysis.gsd.frame_stats`)
 QUANTITIES = ("granules", "d10", "d50", "d90", "largest_granule", "granule_share",
@@ -34,10 +35,11 @@ QUANTITIES = ("granules", "d10", "d50", "d90", "largest_granule", "granule_share
 
 
 def kinetics_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
-                   min_particles: int, volume_column: str = "volume") -> pd.DataFrame:
+                   settings: AnalysisSettings) -> pd.DataFrame:
     """One row per case and frame: condition, cg, rule, replica, step, time (s) and
-    :data:`QUANTITIES`, from the granule-table column ``volume_column`` (physical
-    ``volume`` or ``primary_volume`` = volume / n^3, as the GSD)."""
+    :data:`QUANTITIES` of the granules of ``settings.min_particles`` or more, from the
+    volume the GSD bins (``settings.gsd_volume``: physical, or primary = volume / n^3)."""
+    min_particles, volume_column = settings.min_particles, gsdmod.volume_column(settings)
     cond = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
     replica = {c.case_id: c.replica for c in cases}
     rows = []
@@ -52,22 +54,22 @@ def kinetics_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
                                        "replica", "step", "time", *QUANTITIES])
 
 
-def kinetics_summary(kin: pd.DataFrame, n_boot: int, seed: int,
-                     confidence: float = 0.95) -> pd.DataFrame:
+def kinetics_summary(kin: pd.DataFrame, settings: AnalysisSettings) -> pd.DataFrame:
     """Per condition and time: mean of each quantity over replicas, its bootstrap band
-    (replicas resampled) and, for CG > 1, the ratio to the CG1 mean of the group at the
-    nearest time (``<q>_ratio``)."""
+    (replicas resampled, ``settings.bootstrap`` draws from ``settings.seed``) and, for
+    CG > 1, the ratio to the CG1 mean of the group at the nearest time (``<q>_ratio``)."""
     if kin.empty:
         return pd.DataFrame()
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng(settings.seed)
     out = []
     for (name, group, cg, rule), d in kin.groupby(["condition", "group", "cg", "rule"], sort=True):
         times = np.sort(d["time"].unique())
         for t in times:
             at = d[d["time"] == t]
             vals = at[list(QUANTITIES)].to_numpy(float)
-            draws = gsdmod.bootstrap_means(vals, at["replica"].to_numpy(), n_boot, rng)
-            lo, hi = gsdmod.band(draws, confidence)
+            draws = gsdmod.bootstrap_means(vals, at["replica"].to_numpy(), settings.bootstrap,
+                                           rng)
+            lo, hi = gsdmod.band(draws, gsdmod.CONFIDENCE)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
                 mean = np.nanmean(vals, axis=0)

@@ -1,11 +1,9 @@
-"""Whole-study analysis: every usable case, every frame -> granule tables, GSD, ParaView series.
+"""Whole-study analysis: every usable case, every frame -> flow, granule, GSD tables, series.
 
-Because a frame depends on nothing but its own two dump files, the MPI runner
-(:func:`analyse`) only deals (case, frame) tasks round-robin to ranks
-(:class:`~ligwf.analysis.case_granules.GranuleAnalysis` per frame), gathers the per-frame
-results on rank 0 and lets rank 0 alone sort them and write the outputs: the files are the
-same whatever the number of ranks (each rank writes the per-frame ``.vtu`` files of its
-own frames into the staging folder).
+The MPI runner (:func:`analyse`) deals (case, frame) tasks round-robin to ranks (a frame
+depends only on its own two dumps), gathers the results on rank 0, which alone sorts them
+and writes the outputs: the same files whatever the number of ranks (each rank writes
+the ``.vtu`` files of its own frames into the staging folder).
 
 Cases are used only when the study says they are usable (manifest ``done`` for the scene
 the folder holds and a thermo table that agrees with it,
@@ -26,7 +24,8 @@ others). Otherwise the outputs are replaced as one set
 binning and bootstrap, steady window) come from the study
 (:class:`~ligwf.scene.settings.AnalysisSettings`), so every path that analyses a study
 computes the same numbers. Granules are identified in every frame; the GSD uses the
-frames of each case's steady window only (the flow stage uses the same window).
+frames of each case's steady window only, found once by the flow stage
+(:mod:`ligwf.analysis.flow_run`, every usable case, dealt to the ranks case by case).
 
 Outputs (``OUT`` defaults to the study's analysis folder; names in
 :mod:`ligwf.study.layout`):
@@ -38,16 +37,16 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
   particles, contacts, bonds, granules, largest granule share and whether the largest
   granule percolates (wraps around the periodic axis);
 * GSD and GSD summary tables: see :mod:`ligwf.analysis.gsd_tables`;
-* GSD pooling table: the size limits and errors of CG-n replica pools of K = 1, 2, 4, 8
-  against CG1, and CG1 against itself: see :mod:`ligwf.analysis.gsd_pooling`;
-* kinetics (per case and frame, and per condition with bands and CG-n/CG1 ratios) and
-  sensitivity tables: see :mod:`ligwf.analysis.kinetics`;
-* ``<case_id>/granules.pvd`` + ``granules_<step>.vtu``: particles with a ``granule`` array;
+* GSD pooling table and its summary per condition and pool size: the size limits and
+  errors of CG-n replica pools of K = 1, 2, 4, 8 against CG1, and CG1 against itself;
+* kinetics (per case and frame, per condition with bands and CG-n/CG1 ratios) and
+  sensitivity tables: :mod:`ligwf.analysis.kinetics`; controls: :mod:`.study_controls`;
+* flow table and flow record (steady window, metrics, series): :mod:`.flow_run`;
+* per case a granule series: particles with a ``granule`` array per frame;
 * the analysis record (JSON): settings, analysed and skipped cases with their steady
-  window, skipped frames with reasons, cases without granule data, its provenance (the
-  settings' digest and per case of the study its scene hash and the SHA-256 of its dump
-  record: :func:`~ligwf.analysis.outputs.study_provenance`) and the size and SHA-256 of
-  every table, which the report checks before it uses any of them.
+  window, skipped frames with reasons, cases without granule data, its provenance
+  (:func:`~ligwf.analysis.records.provenance.study_provenance`) and the size and SHA-256 of every
+  table, which the report checks before it uses any of them.
 """
 
 from __future__ import annotations
@@ -64,14 +63,15 @@ import pandas as pd
 from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts, pvd_text
 from ligwf.analysis.frame_checks import FramePlan, plan_frames
 from ligwf.analysis.definitions import GranuleDefinition
-from ligwf.analysis.gsd import VOLUME_COLUMNS, GsdSettings
-from ligwf.analysis.flow_run import steady_start_step
-from ligwf.analysis.gsd_pooling import pooling_table
+from ligwf.analysis.flow_run import flow_cases, flow_record, flow_table
+from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
+from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.study_controls import control_pairs, study_controls
 from ligwf.analysis.kinetics import kinetics_summary, kinetics_table, sensitivity_table
 from ligwf.analysis.dumps import FrameFiles
-from ligwf.analysis.outputs import OutputSet, new_token, study_provenance
+from ligwf.analysis.outputs import OutputSet, new_token
+from ligwf.analysis.records.provenance import study_provenance
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.study import layout
 from ligwf.study.case import granules_absent
@@ -113,15 +113,7 @@ class AnalysisOptions:
 
 
 def granule_definition(s: AnalysisSettings) -> GranuleDefinition:
-    """The granule definition of the settings."""
     return GranuleDefinition.of_settings(s)
-
-
-def gsd_settings(s: AnalysisSettings) -> GsdSettings:
-    """The GSD settings of the settings."""
-    return GsdSettings(bins_per_decade=s.bins_per_decade, min_particles=s.min_particles,
-                       n_boot=s.bootstrap, seed=s.seed, error_band=s.error_band,
-                       volume_column=VOLUME_COLUMNS[s.gsd_volume])
 
 
 def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions = AnalysisOptions(),
@@ -139,6 +131,7 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     outputs = OutputSet(out_dir, token)
 
     usable, skipped_cases = study.usable_cases(options.require_manifest)
+    flow_skipped = list(skipped_cases)
     absent = [{"case_id": c.case_id, "reason": why} for c in usable
               if (why := granules_absent(c.scaled)) is not None]
     facts: list[RunFacts] = []
@@ -152,6 +145,7 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     tasks = [(fi, ff) for fi, f in enumerate(facts) for ff in f.plan.frames]
     mine: list[FrameResult] = []
     try:
+        my_flows = flow_cases(usable[rank::size], settings.steady_after)
         analyses: dict[int, GranuleAnalysis] = {}   # one per case: held windows share reads
         for fi, ff in tasks[rank::size]:
             f = facts[fi]
@@ -164,16 +158,22 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
         outputs.discard()
         raise
     if comm is not None:
-        gathered = comm.gather(mine, root=0)
+        gathered = comm.gather((mine, my_flows), root=0)
         if rank != 0:
             comm.barrier()
             return None
-        results = [r for part in gathered for r in part]
+        results = [r for part, _ in gathered for r in part]
+        by_case = {k: v for _, (f, _) in gathered for k, v in f.items()}
+        notes = {k: v for _, (_, n) in gathered for k, v in n.items()}
     else:
-        results = mine
+        results, (by_case, notes) = mine, my_flows
+    order = [c.case_id for c in usable]
+    flows = flow_record({k: by_case[k] for k in order if k in by_case},
+                        {k: notes[k] for k in order if k in notes}, settings.steady_after,
+                        flow_skipped)
     try:
         record = write_outputs(study, outputs, facts, skipped_cases, results, settings, options,
-                               absent)
+                               absent, flows)
     except BaseException:
         outputs.discard()
         raise
@@ -254,11 +254,12 @@ def nothing_analysed(where: Path, skipped_cases: list[dict], skipped_frames: lis
 
 def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipped_cases,
                   results, settings: AnalysisSettings, options: AnalysisOptions,
-                  absent: list[dict] = ()) -> dict:
+                  absent: list[dict], flows: FlowRecord) -> dict:
     """Tables, series and record of a study analysis, committed as one set. ``absent``:
     usable cases whose runs hold no granule data (``{case_id, reason}``: dry, or no
     contact dumps); when every usable case is one, the record says so and no granule
-    table is written (the flow stage and the report still use those cases)."""
+    table is written (the flow tables are, and the report uses those cases). ``flows``:
+    the flow stage's record (its steady windows are the granule tables' too)."""
     granules, frames, skipped_frames, frame_index, results = frame_tables(facts, results)
     analysed = [f for f in facts if frame_index.get(f.case_id, 0) > 0]
     skipped_cases = skipped_cases + [
@@ -268,7 +269,6 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
         "run_dir": str(study.path),
         "settings": settings.model_dump(mode="json"),
         "definition": asdict(granule_definition(settings)),
-        "gsd": asdict(gsd_settings(settings)),
         "options": {"implementation": options.implementation, "louvain": options.louvain,
                     "write_vtu": options.write_vtu,
                     "require_manifest": options.require_manifest},
@@ -281,15 +281,20 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
         if not absent:
             raise nothing_analysed(study.path, skipped_cases, skipped_frames)
         record = {**base, "cases": []}
+        stage_flow(outputs, flows)
         commit(outputs, record, obsolete=GRANULE_OUTPUTS)
         return record
     cases = [f.case for f in analysed]
-    steady_from = {c.case_id: steady_start_step(c, settings.steady_after) for c in cases}
+    steady_from = {c.case_id: flows.cases[c.case_id].steady_from_step for c in cases}
     steady = granules[granules["step"] >= granules["case_id"].map(steady_from).astype(float)]
-    gsd_df, summary = gsd_tables(steady, cases, gsd_settings(settings))
+    gsd_df, summary = gsd_tables(steady, cases, settings)
     stage_tables(outputs, granules, frames, gsd_df, summary)
-    pooled = pooling_table(steady, cases, gsd_settings(settings), POOL_SIZES)
+    pooled = pooling_table(steady, cases, settings, POOL_SIZES)
     outputs.write(layout.GSD_POOLING_TABLE, pooled.to_csv(index=False).encode())
+    if not pooled.empty:
+        outputs.write(layout.GSD_POOLING_SUMMARY_TABLE,
+                      pooling_summary(pooled).to_csv(index=False).encode())
+    stage_flow(outputs, flows)
     stage_kinetics(outputs, granules, analysed, steady_from, settings, options.implementation)
     stage_controls(outputs, cases, steady_from, settings)
     if options.write_vtu:
@@ -310,6 +315,12 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     }
     commit(outputs, record, obsolete=GRANULE_OUTPUTS)    # e.g. no twins now: no controls.csv
     return record
+
+
+def stage_flow(outputs: OutputSet, flows: FlowRecord) -> None:
+    """Stage the flow table and the flow record (:mod:`ligwf.analysis.flow_run`)."""
+    outputs.write(layout.FLOW_TABLE, flow_table(flows).to_csv(index=False).encode())
+    outputs.write(layout.FLOW_PROFILES, flows.to_text().encode())
 
 
 def stage_controls(outputs: OutputSet, cases: list, steady_from: dict[str, int],
@@ -343,10 +354,9 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
     ``settings.sensitivity_frames`` steady frames, evenly spread, of the first CG1 case
     (else the first case), analysed again under each variant of the definition."""
     cases = [f.case for f in analysed]
-    kin = kinetics_table(granules, cases, settings.min_particles,
-                         VOLUME_COLUMNS[settings.gsd_volume])
+    kin = kinetics_table(granules, cases, settings)
     outputs.write(layout.KINETICS_TABLE, kin.to_csv(index=False).encode())
-    summary = kinetics_summary(kin, settings.bootstrap, settings.seed)
+    summary = kinetics_summary(kin, settings)
     outputs.write(layout.KINETICS_SUMMARY_TABLE, summary.to_csv(index=False).encode())
     if settings.sensitivity_frames == 0:
         return
@@ -363,7 +373,8 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
 
 #: Tables of a granule analysis: an analysis without granule data removes old ones.
 GRANULE_OUTPUTS = (layout.GRANULES_TABLE, layout.FRAMES_TABLE, layout.GSD_TABLE,
-                   layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE, layout.KINETICS_TABLE,
+                   layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE,
+                   layout.GSD_POOLING_SUMMARY_TABLE, layout.KINETICS_TABLE,
                    layout.KINETICS_SUMMARY_TABLE, layout.SENSITIVITY_TABLE, layout.CONTROLS_TABLE)
 
 

@@ -110,14 +110,15 @@ def gsd_overlay(gsd: pd.DataFrame, path: Path, volume: str = "physical") -> Path
 
 def velocity_profiles(cases: pd.DataFrame, profiles: dict, path: Path) -> Path:
     """Mean downhill velocity against the normalised depth below the free surface, per case
-    (the coordinate the profile error compares on)."""
+    (the coordinate the profile error compares on); ``profiles``: case id ->
+    :class:`~ligwf.analysis.records.flow.CaseFlow`."""
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for _, r in cases.sort_values(["cg", "rule", "replica"]).iterrows():
         p = profiles.get(r["case_id"])
-        if not p:
+        if p is None or not p.measured:
             continue
-        v = np.array(p["v_mean"], dtype=float)
-        ax.plot(v, np.array(p["s"]), label=r["case_id"], lw=1.2,
+        v = np.array(p.profile_v_mean, dtype=float)
+        ax.plot(v, np.array(p.profile_s), label=r["case_id"], lw=1.2,
                 ls="-" if r["cg"] == 1 else ("--" if r["rule"] == "weber" else ":"))
     ax.axvline(0, color="k", lw=0.5)
     ax.invert_yaxis()

@@ -15,10 +15,8 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from ligwf.analysis.frame_checks import plan_frames
 from ligwf.engine.mesh import axis_frame
 from ligwf.study.layout import MESH_NAME
-from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_text
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -52,13 +50,12 @@ def _pvd(entries: list[tuple[float, int, str]]) -> str:
     return "\n".join(lines)
 
 
-def case_collection(case: CaseFolder, analysis_dir: Path, out_dir: Path) -> Path | None:
-    """Write ``out_dir/<case>.pvd`` (+ rotated drum files); None when there are no frames."""
+def case_collection(case: CaseFolder, frames, analysis_dir: Path, out_dir: Path) -> Path | None:
+    """Write ``out_dir/<case>.pvd`` (+ rotated drum files) over ``frames`` (the frames the
+    analysis planned, ``(step, dump relative to the case folder)``: missing or unexpected
+    dumps left out, :attr:`ligwf.analysis.records.flow.CaseFlow.frames`); None when there
+    are no frames."""
     s = case.scaled
-    try:
-        frames = plan_frames(case).frames     # missing or unexpected dumps left out
-    except ConfigError:
-        return None
     if not frames:
         return None
     tri_pts = read_stl(case.path / MESH_NAME)
@@ -68,13 +65,13 @@ def case_collection(case: CaseFolder, analysis_dir: Path, out_dir: Path) -> Path
     case_out.mkdir(parents=True, exist_ok=True)
     entries = []
     labelled = analysis_dir / case.case_id
-    for ff in frames:
-        t = ff.step * s.dt
-        g = labelled / layout.granule_frame(ff.step)
-        particles = g if g.is_file() else ff.particles
+    for step, dump in frames:
+        t = step * s.dt
+        g = labelled / layout.granule_frame(step)
+        particles = g if g.is_file() else case.path / dump
         entries.append((t, 0, os.path.relpath(particles, out_dir)))
-        pts = points @ rotation_matrix(s.axis, case.drum_angle(ff.step)).T
-        drum_file = case_out / layout.drum_frame(ff.step)
+        pts = points @ rotation_matrix(s.axis, case.drum_angle(step)).T
+        drum_file = case_out / layout.drum_frame(step)
         tmp = drum_file.with_suffix(".tmp.vtu")
         meshio.write(tmp, meshio.Mesh(pts, [("triangle", tri)]), binary=True)
         os.replace(tmp, drum_file)

@@ -20,29 +20,32 @@ with their status and reason, never averaged in.
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from ligwf.report.uncertainty import (ERROR_METRICS, FRAME_METRICS, ONE_GRANULE,
-                                      ConditionStats, case_series, cost_interval, mark)
+from ligwf.analysis.records.flow import FlowRecord
+from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
+from ligwf.analysis.records.statistics import MEAN
+from ligwf.report.uncertainty import (ConditionStats, case_series, cost_interval, mark,
+                                      report_metrics)
 from ligwf.study import layout
 from ligwf.study.study import Study
 
-METRICS = ["core_seconds", "wall_seconds", "production_core_rate", "production_core_rate_k",
-           "speedup_core",
-           "speedup_wall", "angle_of_repose", "angle_of_repose_std", "angle_error",
-           "profile_error", "rigid_frame_share", "rms_speed_rel_fluctuation",
-           "largest_cluster_fraction", "one_granule_frame_share", "gsd_error_below",
-           "gsd_error_above"]
+#: run costs (a Student-t interval on the logarithm over replicas)
+COST_METRICS = ["core_seconds", "wall_seconds", "production_core_rate",
+                "production_core_rate_k", "speedup_core", "speedup_wall"]
 PHASES = ("fill", "settle", "production")
-
-
 #: Already pooled over replicas by the analysis stage (bootstrap bands), not per case.
 GSD_METRICS = ("gsd_error_below", "gsd_error_above")
+
+
+def metric_columns(flow: FlowRecord) -> list[str]:
+    """The metric columns of the condition table: costs, the flow record's metrics (in
+    their registration order), the granule metrics, the GSD errors."""
+    return [*COST_METRICS, *(m.name for m in flow.metrics),
+            *(m.name for m in GRANULE_METRICS), *GSD_METRICS]
 
 
 def _read_csv(path: Path) -> pd.DataFrame:
@@ -91,27 +94,29 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
     return pd.DataFrame(rows), skipped
 
 
-def merge_analysis(cases: pd.DataFrame, analysis_dir: Path, granules: bool = True) -> pd.DataFrame:
+def merge_analysis(cases: pd.DataFrame, analysis_dir: Path, flow: FlowRecord,
+                   granules: bool = True) -> pd.DataFrame:
     """Add flow, cluster and GSD quantities to the case table (nan where not analysed;
-    ``granules`` False: the granule tables are not used, see
-    :func:`ligwf.report.write.checked_analysis`)."""
+    ``granules`` False: the granule tables are not used): every per-case metric of the
+    flow record and its steady window."""
     df = cases.copy()
-    flow = _read_csv(analysis_dir / layout.FLOW_TABLE)
-    if not flow.empty:
-        keep = flow[["case_id", "angle_of_repose_mean", "angle_of_repose_std", "rigid_frame_share",
-                     "rms_speed_rel_fluctuation", "flowing_layer_thickness_mean",
-                     *[c for c in ("steady_fraction", "steady_from_step") if c in flow]]]
-        df = df.merge(keep.rename(columns={"angle_of_repose_mean": "angle_of_repose"}),
-                      on="case_id", how="left")
+    measured = flow.measured()
+    if measured:
+        keep = pd.DataFrame([{"case_id": c.case_id,
+                              **{m.name: c.values.get(m.name, math.nan)
+                                 for m in flow.frame_metrics},
+                              "steady_fraction": c.steady_fraction,
+                              "steady_from_step": c.steady_from_step} for c in measured])
+        df = df.merge(keep, on="case_id", how="left")
     frames = _read_csv(analysis_dir / layout.FRAMES_TABLE) if granules else pd.DataFrame()
     if not frames.empty and "largest_fraction" in frames:
         ok = frames[frames["status"] == "ok"] if "status" in frames else frames
         if "steady_from_step" in df:   # the flow stage's steady window, case by case
             first = ok["case_id"].map(df.set_index("case_id")["steady_from_step"])
             ok = ok[ok["step"] >= first.fillna(-math.inf)]
+        # pandas' grouped mean (compensated summation) for means, as the tables always had
         agg = ok.groupby("case_id")["largest_fraction"].agg(
-            largest_cluster_fraction="mean",
-            one_granule_frame_share=lambda x: float(np.mean(np.asarray(x) > ONE_GRANULE)))
+            **{m.name: "mean" if m.statistic == MEAN else m.value for m in GRANULE_METRICS})
         df = df.merge(agg.reset_index(), on="case_id", how="left")
     summary = _read_csv(analysis_dir / layout.GSD_SUMMARY_TABLE) if granules else pd.DataFrame()
     if not summary.empty:
@@ -120,13 +125,14 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path, granules: bool = Tru
         g = summary[["group", "cg", "rule", *[c for c in cols if c in summary]]].rename(columns=cols)
         g = g.assign(group=g["group"].astype(str))
         df = df.merge(g, on=["group", "cg", "rule"], how="left")
-    for col in [*METRICS, "steady_fraction", "steady_from_step"]:
+    for col in [*metric_columns(flow), "steady_fraction", "steady_from_step"]:
         if col not in df:
             df[col] = math.nan
     return df
 
 
-def compare_to_cg1(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
+def compare_to_cg1(df: pd.DataFrame, stats: ConditionStats, errors: list[MetricSpec]
+                   ) -> pd.DataFrame:
     """Speedups and errors of every case against the CG1 cases of its sweep group.
 
     Speedup: CG1 production core-seconds per simulated second of production per original
@@ -145,12 +151,13 @@ def compare_to_cg1(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
             rate = df[f"production_{kind}_rate"] / size
             df.loc[idx, f"speedup_{kind}"] = rate[ref.index].mean() / rate[idx]
         for i in idx:
-            for col in ERROR_METRICS:
+            for col in (m.name for m in errors):
                 df.at[i, col] = stats.error_metric([df.at[i, "case_id"]], list(ref["case_id"]), col).value
     return df
 
 
-def condition_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
+def condition_table(df: pd.DataFrame, stats: ConditionStats, columns: list[str]
+                    ) -> pd.DataFrame:
     """Value, 95 % interval (``_lo``/``_hi``, nan: no replica interval) and within-run
     error (``_se``) of every metric per (group, CG level, rule); each error with the
     group's CG1 noise floor (``_floor``, ``_floor_source``) and its mark (``_vs_floor``)."""
@@ -163,15 +170,16 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
                "steps": int(sub["steps"].max())}
         for ph in PHASES:
             row[f"{ph}_core_seconds"] = float(sub[f"{ph}_core_seconds"].mean())
-        for col in METRICS:
+        for col in columns:
+            spec = stats.metrics.get(col)
             if col in GSD_METRICS:  # one value per condition, with its GSD-stage band
                 first = sub.iloc[0]
                 iv = (first[col], first.get(f"{col}_lo", math.nan),
                       first.get(f"{col}_hi", math.nan), math.nan)
-            elif col in FRAME_METRICS:
+            elif spec is not None and not spec.is_error:
                 i = stats.frame_metric(ids, col)
                 iv = (i.value, i.lo, i.hi, i.se_within)
-            elif col in ERROR_METRICS:
+            elif spec is not None:
                 i = stats.error_metric(ids, ref_ids, col) if ref_ids else None
                 iv = (i.value, i.lo, i.hi, i.se_within) if i else (math.nan,) * 4
                 fl = stats.floor(ref_ids, col)
@@ -192,7 +200,7 @@ def noise_floor_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
         ref_ids = list(sub[sub["cg"] == 1]["case_id"])
         if not ref_ids:
             continue
-        for col in FRAME_METRICS:
+        for col in (m.name for m in stats.metrics.values() if not m.is_error):
             value = stats.frame_metric(ref_ids, col).value
             scatter, source = stats.scatter(ref_ids, col)
             rows.append({"group": group, "metric": col, "cg1_value": value,
@@ -200,20 +208,19 @@ def noise_floor_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def build_tables(study: Study, granules: bool = True
-                 ) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], dict, pd.DataFrame]:
-    """(case table, condition table, skipped cases, profiles, noise-floor table) of a
-    finished study (``granules`` False: without the granule analysis' tables)."""
+def build_tables(study: Study, flow: FlowRecord, granules: bool = True
+                 ) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], pd.DataFrame]:
+    """(case table, condition table, skipped cases, noise-floor table) of a finished study
+    from its flow record (``granules`` False: without the granule analysis' tables)."""
     cases, skipped = case_rows(study)
     analysis_dir = study.analysis_dir
-    prof_path = analysis_dir / layout.FLOW_PROFILES
-    profiles = json.loads(prof_path.read_text())["profiles"] if prof_path.is_file() else {}
     if cases.empty:
-        return cases, pd.DataFrame(), skipped, profiles, pd.DataFrame()
-    merged = merge_analysis(cases, analysis_dir, granules)
+        return cases, pd.DataFrame(), skipped, pd.DataFrame()
+    merged = merge_analysis(cases, analysis_dir, flow, granules)
     frames = _read_csv(analysis_dir / layout.FRAMES_TABLE) if granules else pd.DataFrame()
     settings = study.analysis
-    stats = ConditionStats(case_series(list(merged["case_id"]), profiles, frames),
-                           settings.bootstrap, settings.seed)
-    df = compare_to_cg1(merged, stats)
-    return df, condition_table(df, stats), skipped, profiles, noise_floor_table(df, stats)
+    stats = ConditionStats(case_series(list(merged["case_id"]), flow, frames),
+                           settings.bootstrap, settings.seed, report_metrics(flow))
+    df = compare_to_cg1(merged, stats, list(flow.error_metrics))
+    return (df, condition_table(df, stats, metric_columns(flow)), skipped,
+            noise_floor_table(df, stats))

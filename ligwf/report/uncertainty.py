@@ -1,10 +1,11 @@
 """Per-condition values with intervals, and the CG1 noise floor every CG error is held to.
 
 Inputs: the case table (one row per usable case, :mod:`ligwf.report.tables`), the flow
-profiles record (per-frame series of each case's steady window,
-:mod:`ligwf.analysis.flow_run`) and the granule frame table (largest granule per frame).
+record (per-frame series of each case's steady window and the specification of every
+metric: series, statistic, range, :class:`~ligwf.analysis.records.flow.FlowRecord`) and
+the granule frame table (largest granule per frame).
 
-Intervals (:mod:`ligwf.analysis.intervals`): frame metrics are block-bootstrapped over
+Intervals (:mod:`ligwf.analysis.records.intervals`): frame metrics are block-bootstrapped over
 frames and replicas, bounded to their range and never narrower than their within-run
 error; run costs get a Student-t interval on the logarithm; one replica gets none.
 The errors against CG1 (angle, velocity profile) are bootstrapped jointly with the CG1
@@ -21,79 +22,50 @@ seed noise), above it ``beyond``.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.flow import RIGID_FRAME_SHARE, relative_l2
-from ligwf.analysis.intervals import (Interval, condition_draws, frame_metric_interval,
-                                      interval_from_draws, nanmean, positive_replica_interval,
-                                      run_draws)
-
-UNIT = (0.0, 1.0)
-POSITIVE = (0.0, math.inf)
-ONE_GRANULE = 0.99   # a frame where one granule holds more than this of the bed
+from ligwf.analysis.records.flow import FlowRecord
+from ligwf.analysis.records.intervals import (Interval, condition_draws, frame_metric_interval,
+                                              interval_from_draws, nanmean,
+                                              positive_replica_interval, run_draws)
+from ligwf.analysis.records.metrics import GRANULE_METRICS, LARGEST_SERIES, MetricSpec
+from ligwf.analysis.records.statistics import error as error_of
 
 
-def _mean(a):
-    return nanmean(a, axis=1)
-
-
-def _std(a):
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return np.nanstd(a, axis=1)
-
-
-def _rel_fluct(a):
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return _std(a) / _mean(a)
-
-
-def _rigid_share(a):
-    return np.mean(a > RIGID_FRAME_SHARE, axis=1)
-
-
-def _one_granule(a):
-    return np.mean(a > ONE_GRANULE, axis=1)
-
-
-#: column -> (series name, statistic over frames, range)
-FRAME_METRICS = {
-    "angle_of_repose": ("angle", _mean, (-90.0, 90.0)),
-    "angle_of_repose_std": ("angle", _std, POSITIVE),
-    "rigid_frame_share": ("rigid", _rigid_share, UNIT),
-    "rms_speed_rel_fluctuation": ("rms", _rel_fluct, POSITIVE),
-    "largest_cluster_fraction": ("largest", _mean, UNIT),
-    "one_granule_frame_share": ("largest", _one_granule, UNIT),
-}
-ERROR_METRICS = ("angle_error", "profile_error")
+def report_metrics(flow: FlowRecord) -> dict[str, MetricSpec]:
+    """Every metric of the report with a series: the flow record's (in its order), then
+    the granule frame table's."""
+    return {m.name: m for m in (*flow.metrics, *GRANULE_METRICS)}
 
 
 def _arr(values) -> np.ndarray:
     return np.array([np.nan if v is None else v for v in values], dtype=float)
 
 
-def case_series(case_ids: list[str], profiles: dict, frames: pd.DataFrame) -> dict[str, dict]:
-    """Per case: its steady-window frame series by name (angle, rigid, rms, largest,
-    profile)."""
+def case_series(case_ids: list[str], flow: FlowRecord, frames: pd.DataFrame
+                ) -> dict[str, dict]:
+    """Per case: its steady-window frame series by name (the flow record's, and the
+    largest granule's share of the bed from the granule frame table)."""
     out = {}
     for cid in case_ids:
-        p = profiles.get(cid, {})
-        s = {"angle": _arr(p.get("angle_series", [])), "rigid": _arr(p.get("rigid_series", [])),
-             "rms": _arr(p.get("rms_series", []))}
-        vf = p.get("v_frames")
-        s["profile"] = (np.array([_arr(r) for r in vf]) if vf else np.empty((0, 0)))
-        if not frames.empty and "largest_fraction" in frames:
-            first = p.get("steady_from_step", -math.inf)
-            ok = frames[(frames["case_id"] == cid) & (frames["step"] >= first)]
+        c = flow.cases.get(cid)
+        s = {}
+        for name in {m.series for m in flow.metrics}:
+            values = c.series.get(name, []) if c is not None else []
+            if values and isinstance(values[0], list):     # a profile per frame
+                s[name] = np.array([_arr(r) for r in values])
+            else:
+                s[name] = _arr(values)
+        if not frames.empty and "largest_fraction" in frames and c is not None:
+            ok = frames[(frames["case_id"] == cid) & (frames["step"] >= c.steady_from_step)]
             if "status" in ok:
                 ok = ok[ok["status"] == "ok"]
-            s["largest"] = ok.sort_values("step")["largest_fraction"].to_numpy(float)
+            s[LARGEST_SERIES] = ok.sort_values("step")["largest_fraction"].to_numpy(float)
         else:
-            s["largest"] = np.empty(0)
+            s[LARGEST_SERIES] = np.empty(0)
         out[cid] = s
     return out
 
@@ -109,15 +81,17 @@ class Floor:
 class ConditionStats:
     """Intervals and noise floors of one sweep group's conditions."""
 
-    def __init__(self, series: dict[str, dict], draws: int, seed: int):
-        self.series, self.draws, self.seed = series, draws, seed
+    def __init__(self, series: dict[str, dict], draws: int, seed: int,
+                 metrics: dict[str, MetricSpec]):
+        self.series, self.draws, self.seed, self.metrics = series, draws, seed, metrics
 
     def _runs(self, ids, name) -> list[np.ndarray]:
         return [self.series[c][name] for c in ids if c in self.series and len(self.series[c][name])]
 
     def frame_metric(self, ids, col) -> Interval:
-        name, stat, bounds = FRAME_METRICS[col]
-        return frame_metric_interval(self._runs(ids, name), bounds, self.draws, self.seed, stat)
+        m = self.metrics[col]
+        return frame_metric_interval(self._runs(ids, m.series), m.bounds, self.draws,
+                                     self.seed, m.over_frames())
 
     def _error_draws(self, ids, ref_ids, name, stat, error) -> tuple[float, np.ndarray, np.ndarray, int]:
         runs, ref = self._runs(ids, name), self._runs(ref_ids, name)
@@ -132,20 +106,14 @@ class ConditionStats:
             r_comb = r_within
         return float(value), error(r_comb, c_comb), error(r_within, c_within), len(runs)
 
-    @staticmethod
-    def _angle_err(ref, x):
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.abs(x - ref) / np.abs(ref)
-
     def _spec(self, col):
-        if col == "angle_error":
-            return "angle", _mean, self._angle_err
-        return "profile", _mean, relative_l2
+        m = self.metrics[col]
+        return m.series, m.over_frames(), error_of(m.statistic)
 
     def error_metric(self, ids, ref_ids, col) -> Interval:
         name, stat, error = self._spec(col)
         value, comb, within, n = self._error_draws(ids, ref_ids, name, stat, error)
-        return interval_from_draws(value, comb, within, n, POSITIVE)
+        return interval_from_draws(value, comb, within, n, self.metrics[col].bounds)
 
     def floor(self, ref_ids, col) -> Floor:
         """Noise floor of an error metric from the CG1 runs ``ref_ids``."""
@@ -170,8 +138,8 @@ class ConditionStats:
         """CG1-vs-CG1 scatter of a frame metric: std over CG1 replicas, or with one CG1
         run its within-run standard error (the std a second run's value would have)."""
         ref = [c for c in ref_ids if c in self.series]
-        name, stat, _ = FRAME_METRICS[col]
-        runs = self._runs(ref, name)
+        m = self.metrics[col]
+        stat, runs = m.over_frames(), self._runs(ref, m.series)
         if len(runs) >= 2:
             vals = [float(stat(r[None])[0]) for r in runs]
             return float(np.std(vals, ddof=1)), f"std over {len(runs)} CG1 replicas"

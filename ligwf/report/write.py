@@ -19,11 +19,10 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf import __version__
-from ligwf.analysis.frame_checks import last_usable_frame
-from ligwf.analysis.gsd_pooling import pooling_summary
-from ligwf.analysis.outputs import StaleAnalysis, damaged_outputs, provenance_mismatch
-from ligwf.analysis.flow_run import flow_study
-from ligwf.analysis.steady import is_auto
+from ligwf.analysis.records.flow import FlowRecord
+from ligwf.analysis.records.metrics import CASE_TABLE, CONDITION_TABLE, GRANULE_METRICS
+from ligwf.analysis.records.provenance import (StaleAnalysis, changed_dumps, damaged_outputs,
+                                               provenance_mismatch)
 from ligwf.study.layout import MESH_NAME
 from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
@@ -37,23 +36,31 @@ from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.study import Study
 
-CASE_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", "rep"),
-                ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
-                ("wall_seconds", "wall [s]"), ("core_seconds", "core-s"),
-                ("fill_core_seconds", "fill core-s"), ("settle_core_seconds", "settle core-s"),
-                ("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
-                ("speedup_core", "speedup (core-s)"), ("steady_fraction", "steady from"), ("angle_of_repose", "angle [deg]"),
-                ("angle_of_repose_std", "angle std [deg]"), ("angle_error", "angle err"),
-                ("profile_error", "profile err (L2)"), ("rigid_frame_share", "rigid frames"),
-                ("largest_cluster_fraction", "largest cluster"),
-                ("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
+#: the run columns of the case table in summary.md (the metrics follow, from the record)
+RUN_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", "rep"),
+               ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
+               ("wall_seconds", "wall [s]"), ("core_seconds", "core-s"),
+               ("fill_core_seconds", "fill core-s"), ("settle_core_seconds", "settle core-s"),
+               ("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
+               ("speedup_core", "speedup (core-s)"), ("steady_fraction", "steady from")]
+RUN_METRICS = [("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
+               ("speedup_core", "speedup")]
+GSD_COLUMNS = [("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
 
-CONDITION_METRICS = [("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
-                     ("speedup_core", "speedup"), ("angle_of_repose", "angle [deg]"),
-                     ("angle_error", "angle err"), ("profile_error", "profile err"),
-                     ("rigid_frame_share", "rigid frames"),
-                     ("largest_cluster_fraction", "largest cluster"),
-                     ("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
+
+def shown(flow: FlowRecord, table: str) -> list[tuple[str, str]]:
+    """(column, header) of the metrics a markdown table shows: the flow record's and the
+    granule metrics marked for it, in order."""
+    return [(m.name, m.header(table)) for m in (*flow.metrics, *GRANULE_METRICS)
+            if table in m.tables]
+
+
+def case_columns(flow: FlowRecord) -> list[tuple[str, str]]:
+    return RUN_COLUMNS + shown(flow, CASE_TABLE) + GSD_COLUMNS
+
+
+def condition_metrics(flow: FlowRecord) -> list[tuple[str, str]]:
+    return RUN_METRICS + shown(flow, CONDITION_TABLE) + GSD_COLUMNS
 
 
 def _fmt(v) -> str:
@@ -83,7 +90,8 @@ def _ci(row, col) -> str:
     return _fmt(m) + tail
 
 
-def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame) -> list[str]:
+def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame, flow: FlowRecord
+                   ) -> list[str]:
     """The CG1 noise floor: per metric the CG1-vs-CG1 scatter, per error the floor."""
     lines = ["## CG1 noise floor", "",
              "How far one CG1 run is from another (other seed). An error marked `within` is "
@@ -94,12 +102,14 @@ def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame) -> list[str]:
             lines.append(f"| {r['group']} | {r['metric']} | {_fmt(r['cg1_value'])} | "
                          f"{_fmt(r['cg1_scatter'])} | {r['source']} |")
         lines.append("")
-    if not conditions.empty and "angle_error_floor" in conditions:
-        lines += ["| CG | rule | angle err | floor | | profile err | floor | |",
-                  "|---|---|---|---|---|---|---|---|"]
+    errors = [m for m in flow.error_metrics if f"{m.name}_floor" in conditions]
+    if not conditions.empty and errors:
+        lines += ["| CG | rule | " + " ".join(f"{m.header(CONDITION_TABLE)} | floor | |"
+                                              for m in errors),
+                  "|---|---|" + "---|---|---|" * len(errors)]
         for _, r in conditions[conditions["cg"] != 1].iterrows():
             cells = [f"{r['cg']:g}", r["rule"]]
-            for col in ("angle_error", "profile_error"):
+            for col in (m.name for m in errors):
                 cells += [_fmt(r[col]), f"{_fmt(r[f'{col}_floor'])} ({r[f'{col}_floor_source']})",
                           str(r[f"{col}_vs_floor"])]
             lines.append("| " + " | ".join(cells) + " |")
@@ -107,18 +117,16 @@ def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame) -> list[str]:
     return lines
 
 
-def pooling_markdown(analysis_dir: Path) -> list[str]:
+def pooling_markdown(analysis_dir: Path, band: float) -> list[str]:
     """The GSD size limit against replica pooling (ligwf.analysis.gsd_pooling): per
     condition and pool size K, the mean [min, max] over disjoint pools of the source
     study's upper limit and the errors below / above it; the CG1 noise floor first."""
-    path = analysis_dir / layout.GSD_POOLING_TABLE
+    path = analysis_dir / layout.GSD_POOLING_SUMMARY_TABLE
     if not path.is_file() or path.stat().st_size <= 1:
         return []
-    table = pd.read_csv(path)
-    if table.empty:
+    summary = pd.read_csv(path)
+    if summary.empty:
         return []
-    summary = pooling_summary(table)
-    band = table["error_band"].iloc[0]
     lines = ["## GSD size limit and replica pooling", "",
              f"Upper limit: the largest granule volume up to which every bin holding >= 1 % "
              f"of the CG1 granule volume is within {100 * band:g} % of CG1 (the source "
@@ -144,37 +152,38 @@ def pooling_markdown(analysis_dir: Path) -> list[str]:
     return lines + [""]
 
 
-def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame) -> str:
-    head = "| " + " | ".join(t for _, t in CASE_COLUMNS) + " |"
-    sep = "|" + "---|" * len(CASE_COLUMNS)
+def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame, flow: FlowRecord) -> str:
+    columns, metrics = case_columns(flow), condition_metrics(flow)
+    head = "| " + " | ".join(t for _, t in columns) + " |"
+    sep = "|" + "---|" * len(columns)
     lines = ["## Cases", "", head, sep]
     for _, r in cases.sort_values(["group", "cg", "rule", "replica"]).iterrows():
-        lines.append("| " + " | ".join(_fmt(r[c]) for c, _ in CASE_COLUMNS) + " |")
+        lines.append("| " + " | ".join(_fmt(r[c]) for c, _ in columns) + " |")
     lines += ["", "## Conditions (value [95 % interval])", "",
               "Intervals: block bootstrap over frames (block = 2 x the measured "
               "autocorrelation time) and replicas, never narrower than the within-run error, "
-              "bounded to the quantity's range (ligwf.analysis.intervals); run costs: t on the "
+              "bounded to the quantity's range (ligwf.analysis.records.intervals); run costs: t on the "
               "logarithm over replicas; one replica: no replica interval. GSD bands come from "
               "the GSD stage. Errors are marked `within` / `beyond` the CG1 noise floor.", ""]
-    head = "| CG | rule | replicas | particles | core-s | " + " | ".join(t for _, t in CONDITION_METRICS) + " |"
-    lines += [head, "|" + "---|" * (5 + len(CONDITION_METRICS))]
+    head = "| CG | rule | replicas | particles | core-s | " + " | ".join(t for _, t in metrics) + " |"
+    lines += [head, "|" + "---|" * (5 + len(metrics))]
     for _, r in conditions.iterrows():
         cells = [f"{r['cg']:g}", r["rule"], str(r["replicas"]), str(r["particles"]),
-                 _ci(r, "core_seconds")] + [_ci(r, c) for c, _ in CONDITION_METRICS]
+                 _ci(r, "core_seconds")] + [_ci(r, c) for c, _ in metrics]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 
 def write_report(study: Study, out: Path | None = None, snapshots: bool = True) -> Path:
-    """Compute flow metrics (steady window from the study's analysis settings), build the
-    tables and write the report folder; returns it."""
+    """Build the tables from the analysis outputs and write the report folder; returns it.
+    Reads only: the flow metrics, steady windows and granule tables come from ``ligwf
+    analyse`` (refused when missing or stale, :func:`checked_analysis`)."""
     out = Path(out) if out else study.report_dir
-    trusted = checked_analysis(study)
-    flow = flow_study(study)
+    flow = checked_analysis(study)
     nothing_to_report(study, flow)
     fig_dir, pv_dir = out / layout.FIGURES_DIR, out / layout.PARAVIEW_DIR
     fig_dir.mkdir(parents=True, exist_ok=True)
-    cases, conditions, _, profiles, floors = build_tables(study, granules=trusted)
+    cases, conditions, _, floors = build_tables(study, flow)
     problems = study_problems(study)
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
@@ -182,36 +191,40 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
 
     figures: list[tuple[str, Path]] = []
     if not conditions.empty:
-        figures.append(("Error vs run time", figs.pareto(conditions, fig_dir / layout.FIGURE_ERROR_VS_RUNTIME)))
-        figures.append(("Velocity profiles", figs.velocity_profiles(cases, profiles,
-                                                                    fig_dir / layout.FIGURE_VELOCITY_PROFILES)))
+        figures.append(("Error vs run time", figs.pareto(
+            conditions, fig_dir / layout.FIGURE_ERROR_VS_RUNTIME)))
+        figures.append(("Velocity profiles", figs.velocity_profiles(
+            cases, flow.cases, fig_dir / layout.FIGURE_VELOCITY_PROFILES)))
     gsd_path = study.analysis_dir / layout.GSD_TABLE
-    if trusted and gsd_path.is_file() and gsd_path.stat().st_size > 1:
+    if gsd_path.is_file() and gsd_path.stat().st_size > 1:
         gsd = pd.read_csv(gsd_path)
         if not gsd.empty:
-            figures.append(("GSD overlay", figs.gsd_overlay(gsd, fig_dir / layout.FIGURE_GSD_OVERLAY,
-                                                                 study.analysis.gsd_volume)))
-    if trusted:
-        figures += granule_figures(study.analysis_dir, fig_dir)
+            figures.append(("GSD overlay", figs.gsd_overlay(
+                gsd, fig_dir / layout.FIGURE_GSD_OVERLAY, study.analysis.gsd_volume)))
+    figures += granule_figures(study.analysis_dir, fig_dir)
     pvds = []
     by_id = {c.case_id: c for c in study.usable_cases()[0]}
     for case_id in cases.get("case_id", []):
         case: CaseFolder = by_id[case_id]
-        pvd = case_collection(case, study.analysis_dir, pv_dir)
+        record = flow.cases.get(case_id)
+        pvd = case_collection(case, record.frames if record else (), study.analysis_dir, pv_dir)
         if pvd:
             pvds.append(pvd)
-        last = last_usable_frame(case) if snapshots else None
+        last = record.snapshot if snapshots and record is not None else None
         if last is not None:
-            axis, angle, mesh = case.scaled.axis, case.drum_angle(last.step), case.path / MESH_NAME
+            step, dump = last
+            axis, mesh = case.scaled.axis, case.path / MESH_NAME
             figures.append((f"{case_id}: speed", figs.snapshot(
-                last.particles, mesh, axis, angle, "speed",
-                fig_dir / layout.snapshot_figure(case_id, "speed"), f"{case_id} step {last.step}: speed [m/s]")))
-            labelled = last_labelled(study.analysis_dir / case_id, last.step) if trusted else None
+                case.path / dump, mesh, axis, case.drum_angle(step), "speed",
+                fig_dir / layout.snapshot_figure(case_id, "speed"),
+                f"{case_id} step {step}: speed [m/s]")))
+            labelled = last_labelled(study.analysis_dir / case_id, step)
             if labelled is not None:
                 step, path = labelled
                 figures.append((f"{case_id}: granules", figs.snapshot(
                     path, mesh, axis, case.drum_angle(step), "granule",
-                    fig_dir / layout.snapshot_figure(case_id, "granules"), f"{case_id} step {step}: granule id")))
+                    fig_dir / layout.snapshot_figure(case_id, "granules"),
+                    f"{case_id} step {step}: granule id")))
 
     name = study.name
     md = "\n".join([
@@ -221,11 +234,11 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         "second of production per 1,000 particles of the original (CG1) system over the case's, "
         "so a CG level run on a shorter slice compares on the same footing (fill and settle "
         "costs in their own columns).", "",
-        f"Steady window: {steady_line(study, cases)}.", "",
-        markdown_tables(cases, conditions) if not cases.empty else "No usable case.", "",
-        *noise_markdown(conditions, floors),
-        *(controls_markdown(study.analysis_dir) if trusted else []),
-        *(pooling_markdown(study.analysis_dir) if trusted else []),
+        f"Steady window: {steady_line(flow, cases)}.", "",
+        markdown_tables(cases, conditions, flow) if not cases.empty else "No usable case.", "",
+        *noise_markdown(conditions, floors, flow),
+        *controls_markdown(study.analysis_dir),
+        *pooling_markdown(study.analysis_dir, study.analysis.error_band),
         *problems.markdown(),
         "## Figures", "",
         *[f"![{t}]({layout.FIGURES_DIR}/{p.name})" for t, p in figures], "",
@@ -233,7 +246,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
         *[f"- `{layout.PARAVIEW_DIR}/{p.name}`" for p in pvds], ""])
     atomic_write_text(out / layout.SUMMARY_REPORT, md)
     atomic_write_text(out / layout.HTML_REPORT, _html(name, cases, conditions, figures, problems,
-                                                controls_html(study.analysis_dir) if trusted else ""))
+                                                      controls_html(study.analysis_dir), flow))
     return out
 
 
@@ -252,50 +265,63 @@ class NothingToReport(LigwfError):
     """Usable cases, but not one frame of any of them could be used."""
 
 
-def checked_analysis(study: Study) -> bool:
-    """Whether the granule analysis outputs may be used: True when the analysis record
-    is there and its provenance (scene hashes, dump records, settings) and tables
-    (sizes, SHA-256) still match; False when there is no readable record (the report
-    lists that, and leaves the granule columns empty). StaleAnalysis (one line naming what
-    changed) when the outputs are of another study, of an earlier run, or were edited."""
-    path = study.analysis_dir / layout.ANALYSIS_RECORD
-    try:
-        record = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return False
-    if not isinstance(record, dict):
-        return False
+class MissingAnalysis(LigwfError):
+    """The study has no (complete) analysis outputs to report."""
+
+
+def checked_analysis(study: Study) -> FlowRecord:
+    """The flow record of the study's analysis once the analysis record is there and its
+    provenance (scene hashes, dump records, settings) and tables (sizes, SHA-256) still
+    match, and the dumps the flow stage read are still the run's. MissingAnalysis when
+    there is no readable analysis (or no flow record in it); StaleAnalysis (one line
+    naming what changed) when the outputs are of another study, of an earlier run, or were
+    edited, or the dumps changed since."""
     where = study.analysis_dir
+    try:
+        record = json.loads((where / layout.ANALYSIS_RECORD).read_text())
+    except (OSError, ValueError):
+        record = None
+    if not isinstance(record, dict):
+        raise MissingAnalysis(f"{where}: no readable analysis record "
+                              f"({layout.ANALYSIS_RECORD}): run `ligwf analyse` first (or "
+                              "`ligwf study`, which does)")
     if (why := provenance_mismatch(study, study.analysis, record)) is not None:
         raise StaleAnalysis(f"{where}: the analysis outputs are stale: {why}; run `ligwf "
                             "analyse` again (or `ligwf study`, which does)")
     if damaged := damaged_outputs(where, record):
         raise StaleAnalysis(f"{where}/{damaged[0]}" + (f" (and {len(damaged) - 1} more)"
                             if len(damaged) > 1 else "") + "; run `ligwf analyse` again")
-    return True
+    try:
+        flow = FlowRecord.read(where / layout.FLOW_PROFILES)
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise MissingAnalysis(f"{where}/{layout.FLOW_PROFILES}: no flow record "
+                              f"({type(exc).__name__}: {exc}): run `ligwf analyse` again") from exc
+    if (why := changed_dumps(study, flow)) is not None:
+        raise StaleAnalysis(f"nothing to report in {study.path}: {why} (the dumps changed since "
+                            "the analysis); run `ligwf analyse` again")
+    return flow
 
 
-def nothing_to_report(study: Study, flow: pd.DataFrame) -> None:
+def nothing_to_report(study: Study, flow: FlowRecord) -> None:
     """NothingToReport when the study has usable cases but the flow stage could use no
     frame of any (every dump refused: e.g. ``post/`` folders swapped between cases)."""
     usable = study.usable_cases()[0]
-    if not usable or not flow.empty:
+    if not usable or flow.measured():
         return
     try:
-        notes = json.loads((study.analysis_dir / layout.FLOW_PROFILES).read_text())["skipped_frames"]
-        cid, reasons = next(iter(notes.items()))
+        cid, reasons = next(iter(flow.skipped_frames.items()))
         first = f"{cid}: {reasons[0]}"
-    except (OSError, ValueError, KeyError, TypeError, StopIteration, IndexError):
+    except (StopIteration, IndexError):
         first = "no reason recorded"
     raise NothingToReport(f"nothing to report in {study.path}: no frame of the {len(usable)} "
                           f"usable case(s) could be used; first: {first}")
 
 
-def steady_line(study: Study, cases: pd.DataFrame) -> str:
+def steady_line(flow: FlowRecord, cases: pd.DataFrame) -> str:
     """The steady-window rule of the study and the fractions it gave."""
-    setting = study.analysis.steady_after
+    setting = flow.steady_after
     fr = cases.get("steady_fraction", pd.Series(dtype=float)).dropna()
-    if is_auto(setting):
+    if flow.steady_auto:
         span = (f"{100 * fr.min():.0f}-{100 * fr.max():.0f} %" if len(fr) else "–")
         return (f"`steady_after: auto` (the first frame after which running means of the flow "
                 f"angle and kinetic energy stay within their steady scatter, "
@@ -303,14 +329,14 @@ def steady_line(study: Study, cases: pd.DataFrame) -> str:
     return f"`steady_after: {setting}`: the first {100 * float(setting):.0f} % of production left out"
 
 
-def _html(name, cases, conditions, figures, problems, controls: str = "") -> str:
+def _html(name, cases, conditions, figures, problems, controls: str, flow: FlowRecord) -> str:
     def table(df: pd.DataFrame) -> str:
         if df.empty:
             return "<p>none</p>"
         return df.to_html(index=False, float_format=lambda v: f"{v:.3g}", na_rep="–", border=0)
     imgs = "\n".join(f'<figure><img src="{layout.FIGURES_DIR}/{p.name}" alt="{html.escape(t)}">'
                      f"<figcaption>{html.escape(t)}</figcaption></figure>" for t, p in figures)
-    cols = [c for c, _ in CASE_COLUMNS]
+    cols = [c for c, _ in case_columns(flow)]
     return f"""<!doctype html><html><head><meta charset="utf-8"><title>{html.escape(name)}</title>
 <style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse;font-size:12px}}
 td,th{{padding:2px 6px;border-bottom:1px solid #ddd}}img{{max-width:720px}}</style></head><body>

@@ -12,6 +12,7 @@ from types import SimpleNamespace
 
 from ligwf.analysis import gsd
 from ligwf.analysis.gsd_tables import gsd_tables
+from ligwf.scene.settings import AnalysisSettings
 
 V1 = math.pi / 6 * 0.001**3      # one 1 mm primary particle, m^3
 
@@ -102,7 +103,7 @@ def test_cg_comparison_identical_gsd_has_zero_error():
     c1, c2a, c2b = _case("cg1", 1.0, "none", 0), _case("a", 2.0, "weber", 0), _case("b", 2.0, "weber", 1)
     table = pd.concat([_table(c1, 3, sizes, percolating=[5000]), _table(c2a, 3, sizes[2:]),
                        _table(c2b, 2, sizes2)])
-    settings = gsd.GsdSettings(n_boot=200)
+    settings = AnalysisSettings(bootstrap=200)
     # replica b differs: without it the comparison is exact
     dist, summary = gsd_tables(table[table.case_id != "b"], [c1, c2a, c2b], settings)
     s = summary.set_index("condition")
@@ -136,16 +137,16 @@ def test_primary_volume_convention_bins_volume_over_n3():
     sizes = [16, 16, 32, 64, 200]
     c1, c2 = _case("cg1", 1.0, "none", 0), _case("a", 2.0, "weber", 0)
     table = pd.concat([_table(c1, 2, sizes), _table(c2, 2, sizes)])
-    physical = gsd.GsdSettings(n_boot=50)
-    primary = gsd.GsdSettings(n_boot=50, volume_column="primary_volume")
+    physical = AnalysisSettings(bootstrap=50)
+    primary = AnalysisSettings(bootstrap=50, gsd_volume="primary")
     _, s_phys = gsd_tables(table, [c1, c2], physical)
     _, s_prim = gsd_tables(table, [c1, c2], primary)
     phys, prim = s_phys.set_index("condition"), s_prim.set_index("condition")
     assert phys.loc["cg2-weber", "d50"] == pytest.approx(phys.loc["cg1", "d50"])
     assert prim.loc["cg2-weber", "d50"] == pytest.approx(prim.loc["cg1", "d50"] / 2)
     assert prim.loc["cg1", "d50"] == pytest.approx(phys.loc["cg1", "d50"])
-    with pytest.raises(ValueError, match="volume_column"):
-        gsd.GsdSettings(volume_column="mass")
+    with pytest.raises(ValueError, match="gsd_volume"):
+        AnalysisSettings(gsd_volume="mass")
 
 
 def test_bands_respect_frame_autocorrelation():
@@ -153,7 +154,7 @@ def test_bands_respect_frame_autocorrelation():
     95 % band is wider than a band that treats frames as independent, and its half-width
     is not below the within-run standard error (autocorrelation counted). Measured: 0.84x
     of +-1.96 standard errors (moving blocks of 2 tau under-resample slow drifts a little)."""
-    from ligwf.analysis.intervals import within_run_se
+    from ligwf.analysis.records.intervals import within_run_se
 
     rng = np.random.default_rng(11)
     x = np.zeros(400)

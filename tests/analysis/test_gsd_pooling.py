@@ -11,6 +11,7 @@ import pytest
 
 from ligwf.analysis import gsd
 from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table, pools, upper_limit
+from ligwf.scene.settings import AnalysisSettings
 
 
 @dataclass(frozen=True)
@@ -63,7 +64,7 @@ def test_pooling_table_rows_and_known_answer():
     cases = [Case(f"cg1-none-r{r}", 1.0, "none", r) for r in range(2)] + \
             [Case(f"cg2-weber-r{r}", 2.0, "weber", r) for r in range(8)]
     g = table(rng, cases, lambda c: 3.0 if c.cg == 2 else 1.0)
-    t = pooling_table(g, cases, gsd.GsdSettings(n_boot=50), ks=(1, 2, 4))
+    t = pooling_table(g, cases, AnalysisSettings(bootstrap=50), ks=(1, 2, 4))
     cg2 = t[t.cg == 2]
     assert sorted(cg2.groupby("k").size().items()) == [(1, 8), (2, 4), (4, 2)]
     assert set(cg2[cg2.k == 4]["pool"]) == {"0+1+2+3", "4+5+6+7"}
@@ -88,4 +89,4 @@ def test_pooling_table_rows_and_known_answer():
 
 
 def test_empty_table():
-    assert pooling_table(pd.DataFrame(), [], gsd.GsdSettings()).empty
+    assert pooling_table(pd.DataFrame(), [], AnalysisSettings()).empty

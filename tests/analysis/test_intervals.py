@@ -1,11 +1,11 @@
-"""Intervals on synthetic series with known statistics (ligwf.analysis.intervals)."""
+"""Intervals on synthetic series with known statistics (ligwf.analysis.records.intervals)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from ligwf.analysis.intervals import (autocorrelation_time, frame_metric_interval,
+from ligwf.analysis.records.intervals import (autocorrelation_time, frame_metric_interval,
                                       positive_replica_interval, within_run_se)
 
 

@@ -98,8 +98,9 @@ def test_local_and_slurm_give_identical_analysis(slurm_cluster, tmp_path, env):
         "method": "communities", "velocity_frame": "drum", "max_velocity_angle_deg": 60.0,
         "min_bridge_force": 1.0e-9, "min_relative_force": 0.1, "resolution": 0.01, "seed": 3,
         "flow_radius": 2.5, "weight": "force", "hold_time": 0.5}
-    assert rec_local["gsd"]["n_boot"] == 50 and rec_local["gsd"]["bins_per_decade"] == 4
-    assert rec_local["gsd"]["error_band"] == 0.2
+    assert rec_local["settings"]["bootstrap"] == 50
+    assert rec_local["settings"]["bins_per_decade"] == 4
+    assert rec_local["settings"]["error_band"] == 0.2
     cases = Study.open(local).cases
     assert [c["steady_from_step"] for c in rec_local["cases"]] == \
         [c.steady_start_step(0.5) for c in cases]

@@ -104,7 +104,7 @@ def test_intervals_respect_within_run_noise_and_bounds(study):
     """No interval in the report is narrower than the within-run standard error of its
     metric; no bounded quantity has a bound outside its range; one replica: no interval."""
     conds = pd.read_csv(study / "report" / "conditions.csv")
-    profiles = json.loads((study / "analysis" / "flow_profiles.json").read_text())["profiles"]
+    profiles = json.loads((study / "analysis" / "flow_profiles.json").read_text())["cases"]
     cases = pd.read_csv(study / "report" / "cases.csv")
     checked = 0
     for _, c in conds.iterrows():
@@ -126,8 +126,8 @@ def test_intervals_respect_within_run_noise_and_bounds(study):
                 assert lo >= 0, col
         if c["replicas"] >= 2:   # independently: the angle's band vs the frames' plain SE
             ids = cases[(cases["cg"] == c["cg"]) & (cases["rule"] == c["rule"])]["case_id"]
-            ses = [np.nanstd(profiles[i]["angle_series"], ddof=1)
-                   / np.sqrt(len(profiles[i]["angle_series"])) for i in ids]
+            ses = [np.nanstd(np.array(profiles[i]["series"]["angle"], float), ddof=1)
+                   / np.sqrt(len(profiles[i]["series"]["angle"])) for i in ids]
             naive = np.sqrt(np.sum(np.square(ses))) / len(ses)
             assert c["angle_of_repose_hi"] - c["angle_of_repose_lo"] >= naive
     assert checked > 0
