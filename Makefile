@@ -11,8 +11,11 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 STAMP := $(VENV)/.ligwf-installed
 DEMO_OUT ?= runs/demo
 PYTEST_ARGS ?=
+# the fast lane: every test that needs no engine, MPI or Slurm and is not marked slow (by
+# mark; tests/conftest.py marks every test using the engine or Slurm fixtures)
+FAST_MARKS := not engine and not mpi and not slurm and not slow
 
-.PHONY: demo test install system-packages clean
+.PHONY: demo test test-fast install system-packages clean
 
 # The demo study: run (ranks and packing from the rank plan) + analyse + report -> $(DEMO_OUT)/report/
 demo: install
@@ -20,6 +23,10 @@ demo: install
 
 test: install
 	$(PY) -m pytest $(PYTEST_ARGS)
+
+# a developer's loop after every edit: under 90 s on 2 cores, no engine, mpirun or Slurm
+test-fast: install
+	$(PY) -m pytest -m "$(FAST_MARKS)" $(PYTEST_ARGS)
 
 install: system-packages $(STAMP)
 

@@ -1,0 +1,78 @@
+"""The fast lane's guarantees (tests/conftest.py): a test using the engine or Slurm
+fixtures is marked so even when its author forgot, and the engine fixture skips with the
+reason where LIGGGHTS or mpirun is missing, except in CI (``CI=true``), where it fails."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from helpers import ROOT
+
+_CONFTEST = f"""
+import importlib.util
+spec = importlib.util.spec_from_file_location("ligwf_tests_conftest",
+                                              {str(ROOT / "tests" / "conftest.py")!r})
+shared = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(shared)
+engine = shared.engine
+pytest_collection_modifyitems = shared.pytest_collection_modifyitems
+"""
+
+_TESTS = """
+import pytest
+
+def test_needs_the_engine(engine):
+    assert engine.liggghts
+
+@pytest.fixture
+def slurm_cluster():
+    return "a cluster"
+
+def test_needs_slurm(slurm_cluster):
+    pass
+
+def test_plain():
+    pass
+"""
+
+
+def _pytest(folder: Path, *args: str, **env: str) -> subprocess.CompletedProcess:
+    full = {k: v for k, v in os.environ.items() if k != "CI"}
+    full.update(env)
+    return subprocess.run([sys.executable, "-m", "pytest", "-q", "-rs", "-p", "no:cacheprovider",
+                           "--rootdir", str(folder), *args, str(folder)], cwd=folder,
+                          env=full, text=True, capture_output=True, timeout=300)
+
+
+@pytest.fixture
+def folder(tmp_path):
+    (tmp_path / "conftest.py").write_text(_CONFTEST)
+    (tmp_path / "test_sample.py").write_text(_TESTS)
+    return tmp_path
+
+
+def test_engine_and_slurm_fixtures_mark_their_tests(folder):
+    proc = _pytest(folder, "-m", "not engine and not mpi and not slurm and not slow")
+    assert "1 passed, 2 deselected" in proc.stdout, proc.stdout
+
+
+def test_missing_engine_skips_with_the_reason(folder):
+    proc = _pytest(folder, "-k", "engine", LIGWF_LIGGGHTS="/nonexistent/liggghts")
+    assert proc.returncode == 0 and "1 skipped" in proc.stdout, proc.stdout
+    assert "needs the engine" in proc.stdout and "/nonexistent/liggghts" in proc.stdout
+
+
+def test_missing_mpirun_skips_with_the_reason(folder):
+    proc = _pytest(folder, "-k", "engine", LIGWF_MPIRUN="/nonexistent/mpirun")
+    assert "1 skipped" in proc.stdout and "/nonexistent/mpirun" in proc.stdout, proc.stdout
+
+
+def test_missing_engine_fails_in_ci(folder):
+    proc = _pytest(folder, "-k", "engine", LIGWF_LIGGGHTS="/nonexistent/liggghts", CI="true")
+    assert proc.returncode != 0 and "1 error" in proc.stdout, proc.stdout
+    assert "CI=true and the engine is missing" in proc.stdout
