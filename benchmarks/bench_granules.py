@@ -26,9 +26,9 @@ criterion, networkx components, networkx unwrap; and the numpy evaluation of the
 criterion, ``bonded_contacts_reference``) and the fast path's fused pass and table.
 
 The compiled kernels (numba) are compiled or loaded from the cache once by ``warm_up()``
-before anything is timed, so no row includes JIT compilation. The two bond kernels take
-the liquid model's law as arguments and are compiled once per process and model (a few
-seconds, paid by every ``ligwf analyse``); the others are cached per installation.
+before anything is timed, so no row includes JIT compilation. All of them, the bond
+kernels of each liquid law included, are cached per installation: only the first process
+after an install or an edit compiles them (``benchmarks/bench_kernel_cache.py``).
 ``--model`` picks the synthetic frames' law (washino: the force law is provably positive
 and skipped; easo: it is evaluated for every bond).
 """
