@@ -356,7 +356,8 @@ def _for_law(kernel, **law) -> Callable:
     key = (kernel, *law.items())
     compiled = _COMPILED.get(key)
     if compiled is None:
-        model = law["FORCE"].py_func.__module__.rsplit(".", 1)[-1]   # readable cache names
+        force = getattr(law["FORCE"], "py_func", law["FORCE"])
+        model = force.__module__.rsplit(".", 1)[-1]          # readable cache file names
         compiled = specialised(kernel, f"{model}_{law_digest(*law.values())}",
                                {"error_model": "numpy"}, **law)
         _COMPILED[key] = compiled
