@@ -29,7 +29,7 @@ import pandas as pd
 
 from ligwf.analysis import gsd as gsdmod
 from ligwf.scene.settings import AnalysisSettings
-from ligwf.analysis.gsd_tables import CaseLike, Condition
+from ligwf.analysis.records.conditions import CaseLike, Conditions
 
 #: Columns of the pooling table (one row per condition, pool size and pool).
 POOLING_COLUMNS = ["condition", "group", "cg", "rule", "k", "pool", "replicas", "frames",
@@ -122,9 +122,9 @@ def pooling_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
     v_all = granules[col][use] if use.any() else granules[col]
     edges = gsdmod.log_edges(float(v_all.min()), float(v_all.max()), settings.bins_per_decade)
     replica_of = {c.case_id: c.replica for c in cases}
-    by_cond: dict[Condition, list[CaseLike]] = {}
-    for c in cases:
-        by_cond.setdefault(Condition(c.group, c.cg, c.rule), []).append(c)
+    conditions = Conditions.of(cases)
+    by_id = {c.case_id: c for c in cases}
+    by_cond = {cond: [by_id[i] for i in ids] for cond, ids in conditions.cases.items()}
     rng = np.random.default_rng(settings.seed)
     rows = []
 
@@ -133,15 +133,14 @@ def pooling_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
         return _frame_hists(granules[granules["case_id"].isin(ids)], edges, col,
                             settings.min_particles, replica_of)
 
-    for cond in sorted(by_cond, key=lambda c: (c.group, c.cg, c.rule)):
-        refs = [c for k, v in by_cond.items() if k.group == cond.group and k.cg == 1
-                for c in v]
+    for cond in conditions.sorted():
+        refs = [by_id[i] for i in conditions.reference_cases(cond.group)]
         if not refs:
             continue
         members = by_cond[cond]
         head = {"condition": cond.name, "group": cond.group, "cg": cond.cg,
                 "error_band": settings.error_band}
-        if cond.cg == 1:                                   # the noise floor
+        if cond.is_reference:                              # the noise floor
             if len(members) < 2:
                 continue
             for c in sorted(members, key=lambda c: c.replica):

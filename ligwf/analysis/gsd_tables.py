@@ -13,38 +13,14 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
-from typing import Any, Protocol, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 import pandas as pd
 
 from ligwf.analysis import gsd as gsdmod
+from ligwf.analysis.records.conditions import CaseLike, Condition, Conditions
 from ligwf.scene.settings import AnalysisSettings
-
-
-class CaseLike(Protocol):
-    """What the GSD tables need of a case (:class:`ligwf.study.case.CaseFolder` has it)."""
-
-    case_id: str
-    cg: float
-    rule: str
-    replica: int
-    group: str
-
-
-@dataclass(frozen=True)
-class Condition:
-    """Cases pooled for a GSD: same group, CG level and rule (replicas together)."""
-
-    group: str
-    cg: float
-    rule: str
-
-    @property
-    def name(self) -> str:
-        tag = f"cg{self.cg:g}" + ("" if self.cg == 1 else f"-{self.rule}")
-        return tag if self.group in ("{}", "") else f"{tag} {self.group}"
 
 
 #: Columns of ``gsd.csv`` (one row per condition and volume bin).
@@ -71,7 +47,7 @@ def _per_condition(g: pd.DataFrame, cases: Sequence[CaseLike], edges: np.ndarray
                    min_particles: int, column: str) -> dict[Condition, dict[str, Any]]:
     """Per condition the per-frame histograms, scalars, shares and replica of each frame."""
     replica_of = {c.case_id: c.replica for c in cases}
-    cond_of = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
+    cond_of = {c.case_id: Condition.of(c) for c in cases}
     per_cond: dict[Condition, dict[str, Any]] = {}
     for (case_id, step), fr in g.groupby(["case_id", "step"], sort=True):
         vol, mem, perc = (fr[column].to_numpy(), fr["members"].to_numpy(),
@@ -104,8 +80,8 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
     rng = np.random.default_rng(settings.seed)
     per_cond = _per_condition(g, cases, edges, settings.min_particles, col)
     rows, summary = [], []
-    conds = sorted(per_cond, key=lambda c: (c.group, c.cg, c.rule))
-    ref_of = {c.group: c for c in conds if c.cg == 1}
+    conds = sorted(per_cond, key=lambda c: c.key)
+    conditions = Conditions.of(cases)
     conf, nb = gsdmod.CONFIDENCE, len(edges) - 1
     for cond in conds:
         d = per_cond[cond]
@@ -116,7 +92,8 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
         vol_lo, vol_hi = gsdmod.band(vol_draws, conf)
         sc_lo, sc_hi = gsdmod.band(gsdmod.bootstrap_means(scalars, rep, settings.bootstrap, rng), conf)
         mean_vol = vol.mean(axis=0)
-        ref = ref_of.get(cond.group) if cond.cg != 1 else None
+        refs = [r for r in conditions.references(cond.group) if r in per_cond]
+        ref = refs[-1] if refs and not cond.is_reference else None
         rel = rel_lo = rel_hi = ref_vol = np.full(nb, np.nan)
         err = dict.fromkeys([f"error_{side}{s}" for side in ("below", "above")
                              for s in ("", "_lo", "_hi")], math.nan)

@@ -26,7 +26,7 @@ from ligwf.analysis import gsd as gsdmod
 from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts
 from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.dumps import FrameFiles
-from ligwf.analysis.gsd_tables import CaseLike, Condition
+from ligwf.analysis.records.conditions import REFERENCE_CG, CaseLike, Condition
 from ligwf.scene.settings import AnalysisSettings
 
 #: Per-frame quantities (see :func:`ligwf.analysis.gsd.frame_stats`)
@@ -40,7 +40,7 @@ def kinetics_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
     :data:`QUANTITIES` of the granules of ``settings.min_particles`` or more, from the
     volume the GSD bins (``settings.gsd_volume``: physical, or primary = volume / n^3)."""
     min_particles, volume_column = settings.min_particles, gsdmod.volume_column(settings)
-    cond = {c.case_id: Condition(c.group, c.cg, c.rule) for c in cases}
+    cond = {c.case_id: Condition.of(c) for c in cases}
     replica = {c.case_id: c.replica for c in cases}
     rows = []
     for (case_id, step), fr in granules.groupby(["case_id", "step"], sort=True):
@@ -82,10 +82,10 @@ def kinetics_summary(kin: pd.DataFrame, settings: AnalysisSettings) -> pd.DataFr
     for q in QUANTITIES:
         summary[f"{q}_ratio"] = np.nan
     for group, d in summary.groupby("group"):
-        ref = d[d["cg"] == 1].sort_values("time")
+        ref = d[d["cg"] == REFERENCE_CG].sort_values("time")
         if ref.empty:
             continue
-        for idx, row in d[d["cg"] != 1].iterrows():
+        for idx, row in d[d["cg"] != REFERENCE_CG].iterrows():
             k = int(np.abs(ref["time"].to_numpy() - row["time"]).argmin())
             with np.errstate(divide="ignore", invalid="ignore"):
                 for q in QUANTITIES:

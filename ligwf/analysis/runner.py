@@ -65,6 +65,7 @@ from ligwf.analysis.frame_checks import FramePlan, plan_frames
 from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.flow_run import flow_cases, flow_record, flow_table
 from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
+from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.study_controls import control_pairs, study_controls
@@ -360,7 +361,8 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
     outputs.write(layout.KINETICS_SUMMARY_TABLE, summary.to_csv(index=False).encode())
     if settings.sensitivity_frames == 0:
         return
-    facts = next((f for f in analysed if f.cg == 1), analysed[0])
+    first = Conditions.of(cases).first_reference_case()
+    facts = next((f for f in analysed if f.case_id == first), analysed[0])
     steady = [ff for ff in facts.plan.frames if ff.step >= steady_from[facts.case_id]]
     if not steady:
         return

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
 from ligwf.analysis.records.statistics import MEAN
@@ -142,17 +143,19 @@ def compare_to_cg1(df: pd.DataFrame, stats: ConditionStats, errors: list[MetricS
     """
     df = df.copy()
     size = df["original_particles"].astype(float)
-    for _, sub in df.groupby("group"):   # (production_core_rate / size is _rate_k / 1000)
-        ref = sub[sub["cg"] == 1]
-        if ref.empty:
+    conditions = Conditions.of(df.itertuples())
+    for group, sub in df.groupby("group"):   # (production_core_rate / size is _rate_k / 1000)
+        ref_ids = conditions.reference_cases(group)
+        if not ref_ids:
             continue
+        ref = df.index[df["case_id"].isin(ref_ids)]
         idx = sub.index
         for kind in ("core", "wall"):
             rate = df[f"production_{kind}_rate"] / size
-            df.loc[idx, f"speedup_{kind}"] = rate[ref.index].mean() / rate[idx]
+            df.loc[idx, f"speedup_{kind}"] = rate[ref].mean() / rate[idx]
         for i in idx:
             for col in (m.name for m in errors):
-                df.at[i, col] = stats.error_metric([df.at[i, "case_id"]], list(ref["case_id"]), col).value
+                df.at[i, col] = stats.error_metric([df.at[i, "case_id"]], ref_ids, col).value
     return df
 
 
@@ -162,9 +165,11 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats, columns: list[str]
     error (``_se``) of every metric per (group, CG level, rule); each error with the
     group's CG1 noise floor (``_floor``, ``_floor_source``) and its mark (``_vs_floor``)."""
     rows = []
+    conditions = Conditions.of(df.itertuples())
     for (group, cg, rule), sub in df.groupby(["group", "cg", "rule"], sort=True):
         ids = list(sub["case_id"])
-        ref_ids = list(df[(df["group"] == group) & (df["cg"] == 1)]["case_id"])
+        cond = conditions.condition(ids[0])
+        ref_ids = conditions.reference_cases(group)
         row = {"group": group, "cg": cg, "rule": rule, "replicas": len(sub),
                "particles": int(sub["particles"].iloc[0]), "dt": float(sub["dt"].iloc[0]),
                "steps": int(sub["steps"].max())}
@@ -184,7 +189,8 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats, columns: list[str]
                 iv = (i.value, i.lo, i.hi, i.se_within) if i else (math.nan,) * 4
                 fl = stats.floor(ref_ids, col)
                 row[f"{col}_floor"], row[f"{col}_floor_source"] = fl.value, fl.source
-                row[f"{col}_vs_floor"] = "reference" if cg == 1 else mark(iv[0], fl.value)
+                row[f"{col}_vs_floor"] = ("reference" if cond.is_reference
+                                          else mark(iv[0], fl.value))
             else:
                 i = cost_interval(sub[col])
                 iv = (i.value, i.lo, i.hi, i.se_within)
@@ -196,8 +202,9 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats, columns: list[str]
 def noise_floor_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
     """Per group and frame metric: the CG1 value and its CG1-vs-CG1 scatter."""
     rows = []
-    for group, sub in df.groupby("group"):
-        ref_ids = list(sub[sub["cg"] == 1]["case_id"])
+    conditions = Conditions.of(df.itertuples())
+    for group in conditions.groups():
+        ref_ids = conditions.reference_cases(group)
         if not ref_ids:
             continue
         for col in (m.name for m in stats.metrics.values() if not m.is_error):

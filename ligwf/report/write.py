@@ -19,6 +19,7 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf import __version__
+from ligwf.analysis.records.conditions import REFERENCE_CG
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.metrics import CASE_TABLE, CONDITION_TABLE, GRANULE_METRICS
 from ligwf.analysis.records.provenance import (StaleAnalysis, changed_dumps, damaged_outputs,
@@ -107,7 +108,7 @@ def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame, flow: FlowRec
         lines += ["| CG | rule | " + " ".join(f"{m.header(CONDITION_TABLE)} | floor | |"
                                               for m in errors),
                   "|---|---|" + "---|---|---|" * len(errors)]
-        for _, r in conditions[conditions["cg"] != 1].iterrows():
+        for _, r in conditions[conditions["cg"] != REFERENCE_CG].iterrows():
             cells = [f"{r['cg']:g}", r["rule"]]
             for col in (m.name for m in errors):
                 cells += [_fmt(r[col]), f"{_fmt(r[f'{col}_floor'])} ({r[f'{col}_floor_source']})",
