@@ -33,6 +33,13 @@ MESH_VERSION = 5
 SAG_FRACTION = 0.02
 #: Fewest polygon segments of the full circle, whatever the sag allows.
 MIN_SEGMENTS = 96
+#: Smallest angle (deg) a shell triangle may have. LIGGGHTS refuses a mesh with an element
+#: angle below its curvature bound (``fix mesh/surface``, 0.256 deg by default: "Bad mesh,
+#: cannot continue"). One row of triangles along the axis has the angle atan(edge / length)
+#: at its far corner, so a long slice fails: the 40 mm demo drum's 0.63 mm lifter-top edges
+#: in a 144 mm slice gave 0.25 deg (measured). Past this bound the shell gets more rows, so
+#: every drum short enough for one row (0.5 deg at 72 mm there) keeps its mesh byte for byte.
+MIN_FACET_ANGLE_DEG = 0.4
 
 
 def axis_frame(axis: str) -> tuple[int, int, int]:
@@ -105,8 +112,9 @@ def drum_triangles(drum: Drum, sag: float) -> np.ndarray:
     """Triangles (M, 3 vertices, xyz) of the shell, plus end caps when not periodic.
 
     Shell normals point towards the axis (into the particle space). Each outline edge
-    becomes ONE pair of triangles spanning the whole length: the shell is a prism, so more
-    rows would add no geometry, only cost. A turning mesh costs per facet and step (moving
+    becomes ONE pair of triangles spanning the whole length (more rows only where a
+    triangle would be too thin for the engine, :func:`shell_rows`): the shell is a prism,
+    so more rows would add no geometry, only cost. A turning mesh costs per facet and step (moving
     its nodes, refreshing normals and edges): on the 18 mm we_vs_bo drum, 720 facets in
     two rows took 0.26 ms of a 0.45 ms CG3 step, 360 in one row 0.19 ms; the CG1 step did
     not change (7.29 vs 7.36 ms, noise). Long triangles are exact for the engine (contact
@@ -116,12 +124,15 @@ def drum_triangles(drum: Drum, sag: float) -> np.ndarray:
     """
     outline = drum_outline(drum, sag)
     nxt = np.roll(outline, -1, axis=0)
-    lo, hi = np.zeros(len(outline)), np.full(len(outline), drum.length)
-    a0 = _to_xyz(outline[:, 0], outline[:, 1], lo, drum.axis)
-    b0 = _to_xyz(nxt[:, 0], nxt[:, 1], lo, drum.axis)
-    a1 = _to_xyz(outline[:, 0], outline[:, 1], hi, drum.axis)
-    b1 = _to_xyz(nxt[:, 0], nxt[:, 1], hi, drum.axis)
-    tris = [np.stack([a0, b0, b1], axis=1), np.stack([a0, b1, a1], axis=1)]
+    cuts = np.linspace(0.0, drum.length, shell_rows(outline, drum.length) + 1)
+    tris = []
+    for w_lo, w_hi in zip(cuts[:-1], cuts[1:]):
+        lo, hi = np.full(len(outline), w_lo), np.full(len(outline), w_hi)
+        a0 = _to_xyz(outline[:, 0], outline[:, 1], lo, drum.axis)
+        b0 = _to_xyz(nxt[:, 0], nxt[:, 1], lo, drum.axis)
+        a1 = _to_xyz(outline[:, 0], outline[:, 1], hi, drum.axis)
+        b1 = _to_xyz(nxt[:, 0], nxt[:, 1], hi, drum.axis)
+        tris += [np.stack([a0, b0, b1], axis=1), np.stack([a0, b1, a1], axis=1)]
     if not drum.periodic:
         for w in (0.0, drum.length):
             c = _to_xyz(np.zeros(len(outline)), np.zeros(len(outline)),
@@ -134,6 +145,13 @@ def drum_triangles(drum: Drum, sag: float) -> np.ndarray:
             tris.append(fan[area2 > 1e-12 * drum.radius**2])
     tri = np.concatenate(tris)
     return _orient_inward(tri, drum)
+
+
+def shell_rows(outline: np.ndarray, length: float) -> int:
+    """Rows of triangles along the axis so no shell triangle has an angle below
+    :data:`MIN_FACET_ANGLE_DEG` (1 for every drum whose shortest outline edge allows it)."""
+    edge = float(np.min(np.linalg.norm(np.roll(outline, -1, axis=0) - outline, axis=1)))
+    return max(1, math.ceil(length * math.tan(math.radians(MIN_FACET_ANGLE_DEG)) / edge))
 
 
 def _orient_inward(tri: np.ndarray, drum: Drum) -> np.ndarray:

@@ -8,8 +8,8 @@ import meshio
 import numpy as np
 import pytest
 
-from ligwf.engine.mesh import (MIN_SEGMENTS, cached_mesh, drum_outline, drum_stl,
-                               drum_triangles, geometry_key, segment_count, wall_sag)
+from ligwf.engine.mesh import (MIN_FACET_ANGLE_DEG, MIN_SEGMENTS, cached_mesh, drum_outline, drum_stl,
+                               drum_triangles, geometry_key, segment_count, shell_rows, wall_sag, axis_frame)
 from ligwf.scene.model import Drum
 
 
@@ -116,3 +116,80 @@ def test_every_cg_level_of_a_study_shares_one_mesh(tmp_path):
     wf = load_workflow(ROOT / "workflows" / "we_vs_bo.yaml", [])
     meshes = {rc.mesh_text for rc in render_workflow(wf)}
     assert len(meshes) == 1
+
+
+def _min_angle_deg(tri: np.ndarray) -> float:
+    """Smallest corner angle (deg) over triangles (M, 3, 3)."""
+    out = []
+    for i in range(3):
+        u, v = tri[:, (i + 1) % 3] - tri[:, i], tri[:, (i + 2) % 3] - tri[:, i]
+        cos = np.einsum("ij,ij->i", u, v) / np.linalg.norm(u, axis=1) / np.linalg.norm(v, axis=1)
+        out.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
+    return float(np.min(out))
+
+
+DEMO = dict(diameter=0.04, lifters={"count": 10, "height": 0.002, "width_deg": 4})
+
+
+@pytest.mark.parametrize("length", [0.018, 0.036, 0.072, 0.144, 0.5])
+def test_no_shell_triangle_is_thinner_than_the_engine_accepts(length):
+    """LIGGGHTS refuses element angles below 0.256 deg; a 144 mm slice of the demo drum in
+    one row had 0.25 deg (a real failed study). Short slices keep their one-row shell."""
+    d = drum(length=length, **DEMO)
+    tri = drum_triangles(d, wall_sag(0.0015))
+    assert _min_angle_deg(tri) >= MIN_FACET_ANGLE_DEG - 1e-9
+    rows = shell_rows(drum_outline(d, wall_sag(0.0015)), length)
+    assert len(tri) == 2 * rows * len(drum_outline(d, wall_sag(0.0015)))
+    assert (rows == 1) == (length <= 0.072)
+    ia = axis_frame(d.axis)[0]   # rows tile [0, length] without gaps
+    assert tri[..., ia].min() == 0.0 and tri[..., ia].max() == pytest.approx(length, abs=1e-15)
+
+
+_MESH_ONLY = """atom_style granular
+atom_modify map array sort 0 0
+boundary f p f
+newton off
+communicate single vel yes
+units si
+region domain block -0.024 0.024 0 {length} -0.024 0.024 units box
+create_box 2 domain
+neighbor 0.0005 bin
+neigh_modify delay 0
+fix m1 all property/global youngsModulus peratomtype 5.e6 5.e6
+fix m2 all property/global poissonsRatio peratomtype 0.3 0.3
+fix m3 all property/global coefficientRestitution peratomtypepair 2 0.5 0.5 0.5 0.5
+fix m4 all property/global coefficientFriction peratomtypepair 2 0.5 0.5 0.5 0.5
+pair_style gran model hertz tangential history
+pair_coeff * *
+timestep 1.0e-6
+create_atoms 1 single 0.0 0.05 0.0 units box
+set atom 1 diameter 0.0015 density 2500
+fix drum all mesh/surface file drum.stl type 2
+fix walls all wall/gran model hertz tangential history mesh n_meshes 1 meshes drum
+fix integrate all nve/sphere
+run 1
+print "mesh loaded"
+"""
+
+
+@pytest.mark.engine
+def test_the_engine_accepts_the_long_drum_it_refused_in_one_row(engine, tmp_path, monkeypatch):
+    """The real engine on the 144 mm demo-drum slice: the mesh ligwf writes loads; the same
+    drum in one row (the former mesh) is refused, so this test can tell them apart."""
+    import ligwf.engine.mesh as mesh_mod
+    from helpers import run_liggghts
+
+    d = drum(length=0.144, axis="y", **DEMO)
+
+    def load(folder):
+        folder.mkdir()
+        (folder / "drum.stl").write_text(mesh_mod.stl_text(mesh_mod.drum_triangles(
+            d, wall_sag(0.0015))))
+        (folder / "in.liggghts").write_text(_MESH_ONLY.format(length=0.144))
+        return run_liggghts(engine, folder, nprocs=1, timeout=120)
+
+    ok = load(tmp_path / "rows")
+    assert ok.returncode == 0 and "mesh loaded" in ok.stdout, ok.stdout[-2000:]
+    monkeypatch.setattr(mesh_mod, "MIN_FACET_ANGLE_DEG", 0.0)
+    bad = load(tmp_path / "one_row")
+    assert bad.returncode != 0 and "minumum angle" in bad.stdout, bad.stdout[-2000:]
