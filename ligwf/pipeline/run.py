@@ -51,6 +51,7 @@ class Interrupted(LigwfError):
 #: Seconds between looks at cases another runner holds (see :func:`run_study`).
 WAIT_SECONDS = 1.0
 
+
 @dataclass(frozen=True)
 class RunSettings:
     """How the run stage runs (not what it computes).
