@@ -21,6 +21,11 @@ shared = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(shared)
 engine = shared.engine
 pytest_collection_modifyitems = shared.pytest_collection_modifyitems
+
+
+def pytest_collection_finish(session):
+    for item in session.items:
+        print("MARKS", item.name, sorted(m.name for m in item.iter_markers()))
 """
 
 _TESTS = """
@@ -56,23 +61,17 @@ def folder(tmp_path):
     return tmp_path
 
 
-def test_engine_and_slurm_fixtures_mark_their_tests(folder):
-    proc = _pytest(folder, "-m", "not engine and not mpi and not slurm and not slow")
-    assert "1 passed, 2 deselected" in proc.stdout, proc.stdout
-
-
-def test_missing_engine_skips_with_the_reason(folder):
-    proc = _pytest(folder, "-k", "engine", LIGWF_LIGGGHTS="/nonexistent/liggghts")
-    assert proc.returncode == 0 and "1 skipped" in proc.stdout, proc.stdout
-    assert "needs the engine" in proc.stdout and "/nonexistent/liggghts" in proc.stdout
-
-
-def test_missing_mpirun_skips_with_the_reason(folder):
-    proc = _pytest(folder, "-k", "engine", LIGWF_MPIRUN="/nonexistent/mpirun")
-    assert "1 skipped" in proc.stdout and "/nonexistent/mpirun" in proc.stdout, proc.stdout
+def test_fixtures_mark_their_tests_and_a_missing_mpirun_skips_with_the_reason(folder):
+    proc = _pytest(folder, "-s", LIGWF_MPIRUN="/nonexistent/mpirun")
+    assert "MARKS test_needs_the_engine ['engine']" in proc.stdout, proc.stdout
+    assert "MARKS test_needs_slurm ['slurm']" in proc.stdout
+    assert "MARKS test_plain []" in proc.stdout
+    assert proc.returncode == 0 and "2 passed, 1 skipped" in proc.stdout, proc.stdout
+    assert "needs the engine" in proc.stdout and "/nonexistent/mpirun" in proc.stdout
 
 
 def test_missing_engine_fails_in_ci(folder):
     proc = _pytest(folder, "-k", "engine", LIGWF_LIGGGHTS="/nonexistent/liggghts", CI="true")
     assert proc.returncode != 0 and "1 error" in proc.stdout, proc.stdout
     assert "CI=true and the engine is missing" in proc.stdout
+    assert "/nonexistent/liggghts" in proc.stdout
