@@ -28,7 +28,8 @@ from analysis.test_definitions import tiled  # noqa: E402
 from ligwf.analysis import granules_numba  # noqa: E402
 from ligwf.analysis.case_granules import RunFacts  # noqa: E402
 from ligwf.analysis.communities import cpm_labels, cpm_labels_reference, cpm_quality  # noqa: E402
-from ligwf.analysis.definitions import GranuleDefinition, cpm_weights, identify_granules  # noqa: E402
+from ligwf.analysis.definitions import cpm_weights, identify_granules  # noqa: E402
+from ligwf.scene.settings import AnalysisSettings  # noqa: E402
 from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 
@@ -57,13 +58,14 @@ def main() -> None:
     motion = replace(facts.motion, length=length * args.tiles)
     print(f"{args.case.name} step {f.step} tiled {args.tiles}x: {len(pt):,} particles, "
           f"{len(ct):,} contacts; one core, best of 3")
-    for label, d in (("communities (default)", GranuleDefinition()),
-                     ("components lab 30 deg", GranuleDefinition("components", "lab", 30.0))):
+    for label, d in (("communities (default)", AnalysisSettings()),
+                     ("components lab 30 deg", AnalysisSettings(
+                         granules="components", velocity_frame="lab", max_velocity_angle=30.0))):
         t, ident = best_of(lambda d=d: identify_granules(pt, ct, facts.liquid, d, facts.cg, motion))
         print(f"  {label:>22}: {t:6.3f} s per frame = {1 / t:6.2f} frames/s, "
               f"{int(ident.labels.max()) + 1:,} granules")
     i, j, w, nw = cpm_weights(pt, ct, facts.liquid, facts.cg)
-    gamma = GranuleDefinition().resolution
+    gamma = AnalysisSettings().resolution
     t_fast, fast = best_of(lambda: cpm_labels(len(pt), i, j, w, nw, gamma), 1)
     t_ref, ref = best_of(lambda: cpm_labels_reference(len(pt), i, j, w, nw, gamma), 1)
     q_fast, q_ref = cpm_quality(fast, i, j, w, nw, gamma), cpm_quality(ref, i, j, w, nw, gamma)

@@ -30,7 +30,6 @@ import pandas as pd
 
 from ligwf.analysis import gsd
 from ligwf.analysis.case_granules import GranuleAnalysis
-from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.frame_checks import plan_frames
 from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
 from ligwf.fsio import atomic_write_text
@@ -38,13 +37,14 @@ from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.study import Study
 
 DEFINITIONS = {
-    "cpm-energy (default)": GranuleDefinition(),
-    "components lab 30 (source)": GranuleDefinition("components", "lab", 30.0),
-    "cpm-force 0.02 (old default)": GranuleDefinition(resolution=0.02, weight="force"),
+    "cpm-energy (default)": AnalysisSettings(),
+    "components lab 30 (source)": AnalysisSettings(granules="components", velocity_frame="lab",
+                                                   max_velocity_angle=30.0),
+    "cpm-force 0.02 (old default)": AnalysisSettings(resolution=0.02, community_weight="force"),
 }
 
 
-def steady_tables(study: Study, definition: GranuleDefinition) -> tuple[pd.DataFrame, list]:
+def steady_tables(study: Study, definition: AnalysisSettings) -> tuple[pd.DataFrame, list]:
     """Granule table of every case's steady frames under ``definition``."""
     record = json.loads((study.analysis_dir / "analysis.json").read_text())
     steady_from = {c["case_id"]: c["steady_from_step"] for c in record["cases"]}

@@ -23,10 +23,11 @@ from ligwf.analysis.dumps import (ContactFrame, FrameFiles, ParticleFrame, read_
                                   read_particles)
 from ligwf.analysis.persistent import Frame, bridge_keys, held_through, persistent_labels
 from ligwf.analysis.frame_checks import FramePlan, check_contacts, check_particles, plan_frames
-from ligwf.analysis.definitions import GranuleDefinition, Motion, identify_granules
+from ligwf.analysis.definitions import Motion, bond_criterion, identify_granules
 from ligwf.analysis.granules import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.fsio import atomic_write_bytes
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 
@@ -98,7 +99,8 @@ class GranuleAnalysis:
     """Granules of every frame of one case (MDAnalysis-style life cycle).
 
     ``case``: a :class:`~ligwf.study.case.CaseFolder` or the :class:`RunFacts` of a run.
-    ``definition``: the granule definition (:mod:`ligwf.analysis.definitions`).
+    ``definition``: the study's analysis settings, whose granule definition is used
+    (:mod:`ligwf.analysis.definitions`).
     ``implementation`` is ``"fast"`` (compiled) or ``"reference"`` (numpy, networkx,
     leidenalg).
     ``vtu_dir`` set: write ``granules_<step>.vtu`` per frame there (ParaView series).
@@ -106,7 +108,7 @@ class GranuleAnalysis:
     """
 
     case: CaseFolder | RunFacts
-    definition: GranuleDefinition = GranuleDefinition()
+    definition: AnalysisSettings = AnalysisSettings()
     implementation: str = "fast"
     vtu_dir: Path | None = None
     louvain: bool = False
@@ -144,7 +146,7 @@ class GranuleAnalysis:
                 raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
                                     "(was the case rendered with analysis.granules: true?)")
             particles, contacts = self._read(ff)
-            if self.definition.method == "held":
+            if self.definition.granules == "held":
                 ident = self._held(ff, particles, contacts)
             else:
                 ident = identify_granules(particles, contacts, f.liquid, self.definition, f.cg,
@@ -165,7 +167,7 @@ class GranuleAnalysis:
             extra = {}
             if self.louvain:
                 bi, bj, bf = bonded_contacts(particles, contacts, f.liquid,
-                                             self.definition.criterion)
+                                             bond_criterion(self.definition))
                 extra["louvain"] = louvain_labels(len(particles), bi, bj, bf)
             res.vtu = layout.granule_frame(ff.step)
             write_particle_vtu(Path(self.vtu_dir) / res.vtu, particles, labels,

@@ -22,20 +22,21 @@ import pandas as pd
 from ligwf.analysis.case_granules import RunFacts
 from ligwf.analysis.controls import (adjusted_rand_index, bed_share, comovement, granule_count,
                                      granule_sizes, pair_persistence, volume_d50)
-from ligwf.analysis.definitions import GranuleDefinition, identify_granules
+from ligwf.analysis.definitions import identify_granules
 from ligwf.analysis.dumps import ContactFrame, read_contacts, read_particles
 from ligwf.analysis.frame_checks import plan_frames
 from ligwf.analysis.granules import Identification
 from ligwf.analysis.persistent import Frame, bridge_keys, persistent_labels
 from ligwf.errors import DumpReadError
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.case import CaseFolder
 
 #: definitions measured by default: name -> (kind, parameter)
 DEFAULT_CANDIDATES = (
-    ("communities", "frame", GranuleDefinition()),
+    ("communities", "frame", AnalysisSettings()),
     ("source_components_angle30", "frame",
-     GranuleDefinition(method="components", max_velocity_angle_deg=30.0)),
-    ("bridge_components", "frame", GranuleDefinition(method="components")),
+     AnalysisSettings(granules="components", max_velocity_angle=30.0)),
+    ("bridge_components", "frame", AnalysisSettings(granules="components")),
     ("held_0.1s", "window", (0.1, None)),
     ("held_0.25s", "window", (0.25, None)),
     ("held_0.5s", "window", (0.5, None)),
@@ -103,7 +104,8 @@ def labeller(series: Series, kind: str, param,
         def frame_labels(k: int, shuffled: bool = False, seed: int = 0):
             f = series.frames[k]
             contacts = _shuffled(f.contacts, 1 + seed) if shuffled else f.contacts
-            d = replace(param, seed=seed) if param.method == "communities" else param
+            d = (param.model_copy(update={"community_seed": seed})
+                 if param.granules == "communities" else param)
             return identify_granules(f.particles, contacts, facts.liquid, d, facts.cg, motion)
         return frame_labels
     window, passage = param
@@ -194,7 +196,7 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
                 row["comove_ratio"] = np.nan
             if n_start < determinism_frames:
                 row["ari_order"] = adjusted_rand_index(labels, labels_of(k, True, 0).labels)
-                if kind == "frame" and param.method == "communities":
+                if kind == "frame" and param.granules == "communities":
                     row["ari_seed"] = adjusted_rand_index(labels, labels_of(k, False, 1).labels)
             rows.append(row)
     return pd.DataFrame(rows)

@@ -1,12 +1,13 @@
 """Granule definitions: which bonds hold particles together, and how the bond graph is cut.
 
-A definition (:class:`GranuleDefinition`, built from the study's ``analysis:`` block) has
-three parts, applied to one frame by :func:`identify_granules`:
+A definition is the study's :class:`~ligwf.scene.settings.AnalysisSettings` itself (its
+``granules`` method and the fields after it, read as they are: no copy), in three parts,
+applied to one frame by :func:`identify_granules`:
 
 1. **Bonds** -- a dumped pair whose capillary force F (the engine's own law) exceeds
    ``min_bridge_force`` (N), whose relative force f_rel = F / (2 pi R* gamma cos theta)
    exceeds ``min_relative_force`` (CG-neutral: dimensionless under every rule), and whose
-   partners move within ``max_velocity_angle_deg`` of each other, the velocities taken in
+   partners move within ``max_velocity_angle`` (deg) of each other, the velocities taken in
    one of three frames: ``lab`` (as dumped; the source study), ``drum`` (minus the drum's
    rigid rotation omega x r about its axis through the origin, as templates/drum.in.j2
    turns it) or ``flow`` (minus the mean velocity of the particles within ``flow_radius``
@@ -17,7 +18,7 @@ three parts, applied to one frame by :func:`identify_granules`:
    w n^2 and node weight n^3 at CG level n, where w is the bridge's relative rupture work
    e_rel = W / (F_0 R*) (``weight: energy``, the default: the energy needed to pull the
    pair apart, which grows with the bridge volume) or its relative force f_rel
-   (``weight: force``: the touching force of the capillary laws does not depend on the
+   (``community_weight: force``: the touching force of the capillary laws does not depend on the
    liquid volume, so the partition barely responds to the liquid content). A CG-n contact
    stands for ~n^2 primary contacts across the same interface and a CG-n node for n^3
    primaries, so the CPM balance gives the same granule volume at every n (measured CG2/CG1
@@ -45,96 +46,62 @@ from ligwf.analysis.communities import cpm_labels, cpm_labels_reference
 from ligwf.analysis.dumps import ContactFrame, ParticleFrame
 from ligwf.analysis.granules import (BondCriterion, Identification, bonded_contacts,
                                      bonded_contacts_reference, components, identify)
+from ligwf.scene.settings import AnalysisSettings
 
-METHODS = ("communities", "components", "held")
-#: CPM edge weights: the bridge's relative rupture work or its relative force
-WEIGHTS = ("energy", "force")
-VELOCITY_FRAMES = ("lab", "drum", "flow")
 #: the factors the sensitivity table moves each threshold by
 SENSITIVITY_FACTORS = (0.8, 1.25)
 
 
-@dataclass(frozen=True)
-class GranuleDefinition:
-    """A full granule definition (see the module docstring); defaults: the measured one."""
+def bond_criterion(definition: AnalysisSettings) -> BondCriterion:
+    """The force (N) and angle part of the bond test of a definition."""
+    return BondCriterion(definition.min_bridge_force, definition.max_velocity_angle)
 
-    method: str = "communities"
-    velocity_frame: str = "lab"
-    max_velocity_angle_deg: float = 180.0
-    min_bridge_force: float = 0.0          # N
-    min_relative_force: float = 0.0        # F / (2 pi R* gamma cos theta)
-    resolution: float = 0.002              # CPM gamma
-    seed: int = 0                          # seed of the CPM node order
-    flow_radius: float = 3.0               # mean particle diameters
-    weight: str = "energy"                 # CPM edge weight: energy (e_rel) | force (f_rel)
-    hold_time: float = 0.5                 # s, method held: bridges present through [t, t + this]
 
-    def __post_init__(self) -> None:
-        if self.method not in METHODS:
-            raise ValueError(f"method {self.method!r}: use one of {METHODS}")
-        if self.velocity_frame not in VELOCITY_FRAMES:
-            raise ValueError(f"velocity_frame {self.velocity_frame!r}: use one of {VELOCITY_FRAMES}")
-        if self.weight not in WEIGHTS:
-            raise ValueError(f"weight {self.weight!r}: use one of {WEIGHTS}")
-        if not self.hold_time > 0:
-            raise ValueError(f"hold_time {self.hold_time!r}: must be > 0 s")
-        if not (self.resolution > 0 and self.flow_radius > 0 and self.min_relative_force >= 0):
-            raise ValueError(f"{self}: resolution and flow_radius must be > 0, "
-                             "min_relative_force >= 0")
+def describe(definition: AnalysisSettings) -> str:
+    """The definition in words, with the thresholds it uses (figure and table labels)."""
+    d = definition
+    if d.granules == "held":
+        return f"held, bridges through {d.hold_time:g} s"
+    parts = [d.granules]
+    if d.granules == "communities":
+        parts.append(f"resolution {d.resolution:g} ({d.community_weight} weight)")
+    if d.max_velocity_angle < 180.0:
+        parts.append(f"angle {d.max_velocity_angle:g} deg ({d.velocity_frame})")
+    if d.min_relative_force > 0:
+        parts.append(f"f_rel > {d.min_relative_force:g}")
+    if d.min_bridge_force > 0:
+        parts.append(f"F > {d.min_bridge_force:g} N")
+    return ", ".join(parts)
 
-    @classmethod
-    def of_settings(cls, s) -> "GranuleDefinition":
-        """The definition of a study's :class:`~ligwf.scene.settings.AnalysisSettings`."""
-        return cls(s.granules, s.velocity_frame, float(s.max_velocity_angle),
-                   float(s.min_bridge_force), float(s.min_relative_force),
-                   float(s.resolution), int(s.community_seed), float(s.flow_radius),
-                   s.community_weight, float(getattr(s, "hold_time", 0.5)))
 
-    @property
-    def criterion(self) -> BondCriterion:
-        """The force (N) and angle part of the bond test."""
-        return BondCriterion(self.min_bridge_force, self.max_velocity_angle_deg)
+def variants(definition: AnalysisSettings) -> list[tuple[str, AnalysisSettings]]:
+    """(label, settings): the definition as set (its label states the setting), then each
+    threshold it USES moved by x0.8 and x1.25: the hold time of ``held``, the CPM
+    resolution of ``communities``, and the velocity angle, relative and absolute bridge
+    force where they are on. A definition with no threshold in use (components of every
+    bridge) has no variant."""
+    d = definition
 
-    def setting(self) -> str:
-        """The definition in words, with the thresholds it uses (figure and table labels)."""
-        if self.method == "held":
-            return f"held, bridges through {self.hold_time:g} s"
-        parts = [self.method]
-        if self.method == "communities":
-            parts.append(f"resolution {self.resolution:g} ({self.weight} weight)")
-        if self.max_velocity_angle_deg < 180.0:
-            parts.append(f"angle {self.max_velocity_angle_deg:g} deg ({self.velocity_frame})")
-        if self.min_relative_force > 0:
-            parts.append(f"f_rel > {self.min_relative_force:g}")
-        if self.min_bridge_force > 0:
-            parts.append(f"F > {self.min_bridge_force:g} N")
-        return ", ".join(parts)
+    def moved(**update) -> AnalysisSettings:
+        return d.model_copy(update=update)
 
-    def variants(self) -> list[tuple[str, "GranuleDefinition"]]:
-        """(label, definition): the definition as set (its label states the setting), then
-        each threshold it USES moved by x0.8 and x1.25: the hold time of ``held``, the CPM
-        resolution of ``communities``, and the velocity angle, relative and absolute
-        bridge force where they are on. A definition with no threshold in use (components
-        of every bridge) has no variant."""
-        out = [(f"as set: {self.setting()}", self)]
-        for fac in SENSITIVITY_FACTORS:
-            if self.method == "held":
-                out.append((f"hold {self.hold_time * fac:.3g} s",
-                             replace(self, hold_time=self.hold_time * fac)))
-                continue
-            if self.method == "communities":
-                out.append((f"resolution x{fac:g}", replace(self, resolution=self.resolution * fac)))
-            if self.max_velocity_angle_deg < 180.0:
-                a = min(180.0, self.max_velocity_angle_deg * fac)
-                out.append((f"angle {a:.3g} deg ({self.velocity_frame})",
-                            replace(self, max_velocity_angle_deg=a)))
-            if self.min_relative_force > 0:
-                f = self.min_relative_force * fac
-                out.append((f"f_rel > {f:.3g}", replace(self, min_relative_force=f)))
-            if self.min_bridge_force > 0:
-                f = self.min_bridge_force * fac
-                out.append((f"F > {f:.3g} N", replace(self, min_bridge_force=f)))
-        return out
+    out = [(f"as set: {describe(d)}", d)]
+    for fac in SENSITIVITY_FACTORS:
+        if d.granules == "held":
+            out.append((f"hold {d.hold_time * fac:.3g} s", moved(hold_time=d.hold_time * fac)))
+            continue
+        if d.granules == "communities":
+            out.append((f"resolution x{fac:g}", moved(resolution=d.resolution * fac)))
+        if d.max_velocity_angle < 180.0:
+            a = min(180.0, d.max_velocity_angle * fac)
+            out.append((f"angle {a:.3g} deg ({d.velocity_frame})", moved(max_velocity_angle=a)))
+        if d.min_relative_force > 0:
+            f = d.min_relative_force * fac
+            out.append((f"f_rel > {f:.3g}", moved(min_relative_force=f)))
+        if d.min_bridge_force > 0:
+            f = d.min_bridge_force * fac
+            out.append((f"F > {f:.3g} N", moved(min_bridge_force=f)))
+    return out
 
 
 @dataclass(frozen=True)
@@ -196,7 +163,7 @@ def flow_frame_velocities(particles: ParticleFrame, motion: Motion, radius_diame
     return v - total / count[:, None]
 
 
-def frame_velocities(particles: ParticleFrame, definition: GranuleDefinition, motion: Motion,
+def frame_velocities(particles: ParticleFrame, definition: AnalysisSettings, motion: Motion,
                      implementation: str = "fast") -> np.ndarray:
     """The velocities the angle test compares (m/s), in the definition's frame."""
     if definition.velocity_frame == "drum":
@@ -207,35 +174,35 @@ def frame_velocities(particles: ParticleFrame, definition: GranuleDefinition, mo
 
 
 def identify_granules(particles: ParticleFrame, contacts: ContactFrame, liquid: Liquid,
-                      definition: GranuleDefinition, cg: float, motion: Motion,
+                      definition: AnalysisSettings, cg: float, motion: Motion,
                       implementation: str = "fast") -> Identification:
     """Granules of one frame under ``definition`` (``fast`` or ``reference``: the same
     granules; for communities the same CPM quality, see :mod:`ligwf.analysis.communities`).
     ``cg``: the case's CG level n (CPM weights)."""
     if implementation not in ("fast", "reference"):
         raise ValueError(f"implementation {implementation!r}: use fast or reference")
-    if definition.method == "held":
+    if definition.granules == "held":
         raise ValueError("granules: held needs the frames of its hold window "
                          "(ligwf.analysis.persistent), not one frame")
-    crit = definition.criterion
-    if definition.max_velocity_angle_deg < 180.0 and definition.velocity_frame != "lab":
+    crit = bond_criterion(definition)
+    if definition.max_velocity_angle < 180.0 and definition.velocity_frame != "lab":
         particles = replace(particles, velocities=frame_velocities(
             particles, definition, motion, implementation))
     axis, length = motion.periodic_axis, motion.length
-    if definition.method == "components" and definition.min_relative_force == 0.0:
+    if definition.granules == "components" and definition.min_relative_force == 0.0:
         return identify(particles, contacts, liquid, crit, axis, length, implementation)
     bonds = bonded_contacts if implementation == "fast" else bonded_contacts_reference
     i, j, force, rows = bonds(particles, contacts, liquid, crit, with_rows=True)
     f_rel = relative_force(force, particles.radii[i], particles.radii[j], liquid)
     keep = f_rel > definition.min_relative_force
     i, j, force, f_rel, rows = i[keep], j[keep], force[keep], f_rel[keep], rows[keep]
-    if definition.method == "communities":
+    if definition.granules == "communities":
         n = len(particles)
-        weight = f_rel if definition.weight == "force" else relative_energy(
+        weight = f_rel if definition.community_weight == "force" else relative_energy(
             particles, i, j, -contacts.delta[rows], liquid, implementation)
         partition = cpm_labels if implementation == "fast" else cpm_labels_reference
         community = partition(n, i, j, weight * cg ** 2, np.full(n, float(cg) ** 3),
-                              definition.resolution, definition.seed)
+                              definition.resolution, definition.community_seed)
         inside = community[i] == community[j]
         i, j, force = i[inside], j[inside], force[inside]
     return components(particles.positions, i, j, force, axis, length, implementation)

@@ -27,7 +27,7 @@ from ligwf.analysis.dumps import FrameFiles, read_particles
 from ligwf.analysis.granules import AXES, Liquid
 from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.outputs import OutputSet, new_token
-from ligwf.analysis.runner import (granule_definition, commit, frame_tables,
+from ligwf.analysis.runner import (commit, frame_tables,
                                    nothing_analysed, stage_tables)
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
@@ -140,7 +140,7 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
                               "of particle volume)")
     outputs = OutputSet(Path(out_dir), new_token())
     try:
-        ana = GranuleAnalysis(facts, granule_definition(settings),
+        ana = GranuleAnalysis(facts, settings,
                               vtu_dir=outputs.case_dir(facts.case_id) if write_vtu else None)
         results = ana.run(frames).results
         granules, table, skipped, index, results = frame_tables([facts], results)
@@ -155,7 +155,6 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
             outputs.write(f"{facts.case_id}/{layout.GRANULE_SERIES}", pvd_text(entries).encode())
         record = {"dump_dir": str(dump_dir), "run": asdict(run),
                   "settings": settings.model_dump(mode="json"),
-                  "definition": asdict(granule_definition(settings)),
                   "steady_from_step": steady_from_step,
                   "checked_against_scene": False,
                   "cases": [{"case_id": facts.case_id, "cg": facts.cg, "frames": len(frames),

@@ -10,7 +10,7 @@ CG1 condition of its group at the nearest time. Volumes are physical, as in the 
 (:mod:`ligwf.analysis.gsd`: a CG-neutral definition gives CG-n granules of CG1 volume).
 
 Sensitivity: one set of steady frames analysed again under each variant of the definition
-(:meth:`ligwf.analysis.definitions.GranuleDefinition.variants`: every threshold x0.8 and
+(:func:`ligwf.analysis.definitions.variants`: every threshold x0.8 and
 x1.25), so a user sees how much granule count, d50 and the largest granule depend on them.
 """
 
@@ -24,7 +24,7 @@ import pandas as pd
 
 from ligwf.analysis import gsd as gsdmod
 from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts
-from ligwf.analysis.definitions import GranuleDefinition
+from ligwf.analysis.definitions import variants
 from ligwf.analysis.dumps import FrameFiles
 from ligwf.analysis.records.conditions import REFERENCE_CG, CaseLike, Condition
 from ligwf.scene.settings import AnalysisSettings
@@ -93,13 +93,15 @@ def kinetics_summary(kin: pd.DataFrame, settings: AnalysisSettings) -> pd.DataFr
     return summary
 
 
-def sensitivity_table(facts: RunFacts, frames: list[FrameFiles], definition: GranuleDefinition,
-                      min_particles: int, implementation: str = "fast") -> pd.DataFrame:
-    """Per variant of ``definition`` (first: ``as set: <its setting>``) the mean over ``frames`` of
-    granule count, d50 (m), largest granule and percolating share, and d50 relative to
-    the definition as set."""
+def sensitivity_table(facts: RunFacts, frames: list[FrameFiles], settings: AnalysisSettings,
+                      implementation: str = "fast") -> pd.DataFrame:
+    """Per variant of the settings' granule definition (first: ``as set: <its setting>``)
+    the mean over ``frames`` of granule count, d50 (m), largest granule and percolating
+    share of the granules of ``settings.min_particles`` or more, and d50 relative to the
+    definition as set."""
+    min_particles = settings.min_particles
     rows = []
-    for label, variant in definition.variants():
+    for label, variant in variants(settings):
         ana = GranuleAnalysis(facts, variant, implementation).run(frames)
         stats = [gsdmod.frame_stats(r.table["volume"].to_numpy(), r.table["members"].to_numpy(),
                                     r.table["percolating"].to_numpy(bool), min_particles)
@@ -111,9 +113,9 @@ def sensitivity_table(facts: RunFacts, frames: list[FrameFiles], definition: Gra
             mean = {q: float(np.nanmean([s[q] for s in stats])) for q in
                     ("granules", "d50", "largest_granule", "percolating_share")}
         rows.append({"case_id": facts.case_id, "variant": label, "frames": len(stats),
-                     "method": variant.method, "velocity_frame": variant.velocity_frame,
+                     "method": variant.granules, "velocity_frame": variant.velocity_frame,
                      "resolution": variant.resolution,
-                     "max_velocity_angle": variant.max_velocity_angle_deg,
+                     "max_velocity_angle": variant.max_velocity_angle,
                      "min_relative_force": variant.min_relative_force,
                      "hold_time": variant.hold_time, **mean})
     table = pd.DataFrame(rows)

@@ -54,7 +54,7 @@ from __future__ import annotations
 import io
 import json
 import os
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -62,7 +62,6 @@ import pandas as pd
 
 from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts, pvd_text
 from ligwf.analysis.frame_checks import FramePlan, plan_frames
-from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.flow_run import flow_cases, flow_record, flow_table
 from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
 from ligwf.analysis.records.conditions import Conditions
@@ -113,10 +112,6 @@ class AnalysisOptions:
     require_manifest: bool = True
 
 
-def granule_definition(s: AnalysisSettings) -> GranuleDefinition:
-    return GranuleDefinition.of_settings(s)
-
-
 def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions = AnalysisOptions(),
             comm=None) -> dict | None:
     """Analyse a study (or one case) folder; on rank 0 write the outputs and return the
@@ -152,7 +147,7 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
             f = facts[fi]
             if fi not in analyses:
                 analyses[fi] = GranuleAnalysis(
-                    f, granule_definition(settings), options.implementation,
+                    f, settings, options.implementation,
                     outputs.case_dir(f.case_id) if options.write_vtu else None, options.louvain)
             mine.append(analyse_frame(analyses[fi], ff))
     except BaseException:
@@ -269,7 +264,6 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     base = {
         "run_dir": str(study.path),
         "settings": settings.model_dump(mode="json"),
-        "definition": asdict(granule_definition(settings)),
         "options": {"implementation": options.implementation, "louvain": options.louvain,
                     "write_vtu": options.write_vtu,
                     "require_manifest": options.require_manifest},
@@ -333,7 +327,7 @@ def stage_controls(outputs: OutputSet, cases: list, steady_from: dict[str, int],
         return
     start = {w.case_id: (steady_from[w.case_id] - w.production_start_step) * w.scaled.dt
              for w, _ in pairs}
-    table = study_controls(cases, granule_definition(settings), start)
+    table = study_controls(cases, settings, start)
     outputs.write(layout.CONTROLS_TABLE, table.to_csv(index=False).encode())
 
 
@@ -367,8 +361,7 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
     if not steady:
         return
     pick = np.unique(np.linspace(0, len(steady) - 1, settings.sensitivity_frames).round())
-    table = sensitivity_table(facts, [steady[int(k)] for k in pick],
-                              granule_definition(settings), settings.min_particles,
+    table = sensitivity_table(facts, [steady[int(k)] for k in pick], settings,
                               implementation)
     outputs.write(layout.SENSITIVITY_TABLE, table.to_csv(index=False).encode())
 

@@ -17,7 +17,7 @@ import pandas as pd
 
 from ligwf.analysis.control_run import DEFAULT_CANDIDATES, control_rows, load_series, summarise
 from ligwf.analysis.control_verdict import verdict
-from ligwf.analysis.definitions import GranuleDefinition
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.case import CaseFolder
 
 #: the ``varied`` key and value of a cohesionless twin (ligwf.scene.workflow.CONTROL_KEY)
@@ -51,15 +51,15 @@ def is_control(case: CaseFolder) -> bool:
     return CONTROL_KEY in _varied(case)
 
 
-def candidates_for(definition: GranuleDefinition):
+def candidates_for(definition: AnalysisSettings):
     """The study's own definition first, then the candidates of the regime map."""
-    name = "study definition (" + definition.method + ")"
-    own = ((name, "window", (definition.hold_time, None)) if definition.method == "held"
+    name = "study definition (" + definition.granules + ")"
+    own = ((name, "window", (definition.hold_time, None)) if definition.granules == "held"
            else (name, "frame", definition))
-    return (own,) + tuple(c for c in DEFAULT_CANDIDATES if c[0] != definition.method)
+    return (own,) + tuple(c for c in DEFAULT_CANDIDATES if c[0] != definition.granules)
 
 
-def study_controls(cases: list[CaseFolder], definition: GranuleDefinition,
+def study_controls(cases: list[CaseFolder], definition: AnalysisSettings,
                    steady_from: dict[str, float] | None = None) -> pd.DataFrame:
     """One row per (wet case, definition): the wet and twin measures side by side, whether
     the definition passes, and the sentence a report prints. Empty without twins.

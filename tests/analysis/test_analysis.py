@@ -14,7 +14,6 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from ligwf.analysis.definitions import GranuleDefinition
 from ligwf.analysis.dumps import discover_frames, read_particles
 from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, NothingAnalysed, analyse
 from ligwf.cli.main import main
@@ -69,7 +68,7 @@ def test_outputs_of_a_study(study, serial):
     pd.testing.assert_frame_equal(a, b)
     # the table equals a direct run of the life-cycle class
     case = CaseFolder.open(study / "cg3-weber-r0")
-    ref = GranuleAnalysis(case, GranuleDefinition()).run()   # vs reference: test_definitions
+    ref = GranuleAnalysis(case, AnalysisSettings()).run()   # vs reference: test_definitions
     for r in ref.results:
         got = a[a.step == r.step].reset_index(drop=True)
         np.testing.assert_array_equal(got["members"], r.table["members"])

@@ -39,14 +39,15 @@ def test_missing_numbers_fail_rather_than_pass():
 
 
 def test_sensitivity_varies_only_the_thresholds_in_use_and_states_the_setting():
-    from ligwf.analysis.definitions import GranuleDefinition
+    from ligwf.analysis.definitions import variants
+    from ligwf.scene.settings import AnalysisSettings
 
-    labels = [lab for lab, _ in GranuleDefinition().variants()]
+    labels = [lab for lab, _ in variants(AnalysisSettings())]
     assert labels[0] == "as set: communities, resolution 0.002 (energy weight)"
     assert labels[1:] == ["resolution x0.8", "resolution x1.25"]       # angle, f_rel are off
-    held = GranuleDefinition(method="held", hold_time=0.5).variants()
+    held = variants(AnalysisSettings(granules="held", hold_time=0.5))
     assert [lab for lab, _ in held] == ["as set: held, bridges through 0.5 s", "hold 0.4 s",
                                         "hold 0.625 s"]
-    src = GranuleDefinition(method="components", max_velocity_angle_deg=30.0).variants()
+    src = variants(AnalysisSettings(granules="components", max_velocity_angle=30.0))
     assert [lab for lab, _ in src][1:] == ["angle 24 deg (lab)", "angle 37.5 deg (lab)"]
-    assert GranuleDefinition(method="components").variants()[1:] == []
+    assert variants(AnalysisSettings(granules="components"))[1:] == []

@@ -12,7 +12,8 @@ import pytest
 
 from ligwf.analysis.communities import (cpm_labels, cpm_labels_leiden, cpm_labels_leidenalg,
                                         cpm_labels_reference, cpm_quality)
-from ligwf.analysis.definitions import (GranuleDefinition, Motion, cpm_weights,
+from ligwf.scene.settings import AnalysisSettings
+from ligwf.analysis.definitions import (Motion, bond_criterion, cpm_weights,
                                         drum_frame_velocities, flow_frame_velocities,
                                         identify_granules)
 from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles
@@ -38,10 +39,10 @@ def real(engine, tmp_path_factory):
 
 
 @pytest.mark.parametrize("definition", [
-    GranuleDefinition("components", "lab", 30.0),                       # the source study
-    GranuleDefinition("components", "drum", 10.0),
-    GranuleDefinition("components", "flow", 10.0),
-    GranuleDefinition("components", "lab", 180.0, min_relative_force=0.9),
+    AnalysisSettings(granules="components", velocity_frame="lab", max_velocity_angle=30.0),                       # the source study
+    AnalysisSettings(granules="components", velocity_frame="drum", max_velocity_angle=10.0),
+    AnalysisSettings(granules="components", velocity_frame="flow", max_velocity_angle=10.0),
+    AnalysisSettings(granules="components", velocity_frame="lab", max_velocity_angle=180.0, min_relative_force=0.9),
 ])
 def test_component_definitions_reference_equals_fast(real, definition):
     scaled, liquid, motion, frames = real
@@ -78,11 +79,11 @@ def test_cpm_fast_quality_checked_in_numpy_and_against_leiden(real, weight, reso
             # in units of the total edge weight (like a modularity): the CPM quality
             # itself is a small difference of large terms
             assert np.array_equal(fast, ref) or abs(q_fast - q_ref) <= 0.02 * float(w.sum())
-        ident = identify_granules(p, c, liquid, GranuleDefinition(
-            resolution=resolution, weight=weight), n_cg, motion)
+        ident = identify_granules(p, c, liquid, AnalysisSettings(
+            resolution=resolution, community_weight=weight), n_cg, motion)
         np.testing.assert_array_equal(ident.labels, fast)
-        ref_ident = identify_granules(p, c, liquid, GranuleDefinition(
-            resolution=resolution, weight=weight), n_cg, motion, "reference")
+        ref_ident = identify_granules(p, c, liquid, AnalysisSettings(
+            resolution=resolution, community_weight=weight), n_cg, motion, "reference")
         np.testing.assert_array_equal(ref_ident.labels, ident.labels)
 
 
@@ -107,7 +108,7 @@ def test_cpm_quality_matches_leidenalg(real):
 
     scaled, liquid, motion, frames = real
     p, c = frames[-1]
-    i, j, force = bonded_contacts(p, c, liquid, GranuleDefinition().criterion)
+    i, j, force = bonded_contacts(p, c, liquid, bond_criterion(AnalysisSettings()))
     w = relative_force(force, p.radii[i], p.radii[j], liquid)
     labels = cpm_labels(len(p), i, j, w, np.ones(len(p)), 0.05)
     part = leidenalg.CPMVertexPartition(ig.Graph(n=len(p), edges=list(zip(i, j))),
@@ -157,7 +158,7 @@ def test_default_gsd_is_invariant_to_tiling(real):
             pt, ct = (p, c) if tiles == 1 else tiled(p, c, tiles, L)
             per_seed = []
             for seed in seeds:
-                ident = identify_granules(pt, ct, liquid, GranuleDefinition(seed=seed),
+                ident = identify_granules(pt, ct, liquid, AnalysisSettings(community_seed=seed),
                                           scaled.cg, replace(motion, length=L * tiles))
                 vol = np.bincount(ident.labels, weights=pt.volumes)
                 members = np.bincount(ident.labels)
