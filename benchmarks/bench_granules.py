@@ -53,7 +53,8 @@ from ligwf.analysis.granules import (BondCriterion, Liquid, bonded_contacts, bon
                             granule_table, identify, label_reference, unwrap_reference)
 from ligwf.analysis.bridge_law import relative_energy
 from ligwf.analysis.communities import cpm_labels
-from ligwf.analysis.definitions import GranuleDefinition, Motion, identify_granules
+from ligwf.analysis.definitions import Motion, bond_criterion, identify_granules
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.scene.scaling import ScaledScene
 
 R = 0.0005
@@ -187,15 +188,15 @@ def report_communities(label: str, p, c, length: float, liquid: Liquid) -> None:
     bridges, igraph, graph built from numpy arrays) with its split: bond test with forces,
     the rupture-work quadrature, the CPM partition, the components of the intra-community
     bonds; frames/s on one core (target >= 0.5 at 360k)."""
-    definition = GranuleDefinition()
+    definition = AnalysisSettings()
     motion = Motion(1, None, 1, length)
     t_all, ident = timed(lambda: identify_granules(p, c, liquid, definition, 1.0, motion), 1)
     t_bond, (i, j, force, rows) = timed(
-        lambda: bonded_contacts(p, c, liquid, definition.criterion, with_rows=True), 1)
+        lambda: bonded_contacts(p, c, liquid, bond_criterion(definition), with_rows=True), 1)
     t_work, w = timed(lambda: relative_energy(p, i, j, -c.delta[rows], liquid), 1)
     nw = np.ones(len(p))
     t_cpm, _ = timed(lambda: cpm_labels(len(p), i, j, w, nw, definition.resolution), 1)
-    print(f"{'':>16}  communities (CPM, compiled Louvain, {definition.weight} weight, gamma "
+    print(f"{'':>16}  communities (CPM, compiled Louvain, {definition.community_weight} weight, gamma "
           f"{definition.resolution:g}): {t_all:6.3f} s = {1 / t_all:5.2f} frames/s | "
           f"bonds+forces {t_bond * 1e3:6.1f} ms, rupture work {t_work * 1e3:6.1f} ms, "
           f"CPM {t_cpm:6.3f} s, granules {int(ident.labels.max()) + 1:,}", flush=True)
