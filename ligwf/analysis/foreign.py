@@ -9,9 +9,12 @@ box length would silently switch off the detection of granules that wrap around 
 periodic axis. Frames are found by file-name patterns (``*`` stands for the step), read
 and checked like a ligwf case's (structure, nan, duplicate ids, contact geometry against
 the particles); they cannot be checked against a scene (count, radii, drum) or a dump
-record, which the analysis record says. Outputs are those of ``ligwf analyse``
-(:mod:`ligwf.analysis.runner`), written as one set; the GSD uses the frames from
-``steady_from_step`` on.
+record, which the analysis record says. Outputs are the granule outputs of ``ligwf
+analyse`` written by the same stage (:func:`ligwf.analysis.granule_stage.stage_granules`:
+granule, frame, GSD, pooling, kinetics and sensitivity tables, the granule series), as one
+set; the GSD, pooling and sensitivity use the frames from ``steady_from_step`` on. The
+flow metrics (they need the drum) and the controls (no twin) are the two outputs a
+foreign run cannot have: the record says so.
 """
 
 from __future__ import annotations
@@ -22,13 +25,12 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ligwf import liquids
-from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts, pvd_text
+from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts
 from ligwf.analysis.dumps import FrameFiles, read_particles
+from ligwf.analysis.granule_stage import GRANULE_OUTPUTS, commit, frame_tables, stage_granules
 from ligwf.analysis.granules import AXES, Liquid
-from ligwf.analysis.gsd_tables import gsd_tables
 from ligwf.analysis.outputs import OutputSet, new_token
-from ligwf.analysis.runner import (commit, frame_tables,
-                                   nothing_analysed, stage_tables)
+from ligwf.analysis.runner import nothing_analysed
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.scene.settings import AnalysisSettings
@@ -38,6 +40,10 @@ from ligwf.study import layout
 #: 0.5 theta^2, see :mod:`ligwf.liquids.contact_angle`); ``scene``: the angle the engine applied
 #: (an engine with the upstream fix, or an input compensated as ligwf does).
 ANGLE_CONVENTIONS = ("engine", "scene")
+#: what the record says of the two outputs of ``ligwf analyse`` a foreign run cannot have
+NO_FLOW = ("not measured: the flow metrics need the drum (radius, axis, rotation), which "
+           "foreign dumps do not state")
+NO_CONTROLS = "none: a foreign run has no cohesionless twin"
 
 
 @dataclass(frozen=True)
@@ -142,25 +148,23 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
     try:
         ana = GranuleAnalysis(facts, settings,
                               vtu_dir=outputs.case_dir(facts.case_id) if write_vtu else None)
-        results = ana.run(frames).results
-        granules, table, skipped, index, results = frame_tables([facts], results)
+        tables = frame_tables([facts], ana.run(frames).results)
+        index, skipped = tables.frame_index, tables.skipped_frames
         if not index:
             raise nothing_analysed(dump_dir, [], skipped)
-        case = ForeignCase(facts.case_id, facts.cg)
-        gsd_df, summary = gsd_tables(granules[granules["step"] >= steady_from_step], [case],
-                                     settings)
-        stage_tables(outputs, granules, table, gsd_df, summary)
-        entries = [(r.time, r.vtu) for r in results if r.vtu]
-        if entries:
-            outputs.write(f"{facts.case_id}/{layout.GRANULE_SERIES}", pvd_text(entries).encode())
+        stage_granules(outputs, tables, [facts], [ForeignCase(facts.case_id, facts.cg)],
+                       {facts.case_id: float(steady_from_step)}, settings, "fast", write_vtu,
+                       controls=False,
+                       frames_of={facts.case_id: frames})
         record = {"dump_dir": str(dump_dir), "run": asdict(run),
                   "settings": settings.model_dump(mode="json"),
                   "steady_from_step": steady_from_step,
                   "checked_against_scene": False,
+                  "flow": NO_FLOW, "controls": NO_CONTROLS,
                   "cases": [{"case_id": facts.case_id, "cg": facts.cg, "frames": len(frames),
                              "analysed": index.get(facts.case_id, 0)}],
                   "skipped_cases": [], "skipped_frames": skipped}
-        commit(outputs, record)
+        commit(outputs, record, obsolete=GRANULE_OUTPUTS)
         return record
     except BaseException:
         outputs.discard()

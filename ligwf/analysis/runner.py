@@ -51,38 +51,26 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
 
 from __future__ import annotations
 
-import io
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
-
-from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts, pvd_text
-from ligwf.analysis.frame_checks import FramePlan, plan_frames
-from ligwf.analysis.flow_run import flow_cases, flow_record, flow_table
-from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
-from ligwf.analysis.records.conditions import Conditions
-from ligwf.analysis.records.flow import FlowRecord
-from ligwf.analysis.gsd_tables import gsd_tables
-from ligwf.analysis.study_controls import control_pairs, study_controls
-from ligwf.analysis.kinetics import kinetics_summary, kinetics_table, sensitivity_table
+from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts
 from ligwf.analysis.dumps import FrameFiles
+from ligwf.analysis.flow_run import flow_cases, flow_record, flow_table
+from ligwf.analysis.frame_checks import FramePlan, plan_frames
+from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
+                                          stage_granules)
 from ligwf.analysis.outputs import OutputSet, new_token
+from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.provenance import study_provenance
 from ligwf.errors import ConfigError, LigwfError
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.case import granules_absent
-from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.study import Study
 
 __all__ = ["AnalysisOptions", "GranuleAnalysis", "NothingAnalysed", "analyse"]
-
-#: replica pool sizes of the GSD pooling table (ensembles: the source study's fix)
-POOL_SIZES = (1, 2, 4, 8)
-
 
 class NothingAnalysed(LigwfError):
     """No frame of any case could be analysed; the previous outputs were kept."""
@@ -193,52 +181,6 @@ def analyse_frame(ana: GranuleAnalysis, ff: FrameFiles) -> FrameResult:
                                  f"({type(exc).__name__}: {exc})")
 
 
-def frame_tables(facts: list[RunFacts], results: list[FrameResult]):
-    """(granule table, frame rows, skipped frames, analysed frames per case) of results
-    (and of the frames refused before reading) in case and step order."""
-    order = {f.case_id: fi for fi, f in enumerate(facts)}
-    refused = [FrameResult(p["case_id"], p["step"], p["step"] * facts[order[p["case_id"]]].dt,
-                           error=p["reason"], kind=p["kind"])
-               for f in facts if f.plan is not None for p in f.plan.problems]
-    results = sorted(results + refused, key=lambda r: (order[r.case_id], r.step))
-    by_case = {f.case_id: f for f in facts}
-    tables, frame_rows, skipped_frames = [], [], []
-    frame_index: dict[str, int] = {}
-    for r in results:
-        f = by_case[r.case_id]
-        if r.error is not None:
-            kind = r.kind or "skipped"
-            if kind != "window":      # the last hold_time of a run (granules: held): not a fault
-                skipped_frames.append({"case_id": r.case_id, "step": r.step, "kind": kind,
-                                       "reason": r.error})
-            frame_rows.append({"case_id": r.case_id, "step": r.step, "time": r.time,
-                               "status": kind, "reason": r.error})
-            continue
-        k = frame_index.get(r.case_id, 0)
-        frame_index[r.case_id] = k + 1
-        t = r.table
-        c = f.case
-        tables.append(t.assign(case_id=r.case_id, cg=f.cg, rule=c.rule if c else "",
-                               replica=c.replica if c else 0, frame=k, step=r.step, time=r.time))
-        vol = t["volume"].to_numpy()
-        frame_rows.append({"case_id": r.case_id, "step": r.step, "time": r.time, "status": "ok",
-                           "reason": "", "particles": r.particles, "contacts": r.contacts,
-                           "bonds": r.bonds, "granules": len(t),
-                           "largest_fraction": float(vol.max() / vol.sum()),
-                           "largest_percolates": bool(t["percolating"].to_numpy()[vol.argmax()])})
-    granules = (pd.concat(tables, ignore_index=True)[GRANULE_COLUMNS] if tables
-                else pd.DataFrame({c: pd.Series(dtype=float) for c in GRANULE_COLUMNS}))
-    frames = pd.DataFrame(frame_rows, columns=FRAME_COLUMNS)
-    return granules, frames, skipped_frames, frame_index, results
-
-
-GRANULE_COLUMNS = ["case_id", "cg", "rule", "replica", "frame", "step", "time", "granule",
-                   "members", "volume", "primary_volume", "com_x", "com_y", "com_z", "first_id",
-                   "percolating"]
-FRAME_COLUMNS = ["case_id", "step", "time", "status", "reason", "particles", "contacts",
-                 "bonds", "granules", "largest_fraction", "largest_percolates"]
-
-
 def nothing_analysed(where: Path, skipped_cases: list[dict], skipped_frames: list[dict]) -> NothingAnalysed:
     """The one-line refusal when no frame could be analysed (first reason included)."""
     first = (skipped_frames or skipped_cases or [{"reason": "no case and no frame"}])[0]
@@ -256,7 +198,8 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     contact dumps); when every usable case is one, the record says so and no granule
     table is written (the flow tables are, and the report uses those cases). ``flows``:
     the flow stage's record (its steady windows are the granule tables' too)."""
-    granules, frames, skipped_frames, frame_index, results = frame_tables(facts, results)
+    tables = frame_tables(facts, results)
+    skipped_frames, frame_index = tables.skipped_frames, tables.frame_index
     analysed = [f for f in facts if frame_index.get(f.case_id, 0) > 0]
     skipped_cases = skipped_cases + [
         {"case_id": f.case_id, "reason": f"no analysable frame ({f.plan.expected} expected; "
@@ -281,22 +224,9 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
         return record
     cases = [f.case for f in analysed]
     steady_from = {c.case_id: flows.cases[c.case_id].steady_from_step for c in cases}
-    steady = granules[granules["step"] >= granules["case_id"].map(steady_from).astype(float)]
-    gsd_df, summary = gsd_tables(steady, cases, settings)
-    stage_tables(outputs, granules, frames, gsd_df, summary)
-    pooled = pooling_table(steady, cases, settings, POOL_SIZES)
-    outputs.write(layout.GSD_POOLING_TABLE, pooled.to_csv(index=False).encode())
-    if not pooled.empty:
-        outputs.write(layout.GSD_POOLING_SUMMARY_TABLE,
-                      pooling_summary(pooled).to_csv(index=False).encode())
     stage_flow(outputs, flows)
-    stage_kinetics(outputs, granules, analysed, steady_from, settings, options.implementation)
-    stage_controls(outputs, cases, steady_from, settings)
-    if options.write_vtu:
-        for c in cases:
-            entries = [(r.time, r.vtu) for r in results if r.case_id == c.case_id and r.vtu]
-            if entries:
-                outputs.write(f"{c.case_id}/{layout.GRANULE_SERIES}", pvd_text(entries).encode())
+    steady = stage_granules(outputs, tables, analysed, cases, steady_from, settings,
+                            options.implementation, options.write_vtu, controls=True)
     steady_frames = steady.groupby("case_id")["step"].nunique() if len(steady) else {}
     plans: dict[str, FramePlan] = {f.case_id: f.plan for f in analysed}
     record = {
@@ -316,69 +246,3 @@ def stage_flow(outputs: OutputSet, flows: FlowRecord) -> None:
     """Stage the flow table and the flow record (:mod:`ligwf.analysis.flow_run`)."""
     outputs.write(layout.FLOW_TABLE, flow_table(flows).to_csv(index=False).encode())
     outputs.write(layout.FLOW_PROFILES, flows.to_text().encode())
-
-
-def stage_controls(outputs: OutputSet, cases: list, steady_from: dict[str, int],
-                   settings: AnalysisSettings) -> None:
-    """``controls.csv``: every wet case beside its cohesionless twin (none without twins),
-    measured from the wet case's steady window on (:mod:`ligwf.analysis.study_controls`)."""
-    pairs = control_pairs(cases)
-    if not pairs:
-        return
-    start = {w.case_id: (steady_from[w.case_id] - w.production_start_step) * w.scaled.dt
-             for w, _ in pairs}
-    table = study_controls(cases, settings, start)
-    outputs.write(layout.CONTROLS_TABLE, table.to_csv(index=False).encode())
-
-
-def stage_tables(outputs: OutputSet, granules: pd.DataFrame, frames: pd.DataFrame,
-                 gsd_df: pd.DataFrame, summary: pd.DataFrame) -> None:
-    """Stage the four tables of an analysis."""
-    buf = io.BytesIO()
-    granules.to_parquet(buf, index=False)
-    outputs.write(layout.GRANULES_TABLE, buf.getvalue())
-    outputs.write(layout.FRAMES_TABLE, frames.to_csv(index=False).encode())
-    outputs.write(layout.GSD_TABLE, gsd_df.to_csv(index=False).encode())
-    outputs.write(layout.GSD_SUMMARY_TABLE, summary.to_csv(index=False).encode())
-
-
-def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[RunFacts],
-                   steady_from: dict[str, int], settings: AnalysisSettings,
-                   implementation: str) -> None:
-    """Stage the kinetics tables (every frame) and the sensitivity table: up to
-    ``settings.sensitivity_frames`` steady frames, evenly spread, of the first CG1 case
-    (else the first case), analysed again under each variant of the definition."""
-    cases = [f.case for f in analysed]
-    kin = kinetics_table(granules, cases, settings)
-    outputs.write(layout.KINETICS_TABLE, kin.to_csv(index=False).encode())
-    summary = kinetics_summary(kin, settings)
-    outputs.write(layout.KINETICS_SUMMARY_TABLE, summary.to_csv(index=False).encode())
-    if settings.sensitivity_frames == 0:
-        return
-    first = Conditions.of(cases).first_reference_case()
-    facts = next((f for f in analysed if f.case_id == first), analysed[0])
-    steady = [ff for ff in facts.plan.frames if ff.step >= steady_from[facts.case_id]]
-    if not steady:
-        return
-    pick = np.unique(np.linspace(0, len(steady) - 1, settings.sensitivity_frames).round())
-    table = sensitivity_table(facts, [steady[int(k)] for k in pick], settings,
-                              implementation)
-    outputs.write(layout.SENSITIVITY_TABLE, table.to_csv(index=False).encode())
-
-
-#: Tables of a granule analysis: an analysis without granule data removes old ones.
-GRANULE_OUTPUTS = (layout.GRANULES_TABLE, layout.FRAMES_TABLE, layout.GSD_TABLE,
-                   layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE,
-                   layout.GSD_POOLING_SUMMARY_TABLE, layout.KINETICS_TABLE,
-                   layout.KINETICS_SUMMARY_TABLE, layout.SENSITIVITY_TABLE, layout.CONTROLS_TABLE)
-
-
-def commit(outputs: OutputSet, record: dict, obsolete: tuple[str, ...] = ()) -> None:
-    """Stage the analysis record and move the whole set into place (record last). The
-    record lists the size and SHA-256 of every staged table (``outputs``), so a reader can
-    tell a truncated or replaced table from the one written here; ``obsolete``: outputs of
-    an earlier analysis to remove with the set when this one did not write them."""
-    record = {**record, "outputs": outputs.digests()}
-    outputs.write(layout.ANALYSIS_RECORD,
-                  (json.dumps(record, indent=2, sort_keys=True) + "\n").encode())
-    outputs.commit(layout.ANALYSIS_RECORD, obsolete)

@@ -3,6 +3,7 @@ run is required (clear one-line errors), nothing defaults to step 0 or a box len
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 
@@ -14,6 +15,7 @@ from ligwf.analysis.dumps import read_contacts, read_particles
 from ligwf.analysis.granules import Liquid
 from ligwf.cli.main import main
 from ligwf.errors import ConfigError, DumpReadError
+from ligwf.study import layout
 from wetdump import wet_study
 
 ARGS = ["--liquid", "washino", "--surface-tension", "0.216", "--contact-angle", "30",
@@ -38,6 +40,31 @@ def test_analyse_dumps_matches_the_case_analysis(dumps, tmp_path, capsys):
     frames = pd.read_csv(out / "frames.csv")
     assert (frames["status"] == "ok").all() and (g.groupby("step")["members"].sum() == 222).all()
     assert g["percolating"].dtype == bool and (out / "dumps" / "granules.pvd").is_file()
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_analyse_dumps_writes_every_output_analyse_does(dumps, engine, tmp_path_factory,
+                                                       tmp_path):
+    """The same granule stage for both frame sources: analyse-dumps writes every output of
+    ``ligwf analyse`` but the two a foreign run cannot have (flow: no drum; controls: no
+    twin), which its record names."""
+    study = tmp_path / "study"
+    shutil.copytree(wet_study(engine, tmp_path_factory), study)
+    assert main(["analyse", str(study)]) == 0
+    out = tmp_path / "out"
+    assert main(["analyse-dumps", str(dumps), "--out", str(out), "--cg", "3", *ARGS]) == 0
+    ours = {p.name for p in (study / "analysis").iterdir() if p.is_file()}
+    theirs = {p.name for p in out.iterdir() if p.is_file()}
+    assert theirs == ours - {layout.FLOW_TABLE, layout.FLOW_PROFILES}, (ours, theirs)
+    assert {layout.KINETICS_TABLE, layout.KINETICS_SUMMARY_TABLE, layout.SENSITIVITY_TABLE,
+            layout.GSD_POOLING_TABLE} <= theirs
+    assert len(pd.read_csv(out / layout.KINETICS_TABLE)) == len(pd.read_csv(out / "frames.csv"))
+    assert len(pd.read_csv(out / layout.SENSITIVITY_TABLE)) >= 1
+    record = json.loads((out / layout.ANALYSIS_RECORD).read_text())
+    assert "drum" in record["flow"] and "twin" in record["controls"]
+    series = {p.name for p in (out / "dumps").iterdir()}
+    assert layout.GRANULE_SERIES in series and any(layout.granule_frame_step(n) for n in series)
 
 
 @pytest.mark.engine
