@@ -9,15 +9,20 @@ read-only install whose user has no writable cache folder.
 from __future__ import annotations
 
 import json
+import math
 import os
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
+import numpy as np
 import pytest
+from numba import njit
 
 from helpers import ROOT
+from ligwf import liquids
+from ligwf.analysis import granules_numba as gn
 
 # One "analyse-like" process: every kernel started (compiled or loaded), then the bond
 # kernels of each wet law on a frame; prints the start time, numba's cache statistics of
@@ -171,3 +176,86 @@ def test_read_only_install_without_a_user_cache(tmp_path, with_ligwf):
     assert _run(env, code, tmp_path) == [0, 1]
     assert _run(env, code, tmp_path) == [1, 0]
     assert list(tmpdir.glob(f"ligwf-numba-cache-{os.getuid()}/*/kern.twice-*.nbi"))
+
+
+# -- the cached law kernels compute what the law-as-argument kernels computed ---------------
+
+@njit(error_model="numpy")
+def _bond_kernel_law_arguments(id1, id2, id_offset, velocities, radii, content, delta, volume,
+                               within_rupture, force, gamma, theta, cos_max, min_force,
+                               force_needed):
+    """The bond pass as it was compiled before the law kernels were cached: the law's
+    functions as arguments of the kernel (one uncached compilation per process)."""
+    m = len(id1)
+    out_i = np.empty(m, np.int64)
+    out_j = np.empty(m, np.int64)
+    out_f = np.empty(m, np.float64)
+    out_k = np.empty(m, np.int64)
+    count = gn._scan(volume, within_rupture, force, id1, id2, id_offset, velocities, radii,
+                     content, delta, gamma, theta, cos_max, min_force, force_needed, out_i,
+                     out_j, out_f, out_k)
+    return count, out_i, out_j, out_f, out_k
+
+
+@njit(error_model="numpy")
+def _rupture_work_law_argument(r_i, r_j, lo, hi, vol, force, gamma, theta, nodes, weights):
+    cos_theta, sin_theta = math.cos(theta), math.sin(theta)
+    out = np.empty(len(r_i), np.float64)
+    for k in range(len(r_i)):
+        half, mid = 0.5 * (hi[k] - lo[k]), 0.5 * (hi[k] + lo[k])
+        total = 0.0
+        for q in range(len(nodes)):
+            total += weights[q] * force(r_i[k], r_j[k], mid + half * nodes[q], gamma, theta,
+                                        cos_theta, sin_theta, vol[k])
+        out[k] = half * total
+    return out
+
+
+@pytest.mark.mpi
+def test_cached_law_kernels_equal_the_law_argument_kernels_bitwise_on_real_dumps(
+        engine, tmp_path_factory):
+    """Every frame of the real wet run (tests/wetdump.py), both capillary laws, with and
+    without the velocity-angle test: the same bonds, forces, granules, unwrapped
+    coordinates and rupture work, to the bit."""
+    from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles
+    from wetdump import wet_study
+
+    case = wet_study(engine, tmp_path_factory) / "cg3-weber-r0"
+    scaled = json.loads((case / "scene.json").read_text())["scaled"]
+    length = float(scaled["drum_length"])
+    nodes, weights = np.polynomial.legendre.leggauss(8)
+    frames = [(read_particles(f.particles), read_contacts(f.contacts))
+              for f in discover_frames(case)]
+    assert frames
+    for name in ("washino", "easo"):
+        law = gn.law(liquids.get(name))
+        for p, c in frames:
+            a, b = p.index_of(c.id1), p.index_of(c.id2)
+            content = np.asarray(p.liquid_content, dtype=np.float64)
+            y = np.ascontiguousarray(p.positions[:, 1])
+            delta = np.asarray(c.delta, dtype=np.float64)
+            for cos_max in (-1.0, math.cos(math.radians(30.0))):
+                args = (a, b, 0, p.velocities, p.radii, content, delta)
+                crit = (0.02, 0.3, cos_max, 0.0)
+                new = gn.bond_kernel(*args, *law, *crit)
+                old = _bond_kernel_law_arguments(*args, *law, *crit, True)
+                count = new[0]
+                assert count == old[0] and count > 0
+                for x, z in zip(new[1:], old[1:]):
+                    assert x[:count].tobytes() == z[:count].tobytes()
+                comp = gn.bond_components(*args, *law, *crit, True, y, length)
+                assert comp[0] == count
+                for x, z in zip(comp[1:4], new[1:4]):
+                    assert x[:count].tobytes() == z[:count].tobytes()
+                labels, unwrapped, perc, n = gn.components_images(len(p), old[1], old[2],
+                                                                   count, y, length)
+                assert comp[4].tobytes() == labels.tobytes()
+                assert comp[5].tobytes() == unwrapped.tobytes() and comp[7] == n
+                i, j = new[1][:count], new[2][:count]
+                lo, hi = np.zeros(count), np.full(count, 1e-5)
+                vol = np.full(count, 1e-12)
+                w_new = gn.rupture_work(p.radii[i], p.radii[j], lo, hi, vol, law[2], 0.02,
+                                        0.3, nodes, weights)
+                w_old = _rupture_work_law_argument(p.radii[i], p.radii[j], lo, hi, vol,
+                                                   law[2], 0.02, 0.3, nodes, weights)
+                assert w_new.tobytes() == w_old.tobytes()
