@@ -46,14 +46,14 @@ import numpy as np
 
 from ligwf.analysis import dumps_numba
 from ligwf.analysis import granules_numba
-from ligwf.analysis import gsd
-from ligwf.analysis.dumps import (ContactFrame, ParticleFrame, discover_frames, read_contacts,
+from ligwf.analysis.gsd import bins as gsd
+from ligwf.analysis.frames.dumps import (ContactFrame, ParticleFrame, discover_frames, read_contacts,
                          read_particles)
-from ligwf.analysis.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
+from ligwf.analysis.granules.bonds import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
                             granule_table, identify, label_reference, unwrap_reference)
-from ligwf.analysis.bridge_law import relative_energy
-from ligwf.analysis.communities import cpm_labels
-from ligwf.analysis.definitions import Motion, bond_criterion, identify_granules
+from ligwf.analysis.granules.bridge_law import relative_energy
+from ligwf.analysis.granules.communities import cpm_labels
+from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.scene.scaling import ScaledScene
 

@@ -26,11 +26,11 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 from analysis.test_definitions import tiled  # noqa: E402
 from ligwf.analysis import granules_numba  # noqa: E402
-from ligwf.analysis.case_granules import RunFacts  # noqa: E402
-from ligwf.analysis.communities import cpm_labels, cpm_labels_reference, cpm_quality  # noqa: E402
-from ligwf.analysis.definitions import cpm_weights, identify_granules  # noqa: E402
+from ligwf.analysis.granules.case import RunFacts  # noqa: E402
+from ligwf.analysis.granules.communities import cpm_labels, cpm_labels_reference, cpm_quality  # noqa: E402
+from ligwf.analysis.granules.definitions import cpm_weights, identify_granules  # noqa: E402
 from ligwf.scene.settings import AnalysisSettings  # noqa: E402
-from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles  # noqa: E402
+from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 
 

@@ -30,8 +30,8 @@ engine's pair forces (alike in OLD and NEW; nothing else changes).
    and "Dangerous builds"; the manifest's seconds per phase and in all; the time saved NEW vs
    OLD in %. One pair of runs on a shared machine: a few % is noise (load average printed).
 2. Bond statistics over the production frames (``post/contacts_*.vtu`` through
-   ``ligwf.analysis.dumps.read_contacts``, forces of the same rows through
-   ``ligwf.analysis.vtu.read_vtu``): per frame the bridges per particle (2 x pairs /
+   ``ligwf.analysis.frames.dumps.read_contacts``, forces of the same rows through
+   ``ligwf.analysis.frames.vtu.read_vtu``): per frame the bridges per particle (2 x pairs /
    particles), the share of bridges in contact (overlap > 0), the median and 90th percentile
    of |F_n| (Hertz + capillary + viscous, N), the 10th/50th/90th percentiles of the overlap
    delta / d_min (negative: a gap). NEW vs OLD: z = difference of the frame means / combined
@@ -84,9 +84,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles  # noqa: E402
+from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles  # noqa: E402
 from ligwf.analysis.dumps_numba import first_of_each_pair  # noqa: E402
-from ligwf.analysis.vtu import read_vtu  # noqa: E402
+from ligwf.analysis.frames.vtu import read_vtu  # noqa: E402
 from ligwf.engine.guard import engine_env  # noqa: E402
 from ligwf.study.manifest import DONE  # noqa: E402
 from ligwf.engine.launch import run_case  # noqa: E402

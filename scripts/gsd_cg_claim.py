@@ -15,7 +15,7 @@ replicas pooled):
   pools of K = 1, 2, 4 replicas (disjoint pools), and We-CG2 in a 2x and a 4x longer
   slice (2 replicas each: K = 1 and the pair);
 * the source study's per-bin 15 % test and its located size limits (both ends, through
-  :func:`ligwf.analysis.gsd_pooling.pooling_table`, the code ``ligwf analyse`` uses), for
+  :func:`ligwf.analysis.gsd.pooling.pooling_table`, the code ``ligwf analyse`` uses), for
   physical granule volumes (ligwf's default) and volumes / n^3 (the source study's);
 * bin-free distances of the volume-weighted distribution of log10 granule volume:
   Wasserstein-1 (in decades of volume), Kolmogorov-Smirnov, and d10 / d50 / d90 ratios
@@ -48,8 +48,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis import gsd
-from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
+from ligwf.analysis.gsd import bins as gsd
+from ligwf.analysis.gsd.pooling import pooling_summary, pooling_table
 from ligwf.fsio import atomic_write_bytes, atomic_write_text
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout

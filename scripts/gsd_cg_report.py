@@ -12,7 +12,7 @@ every case's steady frames (the window the study's analysis used, from
 
 * ``definitions.csv``: per case, percolating frames, largest granule (share of the bed),
   d50 and granule count (acceptance (a) of the issue);
-* ``pooling.csv`` / ``pooling_summary.csv``: :mod:`ligwf.analysis.gsd_pooling` per
+* ``pooling.csv`` / ``pooling_summary.csv``: :mod:`ligwf.analysis.gsd.pooling` per
   definition and volume convention (physical, and primary = volume / n^3, the source
   study's), pool sizes K = 1, 2, 4, with the CG1-vs-CG1 noise floor.
 """
@@ -28,10 +28,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis import gsd
-from ligwf.analysis.case_granules import GranuleAnalysis
-from ligwf.analysis.frame_checks import plan_frames
-from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
+from ligwf.analysis.gsd import bins as gsd
+from ligwf.analysis.granules.case import GranuleAnalysis
+from ligwf.analysis.frames.checks import plan_frames
+from ligwf.analysis.gsd.pooling import pooling_summary, pooling_table
 from ligwf.fsio import atomic_write_text
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.study import Study

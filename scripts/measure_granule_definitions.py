@@ -63,7 +63,7 @@ import numba
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles
+from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
 # ligwf is being refactored: this script was written against commit 9179dd2 (run it with
 # PYTHONPATH pointing at a checkout of that commit); the newer liquids API is used if present.
 try:
@@ -94,7 +94,7 @@ class Frame:
     dy: np.ndarray           # minimum-image displacement y_j - y_i along the axis, m
     force: np.ndarray        # N
     frel: np.ndarray         # F / (2 pi R* gamma cos theta)
-    erel: np.ndarray         # rupture work / (F0 R*) (ligwf.analysis.bridge_law.relative_energy)
+    erel: np.ndarray         # rupture work / (F0 R*) (ligwf.analysis.granules.bridge_law.relative_energy)
     keys: np.ndarray         # id1 * big + id2 (id1 < id2), for persistence
     cos: dict                # velocity frame -> cos(angle) per bridge (1 for zero speed)
 
@@ -124,7 +124,7 @@ def _cos(vi, vj):
 
 def _relative_energy(p, i, j, gap, model, gamma, theta, content):
     """The bridge's relative rupture work (the default CPM weight since 2026-11-28)."""
-    from ligwf.analysis.bridge_law import Liquid, relative_energy
+    from ligwf.analysis.granules.bridge_law import Liquid, relative_energy
 
     return relative_energy(p, i, j, gap, Liquid(model, gamma, theta, float(content)))
 

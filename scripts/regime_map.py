@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.control_run import control_rows, load_series, summarise
+from ligwf.analysis.granules.control_run import control_rows, load_series, summarise
 from ligwf.scene.regime import regime_numbers
 from ligwf.study.case import CaseFolder
 
@@ -61,7 +61,7 @@ TWIN_OF = {"wet_mu0.001": "twin_mu0.001", "wet_mu0.01": "twin_mu0.001",
 
 def pair_verdicts(summary: pd.DataFrame) -> pd.DataFrame:
     """Per wet point and definition: its measures, its twin's and the pre-registered verdict."""
-    from ligwf.analysis.control_verdict import criteria
+    from ligwf.analysis.granules.control_verdict import criteria
 
     by = {(r["point"], r["definition"]): r for _, r in summary.iterrows()}
     rows = []

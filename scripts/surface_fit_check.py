@@ -4,7 +4,7 @@ Independent fit: the solid volume fraction on a grid of d x d cells of the cross
 (particle volumes over cell area x slice length), the free surface in each vertical column
 where that fraction falls through half its bulk value (linear interpolation), and a plain
 least-squares line through the columns of the central half of the drum (|u| < R / 2).
-It shares no step with ligwf.analysis.surface (no strip tops, no centre-of-mass guess, no
+It shares no step with ligwf.analysis.flow.surface (no strip tops, no centre-of-mass guess, no
 outlier rejection). Usage: python scripts/surface_fit_check.py CASE_DIR [CASE_DIR ...]
 """
 
@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ligwf.analysis.dumps import read_particles
-from ligwf.analysis.flow import DrumGeometry, cross_section, frame_flow, rising_side
-from ligwf.analysis.flow_run import steady_fraction
-from ligwf.analysis.frame_checks import plan_frames
-from ligwf.analysis.steady import AUTO
+from ligwf.analysis.frames.dumps import read_particles
+from ligwf.analysis.flow.frame import DrumGeometry, cross_section, frame_flow, rising_side
+from ligwf.analysis.flow.stage import steady_fraction
+from ligwf.analysis.frames.checks import plan_frames
+from ligwf.analysis.flow.steady import AUTO
 from ligwf.study.case import CaseFolder
 
 

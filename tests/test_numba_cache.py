@@ -217,7 +217,7 @@ def test_cached_law_kernels_equal_the_law_argument_kernels_bitwise_on_real_dumps
     """Every frame of the real wet run (tests/wetdump.py), both capillary laws, with and
     without the velocity-angle test: the same bonds, forces, granules, unwrapped
     coordinates and rupture work, to the bit."""
-    from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles
+    from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
     from wetdump import wet_study
 
     case = wet_study(engine, tmp_path_factory) / "cg3-weber-r0"

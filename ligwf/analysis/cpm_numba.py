@@ -2,7 +2,7 @@
 default granule definition.
 
 CPM quality of a partition: Q = sum over communities c of W_in(c) - gamma N_c^2 / 2, with
-W_in the edge weight inside c and N_c its node weight (:func:`ligwf.analysis.communities.
+W_in the edge weight inside c and N_c its node weight (:func:`ligwf.analysis.granules.communities.
 cpm_quality` computes it in numpy). Louvain (Blondel et al. 2008) with the CPM gain:
 
 1. *local moving*: nodes in order (on the particle graph: id order from a seeded start,
@@ -14,7 +14,7 @@ cpm_quality` computes it in numpy). Louvain (Blondel et al. 2008) with the CPM g
 
 Louvain can leave a community internally disconnected (Leiden's refinement prevents
 that); the granule definition takes the connected components of the bonds inside each
-community anyway (:mod:`ligwf.analysis.definitions`), so a disconnected community
+community anyway (:mod:`ligwf.analysis.granules.definitions`), so a disconnected community
 becomes several granules. Why not igraph's compiled Leiden: at 360k particles its
 partition took ~5 s per frame on one core, an order of magnitude too slow for the issue's
 0.5 frames/s; this Louvain reaches CPM qualities within ~1 % of it (the tests compare them
@@ -195,7 +195,7 @@ def level_order(size, level_no):
     id order from a seeded start: neighbouring ids are mostly neighbouring particles, and a
     random order's cache misses made this level 8x slower at 360k particles (2.2 vs
     0.27 s; CPM quality 0.6 % higher). Aggregated levels: a seeded random permutation.
-    The numpy reference of :mod:`ligwf.analysis.communities` draws the same orders."""
+    The numpy reference of :mod:`ligwf.analysis.granules.communities` draws the same orders."""
     if level_no == 0:
         return (np.arange(size) + np.random.randint(0, size)) % size
     return np.random.permutation(size)
@@ -244,7 +244,7 @@ def louvain_cpm(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50, ma
 @cached_jit()
 def cpm_quality_compiled(labels, i, j, w, node_w, gamma):
     """CPM quality of a partition, sum of W_in(c) - gamma N_c^2 / 2, in one compiled loop
-    (the value the fast path reports; the numpy version in ligwf.analysis.communities is
+    (the value the fast path reports; the numpy version in ligwf.analysis.granules.communities is
     the independent check)."""
     k = 0
     for v in range(len(labels)):

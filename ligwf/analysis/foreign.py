@@ -25,10 +25,10 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ligwf import liquids
-from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts
-from ligwf.analysis.dumps import FrameFiles, read_particles
+from ligwf.analysis.granules.case import GranuleAnalysis, RunFacts
+from ligwf.analysis.frames.dumps import FrameFiles, read_particles
 from ligwf.analysis.granule_stage import GRANULE_OUTPUTS, commit, frame_tables, stage_granules
-from ligwf.analysis.granules import AXES, Liquid
+from ligwf.analysis.granules.bonds import AXES, Liquid
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.analysis.runner import nothing_analysed
 from ligwf.liquids.contact_angle import applied_contact_angle_rad

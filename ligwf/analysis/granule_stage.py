@@ -1,6 +1,6 @@
 """The granule stage's outputs, shared by every frame source (a study, foreign dumps).
 
-From the per-frame results of :class:`~ligwf.analysis.case_granules.GranuleAnalysis`
+From the per-frame results of :class:`~ligwf.analysis.granules.case.GranuleAnalysis`
 (whichever ranks computed them) and each case's steady window, :func:`stage_granules`
 stages the same set for a study (:mod:`ligwf.analysis.runner`) and for dumps ligwf did
 not write (:mod:`ligwf.analysis.foreign`): granule and frame tables, GSD and GSD summary
@@ -19,14 +19,14 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.case_granules import FrameResult, RunFacts, pvd_text
-from ligwf.analysis.dumps import FrameFiles
-from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table
-from ligwf.analysis.gsd_tables import gsd_tables
-from ligwf.analysis.kinetics import kinetics_summary, kinetics_table, sensitivity_table
+from ligwf.analysis.granules.case import FrameResult, RunFacts, pvd_text
+from ligwf.analysis.frames.dumps import FrameFiles
+from ligwf.analysis.gsd.pooling import pooling_summary, pooling_table
+from ligwf.analysis.gsd.tables import gsd_tables
+from ligwf.analysis.gsd.kinetics import kinetics_summary, kinetics_table, sensitivity_table
 from ligwf.analysis.outputs import OutputSet
 from ligwf.analysis.records.conditions import CaseLike, Conditions
-from ligwf.analysis.study_controls import control_pairs, study_controls
+from ligwf.analysis.granules.study_controls import control_pairs, study_controls
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 
@@ -161,7 +161,7 @@ def stage_kinetics(outputs: OutputSet, granules: pd.DataFrame, analysed: list[Ru
 def stage_controls(outputs: OutputSet, cases: list, steady_from: dict[str, int],
                    settings: AnalysisSettings) -> None:
     """``controls.csv``: every wet case beside its cohesionless twin (none without twins),
-    measured from the wet case's steady window on (:mod:`ligwf.analysis.study_controls`)."""
+    measured from the wet case's steady window on (:mod:`ligwf.analysis.granules.study_controls`)."""
     pairs = control_pairs(cases)
     if not pairs:
         return

@@ -159,7 +159,7 @@ def bond_components(id1, id2, id_offset, velocities, radii, content, delta, volu
     layout, keeps its members' positions in the box. Roots are always the
     smallest row of their tree, so granule k is numbered in order of its first member and
     its unwrapped coordinates are laid out from that member, as the breadth-first reference
-    (:func:`ligwf.analysis.granules.unwrap_reference`) lays them out; for a granule that does not
+    (:func:`ligwf.analysis.granules.bonds.unwrap_reference`) lays them out; for a granule that does not
     percolate every path gives the same image counts, so both agree to rounding.
 
     ``length`` <= 0: no periodic axis (image counts stay 0). Returns (count, i, j, force,
@@ -196,7 +196,7 @@ def components_images(n, i, j, count, y, length):
     """Connected components of the first ``count`` pairs (i, j) of n particles with their
     unwrapping along the periodic axis and percolation test (the union-find pass of
     :func:`bond_components`, also used on the intra-community bonds of
-    :mod:`ligwf.analysis.definitions`). Returns (labels, y unwrapped, percolating per
+    :mod:`ligwf.analysis.granules.definitions`). Returns (labels, y unwrapped, percolating per
     granule, granule count); labels canonical (numbered in order of first member).
 
     Each pair is merged into a union-find forest whose nodes also carry their periodic
@@ -341,7 +341,7 @@ def rupture_work(r_i, r_j, lo, hi, vol, force, gamma, theta, nodes, weights):
     """Work, J, the bridge of each pair still does between gap ``lo`` and its rupture gap
     ``hi`` (m): Gauss-Legendre quadrature of the model's numba ``force`` at ``nodes`` /
     ``weights`` on [-1, 1] (the same nodes as the numpy reference,
-    :func:`ligwf.analysis.bridge_law.relative_energy`)."""
+    :func:`ligwf.analysis.granules.bridge_law.relative_energy`)."""
     return _for_law(_rupture_work, FORCE=force)(r_i, r_j, lo, hi, vol, gamma, theta, nodes,
                                                 weights)
 

@@ -8,7 +8,7 @@ the ``.vtu`` files of its own frames into the staging folder).
 Cases are used only when the study says they are usable (manifest ``done`` for the scene
 the folder holds and a thermo table that agrees with it,
 :meth:`ligwf.study.case.CaseFolder.why_not_usable`); frames only when they are the run's
-own (:mod:`ligwf.analysis.frame_checks`: expected steps, dump record, particle count and
+own (:mod:`ligwf.analysis.frames.checks`: expected steps, dump record, particle count and
 ids, radii, drum, contact geometry). Everything else is listed with its reason -- skipped
 cases, and missing, unexpected or refused frames -- in the analysis record and the frame
 table, which the report shows; a case left without any analysable frame is a skipped
@@ -25,7 +25,7 @@ binning and bootstrap, steady window) come from the study
 (:class:`~ligwf.scene.settings.AnalysisSettings`), so every path that analyses a study
 computes the same numbers. Granules are identified in every frame; the GSD uses the
 frames of each case's steady window only, found once by the flow stage
-(:mod:`ligwf.analysis.flow_run`, every usable case, dealt to the ranks case by case).
+(:mod:`ligwf.analysis.flow.stage`, every usable case, dealt to the ranks case by case).
 
 Outputs (``OUT`` defaults to the study's analysis folder; names in
 :mod:`ligwf.study.layout`):
@@ -36,11 +36,11 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
 * frame table: per frame: status (ok, missing, unexpected, skipped) and reason,
   particles, contacts, bonds, granules, largest granule share and whether the largest
   granule percolates (wraps around the periodic axis);
-* GSD and GSD summary tables: see :mod:`ligwf.analysis.gsd_tables`;
+* GSD and GSD summary tables: see :mod:`ligwf.analysis.gsd.tables`;
 * GSD pooling table and its summary per condition and pool size: the size limits and
   errors of CG-n replica pools of K = 1, 2, 4, 8 against CG1, and CG1 against itself;
 * kinetics (per case and frame, per condition with bands and CG-n/CG1 ratios) and
-  sensitivity tables: :mod:`ligwf.analysis.kinetics`; controls: :mod:`.study_controls`;
+  sensitivity tables: :mod:`ligwf.analysis.gsd.kinetics`; controls: :mod:`.study_controls`;
 * flow table and flow record (steady window, metrics, series): :mod:`.flow_run`;
 * per case a granule series: particles with a ``granule`` array per frame;
 * the analysis record (JSON): settings, analysed and skipped cases with their steady
@@ -55,10 +55,10 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from ligwf.analysis.case_granules import FrameResult, GranuleAnalysis, RunFacts
-from ligwf.analysis.dumps import FrameFiles
-from ligwf.analysis.flow_run import flow_cases, flow_record, flow_table
-from ligwf.analysis.frame_checks import FramePlan, plan_frames
+from ligwf.analysis.granules.case import FrameResult, GranuleAnalysis, RunFacts
+from ligwf.analysis.frames.dumps import FrameFiles
+from ligwf.analysis.flow.stage import flow_cases, flow_record, flow_table
+from ligwf.analysis.frames.checks import FramePlan, plan_frames
 from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
                                           stage_granules)
 from ligwf.analysis.outputs import OutputSet, new_token
@@ -243,6 +243,6 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
 
 
 def stage_flow(outputs: OutputSet, flows: FlowRecord) -> None:
-    """Stage the flow table and the flow record (:mod:`ligwf.analysis.flow_run`)."""
+    """Stage the flow table and the flow record (:mod:`ligwf.analysis.flow.stage`)."""
     outputs.write(layout.FLOW_TABLE, flow_table(flows).to_csv(index=False).encode())
     outputs.write(layout.FLOW_PROFILES, flows.to_text().encode())

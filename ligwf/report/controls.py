@@ -1,6 +1,6 @@
 """The report's "Granule controls" section: the granules beside a bed that should have none.
 
-Reads ``analysis/controls.csv`` (:mod:`ligwf.analysis.study_controls`; it computes
+Reads ``analysis/controls.csv`` (:mod:`ligwf.analysis.granules.study_controls`; it computes
 nothing). With twins, a table per wet case of every definition's measures against the
 twin's, and the verdict sentence of the study's own definition first; without twins, one
 sentence saying that the granules of this study were never checked against a control, and

@@ -1,6 +1,6 @@
 """Report figures of the granule analysis: granulation kinetics and definition sensitivity.
 
-Read from the analysis folder (:mod:`ligwf.analysis.kinetics` writes the tables):
+Read from the analysis folder (:mod:`ligwf.analysis.gsd.kinetics` writes the tables):
 ``kinetics_summary.csv`` -> granule count, d50, largest granule and bed share in granules
 against time, one line per condition with its band over replicas; ``sensitivity.csv`` ->
 granule count, d50 and largest granule under each variant of the definition.

@@ -4,7 +4,7 @@ missing or unreadable analysis outputs.
 A problem that sits only in a JSON file is a problem nobody sees, so the report gathers
 them from every stage -- the study (cases not done, stale or unreadable), the granule
 analysis record (cases without an analysable frame, frames missing, unexpected or
-refused, see :mod:`ligwf.analysis.frame_checks`) and the flow stage (frames of the steady
+refused, see :mod:`ligwf.analysis.frames.checks`) and the flow stage (frames of the steady
 window it could not use) -- and lists them in ``summary.md`` and ``index.html``.
 """
 

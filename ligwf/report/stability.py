@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ligwf.analysis.dumps import discover_frames, read_particles
+from ligwf.analysis.frames.dumps import discover_frames, read_particles
 from ligwf.engine import health
 from ligwf.engine.attempt import expectation
 from ligwf.engine.thermo import parse_screen

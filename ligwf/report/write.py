@@ -119,7 +119,7 @@ def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame, flow: FlowRec
 
 
 def pooling_markdown(analysis_dir: Path, band: float) -> list[str]:
-    """The GSD size limit against replica pooling (ligwf.analysis.gsd_pooling): per
+    """The GSD size limit against replica pooling (ligwf.analysis.gsd.pooling): per
     condition and pool size K, the mean [min, max] over disjoint pools of the source
     study's upper limit and the errors below / above it; the CG1 noise floor first."""
     path = analysis_dir / layout.GSD_POOLING_SUMMARY_TABLE
@@ -326,7 +326,7 @@ def steady_line(flow: FlowRecord, cases: pd.DataFrame) -> str:
         span = (f"{100 * fr.min():.0f}-{100 * fr.max():.0f} %" if len(fr) else "–")
         return (f"`steady_after: auto` (the first frame after which running means of the flow "
                 f"angle and kinetic energy stay within their steady scatter, "
-                f"ligwf.analysis.steady): {span} of production left out")
+                f"ligwf.analysis.flow.steady): {span} of production left out")
     return f"`steady_after: {setting}`: the first {100 * float(setting):.0f} % of production left out"
 
 

@@ -39,7 +39,7 @@ class AnalysisSettings(_Frozen):
 
     steady_after: float | Literal["auto"] = Field(
         "auto", description="start-up left out of the flow metrics and the GSD alike: auto "
-        "(default: from the bed's measured spin-up, ligwf.analysis.steady) or a fraction of "
+        "(default: from the bed's measured spin-up, ligwf.analysis.flow.steady) or a fraction of "
         "the production time")
     granules: Literal["communities", "components", "held"] = Field(
         "communities", description="granules are CPM communities of the bond graph "

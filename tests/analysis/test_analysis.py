@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from ligwf.analysis.dumps import discover_frames, read_particles
+from ligwf.analysis.frames.dumps import discover_frames, read_particles
 from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, NothingAnalysed, analyse
 from ligwf.cli.main import main
 from ligwf.study.case import CaseFolder

@@ -1,4 +1,4 @@
-"""ligwf.analysis.bridge_law.relative_energy: the bridge's relative rupture work, the edge
+"""ligwf.analysis.granules.bridge_law.relative_energy: the bridge's relative rupture work, the edge
 weight of the default granule definition. Compiled and numpy paths agree; the quadrature
 is exact where the answer is known in closed form; the weight is CG-neutral under both
 scaling rules and grows with the bridge volume (what makes the granules respond to the
@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 import toy_constant  # noqa: F401  (registers the constant-force toy model)
-from ligwf.analysis.bridge_law import Liquid, relative_energy, work_limits
-from ligwf.analysis.dumps import ParticleFrame
+from ligwf.analysis.granules.bridge_law import Liquid, relative_energy, work_limits
+from ligwf.analysis.frames.dumps import ParticleFrame
 
 THETA = math.radians(30.0)
 
@@ -66,7 +66,7 @@ def test_constant_force_integrates_exactly():
 
 def test_quadrature_converged():
     """16 nodes: within 1e-6 of the same integral on 4x finer sub-intervals (washino law)."""
-    from ligwf.analysis import bridge_law
+    from ligwf.analysis.granules import bridge_law
 
     p, liquid, _, i, j, gap, lo, hi = bonds("washino", 500, 6)
     e16 = relative_energy(p, i, j, gap, liquid, "reference")

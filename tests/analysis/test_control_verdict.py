@@ -1,6 +1,6 @@
 """The pre-registered control criteria on hand-made summary rows."""
 
-from ligwf.analysis.control_verdict import criteria, verdict
+from ligwf.analysis.granules.control_verdict import criteria, verdict
 
 GOOD = {"share_10": 0.10, "persist_quarter": 0.8, "comove_ratio": 0.2, "ari_order": 1.0,
         "percolating": 0.0}
@@ -39,7 +39,7 @@ def test_missing_numbers_fail_rather_than_pass():
 
 
 def test_sensitivity_varies_only_the_thresholds_in_use_and_states_the_setting():
-    from ligwf.analysis.definitions import variants
+    from ligwf.analysis.granules.definitions import variants
     from ligwf.scene.settings import AnalysisSettings
 
     labels = [lab for lab, _ in variants(AnalysisSettings())]

@@ -1,4 +1,4 @@
-"""The control measures (ligwf.analysis.controls) against slow obvious pair enumerations."""
+"""The control measures (ligwf.analysis.granules.controls) against slow obvious pair enumerations."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import itertools
 import numpy as np
 import pytest
 
-from ligwf.analysis.controls import (adjusted_rand_index, bed_share, comovement, granule_count,
+from ligwf.analysis.granules.controls import (adjusted_rand_index, bed_share, comovement, granule_count,
                                      pair_persistence, volume_d50)
 
 

@@ -1,4 +1,4 @@
-"""ligwf.analysis.definitions: every granule definition's reference and fast paths give the
+"""ligwf.analysis.granules.definitions: every granule definition's reference and fast paths give the
 same granules on real engine dumps (communities: the same CPM quality, computed in numpy),
 velocity frames against brute force, and the default GSD is invariant to tiling the
 periodic frame 2x and 4x along its axis."""
@@ -10,17 +10,17 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ligwf.analysis.communities import (cpm_labels, cpm_labels_leiden, cpm_labels_leidenalg,
+from ligwf.analysis.granules.communities import (cpm_labels, cpm_labels_leiden, cpm_labels_leidenalg,
                                         cpm_labels_reference, cpm_quality)
 from ligwf.scene.settings import AnalysisSettings
-from ligwf.analysis.definitions import (Motion, bond_criterion, cpm_weights,
+from ligwf.analysis.granules.definitions import (Motion, bond_criterion, cpm_weights,
                                         drum_frame_velocities, flow_frame_velocities,
                                         identify_granules)
-from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles
-from ligwf.analysis.granules import bonded_contacts
-from ligwf.analysis.bridge_law import relative_force
-from ligwf.analysis import gsd
-from ligwf.analysis.case_granules import RunFacts
+from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
+from ligwf.analysis.granules.bonds import bonded_contacts
+from ligwf.analysis.granules.bridge_law import relative_force
+from ligwf.analysis.gsd import bins as gsd
+from ligwf.analysis.granules.case import RunFacts
 from ligwf.study.case import CaseFolder
 from helpers import tiled
 from wetdump import wet_study

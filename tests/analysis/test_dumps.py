@@ -1,4 +1,4 @@
-"""ligwf.analysis.dumps on real LIGGGHTS output: reading, conventions, and every kind of bad file."""
+"""ligwf.analysis.frames.dumps on real LIGGGHTS output: reading, conventions, and every kind of bad file."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import meshio
 import numpy as np
 import pytest
 
-from ligwf.analysis.dumps import discover_frames, read_contacts, read_particles
+from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
 from ligwf.errors import DumpReadError
 from wetdump import wet_study
 

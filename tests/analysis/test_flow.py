@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ligwf.analysis.dumps import ParticleFrame
-from ligwf.analysis.flow import DrumGeometry, frame_flow, profile_l2_error, rising_side, summarise
+from ligwf.analysis.frames.dumps import ParticleFrame
+from ligwf.analysis.flow.frame import DrumGeometry, frame_flow, profile_l2_error, rising_side, summarise
 
 R, D = 0.025, 0.001
 

@@ -14,9 +14,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from ligwf.analysis import flow_metrics
-from ligwf.analysis.flow import frame_flow
-from ligwf.analysis.flow_run import flow_record, flow_table, measured_flow
+from ligwf.analysis.flow import registry as flow_metrics
+from ligwf.analysis.flow.frame import frame_flow
+from ligwf.analysis.flow.stage import flow_record, flow_table, measured_flow
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.metrics import POSITIVE, MetricSpec
 from ligwf.analysis.records.statistics import MEAN

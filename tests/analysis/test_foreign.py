@@ -10,9 +10,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from ligwf.analysis.case_granules import RunFacts
-from ligwf.analysis.dumps import read_contacts, read_particles
-from ligwf.analysis.granules import Liquid
+from ligwf.analysis.granules.case import RunFacts
+from ligwf.analysis.frames.dumps import read_contacts, read_particles
+from ligwf.analysis.granules.bonds import Liquid
 from ligwf.cli.main import main
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study import layout

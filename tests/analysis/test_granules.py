@@ -1,4 +1,4 @@
-"""ligwf.analysis.granules: reference (networkx BFS, numpy bond criterion) vs compiled fast path
+"""ligwf.analysis.granules.bonds: reference (networkx BFS, numpy bond criterion) vs compiled fast path
 (ligwf.analysis.granules_numba) on real dumps, random frames and random graphs; bond criterion
 against a per-contact scalar evaluation; volumes and periodic CoM."""
 
@@ -17,9 +17,9 @@ from ligwf import liquids
 from ligwf.liquids import washino
 from ligwf.liquids.capillary import rupture_distance
 from ligwf.scene.scaling import ScaledScene
-from ligwf.analysis.dumps import ContactFrame, ParticleFrame, discover_frames, read_contacts, read_particles
+from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame, discover_frames, read_contacts, read_particles
 from ligwf.errors import DumpReadError
-from ligwf.analysis.granules import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
+from ligwf.analysis.granules.bonds import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
                             comoving, force_law_positive, granule_table, identify_fast,
                             identify_reference, label_fast, label_reference, louvain_labels)
 from wetdump import wet_study
@@ -215,7 +215,7 @@ def _frame(radii, positions, velocities, content=0.02) -> ParticleFrame:
 
 def test_broken_bridge_and_threshold():
     """Beyond the rupture distance there is no bond; a threshold drops weak bridges."""
-    from ligwf.analysis.dumps import ContactFrame
+    from ligwf.analysis.frames.dumps import ContactFrame
 
     r = 0.0005
     p = _frame([r] * 4, np.zeros((4, 3)), np.tile([0.1, 0, 0], (4, 1)))

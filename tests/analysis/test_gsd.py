@@ -1,4 +1,4 @@
-"""ligwf.analysis.gsd: bins, distributions, percentiles, bootstrap bands, CG comparison."""
+"""ligwf.analysis.gsd.bins: bins, distributions, percentiles, bootstrap bands, CG comparison."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import pytest
 
 from types import SimpleNamespace
 
-from ligwf.analysis import gsd
-from ligwf.analysis.gsd_tables import gsd_tables
+from ligwf.analysis.gsd import bins as gsd
+from ligwf.analysis.gsd.tables import gsd_tables
 from ligwf.scene.settings import AnalysisSettings
 
 V1 = math.pi / 6 * 0.001**3      # one 1 mm primary particle, m^3

@@ -1,4 +1,4 @@
-"""ligwf.analysis.gsd_pooling: disjoint replica pools, the source study's upper size limit,
+"""ligwf.analysis.gsd.pooling: disjoint replica pools, the source study's upper size limit,
 and the pooling table on synthetic granule tables with a known answer."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from ligwf.analysis import gsd
-from ligwf.analysis.gsd_pooling import pooling_summary, pooling_table, pools, upper_limit
+from ligwf.analysis.gsd import bins as gsd
+from ligwf.analysis.gsd.pooling import pooling_summary, pooling_table, pools, upper_limit
 from ligwf.scene.settings import AnalysisSettings
 
 
@@ -40,7 +40,7 @@ def test_upper_limit_is_where_the_error_first_leaves_the_band():
     # a bin too sparse to count (< 1 % of the CG1 volume) does not stop the search
     ref2 = np.array([0.5, 0.495, 0.005, 0.0])
     assert upper_limit(edges, ref2 * [1.0, 1.0, 3.0, 1.0], ref2, 0.15) == 4.0
-    # the lower limit of ligwf.analysis.gsd is the mirror image
+    # the lower limit of ligwf.analysis.gsd.bins is the mirror image
     assert gsd.located_limit(edges, ref * [1.5, 1.0, 1.0, 1.0], ref, 0.15) == 2.0
 
 

@@ -1,11 +1,11 @@
-"""The ``auto`` steady window on signals with a known spin-up (ligwf.analysis.steady)."""
+"""The ``auto`` steady window on signals with a known spin-up (ligwf.analysis.flow.steady)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from ligwf.analysis.steady import FALLBACK_FRACTION, auto_fraction, settled_index
+from ligwf.analysis.flow.steady import FALLBACK_FRACTION, auto_fraction, settled_index
 
 
 def spin_up(n: int, settle: int, seed: int) -> np.ndarray:

@@ -61,8 +61,8 @@ def test_the_bed_the_preflight_says_will_not_flow_turns_as_a_block(tmp_path):
     a block); the other never turns rigidly and always has an angle of repose. (Measured:
     the warned bed climbs to 66 deg as one block, breaks, and turns rigidly again in the
     last 5 of 10 frames; the other stays at <= 0.85 rigid, 20-62 deg.)"""
-    from ligwf.analysis.dumps import read_particles
-    from ligwf.analysis.flow import DrumGeometry, frame_flow
+    from ligwf.analysis.frames.dumps import read_particles
+    from ligwf.analysis.flow.frame import DrumGeometry, frame_flow
     from ligwf.study.study import Study
 
     out = tmp_path / "study"

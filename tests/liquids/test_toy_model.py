@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from pathlib import Path
 
-from ligwf.analysis.dumps import ContactFrame, ParticleFrame
-from ligwf.analysis.granules import BondCriterion, Liquid, identify_fast, identify_reference
+from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
+from ligwf.analysis.granules.bonds import BondCriterion, Liquid, identify_fast, identify_reference
 from ligwf.engine.render import render
 from ligwf.errors import ConfigError
 from ligwf.scene.scaling import Rule

@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from helpers import ROOT
-from ligwf.analysis.dumps import read_particles
-from ligwf.analysis.flow import DrumGeometry, cross_section, rising_side
-from ligwf.analysis.surface import SurfaceFit, fit_surface
+from ligwf.analysis.frames.dumps import read_particles
+from ligwf.analysis.flow.frame import DrumGeometry, cross_section, rising_side
+from ligwf.analysis.flow.surface import SurfaceFit, fit_surface
 from ligwf.cli.main import main
 from ligwf.study.case import CaseFolder
 

@@ -9,7 +9,7 @@ import json
 import pandas as pd
 import pytest
 
-from ligwf.analysis.control_verdict import verdict
+from ligwf.analysis.granules.control_verdict import verdict
 from ligwf.cli.main import main
 
 from helpers import ROOT
@@ -80,9 +80,9 @@ def test_held_gsd_is_invariant_to_tiling(study):
 
     import numpy as np
 
-    from ligwf.analysis import gsd
-    from ligwf.analysis.control_run import load_series
-    from ligwf.analysis.persistent import Frame, bridge_keys, persistent_labels
+    from ligwf.analysis.gsd import bins as gsd
+    from ligwf.analysis.granules.control_run import load_series
+    from ligwf.analysis.granules.persistent import Frame, bridge_keys, persistent_labels
     from helpers import tiled
 
     series = load_series(study / "cg1-none-r0")

@@ -1,6 +1,6 @@
 """The flow record: what the analysis stage measured of the flow, per case, for the report.
 
-Written once by ``ligwf analyse`` (:mod:`ligwf.analysis.flow_run`) into the analysis
+Written once by ``ligwf analyse`` (:mod:`ligwf.analysis.flow.stage`) into the analysis
 folder (``layout.FLOW_PROFILES``, with the flow table ``layout.FLOW_TABLE`` beside it) and
 listed with its digest in the analysis record. Per case: its steady window (the one the
 GSD, kinetics and controls used), the specifications of the metrics

@@ -1,6 +1,6 @@
 """What a reader needs to know about a metric: its column, label, series, statistic, range.
 
-A flow metric is registered once in :mod:`ligwf.analysis.flow_metrics` (its per-frame
+A flow metric is registered once in :mod:`ligwf.analysis.flow.registry` (its per-frame
 function and this specification); the analysis writes the specifications of every
 registered metric into the flow record, so the report builds its case and condition
 tables, intervals, noise floors and CG1 errors from the record and needs no list of its

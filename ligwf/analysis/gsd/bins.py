@@ -2,7 +2,7 @@
 
 Sizes are granule volumes (m^3) -- physical, NOT divided by n^3: a CG-n bed holds the
 same solid volume as the CG1 bed, and a CG-neutral granule definition (the default CPM
-communities, :mod:`ligwf.analysis.definitions`) gives the same granule volumes at every
+communities, :mod:`ligwf.analysis.granules.definitions`) gives the same granule volumes at every
 level (measured CG2/CG1 d50 = 1.00), so CG-n and CG1 share one axis. (The granule table
 keeps ``primary_volume`` = volume / n^3 for whoever wants that convention; under it the
 same physical granule looks n^3 smaller at CG-n.) Only granules of at least
@@ -102,7 +102,7 @@ def band_misses(cg: np.ndarray, ref: np.ndarray, error_band: float,
     """Per row of ``cg`` / ``ref`` (volume-weighted GSDs, (..., bins)): the used bins (those
     holding at least ``min_share`` of the CG1 volume) and, for each, whether
     |cg - ref| > ``error_band`` x ref -- the test both size limits read (this one and
-    :func:`ligwf.analysis.gsd_pooling.upper_limit`)."""
+    :func:`ligwf.analysis.gsd.pooling.upper_limit`)."""
     out = []
     for c, f in zip(np.atleast_2d(cg), np.atleast_2d(ref)):
         used = np.flatnonzero(f >= min_share)

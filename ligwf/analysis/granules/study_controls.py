@@ -4,8 +4,8 @@ A workflow with ``sweep.controls: [cohesionless]`` runs, beside each case at the
 CG levels, a twin with surface tension and viscosity / 1000 (``ligwf.scene.workflow``).
 :func:`study_controls` pairs each twin with its wet case (same sweep values, CG level,
 rule and replica), measures both with the study's granule definition and the candidate
-definitions (:mod:`ligwf.analysis.control_run`), and judges every definition by the
-pre-registered criteria (:mod:`ligwf.analysis.control_verdict`). The table it returns is
+definitions (:mod:`ligwf.analysis.granules.control_run`), and judges every definition by the
+pre-registered criteria (:mod:`ligwf.analysis.granules.control_verdict`). The table it returns is
 ``analysis/controls.csv``; the report prints it beside the GSD with the verdict sentence.
 """
 
@@ -15,8 +15,8 @@ import json
 
 import pandas as pd
 
-from ligwf.analysis.control_run import DEFAULT_CANDIDATES, control_rows, load_series, summarise
-from ligwf.analysis.control_verdict import verdict
+from ligwf.analysis.granules.control_run import DEFAULT_CANDIDATES, control_rows, load_series, summarise
+from ligwf.analysis.granules.control_verdict import verdict
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.case import CaseFolder
 

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ligwf import liquids
-from ligwf.analysis.dumps import ContactFrame, ParticleFrame
+from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.liquids.base import LiquidModel
 from ligwf.scene.scaling import ScaledScene

@@ -10,7 +10,7 @@ and a patch has not is a history: its bridges hold while the bed around it moves
 when the same pair is bridged (gap below the engine's rupture distance, F > 0) in every
 frame of it; granules at t are the connected components of those bridges, unwrapped and
 tested for percolation along the periodic axis like any other granules
-(:func:`ligwf.analysis.granules.components`). ``passage_speed`` (optional) keeps only the
+(:func:`ligwf.analysis.granules.bonds.components`). ``passage_speed`` (optional) keeps only the
 bridges of which a partner moved faster than that relative to the drum's rigid rotation
 in some frame of the window: contacts of the co-rotating plug then do not count until they
 have been through the flowing layer, where a bed without cohesion loses them.
@@ -25,9 +25,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ligwf.analysis.definitions import Motion, drum_frame_velocities
-from ligwf.analysis.dumps import ContactFrame, ParticleFrame
-from ligwf.analysis.granules import BondCriterion, Identification, Liquid, bonded_contacts, components
+from ligwf.analysis.granules.definitions import Motion, drum_frame_velocities
+from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
+from ligwf.analysis.granules.bonds import BondCriterion, Identification, Liquid, bonded_contacts, components
 
 #: every bridge the engine still holds counts (no force or velocity-angle filter)
 ALL_BRIDGES = BondCriterion(0.0, 180.0)

@@ -20,7 +20,7 @@ frames and report the same reasons:
   dump of the same step: each pair's overlap equals r_i + r_j minus the distance of the
   two centres (nearest periodic image). Permuted ids, a contact dump of another frame or
   flipped bits in positions fail these; flipped bits elsewhere fail the record or the
-  value range LIGGGHTS wrote into the array header (:mod:`ligwf.analysis.vtu`).
+  value range LIGGGHTS wrote into the array header (:mod:`ligwf.analysis.frames.vtu`).
 """
 
 from __future__ import annotations
@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ligwf.analysis.dumps import ContactFrame, FrameFiles, ParticleFrame, dump_files, read_particles
-from ligwf.analysis.granules import AXES
+from ligwf.analysis.frames.dumps import ContactFrame, FrameFiles, ParticleFrame, dump_files, read_particles
+from ligwf.analysis.granules.bonds import AXES
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study.case import CaseFolder, DumpRecord
 

@@ -1,7 +1,7 @@
 """The granule controls of one run: every candidate definition, measured by the same code.
 
 For each start frame t of the steady window and each definition, :func:`control_rows`
-gives the granules at t and measures them (:mod:`ligwf.analysis.controls`): share of the
+gives the granules at t and measures them (:mod:`ligwf.analysis.granules.controls`): share of the
 bed in granules of >= 2 and >= 10 particles, granule count, d50, pair persistence after
 ``short_dt`` and after a quarter revolution, co-movement over ``comove_tau`` and whether a
 granule percolates; for definitions with an optimiser or an order dependence, the adjusted
@@ -19,14 +19,14 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.case_granules import RunFacts
-from ligwf.analysis.controls import (adjusted_rand_index, bed_share, comovement, granule_count,
+from ligwf.analysis.granules.case import RunFacts
+from ligwf.analysis.granules.controls import (adjusted_rand_index, bed_share, comovement, granule_count,
                                      granule_sizes, pair_persistence, volume_d50)
-from ligwf.analysis.definitions import identify_granules
-from ligwf.analysis.dumps import ContactFrame, read_contacts, read_particles
-from ligwf.analysis.frame_checks import plan_frames
-from ligwf.analysis.granules import Identification
-from ligwf.analysis.persistent import Frame, bridge_keys, persistent_labels
+from ligwf.analysis.granules.definitions import identify_granules
+from ligwf.analysis.frames.dumps import ContactFrame, read_contacts, read_particles
+from ligwf.analysis.frames.checks import plan_frames
+from ligwf.analysis.granules.bonds import Identification
+from ligwf.analysis.granules.persistent import Frame, bridge_keys, persistent_labels
 from ligwf.errors import DumpReadError
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.case import CaseFolder

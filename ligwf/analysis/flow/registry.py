@@ -13,7 +13,7 @@ passed its checks, keeps the steady window's values per case in the flow record 
 metric's specification (:mod:`ligwf.analysis.records`), and the report shows every metric
 of the record in its case and condition tables with its interval (and, for an error
 statistic, against the CG1 noise floor) -- nothing else to edit. The function gets the
-frame's built-in flow quantities (``flow``, :class:`~ligwf.analysis.flow.FrameFlow`: the
+frame's built-in flow quantities (``flow``, :class:`~ligwf.analysis.flow.frame.FrameFlow`: the
 surface fit, profile, ...) so it need not fit the surface again. A metric may instead
 summarise a series already registered (no function: angle std from ``angle``), and an
 error statistic compares a series' mean with the CG1 cases' (angle and profile errors).
@@ -25,8 +25,8 @@ from typing import Callable
 
 import numpy as np
 
-from ligwf.analysis.dumps import ParticleFrame
-from ligwf.analysis.flow import RIGID_FRAME_SHARE, DrumGeometry, FrameFlow
+from ligwf.analysis.frames.dumps import ParticleFrame
+from ligwf.analysis.flow.frame import RIGID_FRAME_SHARE, DrumGeometry, FrameFlow
 from ligwf.analysis.records import statistics as st
 from ligwf.analysis.records.metrics import CASE_TABLE, POSITIVE, UNIT, MetricSpec
 

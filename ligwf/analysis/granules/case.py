@@ -6,7 +6,7 @@ fills ``results``. What it needs to know about the run that wrote the frames is 
 :class:`RunFacts`: for a ligwf case it comes from the case's scaled scene
 (:meth:`RunFacts.of_case`), and the frames are also checked against the run (its dump
 record, particle count and ids, radii, drum, contact geometry:
-:mod:`ligwf.analysis.frame_checks`); for dumps ligwf did not write, the caller states
+:mod:`ligwf.analysis.frames.checks`); for dumps ligwf did not write, the caller states
 every fact (:mod:`ligwf.analysis.foreign`): nothing defaults silently.
 """
 
@@ -19,12 +19,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.dumps import (ContactFrame, FrameFiles, ParticleFrame, read_contacts,
+from ligwf.analysis.frames.dumps import (ContactFrame, FrameFiles, ParticleFrame, read_contacts,
                                   read_particles)
-from ligwf.analysis.persistent import Frame, bridge_keys, held_through, persistent_labels
-from ligwf.analysis.frame_checks import FramePlan, check_contacts, check_particles, plan_frames
-from ligwf.analysis.definitions import Motion, bond_criterion, identify_granules
-from ligwf.analysis.granules import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
+from ligwf.analysis.granules.persistent import Frame, bridge_keys, held_through, persistent_labels
+from ligwf.analysis.frames.checks import FramePlan, check_contacts, check_particles, plan_frames
+from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
+from ligwf.analysis.granules.bonds import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.fsio import atomic_write_bytes
 from ligwf.scene.settings import AnalysisSettings
@@ -100,7 +100,7 @@ class GranuleAnalysis:
 
     ``case``: a :class:`~ligwf.study.case.CaseFolder` or the :class:`RunFacts` of a run.
     ``definition``: the study's analysis settings, whose granule definition is used
-    (:mod:`ligwf.analysis.definitions`).
+    (:mod:`ligwf.analysis.granules.definitions`).
     ``implementation`` is ``"fast"`` (compiled) or ``"reference"`` (numpy, networkx,
     leidenalg).
     ``vtu_dir`` set: write ``granules_<step>.vtu`` per frame there (ParaView series).
@@ -116,7 +116,7 @@ class GranuleAnalysis:
 
     def run(self, frames: list[FrameFiles] | None = None) -> "GranuleAnalysis":
         """Analyse ``frames`` (default: every frame the case's run should have left that is
-        there, :func:`~ligwf.analysis.frame_checks.plan_frames`) and fill ``results``."""
+        there, :func:`~ligwf.analysis.frames.checks.plan_frames`) and fill ``results``."""
         self._prepare()
         if frames is None:
             if self._facts.case is None:
@@ -191,7 +191,7 @@ class GranuleAnalysis:
 
     def _held(self, ff: FrameFiles, particles: ParticleFrame, contacts: ContactFrame):
         """Granules of ``granules: held`` at ``ff``: the bridges present in every frame of
-        [t, t + hold_time] (:func:`ligwf.analysis.persistent.persistent_labels`); the frames
+        [t, t + hold_time] (:func:`ligwf.analysis.granules.persistent.persistent_labels`); the frames
         after ``ff`` come from the run's frame plan (foreign dumps: the frames given to
         :meth:`run`), their bridge keys cached while the frames are analysed in order."""
         f = self._facts

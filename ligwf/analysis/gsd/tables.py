@@ -3,7 +3,7 @@ the binned number- and volume-weighted GSD of the counted granules (>= ``min_par
 members, not percolating) with bootstrap bands, the percolating (bed-spanning) clusters on
 their own (share of the bed, share of frames), and for CG > 1 the comparison with the CG1
 reference of the same group with the size limit located from the data and its bootstrap
-interval (see :mod:`ligwf.analysis.gsd`).
+interval (see :mod:`ligwf.analysis.gsd.bins`).
 
 Input is the granule table of the frames to use (the runner passes the steady window of
 every case); output is what ``gsd.csv`` and ``gsd_summary.csv`` hold.
@@ -18,7 +18,7 @@ from typing import Any, Sequence
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis import gsd as gsdmod
+from ligwf.analysis.gsd import bins as gsdmod
 from ligwf.analysis.records.conditions import CaseLike, Condition, Conditions
 from ligwf.scene.settings import AnalysisSettings
 

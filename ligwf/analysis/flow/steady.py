@@ -76,6 +76,6 @@ def describe(steady_after, fraction: float) -> str:
     """One line for the report: the rule and the fraction it gave."""
     if is_auto(steady_after):
         return (f"auto: {100 * fraction:.0f} % of production left out (measured spin-up, "
-                "ligwf.analysis.steady)")
+                "ligwf.analysis.flow.steady)")
     return f"fixed: {100 * fraction:.0f} % of production left out"
 

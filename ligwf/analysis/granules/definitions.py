@@ -41,10 +41,10 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ligwf.analysis.bridge_law import Liquid, relative_energy, relative_force
-from ligwf.analysis.communities import cpm_labels, cpm_labels_reference
-from ligwf.analysis.dumps import ContactFrame, ParticleFrame
-from ligwf.analysis.granules import (BondCriterion, Identification, bonded_contacts,
+from ligwf.analysis.granules.bridge_law import Liquid, relative_energy, relative_force
+from ligwf.analysis.granules.communities import cpm_labels, cpm_labels_reference
+from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
+from ligwf.analysis.granules.bonds import (BondCriterion, Identification, bonded_contacts,
                                      bonded_contacts_reference, components, identify)
 from ligwf.scene.settings import AnalysisSettings
 
@@ -177,13 +177,13 @@ def identify_granules(particles: ParticleFrame, contacts: ContactFrame, liquid: 
                       definition: AnalysisSettings, cg: float, motion: Motion,
                       implementation: str = "fast") -> Identification:
     """Granules of one frame under ``definition`` (``fast`` or ``reference``: the same
-    granules; for communities the same CPM quality, see :mod:`ligwf.analysis.communities`).
+    granules; for communities the same CPM quality, see :mod:`ligwf.analysis.granules.communities`).
     ``cg``: the case's CG level n (CPM weights)."""
     if implementation not in ("fast", "reference"):
         raise ValueError(f"implementation {implementation!r}: use fast or reference")
     if definition.granules == "held":
         raise ValueError("granules: held needs the frames of its hold window "
-                         "(ligwf.analysis.persistent), not one frame")
+                         "(ligwf.analysis.granules.persistent), not one frame")
     crit = bond_criterion(definition)
     if definition.max_velocity_angle < 180.0 and definition.velocity_frame != "lab":
         particles = replace(particles, velocities=frame_velocities(

@@ -10,11 +10,11 @@ either side. Two limits, because the error can leave the band at either end:
 * ``upper_limit`` (the source study's): the upper edge of the largest bin up to which every
   used bin is within the band (CG-n good BELOW it; nan when the smallest used bin is
   already outside);
-* ``lower_limit`` (:func:`ligwf.analysis.gsd.located_limit`): the lower edge of the
+* ``lower_limit`` (:func:`ligwf.analysis.gsd.bins.located_limit`): the lower edge of the
   smallest bin from which on every used bin is within the band (CG-n good ABOVE it: a CG
   level cannot resolve granules smaller than a few of its own particles).
 
-"Used" bins hold >= :data:`ligwf.analysis.gsd.MIN_BIN_SHARE` of the CG1 granule volume.
+"Used" bins hold >= :data:`ligwf.analysis.gsd.bins.MIN_BIN_SHARE` of the CG1 granule volume.
 The same comparison of one CG1 replica against the others (K = 1, rule ``noise floor``)
 gives the errors CG1 makes against itself: a CG error within them is not a CG error.
 """
@@ -27,7 +27,7 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis import gsd as gsdmod
+from ligwf.analysis.gsd import bins as gsdmod
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.analysis.records.conditions import CaseLike, Conditions
 

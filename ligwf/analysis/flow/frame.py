@@ -4,7 +4,7 @@ Everything is measured in the drum cross-section (coordinates u horizontal, v up
 is averaged out). Per frame:
 
 - free surface and dynamic angle of repose: a robust straight-line fit of the surface
-  (:mod:`ligwf.analysis.surface`: centre-of-mass first guess, strip tops across the
+  (:mod:`ligwf.analysis.flow.surface`: centre-of-mass first guess, strip tops across the
   central chord with airborne particles skipped, MAD outlier rejection), the angle signed
   with respect to the rotation (positive: rising towards the wall that moves up), degrees.
 - bed centre-of-mass angle: angle of the bed's centre of mass from straight down, degrees.
@@ -20,13 +20,13 @@ is averaged out). Per frame:
   x (omega R) of the drum's rigid rotation omega x r. A frame with more than 90 % of the
   bed co-rotating is a *rigid frame* (the bed is carried up as one block: slumping).
 - rms speed of the bed (its fluctuation over time is large when the bed slumps) and the
-  kinetic energy per unit mass (the spin-up signal of :mod:`ligwf.analysis.steady`).
+  kinetic energy per unit mass (the spin-up signal of :mod:`ligwf.analysis.flow.steady`).
 
 Over frames: mean and standard deviation of each scalar, the share of rigid frames, and a
 velocity field on a grid of the cross-section averaged over frames.
 Granule-derived quantities (largest granule fraction, share of frames in which one
 granule holds > 99 % of the bed) come from the granule stage and are merged by the report.
-The report's flow metrics are registered in :mod:`ligwf.analysis.flow_metrics`.
+The report's flow metrics are registered in :mod:`ligwf.analysis.flow.registry`.
 """
 
 from __future__ import annotations
@@ -36,9 +36,9 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ligwf.analysis.dumps import ParticleFrame
+from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.analysis.records.statistics import relative_l2
-from ligwf.analysis.surface import fit_surface
+from ligwf.analysis.flow.surface import fit_surface
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
 

@@ -6,14 +6,14 @@ kinetics, the controls and the report use (computed once, from one read of the
 production frames). Only the steady part of the production phase counts: frames from the
 study's ``steady_after`` on (a fraction of the production time,
 :meth:`ligwf.study.case.CaseFolder.steady_start_step`; or ``auto``: from the bed's
-measured spin-up, :mod:`ligwf.analysis.steady`, on every production frame). Frames are
-checked as the granule analysis checks them (:mod:`ligwf.analysis.frame_checks`:
+measured spin-up, :mod:`ligwf.analysis.flow.steady`, on every production frame). Frames are
+checked as the granule analysis checks them (:mod:`ligwf.analysis.frames.checks`:
 expected steps, dump record, particle count, ids, radii, drum); refused and missing ones
 are listed per case with their reasons, never used. Every series registered in
-:mod:`ligwf.analysis.flow_metrics` is evaluated on every checked production frame.
+:mod:`ligwf.analysis.flow.registry` is evaluated on every checked production frame.
 
 Outputs (staged with the granule tables, names in :mod:`ligwf.study.layout`): the flow
-table (one row per case: steady window, the :class:`~ligwf.analysis.flow.FlowSummary`
+table (one row per case: steady window, the :class:`~ligwf.analysis.flow.frame.FlowSummary`
 scalars and the value of every registered metric) and the flow record
 (:class:`~ligwf.analysis.records.flow.FlowRecord`).
 """
@@ -25,12 +25,12 @@ import os
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis import flow_metrics
-from ligwf.analysis.dumps import read_particles
-from ligwf.analysis.flow import DrumGeometry, frame_flow, summarise, velocity_field
-from ligwf.analysis.frame_checks import check_particles, plan_frames
+from ligwf.analysis.flow import registry as flow_metrics
+from ligwf.analysis.frames.dumps import read_particles
+from ligwf.analysis.flow.frame import DrumGeometry, frame_flow, summarise, velocity_field
+from ligwf.analysis.frames.checks import check_particles, plan_frames
 from ligwf.analysis.records.flow import CaseFlow, FlowRecord
-from ligwf.analysis.steady import auto_fraction, is_auto
+from ligwf.analysis.flow.steady import auto_fraction, is_auto
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study.case import CaseFolder
 
@@ -38,7 +38,7 @@ from ligwf.study.case import CaseFolder
 def steady_fraction(case: CaseFolder, steady_after, flows: list) -> float:
     """The steady window as a fraction of production: the fixed setting, or for ``auto``
     the measured spin-up of the flow angle and the kinetic energy (``flows`` are the
-    production frames' :class:`~ligwf.analysis.flow.FrameFlow`)."""
+    production frames' :class:`~ligwf.analysis.flow.frame.FrameFlow`)."""
     if not is_auto(steady_after):
         return float(steady_after)
     dt = case.scaled.dt

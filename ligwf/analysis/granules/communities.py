@@ -1,9 +1,9 @@
 """Granules as communities of the bonded graph: CPM (the default granule definition, see
-:mod:`ligwf.analysis.definitions`; compiled Louvain, its plain-Python reference giving the
+:mod:`ligwf.analysis.granules.definitions`; compiled Louvain, its plain-Python reference giving the
 same partition, igraph's Leiden and leidenalg as independent optimisers compared by
 quality) and modularity Louvain (an extra label), canonical labels.
 
-An alternative to the connected components of :mod:`ligwf.analysis.granules` (which
+An alternative to the connected components of :mod:`ligwf.analysis.granules.bonds` (which
 over-merge a dense wet bed into one cluster), stored next to them on request
 (``ligwf analyse --louvain``).
 """
@@ -39,7 +39,7 @@ def louvain_labels(n: int, i: np.ndarray, j: np.ndarray, force: np.ndarray,
     whereas communities split it where bridges are weak relative to the rest. Weights are
     forces normalised by their mean (N / N), so the result does not depend on the CG rule's
     force scale. Labels are canonical like
-    :func:`ligwf.analysis.granules.label_fast`; singletons stay singletons.
+    :func:`ligwf.analysis.granules.bonds.label_fast`; singletons stay singletons.
     """
     import networkx as nx
 

@@ -1,7 +1,7 @@
 """Does a granule definition beat its null control? The pre-registered criteria, as code.
 
 The criteria (docs/results/granule_definitions.md, "Pre-registered pass criteria") compare
-the control measures of a wet bed (:func:`ligwf.analysis.control_run.summarise`, one row)
+the control measures of a wet bed (:func:`ligwf.analysis.granules.control_run.summarise`, one row)
 with those of its cohesionless twin (the same scene with surface tension and viscosity /
 1000). :func:`verdict` returns each criterion with its numbers and one sentence a report
 can print: a definition that fails any of them finds a tiling or a plug, not granules, and

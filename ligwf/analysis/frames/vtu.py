@@ -1,4 +1,4 @@
-"""VTU (VTK XML unstructured grid) reading for the dump readers of :mod:`ligwf.analysis.dumps`.
+"""VTU (VTK XML unstructured grid) reading for the dump readers of :mod:`ligwf.analysis.frames.dumps`.
 
 Two readers return the same :class:`VtuData`: meshio (the reference; it reads every VTU
 flavour) and a direct decoder for what LIGGGHTS writes (``dump_modify binary yes``: inline

@@ -3,14 +3,14 @@
 Kinetics: per case and frame (every analysed frame, start-up included: growth is what is
 watched) the granule count, d10/d50/d90 (m, volume-equivalent diameters of the counted
 granules: >= ``min_particles`` members, not percolating), the largest counted granule and
-the bed shares in counted and in percolating granules (:func:`ligwf.analysis.gsd.frame_stats`);
+the bed shares in counted and in percolating granules (:func:`ligwf.analysis.gsd.bins.frame_stats`);
 per condition the mean over replicas with a bootstrap band over replicas (zero width with
 one replica: the band is the replica spread, not frame noise) and the ratio of CG-n to the
 CG1 condition of its group at the nearest time. Volumes are physical, as in the GSD
-(:mod:`ligwf.analysis.gsd`: a CG-neutral definition gives CG-n granules of CG1 volume).
+(:mod:`ligwf.analysis.gsd.bins`: a CG-neutral definition gives CG-n granules of CG1 volume).
 
 Sensitivity: one set of steady frames analysed again under each variant of the definition
-(:func:`ligwf.analysis.definitions.variants`: every threshold x0.8 and
+(:func:`ligwf.analysis.granules.definitions.variants`: every threshold x0.8 and
 x1.25), so a user sees how much granule count, d50 and the largest granule depend on them.
 """
 
@@ -22,14 +22,14 @@ from typing import Sequence
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis import gsd as gsdmod
-from ligwf.analysis.case_granules import GranuleAnalysis, RunFacts
-from ligwf.analysis.definitions import variants
-from ligwf.analysis.dumps import FrameFiles
+from ligwf.analysis.gsd import bins as gsdmod
+from ligwf.analysis.granules.case import GranuleAnalysis, RunFacts
+from ligwf.analysis.granules.definitions import variants
+from ligwf.analysis.frames.dumps import FrameFiles
 from ligwf.analysis.records.conditions import REFERENCE_CG, CaseLike, Condition
 from ligwf.scene.settings import AnalysisSettings
 
-#: Per-frame quantities (see :func:`ligwf.analysis.gsd.frame_stats`)
+#: Per-frame quantities (see :func:`ligwf.analysis.gsd.bins.frame_stats`)
 QUANTITIES = ("granules", "d10", "d50", "d90", "largest_granule", "granule_share",
               "percolating_share")
 

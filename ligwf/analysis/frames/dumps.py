@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from ligwf.analysis.dumps_numba import first_of_each_pair
-from ligwf.analysis.vtu import piece_counts, read_vtu
+from ligwf.analysis.frames.vtu import piece_counts, read_vtu
 from ligwf.errors import DumpReadError
 
 PARTICLE_ARRAYS = ("id", "type", "v", "radius")
@@ -127,7 +127,7 @@ def discover_frames(case_dir: Path) -> list[FrameFiles]:
 
     A particle dump without its contact dump is listed with ``contacts=None`` (a dry run
     or a run without granule analysis); a contact dump without particles is ignored here
-    (:func:`ligwf.analysis.frame_checks.plan_frames` reports it).
+    (:func:`ligwf.analysis.frames.checks.plan_frames` reports it).
     """
     parts, contacts = dump_files(case_dir)
     return [FrameFiles(step, parts[step], contacts.get(step)) for step in sorted(parts)]
