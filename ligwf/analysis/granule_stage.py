@@ -15,6 +15,7 @@ from __future__ import annotations
 import io
 import json
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -27,8 +28,23 @@ from ligwf.analysis.gsd.kinetics import kinetics_summary, kinetics_table, sensit
 from ligwf.analysis.outputs import OutputSet
 from ligwf.analysis.records.conditions import CaseLike, Conditions
 from ligwf.analysis.granules.study_controls import control_pairs, study_controls
+from ligwf.errors import LigwfError
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
+
+
+class NothingAnalysed(LigwfError):
+    """No frame of any case could be analysed; the previous outputs were kept."""
+
+
+def nothing_analysed(where: Path, skipped_cases: list[dict], skipped_frames: list[dict]) -> NothingAnalysed:
+    """The one-line refusal when no frame could be analysed (first reason included)."""
+    first = (skipped_frames or skipped_cases or [{"reason": "no case and no frame"}])[0]
+    return NothingAnalysed(
+        f"nothing analysed in {where}: {len(skipped_cases)} case(s) skipped, "
+        f"{len(skipped_frames)} frame(s) missing or refused; first: "
+        f"{first.get('case_id', '')} {first['reason']}; previous outputs kept")
+
 
 #: replica pool sizes of the GSD pooling table (ensembles: the source study's fix)
 POOL_SIZES = (1, 2, 4, 8)

@@ -17,7 +17,7 @@ case. A usable case whose run holds no granule data by design (a dry scene, or
 lists it under ``granules_absent`` with the reason in words, and when every usable case
 is one, the record is written without granule tables (the flow stage and the report use
 those cases all the same). When nothing at all could be analysed otherwise,
-:class:`NothingAnalysed` is raised and the previous outputs stay as they were; a frame
+:class:`~ligwf.analysis.granule_stage.NothingAnalysed` is raised and the previous outputs stay as they were; a frame
 the analysis fails on for any reason is a skipped frame (one bad frame never blocks the
 others). Otherwise the outputs are replaced as one set
 (:class:`~ligwf.analysis.outputs.OutputSet`). The science settings (bond criterion, GSD
@@ -60,21 +60,17 @@ from ligwf.analysis.frames.dumps import FrameFiles
 from ligwf.analysis.flow.stage import flow_cases, flow_record, flow_table
 from ligwf.analysis.frames.checks import FramePlan, plan_frames
 from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
-                                          stage_granules)
+                                          nothing_analysed, stage_granules)
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.provenance import study_provenance
-from ligwf.errors import ConfigError, LigwfError
+from ligwf.errors import ConfigError
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.case import granules_absent
 from ligwf.study.study import Study
 
-__all__ = ["AnalysisOptions", "GranuleAnalysis", "NothingAnalysed", "analyse"]
-
-class NothingAnalysed(LigwfError):
-    """No frame of any case could be analysed; the previous outputs were kept."""
-
+__all__ = ["AnalysisOptions", "analyse"]
 
 def _mpi_comm():
     """MPI.COMM_WORLD when started under mpirun with more than one rank, else None."""
@@ -179,15 +175,6 @@ def analyse_frame(ana: GranuleAnalysis, ff: FrameFiles) -> FrameResult:
         return FrameResult(f.case_id, ff.step, ff.step * f.dt,
                            error=f"{ff.particles}: analysis failed on this frame "
                                  f"({type(exc).__name__}: {exc})")
-
-
-def nothing_analysed(where: Path, skipped_cases: list[dict], skipped_frames: list[dict]) -> NothingAnalysed:
-    """The one-line refusal when no frame could be analysed (first reason included)."""
-    first = (skipped_frames or skipped_cases or [{"reason": "no case and no frame"}])[0]
-    return NothingAnalysed(
-        f"nothing analysed in {where}: {len(skipped_cases)} case(s) skipped, "
-        f"{len(skipped_frames)} frame(s) missing or refused; first: "
-        f"{first.get('case_id', '')} {first['reason']}; previous outputs kept")
 
 
 def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipped_cases,

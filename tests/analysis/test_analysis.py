@@ -15,7 +15,9 @@ import pandas as pd
 import pytest
 
 from ligwf.analysis.frames.dumps import discover_frames, read_particles
-from ligwf.analysis.runner import AnalysisOptions, GranuleAnalysis, NothingAnalysed, analyse
+from ligwf.analysis.granule_stage import NothingAnalysed
+from ligwf.analysis.granules.case import GranuleAnalysis
+from ligwf.analysis.runner import AnalysisOptions, analyse
 from ligwf.cli.main import main
 from ligwf.study.case import CaseFolder
 from ligwf.scene.settings import AnalysisSettings
