@@ -71,8 +71,8 @@ def print_record(record: dict, out: Path) -> None:
     analysed = sum(c["analysed"] for c in record["cases"])
     print(f"analysed {analysed} frame(s) of {len(record['cases'])} case(s) -> {out}")
     for s in record.get("granules_absent", []):
-        print(f"granules not analysed for {s['case_id']}: {s['reason']} (flow metrics: "
-              "`ligwf report`)")
+        print(f"granules not analysed for {s['case_id']}: {s['reason']} (its flow metrics "
+              "are)")
     for s in record["skipped_cases"]:
         print(f"skipped case {s['case_id']}: {s['reason']}", file=sys.stderr)
     for s in record["skipped_frames"]:
