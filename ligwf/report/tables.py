@@ -190,7 +190,8 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats, columns: list[str]
                 fl = stats.floor(ref_ids, col)
                 row[f"{col}_floor"], row[f"{col}_floor_source"] = fl.value, fl.source
                 row[f"{col}_vs_floor"] = ("reference" if cond.is_reference
-                                          else mark(iv[0], fl.value))
+                                          else mark(iv[0], fl.value, iv[1], iv[2],
+                                                    len(ref_ids)))
             else:
                 i = cost_interval(sub[col])
                 iv = (i.value, i.lo, i.hi, i.se_within)

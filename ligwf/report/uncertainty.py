@@ -15,8 +15,12 @@ Noise floor: how far one CG1 run is from another CG1 run of the same scene (othe
 With two or more CG1 replicas it is measured (each CG1 replica against the mean of the
 others, the largest of these); with one it is estimated from that run's within-run noise
 (the 95th percentile of the error between two independent block-bootstrap resamples of
-the run). A CG error at or below the floor is marked ``within`` (indistinguishable from
-seed noise), above it ``beyond``.
+the run), and that floor is labelled *indicative*. The floor decides only where the error's
+interval does (:func:`mark`): ``beyond`` when the whole interval lies above the floor (a CG
+effect), ``within`` when the whole interval lies at or below it (indistinguishable from
+seed noise), otherwise ``undecided``, with the number of CG1 replicas that would decide
+it. (Marking the point value against the floor called an error "beyond" whose interval
+held 0, and a resumed run of the same study "within".)
 """
 
 from __future__ import annotations
@@ -75,7 +79,7 @@ class Floor:
     """CG1-vs-CG1 noise floor of one error metric."""
 
     value: float
-    source: str   # "measured over N CG1 replicas" | "estimated from 1 CG1 run" | "none"
+    source: str   # "measured over N CG1 replicas" | "indicative: estimated from 1 CG1 run" | "none"
 
 
 class ConditionStats:
@@ -132,7 +136,7 @@ class ConditionStats:
         e = np.asarray(error(a, b), float)
         e = e[np.isfinite(e)]
         return Floor(float(np.quantile(e, 0.95)) if len(e) else math.nan,
-                     "estimated from 1 CG1 run (within-run noise)")
+                     "indicative: estimated from 1 CG1 run (within-run noise)")
 
     def scatter(self, ref_ids, col) -> tuple[float, str]:
         """CG1-vs-CG1 scatter of a frame metric: std over CG1 replicas, or with one CG1
@@ -152,8 +156,41 @@ def cost_interval(values: pd.Series) -> Interval:
     return positive_replica_interval(values.to_numpy(float))
 
 
-def mark(error: float, floor: float) -> str:
-    """``within`` / ``beyond`` the noise floor (``–`` when either is unknown)."""
+#: The most CG1 replicas :func:`mark` suggests; more means the error sits on the floor.
+MAX_SUGGESTED_REPLICAS = 64
+
+
+def replicas_to_decide(error: float, lo: float, hi: float, floor: float,
+                       cg1_replicas: int) -> int | None:
+    """CG1 replicas that would make the interval [lo, hi] of ``error`` clear the floor,
+    assuming its half-width is the CG1 reference's noise and shrinks as 1 / sqrt(replicas):
+    ``ceil(R0 (w / |error - floor|)^2)``, at least one more than now; None when the error
+    sits on the floor (no number of replicas decides)."""
+    gap, half = abs(error - floor), 0.5 * (hi - lo)
+    if gap <= 0.0 or not math.isfinite(half):
+        return None
+    need = math.ceil(max(cg1_replicas, 1) * (half / gap) ** 2 - 1e-9)   # rounding of lo, hi
+    return max(need, cg1_replicas + 1)
+
+
+def mark(error: float, floor: float, lo: float = math.nan, hi: float = math.nan,
+         cg1_replicas: int = 1) -> str:
+    """A CG error against the CG1 noise floor, decided by its 95 % interval [lo, hi]:
+    ``beyond`` (lo > floor), ``within`` (hi <= floor), else ``undecided: ...`` saying what
+    would decide it (``–`` when the error or the floor is unknown). Without an interval
+    (one CG-n replica) nothing is decided."""
     if not (math.isfinite(error) and math.isfinite(floor)):
         return "–"
-    return "within" if error <= floor else "beyond"
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return "undecided: 1 replica, no interval (add CG-n replicas)"
+    if lo > floor:
+        return "beyond"
+    if hi <= floor:
+        return "within"
+    need = replicas_to_decide(error, lo, hi, floor, cg1_replicas)
+    if need is None:
+        return "undecided: the error sits on the floor"
+    if need > MAX_SUGGESTED_REPLICAS:
+        return (f"undecided: the error is close to the floor (over {MAX_SUGGESTED_REPLICAS} "
+                "CG1 replicas would be needed)")
+    return f"undecided: about {need} CG1 replicas would decide"

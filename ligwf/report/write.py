@@ -82,6 +82,8 @@ def _ci(row, col) -> str:
     if mark == "reference":   # CG1's error against itself
         return "reference"
     tail = f" {mark}" if isinstance(mark, str) and mark not in ("–", "reference") else ""
+    if tail.startswith(" undecided"):   # what would decide it: in the noise-floor section
+        tail = " undecided"
     if not (isinstance(m, float) and math.isfinite(m)):
         return _fmt(m)
     if isinstance(lo, float) and math.isfinite(lo):
@@ -95,8 +97,11 @@ def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame, flow: FlowRec
                    ) -> list[str]:
     """The CG1 noise floor: per metric the CG1-vs-CG1 scatter, per error the floor."""
     lines = ["## CG1 noise floor", "",
-             "How far one CG1 run is from another (other seed). An error marked `within` is "
-             "not distinguishable from seed noise; `beyond` is a CG effect.", ""]
+             "How far one CG1 run is from another (other seed). An error is `beyond` the "
+             "floor (a CG effect) when its whole 95 % interval lies above it, `within` (not "
+             "distinguishable from seed noise) when its whole interval lies at or below it, "
+             "and `undecided` otherwise, with the CG1 replicas that would decide it. A floor "
+             "estimated from one CG1 run's own scatter is indicative.", ""]
     if not floors.empty:
         lines += ["| group | metric | CG1 value | CG1 scatter | from |", "|---|---|---|---|---|"]
         for _, r in floors.iterrows():
@@ -165,7 +170,8 @@ def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame, flow: FlowRec
               "autocorrelation time) and replicas, never narrower than the within-run error, "
               "bounded to the quantity's range (ligwf.analysis.records.intervals); run costs: t on the "
               "logarithm over replicas; one replica: no replica interval. GSD bands come from "
-              "the GSD stage. Errors are marked `within` / `beyond` the CG1 noise floor.", ""]
+              "the GSD stage. Errors are marked `within` / `beyond` / `undecided` against the "
+              "CG1 noise floor by their interval (section CG1 noise floor).", ""]
     head = "| CG | rule | replicas | particles | core-s | " + " | ".join(t for _, t in metrics) + " |"
     lines += [head, "|" + "---|" * (5 + len(metrics))]
     for _, r in conditions.iterrows():

@@ -258,6 +258,13 @@ def comparison_warnings(wf: Workflow) -> list[str]:
         return [f"sweep.cg_levels = {shown}: no CG1 case, so no CG-n "
                 "result can be compared with the original size (errors, size limit and "
                 "CG-n/CG1 ratios stay empty); add 1 to sweep.cg_levels to compare"]
+    cg1 = [c.replica for c in wf.cases
+           if c.cg == 1.0 and "control" not in dict(c.varied)]   # twins are not replicas
+    reps = 1 + max(cg1) if cg1 else 0
+    if len(levels) > 1 and reps < 2:
+        return [f"sweep.replicas = {reps} at CG1: the CG1 noise floor comes from one run's own "
+                "scatter (indicative), and CG errors near it stay undecided; 2 or more CG1 "
+                "replicas per group measure it (sweep.replicas: {1: 2, ...})"]
     return []
 
 

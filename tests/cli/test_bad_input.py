@@ -212,6 +212,8 @@ CORPUS: list[Bad] = [
         overrides=("sweep.per_cg={2: {process.run_time: 0.04}}",)),
     Bad("no-cg1-to-compare", ("warning", "sweep.cg_levels = [2, 3]", "no CG1 case"),
         overrides=("sweep.cg_levels=[2, 3]",), command="check", warns=True),
+    Bad("one-cg1-replica", ("warning", "sweep.replicas = 1 at CG1", "indicative", "undecided"),
+        overrides=("sweep.cg_levels=[1, 2]", "sweep.replicas=1"), command="check", warns=True),
     Bad("case-folders-collide", ("sweep.scene.name", "'a b' and 'a-b'", "same case folder"),
         overrides=("sweep.scene.name=['a b', 'a-b']",)),
     Bad("case-folders-collide-signed-zero", ("sweep.scene.particles.rolling_friction",

@@ -105,9 +105,11 @@ def test_condition_rows_one_per_group_level_and_rule():
 
 def test_condition_value_interval_floor_and_mark():
     """CG2 weber: angle 35 with the two replicas' spread widened by sqrt(2): 35 -+ sqrt(2);
-    its error |35 - 30| / 30 = 1/6 is beyond the CG1 floor (each CG1 replica against the
-    mean of the other two, the largest: 33 vs 28.5 -> 4.5 / 28.5 = 0.158); bond's 1/30 is
-    within it. The CG1 row is the reference."""
+    its error |35 - 30| / 30 = 1/6 is above the CG1 floor (each CG1 replica against the
+    mean of the other two, the largest: 33 vs 28.5 -> 4.5 / 28.5 = 0.158) but its interval
+    (replicas at 4/30 and 6/30) holds the floor: undecided, and too close to it for a
+    replica count; bond's 1/30 is below it, from one replica without an interval: undecided
+    too. The CG1 row is the reference."""
     table = condition_rows()
     weber, bond, cg1 = (table.loc[k] for k in [("g", 2.0, "weber"), ("g", 2.0, "bond"),
                                                ("g", 1.0, "none")])
@@ -119,9 +121,10 @@ def test_condition_value_interval_floor_and_mark():
     for row in (weber, bond, cg1):
         assert row["angle_error_floor"] == pytest.approx(floor, rel=1e-13)
         assert row["angle_error_floor_source"] == "measured over 3 CG1 replicas"
-    assert weber["angle_error_vs_floor"] == "beyond"
+    assert weber["angle_error_lo"] < floor < weber["angle_error_hi"]
+    assert weber["angle_error_vs_floor"].startswith("undecided: the error is close to the floor")
     assert bond["angle_error"] == pytest.approx(1.0 / 30.0, rel=1e-13)
-    assert bond["angle_error_vs_floor"] == "within"
+    assert bond["angle_error_vs_floor"] == "undecided: 1 replica, no interval (add CG-n replicas)"
     assert math.isnan(bond["angle_lo"])                  # one replica: no interval
     assert cg1["angle_error_vs_floor"] == "reference"
     assert cg1["angle_error"] == pytest.approx(0.0, abs=1e-15)

@@ -17,7 +17,7 @@ import pytest
 
 from ligwf.analysis.records import statistics as st
 from ligwf.analysis.records.metrics import POSITIVE, UNIT, MetricSpec
-from ligwf.report.uncertainty import ConditionStats, Floor, mark
+from ligwf.report.uncertainty import ConditionStats, Floor, mark, replicas_to_decide
 
 #: 97.5 % point of the standard normal, and of Student's t with 1 degree of freedom
 Z = 1.959963984540054
@@ -46,12 +46,35 @@ def runs(name: str, values: dict[str, np.ndarray]) -> dict[str, dict]:
 
 # -- within / beyond ----------------------------------------------------------------------
 
-@pytest.mark.parametrize("error,floor,expected", [
-    (0.05, 0.10, "within"), (0.10, 0.10, "within"),      # at the floor: not distinguishable
-    (0.1000001, 0.10, "beyond"), (0.0, 0.0, "within"), (1e-9, 0.0, "beyond"),
-    (math.nan, 0.1, "–"), (0.1, math.nan, "–"), (math.inf, 0.1, "–")])
-def test_mark_within_or_beyond_the_floor(error, floor, expected):
-    assert mark(error, floor) == expected
+@pytest.mark.parametrize("error,lo,hi,floor,expected", [
+    (0.05, 0.02, 0.08, 0.10, "within"), (0.10, 0.09, 0.10, 0.10, "within"),   # hi at the floor
+    (0.20, 0.1000001, 0.3, 0.10, "beyond"), (0.0, 0.0, 0.0, 0.0, "within"),
+    (1e-3, 1e-9, 2e-3, 0.0, "beyond"),
+    # the demo's Bond-CG2 angle error 0.0957 [0, 0.338] against its floor: not "beyond"
+    (0.0957, 0.0, 0.338, 0.0336, "undecided"),
+    (0.05, 0.0, 0.2, 0.10, "undecided"),                 # a point within, an interval across
+    (math.nan, 0.0, 1.0, 0.1, "–"), (0.1, 0.0, 1.0, math.nan, "–"), (math.inf, 0, 1, 0.1, "–")])
+def test_the_interval_decides_against_the_floor(error, lo, hi, floor, expected):
+    assert mark(error, floor, lo, hi, 2).split(":")[0] == expected
+
+
+def test_without_an_interval_nothing_is_decided():
+    """One CG-n replica (no replica interval): a point far above or below the floor is
+    still undecided, and the mark says what is missing."""
+    for error in (0.01, 10.0):
+        assert mark(error, 0.1) == "undecided: 1 replica, no interval (add CG-n replicas)"
+
+
+def test_replicas_that_would_decide():
+    """Half-width 0.1, gap 0.05 to the floor, 2 CG1 replicas: 2 (0.1 / 0.05)^2 = 8; an
+    error on the floor cannot be decided; a huge count is not suggested."""
+    assert replicas_to_decide(0.15, 0.05, 0.25, 0.10, 2) == 8
+    assert mark(0.15, 0.10, 0.05, 0.25, 2) == "undecided: about 8 CG1 replicas would decide"
+    assert replicas_to_decide(0.10, 0.0, 0.2, 0.10, 2) is None
+    assert mark(0.10, 0.10, 0.0, 0.2, 2) == "undecided: the error sits on the floor"
+    assert replicas_to_decide(0.101, 0.0, 0.2, 0.10, 2) == 20000
+    assert mark(0.101, 0.10, 0.0, 0.2, 2).startswith("undecided: the error is close to the floor")
+    assert replicas_to_decide(0.3, 0.29, 0.31, 0.10, 3) == 4            # at least one more
 
 
 # -- frame metrics: value and interval ------------------------------------------------------
@@ -217,7 +240,7 @@ def test_floor_estimated_from_one_cg1_run_is_the_95th_percentile_of_its_noise():
     floor = stats_of(runs("angle", {"cg1": x})).floor(["cg1"], "angle_error")
     assert floor.value == pytest.approx(Z * math.sqrt(2) * sigma / (math.sqrt(n) * mu),
                                         rel=0.15)
-    assert floor.source.startswith("estimated from 1 CG1 run")
+    assert floor.source.startswith("indicative: estimated from 1 CG1 run")
 
 
 def test_floor_of_a_noiseless_single_run_is_zero_and_of_none_is_unknown():
@@ -238,7 +261,7 @@ def test_an_error_within_the_measured_floor_is_within():
     near = s.error_metric(["near"], ["a", "b", "c"], "angle_error").value
     far = s.error_metric(["far"], ["a", "b", "c"], "angle_error").value
     assert near == pytest.approx(2.0 / 30.0) and far == pytest.approx(6.0 / 30.0)
-    assert (mark(near, floor.value), mark(far, floor.value)) == ("within", "beyond")
+    assert near < floor.value < far   # the points; their intervals decide the marks
     assert isinstance(floor, Floor)
 
 
