@@ -41,10 +41,9 @@ from pathlib import Path
 from ligwf.engine.attempt import DISK_FULL, finish_attempt, restart_unreadable, stamp_restarts
 from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
 from ligwf.engine.health import log_errors
-from ligwf.engine.guard import (RANK_NAMES, STOP_GRACE_SECONDS, engine_env, engine_tree, release,
-                                watch)
+from ligwf.engine.guard import RANK_NAMES, engine_env, engine_tree, release, watch
 from ligwf.engine.launch import (Monitor, NullMonitor, interrupted_reason, signal_engine,
-                                 take_over)
+                                 stop_engine, take_over)
 from ligwf.engine.restart_id import SETTLE_SECONDS
 from ligwf.engine.resume import SKIP, RestartFile, discard_restart, plan_case
 from ligwf.engine.site import EngineConfig
@@ -242,13 +241,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                     stop_sent = True
                 time.sleep(poll_seconds)
         except BaseException:
-            # ligwf itself is going down: the ranks write their restarts first
-            if proc.poll() is None:
-                signal_engine(proc)
-                try:
-                    proc.wait(timeout=STOP_GRACE_SECONDS)
-                except subprocess.TimeoutExpired:
-                    os.killpg(proc.pid, signal.SIGKILL)
+            stop_engine(proc)   # ligwf itself is going down: the ranks write their restarts first
             raise
         finally:
             release(watchdog)

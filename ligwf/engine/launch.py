@@ -85,6 +85,18 @@ def signal_engine(proc: subprocess.Popen, sig: int = signal.SIGTERM) -> None:
             pass
 
 
+def stop_engine(proc: subprocess.Popen) -> None:
+    """ligwf itself is going down: ask the engine ranks to write their restarts and stop
+    (:func:`signal_engine`), and kill the launcher's process group after
+    ``STOP_GRACE_SECONDS``, so no orphaned engine is left behind (local and ensemble runs)."""
+    if proc.poll() is None:
+        signal_engine(proc)
+        try:
+            proc.wait(timeout=STOP_GRACE_SECONDS)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+
+
 def live_problem(rows: Sequence[ThermoRow], expect: Expectation | None) -> str | None:
     """A reason to stop a run now: nan, atom loss or energy blow-up in the case's rows
     (earlier attempts included), by the rule of the final assessment."""
@@ -147,13 +159,7 @@ def launch(case_dir: Path, command: Sequence[str], case_id: str = "",
             elif time.monotonic() - stop_sent_at > STOP_GRACE_SECONDS:
                 os.killpg(proc.pid, signal.SIGKILL)
     except BaseException:
-        # ligwf itself is going down: never leave an orphaned engine behind
-        if proc.poll() is None:
-            signal_engine(proc)
-            try:
-                proc.wait(timeout=STOP_GRACE_SECONDS)
-            except subprocess.TimeoutExpired:
-                os.killpg(proc.pid, signal.SIGKILL)
+        stop_engine(proc)   # ligwf itself is going down: never leave an orphaned engine behind
         raise
     finally:
         release(watchdog)
