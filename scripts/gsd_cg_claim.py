@@ -49,7 +49,7 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis.gsd import bins as gsd
-from ligwf.analysis.gsd.pooling import pooling_summary, pooling_table
+from ligwf.analysis.gsd.pooling import frame_histograms, pooling_summary, pooling_table
 from ligwf.fsio import atomic_write_bytes, atomic_write_text
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
@@ -105,16 +105,11 @@ def is_twin(case_id: str) -> bool:
 
 def frame_hists(g: pd.DataFrame, edges: np.ndarray, column: str, min_particles: int,
                 replica_of: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
-    """Per-frame volume-weighted histograms (rows) and the replica of each frame."""
-    hists, reps = [], []
-    for (case_id, _), fr in g.groupby(["case_id", "step"], sort=True):
-        keep = gsd.counted(fr["members"].to_numpy(), fr["percolating"].to_numpy(bool),
-                           min_particles)
-        if not keep.any():
-            continue
-        hists.append(gsd.histogram(fr[column].to_numpy()[keep], edges)[1])
-        reps.append(replica_of[case_id])
-    return np.asarray(hists).reshape(-1, len(edges) - 1), np.asarray(reps)
+    """Per-frame volume-weighted histograms (rows) and the replica of each frame, frames
+    without a counted granule left out (their zero rows would not sum to a CDF)."""
+    hists, reps = frame_histograms(g, edges, column, min_particles, replica_of)
+    keep = hists.sum(axis=1) > 0
+    return hists[keep], reps[keep]
 
 
 def distances(cdf_a: np.ndarray, cdf_b: np.ndarray, log_edges: np.ndarray) -> np.ndarray:

@@ -259,7 +259,7 @@ def comparison_warnings(wf: Workflow) -> list[str]:
                 "result can be compared with the original size (errors, size limit and "
                 "CG-n/CG1 ratios stay empty); add 1 to sweep.cg_levels to compare"]
     cg1 = [c.replica for c in wf.cases
-           if c.cg == 1.0 and "control" not in dict(c.varied)]   # twins are not replicas
+           if c.cg == 1.0 and CONTROL_KEY not in dict(c.varied)]   # twins are not replicas
     reps = 1 + max(cg1) if cg1 else 0
     if len(levels) > 1 and reps < 2:
         return [f"sweep.replicas = {reps} at CG1: the CG1 noise floor comes from one run's own "

@@ -18,10 +18,11 @@ import pandas as pd
 from ligwf.analysis.granules.control_run import DEFAULT_CANDIDATES, control_rows, load_series, summarise
 from ligwf.analysis.granules.control_verdict import verdict
 from ligwf.scene.settings import AnalysisSettings
+from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.case import CaseFolder
 
-#: the ``varied`` key and value of a cohesionless twin (ligwf.scene.workflow.CONTROL_KEY)
-CONTROL_KEY, COHESIONLESS = "control", "cohesionless"
+#: the ``varied`` value (under CONTROL_KEY) of a cohesionless twin
+COHESIONLESS = "cohesionless"
 
 
 def _varied(case: CaseFolder) -> dict:

@@ -71,9 +71,10 @@ def _below_upper(edges: np.ndarray, limit: float) -> np.ndarray:
     return np.sqrt(edges[:-1] * edges[1:]) < limit
 
 
-def _frame_hists(g: pd.DataFrame, edges: np.ndarray, column: str, min_particles: int,
+def frame_histograms(g: pd.DataFrame, edges: np.ndarray, column: str, min_particles: int,
                  replica_of: dict[str, int]) -> tuple[np.ndarray, np.ndarray]:
-    """(per-frame volume-weighted histograms, replica per frame) of a granule table."""
+    """(per-frame volume-weighted histograms, replica per frame) of a granule table; a frame
+    without a counted granule has a row of zeros."""
     hists, reps = [], []
     for (case_id, _), fr in g.groupby(["case_id", "step"], sort=True):
         keep = gsdmod.counted(fr["members"].to_numpy(), fr["percolating"].to_numpy(bool),
@@ -130,7 +131,7 @@ def pooling_table(granules: pd.DataFrame, cases: Sequence[CaseLike],
 
     def frames_of(members: list[CaseLike]):
         ids = [c.case_id for c in members]
-        return _frame_hists(granules[granules["case_id"].isin(ids)], edges, col,
+        return frame_histograms(granules[granules["case_id"].isin(ids)], edges, col,
                             settings.min_particles, replica_of)
 
     for cond in conditions.sorted():
