@@ -9,8 +9,9 @@ Per case: CG level, rule, particles, dt, steps, wall and core-seconds split into
 settle and production (the manifest's per-phase times), the production cost per simulated
 second of production (core-s / s: CG levels may simulate different times, and filling
 costs differ), speedup vs CG1 on that footing, and errors vs CG1: angle of repose
-(relative), velocity profile (relative L2 on the normalised depth), GSD error below/above
-the size limit, largest-cluster fraction.
+(relative), velocity profile (relative L2 on the normalised depth), GSD errors below and
+above the lower size limit and over all bins (the limit with them: :data:`GSD_METRICS`),
+largest-cluster fraction.
 Per condition (CG level, rule, group): value with a 95 % interval that respects the data
 (:mod:`ligwf.report.uncertainty`: block bootstrap over frames and replicas, bounded, never
 narrower than the within-run error, none for one replica) and each error against the CG1
@@ -25,6 +26,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ligwf.analysis.gsd.tables import GSD_ERRORS
 from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
@@ -38,8 +40,13 @@ from ligwf.study.study import Study
 COST_METRICS = ["core_seconds", "wall_seconds", "production_core_rate",
                 "production_core_rate_k", "speedup_core", "speedup_wall"]
 PHASES = ("fill", "settle", "production")
-#: Already pooled over replicas by the analysis stage (bootstrap bands), not per case.
-GSD_METRICS = ("gsd_error_below", "gsd_error_above")
+#: ``gsd_summary.csv`` columns -> case / condition table columns (``gsd_`` + the name; each
+#: with ``_lo`` / ``_hi``): already pooled over replicas by the analysis stage (bootstrap
+#: bands), one value per condition. The errors name their limit (the lower one, located
+#: from the data, :data:`ligwf.analysis.gsd.tables.GSD_ERRORS`); ``gsd_lower_limit`` (m^3)
+#: is that limit (nan: none located, every bin below it).
+GSD_SUMMARY = {**{e: f"gsd_{e}" for e in GSD_ERRORS}, "lower_limit": "gsd_lower_limit"}
+GSD_METRICS = tuple(GSD_SUMMARY.values())
 
 
 def metric_columns(flow: FlowRecord) -> list[str]:
@@ -121,8 +128,8 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path, flow: FlowRecord,
         df = df.merge(agg.reset_index(), on="case_id", how="left")
     summary = _read_csv(analysis_dir / layout.GSD_SUMMARY_TABLE) if granules else pd.DataFrame()
     if not summary.empty:
-        cols = {f"error_{side}{sfx}": f"gsd_error_{side}{sfx}"
-                for side in ("below", "above") for sfx in ("", "_lo", "_hi")}
+        cols = {f"{k}{sfx}": f"{v}{sfx}" for k, v in GSD_SUMMARY.items()
+                for sfx in ("", "_lo", "_hi")}
         g = summary[["group", "cg", "rule", *[c for c in cols if c in summary]]].rename(columns=cols)
         g = g.assign(group=g["group"].astype(str))
         df = df.merge(g, on=["group", "cg", "rule"], how="left")
@@ -153,9 +160,9 @@ def compare_to_cg1(df: pd.DataFrame, stats: ConditionStats, errors: list[MetricS
         for kind in ("core", "wall"):
             rate = df[f"production_{kind}_rate"] / size
             df.loc[idx, f"speedup_{kind}"] = rate[ref].mean() / rate[idx]
-        for i in idx:
-            for col in (m.name for m in errors):
-                df.at[i, col] = stats.error_metric([df.at[i, "case_id"]], ref_ids, col).value
+        for col in (m.name for m in errors):   # (a whole column at once: .at would add it)
+            df.loc[idx, col] = [stats.error_metric([cid], ref_ids, col).value
+                                for cid in df.loc[idx, "case_id"]]
     return df
 
 

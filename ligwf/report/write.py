@@ -46,7 +46,10 @@ RUN_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", 
                ("speedup_core", "speedup (core-s)"), ("steady_fraction", "steady from")]
 RUN_METRICS = [("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
                ("speedup_core", "speedup")]
-GSD_COLUMNS = [("gsd_error_below", "GSD err below"), ("gsd_error_above", "GSD err above")]
+GSD_COLUMNS = [("gsd_lower_limit", "GSD lower limit [m^3]"),
+               ("gsd_error_below_lower", "GSD err below lower limit"),
+               ("gsd_error_above_lower", "GSD err above lower limit"),
+               ("gsd_error_all", "GSD err all bins")]
 
 
 def shown(flow: FlowRecord, table: str) -> list[tuple[str, str]]:
@@ -139,8 +142,8 @@ def pooling_markdown(analysis_dir: Path, band: float) -> list[str]:
              f"study's limit; nan: the smallest bin is already outside). Errors: relative L1 "
              f"of the volume-weighted GSD below / above it. K replicas pooled, mean [min, max] "
              f"over disjoint pools; `noise floor`: one CG1 replica against the others.", "",
-             "| condition | rule | K | pools | upper limit [m^3] | error below | error above "
-             "| lower limit [m^3] |", "|---|---|---|---|---|---|---|---|"]
+             "| condition | rule | K | pools | upper limit [m^3] | error below upper limit "
+             "| error above upper limit | lower limit [m^3] |", "|---|---|---|---|---|---|---|---|"]
 
     def cell(r, v):
         m, lo, hi = r[f"{v}_mean"], r[f"{v}_min"], r[f"{v}_max"]

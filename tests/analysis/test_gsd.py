@@ -108,8 +108,8 @@ def test_cg_comparison_identical_gsd_has_zero_error():
     dist, summary = gsd_tables(table[table.case_id != "b"], [c1, c2a, c2b], settings)
     s = summary.set_index("condition")
     row = s.loc["cg2-weber"]
-    assert row["error_above"] == 0 and row["error_band"] == 0.15
-    assert row["size_limit"] == pytest.approx(dist["v_lo"].min())
+    assert row["error_above_lower"] == 0 == row["error_all"] and row["error_band"] == 0.15
+    assert row["lower_limit"] == pytest.approx(dist["v_lo"].min())
     assert row["reference"] == "cg1"
     assert s.loc["cg1", "percolating_frames"] == 1 and row["percolating_frames"] == 0
     total = sum(sizes) + 5000
@@ -121,13 +121,29 @@ def test_cg_comparison_identical_gsd_has_zero_error():
     # with replica b the small sizes are missing: the limit moves up, the error below grows
     dist, summary = gsd_tables(table, [c1, c2a, c2b], settings)
     row = summary.set_index("condition").loc["cg2-weber"]
-    assert row["error_below"] > 0.05 and row["replicas"] == 2 and row["frames"] == 5
-    assert row["size_limit"] > 32 * V1
-    assert row["size_limit_lo"] <= row["size_limit"] <= row["size_limit_hi"]
-    assert row["error_below_lo"] <= row["error_below"] <= row["error_below_hi"]
+    assert row["error_below_lower"] > 0.05 and row["replicas"] == 2 and row["frames"] == 5
+    assert row["lower_limit"] > 32 * V1
+    assert row["lower_limit_lo"] <= row["lower_limit"] <= row["lower_limit_hi"]
+    assert row["error_below_lower_lo"] <= row["error_below_lower"] <= row["error_below_lower_hi"]
+    assert row["error_all_lo"] <= row["error_all"] <= row["error_all_hi"]
     for cond, d in dist.groupby("condition"):
         assert d["volume_fraction"].sum() == pytest.approx(1)
         assert d["number_fraction"].sum() == pytest.approx(1)
+
+
+def test_no_lower_limit_is_stated_not_silently_below():
+    """CG2 granules all in other bins than CG1's: no lower limit is located (nan), every
+    bin is below it (``below_lower_limit``), the error below it is the whole GSD's
+    (``error_all``) and the error above it is nan (no bin there) -- the names say which
+    limit, and the nan case reads as "all bins", not as some finite limit's "below"."""
+    c1, c2 = _case("cg1", 1.0, "none", 0), _case("a", 2.0, "weber", 0)
+    table = pd.concat([_table(c1, 3, [16, 16, 20]), _table(c2, 3, [800, 900])])
+    dist, summary = gsd_tables(table, [c1, c2], AnalysisSettings(bootstrap=50))
+    row = summary.set_index("condition").loc["cg2-weber"]
+    assert math.isnan(row["lower_limit"])
+    assert row["error_below_lower"] == pytest.approx(row["error_all"]) == pytest.approx(2.0)
+    assert math.isnan(row["error_above_lower"])
+    assert dist[dist.condition == "cg2-weber"]["below_lower_limit"].all()
 
 
 def test_primary_volume_convention_bins_volume_over_n3():

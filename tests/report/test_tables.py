@@ -50,9 +50,9 @@ def case_table() -> pd.DataFrame:
                      "production_core_rate": rate, "production_wall_rate": rate / 2,
                      "fill_core_seconds": 1.0, "settle_core_seconds": 2.0,
                      "production_core_seconds": core,
-                     "gsd_error_below": 0.3 if cg == 2 else math.nan,
-                     "gsd_error_below_lo": 0.2 if cg == 2 else math.nan,
-                     "gsd_error_below_hi": 0.5 if cg == 2 else math.nan})
+                     "gsd_error_below_lower": 0.3 if cg == 2 else math.nan,
+                     "gsd_error_below_lower_lo": 0.2 if cg == 2 else math.nan,
+                     "gsd_error_below_lower_hi": 0.5 if cg == 2 else math.nan})
     return pd.DataFrame(rows)
 
 
@@ -90,7 +90,7 @@ def test_case_errors_are_against_the_mean_of_the_groups_cg1_runs():
 def condition_rows() -> pd.DataFrame:
     df = compare_to_cg1(case_table(), stats(), [ANGLE_ERROR])
     table = condition_table(df, stats(), ["core_seconds", "angle", "angle_error",
-                                          "gsd_error_below"])
+                                          "gsd_error_below_lower"])
     return table.set_index(["group", "cg", "rule"])
 
 
@@ -146,8 +146,8 @@ def test_costs_get_a_t_interval_on_the_log_and_gsd_errors_their_own_band():
     assert weber["core_seconds"] == 5.0
     assert weber["core_seconds_lo"] == pytest.approx(4.0 * math.exp(-half), rel=1e-12)
     assert weber["core_seconds_hi"] == pytest.approx(4.0 * math.exp(half), rel=1e-12)
-    assert (weber["gsd_error_below"], weber["gsd_error_below_lo"],
-            weber["gsd_error_below_hi"]) == (0.3, 0.2, 0.5)
+    assert (weber["gsd_error_below_lower"], weber["gsd_error_below_lower_lo"],
+            weber["gsd_error_below_lower_hi"]) == (0.3, 0.2, 0.5)
 
 
 def test_noise_floor_table_cg1_value_and_scatter():
@@ -180,18 +180,18 @@ def test_granule_columns_come_from_the_steady_window_frames_only(tmp_path):
         "status": ["ok", "ok", "ok", "unreadable", "ok", "ok"],
         "largest_fraction": [0.9, 0.2, 1.0, 0.7, 0.3, 0.5]})
     frames.to_csv(tmp_path / layout.FRAMES_TABLE, index=False)
-    pd.DataFrame({"group": ["g"], "cg": [2.0], "rule": ["weber"], "error_below": [0.25],
-                  "error_below_lo": [0.1], "error_below_hi": [0.4]}).to_csv(
+    pd.DataFrame({"group": ["g"], "cg": [2.0], "rule": ["weber"], "error_below_lower": [0.25],
+                  "error_below_lower_lo": [0.1], "error_below_lower_hi": [0.4]}).to_csv(
         tmp_path / layout.GSD_SUMMARY_TABLE, index=False)
-    cases = case_table().drop(columns=["gsd_error_below", "gsd_error_below_lo",
-                                       "gsd_error_below_hi"])
+    cases = case_table().drop(columns=["gsd_error_below_lower", "gsd_error_below_lower_lo",
+                                       "gsd_error_below_lower_hi"])
     df = merge_analysis(cases, tmp_path, _flow_record({"cg1-r0": 100, "cg2-w-r0": 150}))
     df = df.set_index("case_id")
     assert df.at["cg1-r0", "largest_cluster_fraction"] == pytest.approx(0.6)
     assert df.at["cg1-r0", "one_granule_frame_share"] == pytest.approx(0.5)
     assert df.at["cg2-w-r0", "largest_cluster_fraction"] == pytest.approx(0.5)
     assert df.at["cg1-r0", "angle"] == 30.0 and df.at["cg1-r0", "steady_from_step"] == 100
-    assert df.at["cg2-w-r0", "gsd_error_below"] == 0.25
-    assert df.at["cg2-w-r1", "gsd_error_below_hi"] == 0.4
-    assert math.isnan(df.at["cg2-b-r0", "gsd_error_below"])
+    assert df.at["cg2-w-r0", "gsd_error_below_lower"] == 0.25
+    assert df.at["cg2-w-r1", "gsd_error_below_lower_hi"] == 0.4
+    assert math.isnan(df.at["cg2-b-r0", "gsd_error_below_lower"])
     assert math.isnan(df.at["cg3-r0", "largest_cluster_fraction"])

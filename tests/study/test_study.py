@@ -74,8 +74,8 @@ def test_gsd_errors_and_condition_means(study):
         assert c["angle_of_repose"] == pytest.approx(sub["angle_of_repose"].mean())
         if c["cg"] > 1:
             s = summary[(summary["cg"] == c["cg"]) & (summary["rule"] == c["rule"])].iloc[0]
-            assert c["gsd_error_below"] == pytest.approx(s["error_below"], nan_ok=True)
-            assert c["gsd_error_above"] == pytest.approx(s["error_above"], nan_ok=True)
+            for e in ("error_below_lower", "error_above_lower", "error_all", "lower_limit"):
+                assert c[f"gsd_{e}"] == pytest.approx(s[e], nan_ok=True)
             lo, hi = c["angle_of_repose_lo"], c["angle_of_repose_hi"]
             assert lo <= c["angle_of_repose"] <= hi
 

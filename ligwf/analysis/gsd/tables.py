@@ -2,7 +2,7 @@
 the binned number- and volume-weighted GSD of the counted granules (>= ``min_particles``
 members, not percolating) with bootstrap bands, the percolating (bed-spanning) clusters on
 their own (share of the bed, share of frames), and for CG > 1 the comparison with the CG1
-reference of the same group with the size limit located from the data and its bootstrap
+reference of the same group with the lower size limit located from the data and its bootstrap
 interval (see :mod:`ligwf.analysis.gsd.bins`).
 
 Input is the granule table of the frames to use (the runner passes the steady window of
@@ -27,8 +27,17 @@ from ligwf.scene.settings import AnalysisSettings
 GSD_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames", "bin", "v_lo", "v_hi",
                "v_mid", "number_fraction", "number_lo", "number_hi", "volume_fraction",
                "volume_lo", "volume_hi", "ref_volume_fraction", "rel_error", "rel_error_lo",
-               "rel_error_hi", "below_limit"]
-#: Columns of ``gsd_summary.csv`` (one row per condition). ``size_limit`` (m^3) is located
+               "rel_error_hi", "below_lower_limit"]
+#: The GSD errors of ``gsd_summary.csv`` (each with ``_lo`` / ``_hi``): the relative L1
+#: error of the volume-weighted GSD against CG1 below and above the LOWER size limit
+#: (:func:`ligwf.analysis.gsd.bins.located_limit`: CG-n is within the band from it on, so
+#: "below" is the side CG-n does not resolve) and over all bins (no limit). When no lower
+#: limit is located (nan: CG-n never enters the band) every bin is below it, so
+#: ``error_below_lower`` equals ``error_all`` and ``error_above_lower`` is nan. The
+#: pooling table's upper-limit errors are ``error_below_upper`` / ``error_above_upper``
+#: (:mod:`ligwf.analysis.gsd.pooling`): the names say against which limit.
+GSD_ERRORS = ("error_below_lower", "error_above_lower", "error_all")
+#: Columns of ``gsd_summary.csv`` (one row per condition). ``lower_limit`` (m^3) is located
 #: from the data (nan: CG-n never enters the error band, or no CG1 reference);
 #: ``percolating_share``: mean share of the bed in percolating granules, left out of the
 #: GSD; ``percolating_frames``: share of frames holding one; ``granule_share``: mean share
@@ -37,9 +46,9 @@ SUMMARY_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames",
                    *[f"{q}{s}" for q in ("d10", "d50", "d90", "largest_fraction")
                      for s in ("", "_lo", "_hi")],
                    "granule_share", "percolating_share", "percolating_frames",
-                   "size_limit", "size_limit_lo", "size_limit_hi", "error_band",
+                   "lower_limit", "lower_limit_lo", "lower_limit_hi", "error_band",
                    "min_particles", "reference",
-                   *[f"error_{side}{s}" for side in ("below", "above") for s in ("", "_lo", "_hi")]]
+                   *[f"{e}{s}" for e in GSD_ERRORS for s in ("", "_lo", "_hi")]]
 SCALARS = ("d10", "d50", "d90", "largest_granule")
 
 
@@ -95,8 +104,8 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
         refs = [r for r in conditions.references(cond.group) if r in per_cond]
         ref = refs[-1] if refs and not cond.is_reference else None
         rel = rel_lo = rel_hi = ref_vol = np.full(nb, np.nan)
-        err = dict.fromkeys([f"error_{side}{s}" for side in ("below", "above")
-                             for s in ("", "_lo", "_hi")], math.nan)
+        err = dict.fromkeys([f"{e}{s}" for e in GSD_ERRORS for s in ("", "_lo", "_hi")],
+                            math.nan)
         limit = limit_lo = limit_hi = math.nan
         below = np.zeros(nb, dtype=bool)
         if ref is not None:
@@ -110,12 +119,15 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
             limit_lo, limit_hi = gsdmod.band(
                 gsdmod.located_limit(edges, vol_draws, ref_draws, settings.error_band), conf)
             below = gsdmod.below_limit(edges, limit)
-            eb, ea = gsdmod.side_errors(mean_vol, ref_vol, below)
-            eb_d, ea_d = gsdmod.side_errors(vol_draws, ref_draws, below)
-            (eb_lo, ea_lo), (eb_hi, ea_hi) = gsdmod.band(np.column_stack([eb_d, ea_d]), conf)
-            err = {"error_below": float(eb), "error_below_lo": float(eb_lo),
-                   "error_below_hi": float(eb_hi), "error_above": float(ea),
-                   "error_above_lo": float(ea_lo), "error_above_hi": float(ea_hi)}
+            every = np.ones(nb, dtype=bool)
+            values = [*gsdmod.side_errors(mean_vol, ref_vol, below),
+                      gsdmod.side_errors(mean_vol, ref_vol, every)[0]]
+            draws = [*gsdmod.side_errors(vol_draws, ref_draws, below),
+                     gsdmod.side_errors(vol_draws, ref_draws, every)[0]]
+            los, his = gsdmod.band(np.column_stack(draws), conf)
+            err = {}
+            for e, v, lo, hi in zip(GSD_ERRORS, values, los, his):
+                err.update({e: float(v), f"{e}_lo": float(lo), f"{e}_hi": float(hi)})
         n_reps = len(np.unique(rep))
         head = {"condition": cond.name, "group": cond.group, "cg": cond.cg, "rule": cond.rule,
                 "replicas": n_reps, "frames": len(rep)}
@@ -127,7 +139,7 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
                          "volume_lo": vol_lo[b], "volume_hi": vol_hi[b],
                          "ref_volume_fraction": ref_vol[b], "rel_error": rel[b],
                          "rel_error_lo": rel_lo[b], "rel_error_hi": rel_hi[b],
-                         "below_limit": bool(below[b])})
+                         "below_lower_limit": bool(below[b])})
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)     # no granule in any frame
             means = np.nanmean(scalars, axis=0)
@@ -138,8 +150,8 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
                         "granule_share": float(np.mean(d["share"])),
                         "percolating_share": float(perc.mean()),
                         "percolating_frames": float(np.mean(perc > 0)),
-                        "size_limit": limit, "size_limit_lo": float(limit_lo),
-                        "size_limit_hi": float(limit_hi), "error_band": settings.error_band,
+                        "lower_limit": limit, "lower_limit_lo": float(limit_lo),
+                        "lower_limit_hi": float(limit_hi), "error_band": settings.error_band,
                         "min_particles": settings.min_particles,
                         "reference": ref.name if ref is not None else "", **err})
     return pd.DataFrame(rows, columns=GSD_COLUMNS), pd.DataFrame(summary, columns=SUMMARY_COLUMNS)
