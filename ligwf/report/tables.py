@@ -26,9 +26,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.gsd.tables import GSD_ERRORS
 from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.flow import FlowRecord
+from ligwf.analysis.records.gsd import GSD_ERRORS, LOWER_LIMIT
 from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
 from ligwf.analysis.records.statistics import MEAN
 from ligwf.report.uncertainty import (ConditionStats, case_series, cost_interval, mark,
@@ -43,9 +43,9 @@ PHASES = ("fill", "settle", "production")
 #: ``gsd_summary.csv`` columns -> case / condition table columns (``gsd_`` + the name; each
 #: with ``_lo`` / ``_hi``): already pooled over replicas by the analysis stage (bootstrap
 #: bands), one value per condition. The errors name their limit (the lower one, located
-#: from the data, :data:`ligwf.analysis.gsd.tables.GSD_ERRORS`); ``gsd_lower_limit`` (m^3)
+#: from the data, ligwf.analysis.records.gsd); ``gsd_lower_limit`` (m^3)
 #: is that limit (nan: none located, every bin below it).
-GSD_SUMMARY = {**{e: f"gsd_{e}" for e in GSD_ERRORS}, "lower_limit": "gsd_lower_limit"}
+GSD_SUMMARY = {**{e: f"gsd_{e}" for e in GSD_ERRORS}, LOWER_LIMIT: "gsd_lower_limit"}
 GSD_METRICS = tuple(GSD_SUMMARY.values())
 
 

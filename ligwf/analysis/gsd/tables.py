@@ -20,6 +20,8 @@ import pandas as pd
 
 from ligwf.analysis.gsd import bins as gsdmod
 from ligwf.analysis.records.conditions import CaseLike, Condition, Conditions
+# the GSD errors name their limit: ligwf.analysis.records.gsd
+from ligwf.analysis.records.gsd import GSD_ERRORS, LOWER_LIMIT
 from ligwf.scene.settings import AnalysisSettings
 
 
@@ -28,15 +30,6 @@ GSD_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames", "bin", 
                "v_mid", "number_fraction", "number_lo", "number_hi", "volume_fraction",
                "volume_lo", "volume_hi", "ref_volume_fraction", "rel_error", "rel_error_lo",
                "rel_error_hi", "below_lower_limit"]
-#: The GSD errors of ``gsd_summary.csv`` (each with ``_lo`` / ``_hi``): the relative L1
-#: error of the volume-weighted GSD against CG1 below and above the LOWER size limit
-#: (:func:`ligwf.analysis.gsd.bins.located_limit`: CG-n is within the band from it on, so
-#: "below" is the side CG-n does not resolve) and over all bins (no limit). When no lower
-#: limit is located (nan: CG-n never enters the band) every bin is below it, so
-#: ``error_below_lower`` equals ``error_all`` and ``error_above_lower`` is nan. The
-#: pooling table's upper-limit errors are ``error_below_upper`` / ``error_above_upper``
-#: (:mod:`ligwf.analysis.gsd.pooling`): the names say against which limit.
-GSD_ERRORS = ("error_below_lower", "error_above_lower", "error_all")
 #: Columns of ``gsd_summary.csv`` (one row per condition). ``lower_limit`` (m^3) is located
 #: from the data (nan: CG-n never enters the error band, or no CG1 reference);
 #: ``percolating_share``: mean share of the bed in percolating granules, left out of the
@@ -46,7 +39,7 @@ SUMMARY_COLUMNS = ["condition", "group", "cg", "rule", "replicas", "frames",
                    *[f"{q}{s}" for q in ("d10", "d50", "d90", "largest_fraction")
                      for s in ("", "_lo", "_hi")],
                    "granule_share", "percolating_share", "percolating_frames",
-                   "lower_limit", "lower_limit_lo", "lower_limit_hi", "error_band",
+                   *[f"{LOWER_LIMIT}{s}" for s in ("", "_lo", "_hi")], "error_band",
                    "min_particles", "reference",
                    *[f"{e}{s}" for e in GSD_ERRORS for s in ("", "_lo", "_hi")]]
 SCALARS = ("d10", "d50", "d90", "largest_granule")
@@ -150,8 +143,8 @@ def gsd_tables(granules: pd.DataFrame, cases: Sequence[CaseLike],
                         "granule_share": float(np.mean(d["share"])),
                         "percolating_share": float(perc.mean()),
                         "percolating_frames": float(np.mean(perc > 0)),
-                        "lower_limit": limit, "lower_limit_lo": float(limit_lo),
-                        "lower_limit_hi": float(limit_hi), "error_band": settings.error_band,
+                        LOWER_LIMIT: limit, f"{LOWER_LIMIT}_lo": float(limit_lo),
+                        f"{LOWER_LIMIT}_hi": float(limit_hi), "error_band": settings.error_band,
                         "min_particles": settings.min_particles,
                         "reference": ref.name if ref is not None else "", **err})
     return pd.DataFrame(rows, columns=GSD_COLUMNS), pd.DataFrame(summary, columns=SUMMARY_COLUMNS)
