@@ -64,18 +64,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
-# ligwf is being refactored: this script was written against commit 9179dd2 (run it with
-# PYTHONPATH pointing at a checkout of that commit); the newer liquids API is used if present.
-try:
-    from ligwf.liquids import bridges as _bridges
+from ligwf import liquids as _liquids
 
-    def capillary(model, *args):
-        return _bridges.capillary_force(model, *args)
-except ImportError:                                   # after the liquids refactor
-    from ligwf import liquids as _liquids
 
-    def capillary(model, *args):
-        return _liquids.get(model).capillary_force(*args)
+def capillary(model, *args):
+    """The registered liquid model's capillary bridge force (ligwf.liquids registry)."""
+    return _liquids.get(model).capillary_force(*args)
+
 
 # --------------------------------------------------------------------------- frames
 

@@ -20,12 +20,13 @@ def warnings_for(**sweep) -> list[str]:
 
 
 def test_one_cg1_replica_warns_and_its_twin_does_not_count():
-    """The demo: 1 CG1 replica (plus its cohesionless twin, which is not a replica)."""
-    (w,) = warnings_for()
+    """One CG1 replica (plus its cohesionless twin, which is not a replica)."""
+    (w,) = warnings_for(replicas={1: 1, 2: 2})
     assert w.startswith("sweep.replicas = 1 at CG1") and "indicative" in w
 
 
 def test_two_cg1_replicas_or_cg1_alone_do_not_warn():
+    assert warnings_for() == []          # the demo: 2 CG1 seeds
     assert warnings_for(replicas={1: 2, 2: 2}) == []
     assert warnings_for(cg_levels=[1], replicas=1, controls=[]) == []
 

@@ -9,7 +9,7 @@ import pytest
 from ligwf.cli.main import main
 from ligwf.errors import ConfigError
 from ligwf.scene.regime import GRANULATING_BOND, GRANULATING_ST_V, original_numbers, regime_numbers
-from ligwf.scene.workflow import load_workflow
+from ligwf.scene.workflow import CONTROL_KEY, load_workflow
 
 from helpers import ROOT
 
@@ -75,7 +75,9 @@ def test_cohesionless_twin_keeps_everything_but_the_bridge_forces():
     assert b.viscosity == pytest.approx(a.viscosity / 1000)
     same = ("seeds", "particle_count", "dt", "liquid_content", "granules", "run_steps")
     assert all(getattr(a, k) == getattr(b, k) for k in same)
-    assert sum(c.cg == 1 for c in cases) == 2 and sum(c.cg == 2 for c in cases) == 4
+    # the demo: 2 CG1 seeds, each with its twin; 2 seeds of each CG2 rule
+    assert sum(c.cg == 1 for c in cases) == 4 and sum(c.cg == 2 for c in cases) == 4
+    assert sum(CONTROL_KEY in dict(c.varied) for c in cases) == 2
 
 
 def test_controls_refused_on_a_dry_scene_and_at_a_missing_level():

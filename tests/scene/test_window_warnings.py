@@ -1,0 +1,48 @@
+"""The held-granule window warning: production - steady start - hold_time - T/4 must leave
+the survival measure frames (the gsd_cg study's lost measure, said before the run)."""
+
+from __future__ import annotations
+
+import copy
+
+import pytest
+import yaml
+
+from helpers import ROOT
+from ligwf.scene.window import MIN_USABLE_FRAMES, held_window_warnings
+from ligwf.scene.workflow import expand
+
+DEMO = yaml.safe_load((ROOT / "workflows" / "demo.yaml").read_text())
+
+
+def warnings_for(run_time: float, **analysis) -> list[str]:
+    raw = copy.deepcopy(DEMO)
+    raw["scene"]["process"]["run_time"] = run_time
+    raw["analysis"].update(analysis)
+    return held_window_warnings(expand(raw))
+
+
+def test_demo_timing_warns_once_naming_the_fields_and_the_run_time_that_fits():
+    """Demo: 30 rpm (T = 2 s), 1 s hold, dumps every 0.05 s, 2.5 s production: an auto window
+    starting at 1.25 s leaves 1.25 - 1 - 0.5 < 0 s."""
+    (w,) = warnings_for(2.5)
+    assert w.startswith("analysis.hold_time = 1 s") and "process.run_time = 2.5 s" in w
+    assert "0 of the 10" in w
+    need = float(w.split("at least ")[1].split(" s")[0])
+    assert need == pytest.approx((1.0 + 0.5 + MIN_USABLE_FRAMES * 0.05) / 0.5, rel=1e-3)
+    assert warnings_for(need * 1.01) == []          # the suggested run time is enough
+
+
+def test_fixed_steady_fraction_is_used_instead_of_the_latest_auto_start():
+    assert warnings_for(2.5, steady_after=0.1) == []      # 2.25 - 1.5 = 0.75 s: 15 frames
+    (w,) = warnings_for(2.5, steady_after=0.3)            # 1.75 - 1.5 = 0.25 s: 5 frames
+    assert "steady_after = 0.3" in w and "5 of the 10" in w
+
+
+def test_other_definitions_and_dry_scenes_do_not_warn():
+    assert warnings_for(2.5, granules="communities") == []
+    raw = copy.deepcopy(DEMO)
+    raw["scene"]["liquid"] = {"model": "none"}
+    raw["scene"]["analysis"] = {"granules": False}
+    raw["sweep"].update(controls=[], rules=["weber"])
+    assert held_window_warnings(expand(raw)) == []
