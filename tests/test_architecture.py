@@ -89,6 +89,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("scheduler", ("ligwf.scheduler", "ligwf.slurm")),
     ("pipeline", ("ligwf.pipeline",)),
     ("cli", ("ligwf.cli",)),
+    ("api", ("ligwf.api",)),
 )
 
 
@@ -177,3 +178,27 @@ def test_the_checker_sees_function_level_and_relative_imports(tmp_path):
     src = tmp_path / "fake.py"
     src.write_text("from ..engine import site\n\ndef f():\n    from ligwf.cli import main\n")
     assert _imports("ligwf.cli.fake", src) == {"ligwf.engine.site", "ligwf.cli.main"}
+
+
+def test_the_package_root_reaches_the_api_only_lazily():
+    """``ligwf/__init__`` is the base layer, and the import graph lets a package's
+    ``__init__`` import its own modules; the root must not use that to import a stage: its
+    only import above the base layer is :mod:`ligwf.api`, inside the module
+    ``__getattr__`` (and under ``TYPE_CHECKING`` for type checkers), so ``from ligwf
+    import open_study`` works and ``import ligwf`` loads no stage."""
+    tree = ast.parse(MODULES["ligwf"].read_text())
+    lazy = {n for f in tree.body if isinstance(f, ast.FunctionDef) and f.name == "__getattr__"
+            for n in ast.walk(f)}
+    typing_only = {n for b in tree.body if isinstance(b, ast.If)
+                   and "TYPE_CHECKING" in ast.unparse(b.test) for n in ast.walk(b)}
+    for node in ast.walk(tree):
+        if not isinstance(node, (ast.Import, ast.ImportFrom)):
+            continue
+        names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                 [f"{node.module}.{a.name}" for a in node.names])
+        for target in filter(None, map(_resolve, names)):
+            if node in lazy or node in typing_only:
+                assert target == "ligwf.api", ast.unparse(node)
+            else:
+                assert layer_of(target) == 0, f"ligwf/__init__ imports {target} at import time"
+    assert any(isinstance(n, ast.ImportFrom) for n in lazy), "no lazy import of ligwf.api"

@@ -1,0 +1,375 @@
+"""The Python API: a finished study's tables, settings, paths and plots in one object.
+
+A notebook user asks for what a study measured by its meaning, never by a file name::
+
+    import ligwf
+    s = ligwf.open_study("runs/demo")
+    s.verdict                        # per sweep group, CG level, rule and criterion
+    s.conditions[["cg", "rule", "speedup_core", "angle_error", "angle_error_vs_floor"]]
+    s.plot_pareto()                  # error vs run cost, returns the matplotlib Axes
+
+Every table is read from the study folder on first use (then cached; each access returns
+a copy, so editing one never changes the next), from the file :mod:`ligwf.study.layout`
+names for it (``TABLES``: attribute, file, the command that writes it). A table that is
+not there is one line naming the command that writes it (:class:`MissingOutput`, a
+:class:`~ligwf.errors.LigwfError`), never a traceback; granule tables of a study that has
+no granule data by design (a dry scene, ``scene.analysis.granules: false``) say why.
+
+Dtypes, the same in every table: numbers are ``float64`` (``int64`` where a column is a
+count or an index that is never missing), flags are pandas' nullable ``boolean``, text
+(case ids, rules, groups, statuses, reasons, floor sources and marks) is pandas' ``string``
+dtype -- never ``object`` -- and a text column stays ``string`` when every value is
+missing (a ``reason`` column of frames that were all fine). Errors against CG1 are
+fractions (0.05 = 5 %), times in seconds, lengths in metres, volumes in m^3 (SI, as in
+the study's tables; the report shows them in readable units).
+
+This module is the top layer (``tests/test_architecture.py``): it may import any stage,
+and ``ligwf`` itself imports it only lazily, when ``ligwf.open_study`` is first asked for.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from ligwf.analysis.records.flow import FlowRecord
+from ligwf.errors import ConfigError, LigwfError
+from ligwf.scene.settings import AnalysisSettings
+from ligwf.study import layout
+from ligwf.study.study import Study
+
+__all__ = ["MissingOutput", "StudyResults", "TABLES", "TableSpec", "open_study"]
+
+ANALYSE, REPORT = "ligwf analyse", "ligwf report"
+
+
+class MissingOutput(LigwfError):
+    """A table or record the study does not (yet) have; the message names the command
+    that writes it (or why the study has none by design)."""
+
+
+@dataclass(frozen=True)
+class TableSpec:
+    """Where one table of :class:`StudyResults` comes from."""
+
+    attribute: str      # the StudyResults property
+    folder: str         # layout.ANALYSIS_DIR or layout.REPORT_DIR
+    file: str           # its name in that folder (from ligwf.study.layout)
+    command: str        # the command that writes it
+    granules: bool      # only a study with granule data has it
+    what: str           # one line: one row per ...
+
+
+#: Every table of a study, in the order a reader meets them.
+TABLES: tuple[TableSpec, ...] = (
+    TableSpec("cases", layout.REPORT_DIR, layout.CASES_REPORT, REPORT, False,
+              "one row per usable case: run facts, costs, metrics, errors against CG1"),
+    TableSpec("conditions", layout.REPORT_DIR, layout.CONDITIONS_REPORT, REPORT, False,
+              "one row per (sweep group, CG level, rule): m, m_lo, m_hi, m_se per metric, "
+              "errors also m_floor, m_floor_source, m_vs_floor"),
+    TableSpec("noise_floor", layout.REPORT_DIR, layout.NOISE_FLOOR_REPORT, REPORT, False,
+              "one row per (sweep group, metric): the CG1 value and CG1-vs-CG1 scatter"),
+    TableSpec("flow", layout.ANALYSIS_DIR, layout.FLOW_TABLE, ANALYSE, False,
+              "one row per case: its steady window and flow metrics"),
+    TableSpec("frames", layout.ANALYSIS_DIR, layout.FRAMES_TABLE, ANALYSE, True,
+              "one row per case and frame: status, particles, contacts, bonds, granules"),
+    TableSpec("granules", layout.ANALYSIS_DIR, layout.GRANULES_TABLE, ANALYSE, True,
+              "one row per granule and frame: members, volume, centre of mass"),
+    TableSpec("gsd", layout.ANALYSIS_DIR, layout.GSD_TABLE, ANALYSE, True,
+              "one row per condition and volume bin: the steady-window GSD with bands"),
+    TableSpec("gsd_summary", layout.ANALYSIS_DIR, layout.GSD_SUMMARY_TABLE, ANALYSE, True,
+              "one row per condition: GSD size limits and errors against CG1"),
+    TableSpec("gsd_pooling", layout.ANALYSIS_DIR, layout.GSD_POOLING_TABLE, ANALYSE, True,
+              "one row per condition, pool size and pool: the GSD size limit of pooled replicas"),
+    TableSpec("kinetics", layout.ANALYSIS_DIR, layout.KINETICS_TABLE, ANALYSE, True,
+              "one row per case and frame: granule count, d10/d50/d90, largest granule"),
+    TableSpec("kinetics_summary", layout.ANALYSIS_DIR, layout.KINETICS_SUMMARY_TABLE, ANALYSE,
+              True, "one row per condition and time: the kinetics with bands over replicas"),
+    TableSpec("sensitivity", layout.ANALYSIS_DIR, layout.SENSITIVITY_TABLE, ANALYSE, True,
+              "one row per variant of the granule definition"),
+    TableSpec("controls", layout.ANALYSIS_DIR, layout.CONTROLS_TABLE, ANALYSE, True,
+              "one row per wet case and definition beside its cohesionless twin"),
+)
+_BY_NAME = {t.attribute: t for t in TABLES}
+
+#: text columns by name (also when every value is missing, where a CSV reader sees nan)
+TEXT_COLUMNS = frozenset({"case_id", "condition", "group", "rule", "status", "reason",
+                          "metric", "source", "variant", "definition", "control", "twin",
+                          "twin_id", "twin_case_id", "verdict", "criterion", "outcome",
+                          "sentence", "method", "velocity_frame", "pool", "reference"})
+TEXT_SUFFIXES = ("_floor_source", "_vs_floor", "_reason", "_verdict")
+
+
+def is_text_column(name: str) -> bool:
+    """Whether a column of a study table holds text by its name (see the module docstring)."""
+    return name in TEXT_COLUMNS or name.endswith(TEXT_SUFFIXES)
+
+
+def typed(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with the API's dtypes: text columns ``string``, yes/no columns
+    ``boolean``, numbers left numeric; no ``object`` column survives (a column of mixed
+    values that is neither becomes ``string``)."""
+    out = {}
+    for col in table.columns:
+        s = table[col]
+        if is_text_column(str(col)):
+            out[col] = s.astype("string")
+        elif pd.api.types.is_bool_dtype(s) or _is_flags(s):
+            out[col] = s.astype("boolean")
+        elif pd.api.types.is_numeric_dtype(s):
+            out[col] = s
+        else:
+            numbers = pd.to_numeric(s, errors="coerce")
+            numeric = numbers.notna().sum() == s.notna().sum()
+            out[col] = numbers if numeric else s.astype("string")
+    return pd.DataFrame(out, index=table.index)
+
+
+def _is_flags(s: pd.Series) -> bool:
+    """An object/text column holding only True/False (and missing values)."""
+    if pd.api.types.is_numeric_dtype(s):
+        return False
+    values = set(s.dropna().astype(str).unique())
+    return bool(values) and values <= {"True", "False"}
+
+
+def read_table(path: Path) -> pd.DataFrame:
+    """A study table (``.csv`` or ``.parquet``) with the API's dtypes; an empty file is an
+    empty table."""
+    if path.suffix == ".parquet":
+        return typed(pd.read_parquet(path))
+    try:
+        return typed(pd.read_csv(path))
+    except pd.errors.EmptyDataError:
+        return pd.DataFrame()
+
+
+def open_study(path: str | Path) -> "StudyResults":
+    """A study folder's results (:class:`StudyResults`); ConfigError (one line) when
+    ``path`` is no study folder. Nothing is read until a table is asked for."""
+    study = Study.open(Path(path))
+    if study.single_case:
+        raise ConfigError(f"{path}: a case folder, not a study: open the study folder above "
+                          "it (ligwf.analysis.foreign analyses dumps run by hand)")
+    return StudyResults(study)
+
+
+@dataclass(frozen=True)
+class StudyResults:
+    """What a study measured: its tables (pandas, typed as the module docstring says),
+    its workflow and analysis settings, the paths of its report; plots that take and
+    return a matplotlib Axes. Make one with :func:`open_study`."""
+
+    study: Study
+
+    # ------------------------------------------------------------- identity and settings
+    @property
+    def path(self) -> Path:
+        """The study folder."""
+        return self.study.path
+
+    @property
+    def name(self) -> str:
+        return self.study.name
+
+    @property
+    def settings(self) -> AnalysisSettings:
+        """The study's ``analysis:`` settings (what the analysis ran with)."""
+        return self.study.analysis
+
+    @cached_property
+    def record(self) -> dict[str, Any]:
+        """The study record (``study.json``): name, workflow, analysis settings, cases."""
+        return json.loads((self.path / layout.STUDY_FILE).read_text())
+
+    @property
+    def workflow(self) -> dict[str, Any]:
+        """The workflow the study was rendered from (scene, sweep, analysis, as validated)."""
+        return dict(self.record.get("workflow") or {})
+
+    @property
+    def case_ids(self) -> tuple[str, ...]:
+        """Every case of the study in case-index order (usable or not)."""
+        return self.study.case_ids
+
+    # ------------------------------------------------------------- paths
+    @property
+    def analysis_dir(self) -> Path:
+        return self.study.analysis_dir
+
+    @property
+    def report_dir(self) -> Path:
+        return self.study.report_dir
+
+    @property
+    def summary(self) -> Path:
+        """The report's markdown page (MissingOutput before ``ligwf report``)."""
+        return self._file(layout.REPORT_DIR, layout.SUMMARY_REPORT, REPORT, "report page")
+
+    @property
+    def html(self) -> Path:
+        """The report's HTML page (MissingOutput before ``ligwf report``)."""
+        return self._file(layout.REPORT_DIR, layout.HTML_REPORT, REPORT, "report page")
+
+    @property
+    def paraview(self) -> dict[str, Path]:
+        """case id -> its ParaView collection (particles + turning drum) in the report;
+        only the cases the report wrote one for."""
+        folder = self.report_dir / layout.PARAVIEW_DIR
+        found = {cid: folder / layout.paraview_collection(cid) for cid in self.case_ids}
+        return {cid: p for cid, p in found.items() if p.is_file()}
+
+    @property
+    def figures(self) -> dict[str, Path]:
+        """file name -> path of every figure the report wrote."""
+        folder = self.report_dir / layout.FIGURES_DIR
+        return {p.name: p for p in sorted(folder.glob("*.png"))} if folder.is_dir() else {}
+
+    # ------------------------------------------------------------- tables
+    @property
+    def cases(self) -> pd.DataFrame:
+        """One row per usable case: run facts, costs, metrics, errors against CG1."""
+        return self.table("cases")
+
+    @property
+    def conditions(self) -> pd.DataFrame:
+        """One row per (sweep group, CG level, rule); per metric ``m``: ``m``, ``m_lo``,
+        ``m_hi``, ``m_se``; errors also ``m_floor``, ``m_floor_source``, ``m_vs_floor``."""
+        return self.table("conditions")
+
+    @property
+    def noise_floor(self) -> pd.DataFrame:
+        """Per sweep group and metric the CG1 value and its CG1-vs-CG1 scatter."""
+        return self.table("noise_floor")
+
+    @property
+    def flow(self) -> pd.DataFrame:
+        """Per case its steady window and flow metrics."""
+        return self.table("flow")
+
+    @property
+    def frames(self) -> pd.DataFrame:
+        """Per case and frame: status, reason, particles, contacts, bonds, granules."""
+        return self.table("frames")
+
+    @property
+    def granules(self) -> pd.DataFrame:
+        """Per granule and frame: members, volume [m^3], centre of mass [m]."""
+        return self.table("granules")
+
+    @property
+    def gsd(self) -> pd.DataFrame:
+        """Per condition and volume bin the steady-window GSD with bootstrap bands."""
+        return self.table("gsd")
+
+    @property
+    def gsd_summary(self) -> pd.DataFrame:
+        return self.table("gsd_summary")
+
+    @property
+    def gsd_pooling(self) -> pd.DataFrame:
+        return self.table("gsd_pooling")
+
+    @property
+    def kinetics(self) -> pd.DataFrame:
+        """Per case and frame: granule count, d10 / d50 / d90 [m], largest granule."""
+        return self.table("kinetics")
+
+    @property
+    def kinetics_summary(self) -> pd.DataFrame:
+        return self.table("kinetics_summary")
+
+    @property
+    def sensitivity(self) -> pd.DataFrame:
+        """Granule count, d50 and largest granule under each variant of the definition."""
+        return self.table("sensitivity")
+
+    @property
+    def controls(self) -> pd.DataFrame:
+        """Each wet case beside its cohesionless twin, per granule definition."""
+        return self.table("controls")
+
+    def table(self, name: str) -> pd.DataFrame:
+        """The table called ``name`` (an attribute of :data:`TABLES`), as a copy."""
+        return self._read(name).copy()
+
+    def tables(self) -> dict[str, pd.DataFrame]:
+        """Every table the study has now, by name (copies; the missing ones left out)."""
+        return {name: self.table(name) for name, there in self.available().items() if there}
+
+    def available(self) -> dict[str, bool]:
+        """table name -> whether the study has it now (nothing is read)."""
+        return {t.attribute: self._path(t).is_file() for t in TABLES}
+
+    @cached_property
+    def flow_record(self) -> FlowRecord:
+        """The flow record of the analysis: per case its steady window, per-frame metric
+        series, velocity profile (``ligwf.analysis.records.flow``)."""
+        path = self._file(layout.ANALYSIS_DIR, layout.FLOW_PROFILES, ANALYSE, "flow record")
+        try:
+            return FlowRecord.read(path)
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise MissingOutput(f"{path}: unreadable flow record ({type(exc).__name__}): run "
+                                f"`{ANALYSE} {self.path}` again") from None
+
+    @property
+    def profiles(self) -> pd.DataFrame:
+        """Per measured case and depth bin: the mean downhill velocity [m/s] (and its std)
+        against the normalised depth below the free surface (``depth``: 0 at the surface,
+        1 at the bed's bottom), from the flow record."""
+        rows = [{"case_id": c.case_id, "cg": c.cg, "rule": c.rule, "replica": c.replica,
+                 "depth": s, "v_mean": v, "v_std": sd}
+                for c in self.flow_record.measured()
+                for s, v, sd in zip(c.profile_s, c.profile_v_mean, c.profile_v_std)]
+        frame = pd.DataFrame(rows, columns=["case_id", "cg", "rule", "replica", "depth",
+                                            "v_mean", "v_std"])
+        return typed(frame.astype({"cg": float, "replica": int, "depth": float,
+                                   "v_mean": float, "v_std": float}))
+
+    # ------------------------------------------------------------- reading
+    def _path(self, spec: TableSpec) -> Path:
+        return self.path / spec.folder / spec.file
+
+    def _file(self, folder: str, file: str, command: str, what: str) -> Path:
+        path = self.path / folder / file
+        if not path.is_file():
+            raise MissingOutput(f"{path}: no {what} yet: run `{command} {self.path}`"
+                                + (" (or `ligwf study`, which does)" if command != REPORT
+                                   else ""))
+        return path
+
+    def _read(self, name: str) -> pd.DataFrame:
+        cache = self.__dict__.setdefault("_tables", {})
+        if name not in cache:
+            spec = _BY_NAME.get(name)
+            if spec is None:
+                raise LigwfError(f"no table {name!r}: the tables are {', '.join(_BY_NAME)}")
+            path = self._path(spec)
+            if not path.is_file() and spec.granules:
+                if (why := self._why_no_granules()) is not None:
+                    raise MissingOutput(f"{self.path}: no {name} table: {why}")
+            path = self._file(spec.folder, spec.file, spec.command, f"{name} table")
+            try:
+                cache[name] = read_table(path)
+            except (OSError, ValueError) as exc:
+                raise MissingOutput(f"{path}: unreadable ({type(exc).__name__}: {exc}); run "
+                                    f"`{spec.command} {self.path}` again") from None
+        return cache[name]
+
+    def _why_no_granules(self) -> str | None:
+        """Why the analysis wrote no granule tables, from its record (None: no such
+        reason recorded, the tables are simply missing)."""
+        try:
+            record = json.loads((self.analysis_dir / layout.ANALYSIS_RECORD).read_text())
+        except (OSError, ValueError):
+            return None
+        absent = [a for a in record.get("granules_absent", []) if isinstance(a, dict)]
+        if not absent:
+            return None
+        reasons = sorted({str(a.get("reason", "")) for a in absent})
+        return "no granule data by design (" + "; ".join(reasons) + ")"

@@ -1,0 +1,31 @@
+"""A tiny real study for the Python API tests (tests/test_api.py, tests/test_notebook.py),
+made once per test session through ``ligwf study`` (run + analyse + report).
+
+tests/workflows/tiny_study.yaml with the Weber rule only: CG1 (and its cohesionless twin,
+so the controls table exists) and two CG2 replicas, no snapshots: 4 real LIGGGHTS runs of
+a few seconds each on one core.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from helpers import ROOT
+from ligwf.cli.main import main
+
+TINY = ROOT / "tests" / "workflows" / "tiny_study.yaml"
+ARGS = ["--no-snapshots", "--set", "sweep.rules=[weber]", "--set", "sweep.replicas={1: 1, 2: 2}",
+        "--set", "sweep.controls=[cohesionless]", "--set", "analysis.bootstrap=50"]
+
+_CACHE: dict[str, Path] = {}
+
+
+def api_study(engine, tmp_path_factory) -> Path:
+    """The reported tiny study folder (made on first use)."""
+    if "study" not in _CACHE:
+        out = tmp_path_factory.mktemp("apistudy") / "tiny"
+        code = main(["study", str(TINY), "--out", str(out),
+                     "--mesh-cache", str(out.parent / "meshes"), *ARGS])
+        assert code == 0, f"ligwf study exited {code}"
+        _CACHE["study"] = out
+    return _CACHE["study"]

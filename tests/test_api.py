@@ -1,0 +1,204 @@
+"""ligwf.api / ``ligwf.open_study``: every table of a real reported study read and typed,
+missing outputs as one line naming the command, the public names.
+
+The real study is tests/apistudy.py's tiny ``ligwf study`` (engine-marked); the refusals
+use a study that is only rendered (no engine) and hand-made analysis records.
+"""
+
+from __future__ import annotations
+
+import ast
+import json
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import ligwf
+from apistudy import api_study
+from helpers import ROOT
+from ligwf.api import TABLES, MissingOutput, is_text_column, read_table, typed
+from ligwf.cli.main import main
+from ligwf.errors import ConfigError, LigwfError
+from ligwf.study import layout
+
+TINY = ROOT / "tests" / "workflows" / "tiny_study.yaml"
+#: column names with two meanings across tables (one name, two meanings: to be renamed by
+#: the analysis owner); their dtypes differ for that reason
+TWO_MEANINGS = {"percolating": "granules: the granule spans the periodic slice (flag); "
+                               "controls: the share of frames with a percolating cluster"}
+
+
+@pytest.fixture(scope="module")
+def reported(engine, tmp_path_factory):
+    return api_study(engine, tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def rendered(tmp_path_factory):
+    """A rendered study: no engine run, no analysis, no report."""
+    out = tmp_path_factory.mktemp("rendered") / "study"
+    assert main(["render", str(TINY), "--out", str(out), "--set", "sweep.rules=[weber]"]) == 0
+    return out
+
+
+# ---------------------------------------------------------------- a real study
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_every_table_reads_with_its_rows(reported):
+    s = ligwf.open_study(reported)
+    assert all(s.available().values()), s.available()
+    for spec in TABLES:
+        table = s.table(spec.attribute)
+        assert len(table) > 0, spec.attribute
+        raw = (pd.read_parquet if spec.file.endswith("parquet") else pd.read_csv)(
+            reported / spec.folder / spec.file)
+        assert list(table.columns) == list(raw.columns) and len(table) == len(raw)
+        for col in raw.columns:   # same values as the file, numbers as numbers
+            if pd.api.types.is_numeric_dtype(table[col]) and not is_text_column(col):
+                assert np.allclose(table[col].to_numpy(float), raw[col].to_numpy(float),
+                                   equal_nan=True), (spec.attribute, col)
+    usable = [c for c in s.case_ids]
+    assert sorted(s.cases["case_id"]) == sorted(usable)
+    assert set(s.conditions["cg"]) == {1.0, 2.0}
+    assert s.cases is not s.cases                          # a copy each time
+    cases = s.cases
+    cases["cg"] = -1
+    assert (s.cases["cg"] > 0).all()
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_dtypes_are_typed_and_one_per_column_name(reported):
+    s = ligwf.open_study(reported)
+    seen: dict[str, str] = {}
+    for name, table in {**s.tables(), "profiles": s.profiles}.items():
+        for col, dtype in table.dtypes.items():
+            assert dtype != object, f"{name}.{col} is object"
+            if is_text_column(col):
+                assert dtype == "string", f"{name}.{col}: {dtype}"
+            else:
+                assert (pd.api.types.is_numeric_dtype(dtype) or dtype == "boolean"), \
+                    f"{name}.{col}: {dtype}"
+            if col in seen and name != "profiles" and col not in TWO_MEANINGS:
+                kind = lambda d: "float" if str(d).startswith(("float", "int")) else str(d)
+                assert kind(dtype) == kind(seen[col]), f"{col}: {dtype} here, {seen[col]} before"
+            seen.setdefault(col, dtype)
+    assert s.frames["reason"].dtype == "string"              # all-missing in a clean study
+    assert s.conditions["speedup_core"].dtype == "float64"
+    assert s.conditions["angle_error_vs_floor"].dtype == "string"
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_settings_paths_profiles_and_flow_record(reported):
+    s = ligwf.open_study(reported)
+    assert s.name == "tiny-study" and s.settings.bootstrap == 50
+    assert s.workflow["sweep"]["rules"] == ["weber"]
+    assert s.summary.is_file() and s.html.is_file() and s.report_dir == reported / "report"
+    assert set(s.paraview) == set(s.cases["case_id"])
+    assert all(p.suffix == ".pvd" and p.is_file() for p in s.paraview.values())
+    assert layout.FIGURE_ERROR_VS_RUNTIME in s.figures
+    prof = s.profiles
+    assert set(prof["case_id"]) == {c.case_id for c in s.flow_record.measured()}
+    assert prof["depth"].between(0, 1).all() and np.isfinite(prof["v_mean"]).any()
+
+
+# ---------------------------------------------------------------- missing outputs
+def test_a_rendered_study_names_the_command_for_every_table(rendered):
+    s = ligwf.open_study(rendered)
+    assert not any(s.available().values())
+    for spec in TABLES:
+        with pytest.raises(MissingOutput) as err:
+            s.table(spec.attribute)
+        text = str(err.value)
+        assert "\n" not in text and f"`{spec.command} {rendered}`" in text, text
+        assert spec.file in text
+    for attribute, command in (("summary", "ligwf report"), ("flow_record", "ligwf analyse"),
+                               ("profiles", "ligwf analyse")):
+        with pytest.raises(MissingOutput, match=command):
+            getattr(s, attribute)
+    assert s.paraview == {} and s.figures == {}
+
+
+def test_granule_tables_of_a_study_without_granule_data_say_why(rendered, tmp_path):
+    study = tmp_path / "dry"
+    subprocess.run(["cp", "-r", str(rendered), str(study)], check=True)
+    (study / layout.ANALYSIS_DIR).mkdir()
+    (study / layout.ANALYSIS_DIR / layout.ANALYSIS_RECORD).write_text(json.dumps(
+        {"granules_absent": [{"case_id": "cg1-none-r0", "reason": "dry scene (liquid.model: "
+                              "none)"}]}))
+    s = ligwf.open_study(study)
+    with pytest.raises(MissingOutput, match=r"no gsd table: no granule data by design \(dry"):
+        s.gsd
+    with pytest.raises(MissingOutput, match="ligwf analyse"):   # not a granule table
+        s.flow
+
+
+def test_a_truncated_table_is_one_line(rendered, tmp_path):
+    study = tmp_path / "broken"
+    subprocess.run(["cp", "-r", str(rendered), str(study)], check=True)
+    (study / layout.ANALYSIS_DIR).mkdir()
+    (study / layout.ANALYSIS_DIR / layout.GRANULES_TABLE).write_bytes(b"PAR1\0\0")
+    with pytest.raises(MissingOutput) as err:
+        ligwf.open_study(study).granules
+    assert "unreadable" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_open_study_refuses_what_is_no_study(tmp_path, rendered):
+    with pytest.raises(ConfigError, match="not a ligwf study folder"):
+        ligwf.open_study(tmp_path)
+    with pytest.raises(ConfigError, match="a case folder, not a study"):
+        ligwf.open_study(rendered / "cg1-none-r0")
+    with pytest.raises(LigwfError, match="no table 'gsds'"):
+        ligwf.open_study(rendered).table("gsds")
+
+
+# ---------------------------------------------------------------- typing rules
+def test_typed_gives_text_flags_and_numbers(tmp_path):
+    raw = pd.DataFrame({"case_id": ["a", "b"], "reason": [np.nan, np.nan],
+                        "largest_percolates": [True, np.nan], "x": ["1.5", "2"],
+                        "angle_error_vs_floor": [np.nan, "within"], "n": [1, 2]},
+                       ).astype({"largest_percolates": object, "x": object})
+    t = typed(raw)
+    assert t.dtypes.to_dict() == {"case_id": "string", "reason": "string",
+                                  "largest_percolates": "boolean", "x": "float64",
+                                  "angle_error_vs_floor": "string", "n": "int64"}
+    path = tmp_path / "t.csv"
+    raw.to_csv(path, index=False)
+    assert read_table(path).dtypes.to_dict() == t.dtypes.to_dict()
+    path.write_text("")
+    assert read_table(path).empty
+
+
+# ---------------------------------------------------------------- public names
+def test_every_public_name_imports_and_import_ligwf_loads_no_stage():
+    code = ("import sys, ligwf\n"
+            "assert 'ligwf.api' not in sys.modules and 'pandas' not in sys.modules\n"
+            "from ligwf import *\n"
+            "assert all(n in globals() for n in ligwf.__all__), ligwf.__all__\n"
+            "assert set(ligwf.__all__) <= set(dir(ligwf))\n"
+            "from ligwf import open_study, StudyResults\n"
+            "import ligwf.api\n"
+            "assert open_study is ligwf.api.open_study and 'pandas' in sys.modules\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
+        ligwf.nonsense    # noqa: B018
+    assert (ROOT / "ligwf" / "py.typed").is_file()
+
+
+def test_the_api_names_no_file_itself():
+    """Output names belong to ligwf.study.layout: the API asks it for every one (string
+    constants other than docstrings hold no file name)."""
+    tree = ast.parse((ROOT / "ligwf" / "api.py").read_text())
+    docs = {id(n.body[0].value) for n in ast.walk(tree)
+            if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef)) and n.body
+            and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+    names = re.compile(r"\w\.(csv|parquet|json|png|html|md|pvd|vtu|npz|vti|vtr)\b")
+    hits = [n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and id(n) not in docs
+            and isinstance(n.value, str) and names.search(n.value)]
+    assert not hits, hits
