@@ -1,0 +1,121 @@
+"""The tables of a study as the API reads them: where each comes from, and their dtypes.
+
+:data:`TABLES` says for every table its file (a name from :mod:`ligwf.study.layout`), the
+command that writes it and whether only a study with granule data has it;
+:func:`read_table` reads one with the API's dtypes (:func:`typed`, the rules in
+:mod:`ligwf.api`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from ligwf.errors import LigwfError
+from ligwf.study import layout
+
+ANALYSE, REPORT = "ligwf analyse", "ligwf report"
+
+
+class MissingOutput(LigwfError):
+    """A table or record the study does not (yet) have; the message names the command
+    that writes it (or why the study has none by design)."""
+
+
+@dataclass(frozen=True)
+class TableSpec:
+    """Where one table of :class:`StudyResults` comes from."""
+
+    attribute: str      # the StudyResults property
+    folder: str         # layout.ANALYSIS_DIR or layout.REPORT_DIR
+    file: str           # its name in that folder (from ligwf.study.layout)
+    command: str        # the command that writes it
+    granules: bool      # only a study with granule data has it
+    what: str           # one line: one row per ...
+
+
+#: Every table of a study, in the order a reader meets them.
+TABLES: tuple[TableSpec, ...] = (
+    TableSpec("cases", layout.REPORT_DIR, layout.CASES_REPORT, REPORT, False,
+              "one row per usable case: run facts, costs, metrics, errors against CG1"),
+    TableSpec("conditions", layout.REPORT_DIR, layout.CONDITIONS_REPORT, REPORT, False,
+              "one row per (sweep group, CG level, rule): m, m_lo, m_hi, m_se per metric, "
+              "errors also m_floor, m_floor_source, m_vs_floor"),
+    TableSpec("noise_floor", layout.REPORT_DIR, layout.NOISE_FLOOR_REPORT, REPORT, False,
+              "one row per (sweep group, metric): the CG1 value and CG1-vs-CG1 scatter"),
+    TableSpec("flow", layout.ANALYSIS_DIR, layout.FLOW_TABLE, ANALYSE, False,
+              "one row per case: its steady window and flow metrics"),
+    TableSpec("frames", layout.ANALYSIS_DIR, layout.FRAMES_TABLE, ANALYSE, True,
+              "one row per case and frame: status, particles, contacts, bonds, granules"),
+    TableSpec("granules", layout.ANALYSIS_DIR, layout.GRANULES_TABLE, ANALYSE, True,
+              "one row per granule and frame: members, volume, centre of mass"),
+    TableSpec("gsd", layout.ANALYSIS_DIR, layout.GSD_TABLE, ANALYSE, True,
+              "one row per condition and volume bin: the steady-window GSD with bands"),
+    TableSpec("gsd_summary", layout.ANALYSIS_DIR, layout.GSD_SUMMARY_TABLE, ANALYSE, True,
+              "one row per condition: GSD size limits and errors against CG1"),
+    TableSpec("gsd_pooling", layout.ANALYSIS_DIR, layout.GSD_POOLING_TABLE, ANALYSE, True,
+              "one row per condition, pool size and pool: the GSD size limit of pooled replicas"),
+    TableSpec("kinetics", layout.ANALYSIS_DIR, layout.KINETICS_TABLE, ANALYSE, True,
+              "one row per case and frame: granule count, d10/d50/d90, largest granule"),
+    TableSpec("kinetics_summary", layout.ANALYSIS_DIR, layout.KINETICS_SUMMARY_TABLE, ANALYSE,
+              True, "one row per condition and time: the kinetics with bands over replicas"),
+    TableSpec("sensitivity", layout.ANALYSIS_DIR, layout.SENSITIVITY_TABLE, ANALYSE, True,
+              "one row per variant of the granule definition"),
+    TableSpec("controls", layout.ANALYSIS_DIR, layout.CONTROLS_TABLE, ANALYSE, True,
+              "one row per wet case and definition beside its cohesionless twin"),
+)
+
+#: text columns by name (also when every value is missing, where a CSV reader sees nan)
+TEXT_COLUMNS = frozenset({"case_id", "condition", "group", "rule", "status", "reason",
+                          "metric", "source", "variant", "definition", "control", "twin",
+                          "twin_id", "twin_case_id", "verdict", "criterion", "outcome",
+                          "sentence", "method", "velocity_frame", "pool", "reference"})
+TEXT_SUFFIXES = ("_floor_source", "_vs_floor", "_reason", "_verdict")
+
+
+def is_text_column(name: str) -> bool:
+    """Whether a column of a study table holds text by its name (see the module docstring)."""
+    return name in TEXT_COLUMNS or name.endswith(TEXT_SUFFIXES)
+
+
+def typed(table: pd.DataFrame) -> pd.DataFrame:
+    """``table`` with the API's dtypes: text columns ``string``, yes/no columns
+    ``boolean``, numbers left numeric; no ``object`` column survives (a column of mixed
+    values that is neither becomes ``string``)."""
+    out = {}
+    for col in table.columns:
+        s = table[col]
+        if is_text_column(str(col)):
+            out[col] = s.astype("string")
+        elif pd.api.types.is_bool_dtype(s) or _is_flags(s):
+            out[col] = s.astype("boolean")
+        elif pd.api.types.is_numeric_dtype(s):
+            out[col] = s
+        else:
+            numbers = pd.to_numeric(s, errors="coerce")
+            numeric = numbers.notna().sum() == s.notna().sum()
+            out[col] = numbers if numeric else s.astype("string")
+    return pd.DataFrame(out, index=table.index)
+
+
+def _is_flags(s: pd.Series) -> bool:
+    """An object/text column holding only True/False (and missing values)."""
+    if pd.api.types.is_numeric_dtype(s):
+        return False
+    values = set(s.dropna().astype(str).unique())
+    return bool(values) and values <= {"True", "False"}
+
+
+def read_table(path: Path) -> pd.DataFrame:
+    """A study table (``.csv`` or ``.parquet``) with the API's dtypes; an empty file is an
+    empty table."""
+    if path.suffix == ".parquet":
+        return typed(pd.read_parquet(path))
+    try:
+        return typed(pd.read_csv(path))
+    except pd.errors.EmptyDataError:
+        return pd.DataFrame()
+
+
