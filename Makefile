@@ -7,6 +7,8 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 LIGWF := $(VENV)/bin/ligwf
 APT_PACKAGES := liggghts openmpi-bin libopenmpi-dev python3-venv python3-dev libgl1 libegl1 libxrender1
+# what only the tests need: headless Chromium opens the report page (tests/report/test_page_browser.py)
+TEST_APT_PACKAGES := chromium
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 STAMP := $(VENV)/.ligwf-installed
 DEMO_OUT ?= runs/demo
@@ -15,13 +17,13 @@ PYTEST_ARGS ?=
 # mark; tests/conftest.py marks every test using the engine or Slurm fixtures)
 FAST_MARKS := not engine and not mpi and not slurm and not slow
 
-.PHONY: demo test test-fast install system-packages clean
+.PHONY: demo test test-fast install system-packages test-packages clean
 
 # The demo study: run (ranks and packing from the rank plan) + analyse + report -> $(DEMO_OUT)/report/
 demo: install
 	$(LIGWF) study workflows/demo.yaml --out $(DEMO_OUT)
 
-test: install
+test: install test-packages
 	$(PY) -m pytest $(PYTEST_ARGS)
 
 # a developer's loop after every edit: under 90 s on 2 cores, no engine, mpirun or Slurm
@@ -37,6 +39,13 @@ system-packages:
 	  echo "installing Debian packages: $(APT_PACKAGES)"; \
 	  $(SUDO) apt-get update -qq && \
 	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $(APT_PACKAGES); \
+	fi
+
+test-packages:
+	@if ! dpkg -s $(TEST_APT_PACKAGES) >/dev/null 2>&1; then \
+	  echo "installing Debian packages for the tests: $(TEST_APT_PACKAGES)"; \
+	  $(SUDO) apt-get update -qq && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -qq --no-install-recommends $(TEST_APT_PACKAGES); \
 	fi
 
 # mpi4py must be compiled against the system OpenMPI (the PyPI wheel brings its own MPI,

@@ -10,7 +10,7 @@ import pytest
 
 #: marks a test gets from the fixtures it uses (directly or through other fixtures), so a
 #: test that needs the engine or a Slurm cluster can never run in the fast lane unmarked
-FIXTURE_MARKS = {"engine": ("engine",), "slurm_cluster": ("slurm",)}
+FIXTURE_MARKS = {"engine": ("engine",), "slurm_cluster": ("slurm",), "chromium": ("browser",)}
 
 
 def pytest_collection_modifyitems(config, items):
@@ -44,3 +44,19 @@ def engine():
             pytest.fail(f"CI=true and the engine is missing: {exc}", pytrace=False)
         pytest.skip(f"needs the engine: {exc} (`make install` installs it)")
     return cfg
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """Path of Debian's headless-capable Chromium (report page tests). Skipped with the
+    reason where it is missing; in CI (``CI=true``) it fails instead (``make test``
+    installs it)."""
+    import shutil
+
+    path = shutil.which("chromium") or shutil.which("chromium-browser")
+    if path is None:
+        why = "needs Debian's chromium (`make test` installs it: apt-get install chromium)"
+        if in_ci():
+            pytest.fail(f"CI=true and Chromium is missing: {why}", pytrace=False)
+        pytest.skip(why)
+    return path

@@ -9,7 +9,6 @@ what the regime map found (docs/results/granule_definitions.md).
 
 from __future__ import annotations
 
-import html
 from pathlib import Path
 
 import pandas as pd
@@ -63,23 +62,3 @@ def controls_markdown(analysis_dir: Path) -> list[str]:
     lines.append("Definitions that beat the control here: "
                  + (", ".join(f"`{d}`" for d in passing) if len(passing) else "none") + ".")
     return lines + [""]
-
-
-def controls_html(analysis_dir: Path) -> str:
-    """The same section as HTML."""
-    table = read_controls(analysis_dir)
-    out = ["<h2>Granule controls (wet bed / cohesionless twin)</h2>"]
-    if table is None:
-        return out[0] + f"<p>{html.escape(NO_CONTROL)}</p>"
-    for case_id, rows in table.groupby("case_id", sort=False):
-        own = rows.iloc[0]
-        out.append(f"<p><b>{html.escape(str(case_id))}</b> against "
-                   f"<code>{html.escape(str(own['twin_id']))}</code>: "
-                   f"{html.escape(str(own['verdict']))}.</p>")
-        head = "".join(f"<th>{html.escape(h)}</th>" for _, h in COLUMNS)
-        body = "".join(
-            f"<tr><td>{html.escape(str(r['definition']))}</td><td>{'yes' if r['passes'] else 'no'}"
-            "</td>" + "".join(f"<td>{_cell(r, c)}</td>" for c, _ in COLUMNS) + "</tr>"
-            for _, r in rows.iterrows())
-        out.append(f"<table><tr><th>definition</th><th>passes</th>{head}</tr>{body}</table>")
-    return "\n".join(out)

@@ -1,170 +1,204 @@
-"""Report figures (matplotlib, Agg) and off-screen pyvista snapshots, as PNG files.
+"""Report figures: plotting functions that draw into a matplotlib ``Axes`` and return it.
 
-Each function takes tables already computed by :mod:`ligwf.report.tables` and one output path,
-and writes the PNG atomically (render to memory, then rename).
+Each ``*_ax`` function takes tables already computed by :mod:`ligwf.report.tables` (or read
+from the analysis folder) and an ``Axes``; the report's figure functions (:func:`pareto`,
+:func:`gsd_overlay`, :func:`velocity_profiles`) lay them out on a
+:class:`matplotlib.figure.Figure` and :func:`save` writes the PNG atomically. No backend is
+switched at import: a ``Figure`` made directly renders to PNG without pyplot, so a notebook
+that imports ligwf keeps its own backend.
+
+Conventions every figure keeps: legends outside the data (below the axes), log axes with a
+tick label at every 1-2-5 (or every integer) step so a short span still reads, granule
+sizes as equivalent diameters in mm.
 """
 
 from __future__ import annotations
 
 import io
+import math
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.ticker import NullFormatter  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
+from ligwf.fsio import atomic_write_bytes
 
-from ligwf.fsio import atomic_write_bytes  # noqa: E402
-
-
-def _axes(ax, xlabel: str, ylabel: str, title: str, legend: int | None = None) -> None:
-    """Axis labels, a small title, an optional legend (font size) and a light grid."""
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=10)
-    if legend:
-        ax.legend(fontsize=legend)
-    ax.grid(alpha=0.3)
+#: phases of a run's cost, as the conditions table names them (``<phase>_core_seconds``)
+PHASES = ("fill", "settle", "production")
 
 
-def _save(fig, path: Path) -> Path:
+def save(fig: Figure, path: Path, dpi: int = 110) -> Path:
+    """Write ``fig`` as PNG to ``path`` atomically (rendered in memory, then renamed)."""
     buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     atomic_write_bytes(path, buf.getvalue())
     return path
 
 
-def _label(cg: float, rule: str) -> str:
+def legend_below(ax: Axes, ncol: int = 3, fontsize: int = 8) -> None:
+    """The legend under the axes (never over the data or its error bars)."""
+    handles, labels = ax.get_legend_handles_labels()
+    if handles:
+        ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.2),
+                  ncol=min(ncol, len(handles)), fontsize=fontsize, frameon=False)
+
+
+def log_ticks(ax: Axes, axis: str = "x") -> None:
+    """Readable tick labels on a log axis: every decade on a wide span, 1-2-5 on one to
+    three decades, every integer multiple on less than a decade (plain numbers, no
+    overlapping minor labels)."""
+    lo, hi = ax.get_xlim() if axis == "x" else ax.get_ylim()
+    decades = math.log10(hi / lo) if lo > 0 and hi > lo else 1.0
+    subs = (1.0,) if decades > 3 else (1.0, 2.0, 5.0) if decades > 1 else tuple(range(1, 10))
+    target = ax.xaxis if axis == "x" else ax.yaxis
+    target.set_major_locator(LogLocator(base=10, subs=subs))
+    target.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    target.set_minor_formatter(NullFormatter())
+
+
+def condition_label(cg: float, rule: str) -> str:
     return "CG1" if cg == 1 else f"CG{cg:g} {rule}"
 
 
-def pareto(conditions: pd.DataFrame, path: Path) -> Path:
-    """Error vs run time on the table's footing: x is production core-seconds per simulated
-    second of production per 1,000 particles of the original system (what the speedup
-    column divides), errors with their intervals
-    and the CG1 noise floor (dotted); a third panel shows each condition's fill, settle and
-    production core-seconds, which the x axis leaves out."""
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
-    for ax, col, title in ((axes[0], "angle_error", "angle of repose error vs CG1"),
-                           (axes[1], "profile_error", "velocity profile error (rel. L2) vs CG1")):
-        for _, r in conditions.iterrows():
-            y, x = r[col], r["production_core_rate_k"]
-            if not np.isfinite(y) or not np.isfinite(x):
-                continue
-            lo, hi = r.get(f"{col}_lo"), r.get(f"{col}_hi")
-            yerr = None
-            if np.isfinite(lo) and np.isfinite(hi):
-                yerr = 100 * np.array([[max(y - lo, 0)], [max(hi - y, 0)]])
-            ax.errorbar(x, 100 * y, yerr=yerr, fmt="o", capsize=3)
-            ax.annotate(_label(r["cg"], r["rule"]), (x, 100 * y),
-                        textcoords="offset points", xytext=(4, 4), fontsize=8)
-        floors = conditions.get(f"{col}_floor", pd.Series(dtype=float)).dropna()
-        if len(floors):
-            ax.axhline(100 * floors.iloc[0], ls=":", color="grey",
-                       label=f"CG1 noise floor ({conditions[f'{col}_floor_source'].iloc[0]})")
-        ax.set_xscale("log")
-        ax.xaxis.set_minor_formatter(NullFormatter())   # minor labels overlap on short spans
-        _axes(ax, "production core-s / simulated s / 1k original particles",
-              "error [%]", title,
-              legend=7 if len(floors) else None)
-    ax = axes[2]
-    labels = [_label(r["cg"], r["rule"]).replace(" ", "\n") for _, r in conditions.iterrows()]
-    bottom = np.zeros(len(conditions))
-    for phase in ("fill", "settle", "production"):
-        vals = conditions.get(f"{phase}_core_seconds", pd.Series(np.nan, index=conditions.index))
-        vals = np.nan_to_num(vals.to_numpy(float))
-        ax.bar(labels, vals, bottom=bottom, label=phase)
-        bottom += vals
+def error_ax(ax: Axes, conditions: pd.DataFrame, col: str, title: str) -> Axes:
+    """One error against the production cost per condition: points with their 95 %
+    interval, the CG1 noise floor as a dotted line; x: production core-s per simulated s
+    per 1,000 original particles (the speedup's footing), log scale."""
+    for i, (_, r) in enumerate(conditions.iterrows()):
+        y, x = r[col], r["production_core_rate_k"]
+        if not (np.isfinite(y) and np.isfinite(x)):
+            continue
+        lo, hi = r.get(f"{col}_lo", np.nan), r.get(f"{col}_hi", np.nan)
+        yerr = (100 * np.array([[max(y - lo, 0)], [max(hi - y, 0)]])
+                if np.isfinite(lo) and np.isfinite(hi) else None)
+        ax.errorbar(x, 100 * y, yerr=yerr, fmt="o", capsize=3, color=f"C{i}",
+                    label=condition_label(r["cg"], r["rule"]))
+    floors = conditions.get(f"{col}_floor", pd.Series(dtype=float)).dropna()
+    if len(floors):
+        source = conditions.loc[floors.index[0], f"{col}_floor_source"]
+        ax.axhline(100 * floors.iloc[0], ls=":", color="grey",
+                   label=f"CG1 noise floor ({source})")
+    ax.set_xscale("log")
+    ax.margins(x=0.15)
+    log_ticks(ax, "x")
+    ax.set_xlabel("production core-s / simulated s / 1k original particles")
+    ax.set_ylabel("error [%]")
+    ax.set_title(title, fontsize=10)
+    ax.grid(alpha=0.3)
+    legend_below(ax, ncol=2)
+    return ax
+
+
+def run_cost_ax(ax: Axes, conditions: pd.DataFrame) -> Axes:
+    """Core-seconds of each phase per condition as grouped bars (each from the axis, so a
+    small phase never vanishes under a large one on the log scale), the value on top."""
+    labels = [condition_label(r["cg"], r["rule"]) for _, r in conditions.iterrows()]
+    x = np.arange(len(labels))
+    width = 0.8 / len(PHASES)
+    for k, phase in enumerate(PHASES):
+        vals = conditions.get(f"{phase}_core_seconds",
+                              pd.Series(np.nan, index=conditions.index)).to_numpy(float)
+        bars = ax.bar(x + (k - 1) * width, np.where(vals > 0, vals, np.nan), width,
+                      label=phase, color=f"C{k}")
+        ax.bar_label(bars, labels=[f"{v:.3g}" if v > 0 else "" for v in vals], fontsize=6,
+                     padding=1)
+    ax.set_xticks(x, labels, fontsize=8)
     ax.set_yscale("log")
-    _axes(ax, "condition", "core-seconds per run (mean over replicas)",
-          "run cost by phase", legend=8)
-    return _save(fig, path)
+    log_ticks(ax, "y")
+    ax.set_ylabel("core-seconds per run (mean over replicas)")
+    ax.set_title("run cost by phase", fontsize=10)
+    ax.grid(alpha=0.3, axis="y")
+    legend_below(ax)
+    return ax
+
+
+def pareto(conditions: pd.DataFrame, path: Path) -> Path:
+    """Error vs run time (angle of repose, velocity profile) and the run cost by phase."""
+    fig = Figure(figsize=(15, 4.8))
+    axes = fig.subplots(1, 3)
+    error_ax(axes[0], conditions, "angle_error", "angle of repose error vs CG1")
+    error_ax(axes[1], conditions, "profile_error", "velocity profile error (rel. L2) vs CG1")
+    run_cost_ax(axes[2], conditions)
+    fig.subplots_adjust(wspace=0.3)
+    return save(fig, path)
 
 
 #: axis label and title part of each analysis.gsd_volume convention
 GSD_VOLUME_LABELS = {
-    "physical": ("granule volume [m$^3$]", "physical granule volumes"),
-    "primary": ("granule volume, primary-particle equivalent [m$^3$]", "CG-n volumes / n$^3$"),
+    "physical": ("granule equivalent diameter [mm]", "physical granule volumes"),
+    "primary": ("granule equivalent diameter, primary-particle scale [mm]",
+                "CG-n volumes / n$^3$"),
 }
 
 
-def gsd_overlay(gsd: pd.DataFrame, path: Path, volume: str = "physical") -> Path:
-    """Volume-weighted GSD of each condition with bootstrap bands, on the volume axis of
-    the study's ``gsd_volume`` convention (physical, or primary = CG-n volume / n^3)."""
+def equivalent_diameter_mm(volume_m3) -> np.ndarray:
+    """Diameter of the sphere of the given volume, in mm: (6 V / pi)^(1/3)."""
+    return 1e3 * np.cbrt(6 * np.asarray(volume_m3, dtype=float) / np.pi)
+
+
+def gsd_ax(ax: Axes, gsd: pd.DataFrame, volume: str = "physical",
+           size_limits: dict[str, float] | None = None) -> Axes:
+    """Volume-weighted GSD of each condition with its bootstrap band against the
+    equivalent diameter (mm, log axis); ``size_limits`` (condition -> granule volume, m^3,
+    gsd_summary.csv's located ``lower_limit``) marked as dashed lines of the condition's colour,
+    an absent one said in the legend."""
     xlabel, what = GSD_VOLUME_LABELS[volume]
-    fig, ax = plt.subplots(figsize=(7, 4.2))
+    limits = size_limits or {}
     for name, sub in gsd.groupby("condition", sort=True):
         sub = sub.sort_values("v_mid")
-        line, = ax.plot(sub["v_mid"], sub["volume_fraction"], marker=".", label=name)
-        ax.fill_between(sub["v_mid"], sub["volume_lo"], sub["volume_hi"], alpha=0.2,
-                        color=line.get_color())
+        d = equivalent_diameter_mm(sub["v_mid"])
+        line, = ax.plot(d, sub["volume_fraction"], marker=".", label=name)
+        ax.fill_between(d, sub["volume_lo"], sub["volume_hi"], alpha=0.2, color=line.get_color())
+        limit = limits.get(name)
+        if limit is not None and np.isfinite(limit) and limit > 0:
+            ax.axvline(float(equivalent_diameter_mm(limit)), ls="--", lw=1, color=line.get_color(),
+                       label=f"{name}: lower size limit {float(equivalent_diameter_mm(limit)):.2g} mm")
+        elif name in limits:
+            ax.plot([], [], ls="--", color=line.get_color(), label=f"{name}: no lower size limit located")
     ax.set_xscale("log")
-    _axes(ax, xlabel, "volume fraction per bin",
-          f"GSD, {what}, against CG1 (95 % bootstrap bands)", legend=8)
-    return _save(fig, path)
+    log_ticks(ax, "x")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("volume fraction per bin")
+    ax.set_title(f"GSD, {what}, against CG1 (95 % bootstrap bands)", fontsize=10)
+    ax.grid(alpha=0.3)
+    legend_below(ax, ncol=2, fontsize=7)
+    return ax
 
 
-def velocity_profiles(cases: pd.DataFrame, profiles: dict, path: Path) -> Path:
+def gsd_overlay(gsd: pd.DataFrame, path: Path, volume: str = "physical",
+                size_limits: dict[str, float] | None = None) -> Path:
+    """The GSD figure of the report (:func:`gsd_ax`)."""
+    fig = Figure(figsize=(7.5, 5.2))
+    gsd_ax(fig.subplots(), gsd, volume, size_limits)
+    return save(fig, path)
+
+
+def velocity_profiles_ax(ax: Axes, cases: pd.DataFrame, profiles: dict) -> Axes:
     """Mean downhill velocity against the normalised depth below the free surface, per case
     (the coordinate the profile error compares on); ``profiles``: case id ->
     :class:`~ligwf.analysis.records.flow.CaseFlow`."""
-    fig, ax = plt.subplots(figsize=(7, 4.2))
     for _, r in cases.sort_values(["cg", "rule", "replica"]).iterrows():
         p = profiles.get(r["case_id"])
         if p is None or not p.measured:
             continue
-        v = np.array(p.profile_v_mean, dtype=float)
-        ax.plot(v, np.array(p.profile_s), label=r["case_id"], lw=1.2,
+        ax.plot(np.array(p.profile_v_mean, dtype=float), np.array(p.profile_s),
+                label=r["case_id"], lw=1.2,
                 ls="-" if r["cg"] == 1 else ("--" if r["rule"] == "weber" else ":"))
     ax.axvline(0, color="k", lw=0.5)
     ax.invert_yaxis()
-    _axes(ax, "velocity down the free surface [m/s]",
-          "depth below the free surface / bed depth",
-          "velocity profiles (solid CG1, dashed weber, dotted bond)", legend=7)
-    return _save(fig, path)
+    ax.set_xlabel("velocity down the free surface [m/s]")
+    ax.set_ylabel("depth below the free surface / bed depth")
+    ax.set_title("velocity profiles (solid CG1, dashed weber, dotted bond)", fontsize=10)
+    ax.grid(alpha=0.3)
+    legend_below(ax, ncol=3, fontsize=7)
+    return ax
 
 
-def snapshot(particles_vtu: Path, drum_stl: Path, axis: str, drum_angle: float, scalar: str,
-             path: Path, title: str) -> Path:
-    """Off-screen pyvista picture of one frame seen along the drum axis, coloured by
-    ``scalar`` (``speed`` or ``granule``), with the drum turned to ``drum_angle`` (rad)."""
-    from ligwf.report.offscreen import granule_colours, pyvista_offscreen
-    from ligwf.report.paraview import read_stl, rotation_matrix
-
-    pv = pyvista_offscreen()
-    cloud = pv.read(str(particles_vtu))
-    note = ""
-    if scalar == "granule":
-        cloud["colour"], note = granule_colours(np.asarray(cloud["granule"]))
-    if scalar == "speed":
-        cloud["speed"] = np.linalg.norm(np.asarray(cloud["v"]), axis=1)
-    if "radius" in cloud.array_names:
-        cloud["diameter"] = 2 * np.asarray(cloud["radius"])
-        spheres = cloud.glyph(scale="diameter", geom=pv.Sphere(theta_resolution=10,
-                                                               phi_resolution=10), orient=False)
-    else:
-        spheres = cloud
-    plotter = pv.Plotter(off_screen=True, window_size=(640, 640))
-    if scalar == "granule":   # categorical: one colour per granule, no continuous bar
-        plotter.add_mesh(spheres, scalars="colour", rgb=True)
-    else:
-        plotter.add_mesh(spheres, scalars=scalar, cmap="viridis", show_scalar_bar=True)
-    tri = read_stl(drum_stl) @ rotation_matrix(axis, drum_angle).T
-    drum = pv.PolyData(tri.reshape(-1, 3),
-                       np.c_[np.full(len(tri), 3), np.arange(3 * len(tri)).reshape(-1, 3)].ravel())
-    plotter.add_mesh(drum, style="wireframe", color="grey", opacity=0.3)
-    plotter.add_text(title + (f"\n{note}" if note else ""), font_size=10)
-    normal = {"x": (1, 0, 0), "y": (0, -1, 0), "z": (0, 0, 1)}[axis]
-    plotter.view_vector(normal, viewup=(0, 0, 1) if axis != "z" else (0, 1, 0))
-    png = plotter.screenshot(return_img=True)
-    plotter.close()
-    from PIL import Image
-
-    buf = io.BytesIO()
-    Image.fromarray(png).save(buf, format="PNG")
-    atomic_write_bytes(path, buf.getvalue())
-    return path
+def velocity_profiles(cases: pd.DataFrame, profiles: dict, path: Path) -> Path:
+    """The velocity-profile figure of the report (:func:`velocity_profiles_ax`)."""
+    fig = Figure(figsize=(7.5, 5.2))
+    velocity_profiles_ax(fig.subplots(), cases, profiles)
+    return save(fig, path)

@@ -10,7 +10,6 @@ window it could not use) -- and lists them in ``summary.md`` and ``index.html``.
 
 from __future__ import annotations
 
-import html
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -66,22 +65,6 @@ class Problems:
                     "GSD figures are left out; the flow metrics are complete. Cases:")
         return ["## Granules", "", head, "",
                 *[f"- {cid}: {why}" for cid, why in self.granules_absent], ""]
-
-    def html(self) -> str:
-        """The same sections as HTML."""
-        e = html.escape
-        cases = "".join(f"<li>{e(c)}: {e(w)}</li>" for c, w in self.cases) or "<li>none</li>"
-        rows = "".join(f"<tr><td>{e(c)}</td><td>{e(s)}</td><td>{e(k)}</td><td>{e(r)}</td></tr>"
-                       for c, s, k, r in self.frames)
-        frames = (f"<table><tr><th>case</th><th>step</th><th>kind</th><th>reason</th></tr>{rows}"
-                  "</table>" if rows else "<p>none</p>")
-        outputs = "".join(f"<li>{e(o)}</li>" for o in self.outputs) or "<li>complete</li>"
-        absent = "".join(f"<li>{e(c)}: {e(w)}</li>" for c, w in self.granules_absent)
-        granules = (f"<h2>Granules</h2><p>Granules, GSD and kinetics were not analysed for "
-                    f"these cases (flow metrics complete):</p><ul>{absent}</ul>" if absent else "")
-        return (f"<h2>Skipped cases</h2><ul>{cases}</ul>"
-                f"<h2>Skipped or missing frames</h2>{frames}"
-                f"<h2>Analysis outputs</h2><ul>{outputs}</ul>{granules}")
 
 
 def _read_json(path: Path, what: str, outputs: list[str]) -> dict:

@@ -2,18 +2,17 @@
 
 The study's report folder (:attr:`ligwf.study.study.Study.report_dir`):
 ``cases.csv`` and ``conditions.csv`` (the numbers), ``summary.md`` and ``index.html``
-(the same tables with the figures), ``figures/*.png`` (error vs run time, GSD overlay,
-velocity profiles, one snapshot per case coloured by speed and one by granule id) and
-``paraview/<case>.pvd`` (particles + turning drum, open in ParaView). Whatever was not
-used -- skipped cases, missing or refused frames, missing analysis outputs -- is listed
-with its reason in ``summary.md`` and ``index.html`` (:mod:`ligwf.report.problems`).
+(the same sections, :mod:`ligwf.report.sections`, in the same order: the verdict first),
+``figures/*.png`` (error vs run time, GSD overlay, velocity profiles, one snapshot per case
+coloured by speed and one by granule id) and ``paraview/<case>.pvd`` (particles + turning
+drum, open in ParaView). Whatever was not used -- skipped cases, missing or refused frames,
+missing analysis outputs -- is listed with its reason (:mod:`ligwf.report.problems`).
 """
 
 from __future__ import annotations
 
-import html
 import json
-import math
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
@@ -21,167 +20,42 @@ import pandas as pd
 from ligwf import __version__
 from ligwf.analysis.records.conditions import REFERENCE_CG
 from ligwf.analysis.records.flow import FlowRecord
-from ligwf.analysis.records.metrics import CASE_TABLE, CONDITION_TABLE, GRANULE_METRICS
+from ligwf.analysis.records.gsd import LOWER_LIMIT
 from ligwf.analysis.records.provenance import (StaleAnalysis, changed_dumps, damaged_outputs,
                                                provenance_mismatch)
-from ligwf.study.layout import MESH_NAME
 from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
+from ligwf.report.controls import controls_markdown
 from ligwf.report.granule_figures import granule_figures
+from ligwf.report.html import render_page
 from ligwf.report.paraview import case_collection
-from ligwf.report.problems import study_problems
-from ligwf.report.controls import controls_html, controls_markdown
+from ligwf.report.problems import Problems, study_problems
+from ligwf.report.snapshots import snapshot, speed_scale
+from ligwf.report.sections import (Figure, Section, figure_section, ordered, render_markdown,
+                                   split_markdown)
+from ligwf.report.table_sections import (markdown_tables, noise_markdown, paraview_markdown,
+                                         pooling_markdown, stability_markdown, steady_line)
 from ligwf.report.tables import build_tables
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
+from ligwf.study.layout import MESH_NAME
 from ligwf.study.study import Study
 
-#: the run columns of the case table in summary.md (the metrics follow, from the record)
-RUN_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", "rep"),
-               ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
-               ("wall_seconds", "wall [s]"), ("core_seconds", "core-s"),
-               ("fill_core_seconds", "fill core-s"), ("settle_core_seconds", "settle core-s"),
-               ("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
-               ("speedup_core", "speedup (core-s)"), ("steady_fraction", "steady from")]
-RUN_METRICS = [("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
-               ("speedup_core", "speedup")]
-GSD_COLUMNS = [("gsd_lower_limit", "GSD lower limit [m^3]"),
-               ("gsd_error_below_lower", "GSD err below lower limit"),
-               ("gsd_error_above_lower", "GSD err above lower limit"),
-               ("gsd_error_all", "GSD err all bins")]
+NO_VERDICT = ("No acceptance budget was evaluated for this study, so there is no pass / fail "
+              "verdict per CG level: read the errors against the CG1 noise floor in the "
+              "conditions below.")
 
 
-def shown(flow: FlowRecord, table: str) -> list[tuple[str, str]]:
-    """(column, header) of the metrics a markdown table shows: the flow record's and the
-    granule metrics marked for it, in order."""
-    return [(m.name, m.header(table)) for m in (*flow.metrics, *GRANULE_METRICS)
-            if table in m.tables]
+@dataclass
+class ReportFigures:
+    """The figures of a report by the section that shows them, and the ParaView files."""
 
-
-def case_columns(flow: FlowRecord) -> list[tuple[str, str]]:
-    return RUN_COLUMNS + shown(flow, CASE_TABLE) + GSD_COLUMNS
-
-
-def condition_metrics(flow: FlowRecord) -> list[tuple[str, str]]:
-    return RUN_METRICS + shown(flow, CONDITION_TABLE) + GSD_COLUMNS
-
-
-def _fmt(v) -> str:
-    if isinstance(v, str):
-        return v
-    if v is None or (isinstance(v, float) and not math.isfinite(v)):
-        return "–"
-    if isinstance(v, float):
-        return f"{v:.3g}"
-    return str(v)
-
-
-def _ci(row, col) -> str:
-    """Value [95 % interval], "(no replica interval)" for one replica, and for an error
-    its mark against the CG1 noise floor."""
-    m, lo, hi = row[col], row.get(f"{col}_lo"), row.get(f"{col}_hi")
-    mark = row.get(f"{col}_vs_floor")
-    if mark == "reference":   # CG1's error against itself
-        return "reference"
-    tail = f" {mark}" if isinstance(mark, str) and mark not in ("–", "reference") else ""
-    if tail.startswith(" undecided"):   # what would decide it: in the noise-floor section
-        tail = " undecided"
-    if not (isinstance(m, float) and math.isfinite(m)):
-        return _fmt(m)
-    if isinstance(lo, float) and math.isfinite(lo):
-        return f"{_fmt(m)} [{_fmt(lo)}, {_fmt(hi)}]{tail}"
-    if row.get("replicas", 0) < 2 and not col.startswith("gsd_"):
-        return f"{_fmt(m)} (no replica interval){tail}"
-    return _fmt(m) + tail
-
-
-def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame, flow: FlowRecord
-                   ) -> list[str]:
-    """The CG1 noise floor: per metric the CG1-vs-CG1 scatter, per error the floor."""
-    lines = ["## CG1 noise floor", "",
-             "How far one CG1 run is from another (other seed). An error is `beyond` the "
-             "floor (a CG effect) when its whole 95 % interval lies above it, `within` (not "
-             "distinguishable from seed noise) when its whole interval lies at or below it, "
-             "and `undecided` otherwise, with the CG1 replicas that would decide it. A floor "
-             "estimated from one CG1 run's own scatter is indicative.", ""]
-    if not floors.empty:
-        lines += ["| group | metric | CG1 value | CG1 scatter | from |", "|---|---|---|---|---|"]
-        for _, r in floors.iterrows():
-            lines.append(f"| {r['group']} | {r['metric']} | {_fmt(r['cg1_value'])} | "
-                         f"{_fmt(r['cg1_scatter'])} | {r['source']} |")
-        lines.append("")
-    errors = [m for m in flow.error_metrics if f"{m.name}_floor" in conditions]
-    if not conditions.empty and errors:
-        lines += ["| CG | rule | " + " ".join(f"{m.header(CONDITION_TABLE)} | floor | |"
-                                              for m in errors),
-                  "|---|---|" + "---|---|---|" * len(errors)]
-        for _, r in conditions[conditions["cg"] != REFERENCE_CG].iterrows():
-            cells = [f"{r['cg']:g}", r["rule"]]
-            for col in (m.name for m in errors):
-                cells += [_fmt(r[col]), f"{_fmt(r[f'{col}_floor'])} ({r[f'{col}_floor_source']})",
-                          str(r[f"{col}_vs_floor"])]
-            lines.append("| " + " | ".join(cells) + " |")
-        lines.append("")
-    return lines
-
-
-def pooling_markdown(analysis_dir: Path, band: float) -> list[str]:
-    """The GSD size limit against replica pooling (ligwf.analysis.gsd.pooling): per
-    condition and pool size K, the mean [min, max] over disjoint pools of the source
-    study's upper limit and the errors below / above it; the CG1 noise floor first."""
-    path = analysis_dir / layout.GSD_POOLING_SUMMARY_TABLE
-    if not path.is_file() or path.stat().st_size <= 1:
-        return []
-    summary = pd.read_csv(path)
-    if summary.empty:
-        return []
-    lines = ["## GSD size limit and replica pooling", "",
-             f"Upper limit: the largest granule volume up to which every bin holding >= 1 % "
-             f"of the CG1 granule volume is within {100 * band:g} % of CG1 (the source "
-             f"study's limit; nan: the smallest bin is already outside). Errors: relative L1 "
-             f"of the volume-weighted GSD below / above it. K replicas pooled, mean [min, max] "
-             f"over disjoint pools; `noise floor`: one CG1 replica against the others.", "",
-             "| condition | rule | K | pools | upper limit [m^3] | error below upper limit "
-             "| error above upper limit | lower limit [m^3] |", "|---|---|---|---|---|---|---|---|"]
-
-    def cell(r, v):
-        m, lo, hi = r[f"{v}_mean"], r[f"{v}_min"], r[f"{v}_max"]
-        text = _fmt(m) if r["pools"] < 2 else f"{_fmt(m)} [{_fmt(lo)}, {_fmt(hi)}]"
-        nan = r[f"{v}_nan_pools"]
-        return text + (f" ({int(nan)} nan)" if nan else "")
-
-    order = summary.assign(first=summary["rule"] != "noise floor").sort_values(
-        ["first", "condition", "k"])
-    for _, r in order.iterrows():
-        lines.append(f"| {r['condition']} | {r['rule']} | {int(r['k'])} | {int(r['pools'])} | "
-                     + " | ".join(cell(r, v) for v in ("upper_limit", "error_below_upper",
-                                                       "error_above_upper", "lower_limit"))
-                     + " |")
-    return lines + [""]
-
-
-def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame, flow: FlowRecord) -> str:
-    columns, metrics = case_columns(flow), condition_metrics(flow)
-    head = "| " + " | ".join(t for _, t in columns) + " |"
-    sep = "|" + "---|" * len(columns)
-    lines = ["## Cases", "", head, sep]
-    for _, r in cases.sort_values(["group", "cg", "rule", "replica"]).iterrows():
-        lines.append("| " + " | ".join(_fmt(r[c]) for c, _ in columns) + " |")
-    lines += ["", "## Conditions (value [95 % interval])", "",
-              "Intervals: block bootstrap over frames (block = 2 x the measured "
-              "autocorrelation time) and replicas, never narrower than the within-run error, "
-              "bounded to the quantity's range (ligwf.analysis.records.intervals); run costs: t on the "
-              "logarithm over replicas; one replica: no replica interval. GSD bands come from "
-              "the GSD stage. Errors are marked `within` / `beyond` / `undecided` against the "
-              "CG1 noise floor by their interval (section CG1 noise floor).", ""]
-    head = "| CG | rule | replicas | particles | core-s | " + " | ".join(t for _, t in metrics) + " |"
-    lines += [head, "|" + "---|" * (5 + len(metrics))]
-    for _, r in conditions.iterrows():
-        cells = [f"{r['cg']:g}", r["rule"], str(r["replicas"]), str(r["particles"]),
-                 _ci(r, "core_seconds")] + [_ci(r, c) for c, _ in metrics]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines)
+    flow: list[Figure] = field(default_factory=list)        # error vs run time, profiles
+    gsd: list[Figure] = field(default_factory=list)
+    kinetics: list[Figure] = field(default_factory=list)    # kinetics, definition sensitivity
+    snapshots: list[Figure] = field(default_factory=list)
+    paraview: list[Path] = field(default_factory=list)
 
 
 def write_report(study: Study, out: Path | None = None, snapshots: bool = True) -> Path:
@@ -191,72 +65,134 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     out = Path(out) if out else study.report_dir
     flow = checked_analysis(study)
     nothing_to_report(study, flow)
-    fig_dir, pv_dir = out / layout.FIGURES_DIR, out / layout.PARAVIEW_DIR
-    fig_dir.mkdir(parents=True, exist_ok=True)
+    (out / layout.FIGURES_DIR).mkdir(parents=True, exist_ok=True)
     cases, conditions, _, floors = build_tables(study, flow)
     problems = study_problems(study)
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
+    figures = report_figures(study, flow, cases, conditions, out, snapshots)
+    sections = report_sections(study, flow, cases, conditions, floors, problems, figures)
+    title = f"{study.name}: error against run time"
+    preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "
+                "relative to the CG1 cases of the same sweep group; speedup is CG1 production "
+                "core-seconds per simulated second of production per 1,000 particles of the "
+                "original (CG1) system over the case's, so a CG level run on a shorter slice "
+                "compares on the same footing (fill and settle costs in their own columns).")
+    atomic_write_text(out / layout.SUMMARY_REPORT, render_markdown(title, preamble, sections))
+    atomic_write_text(out / layout.HTML_REPORT, render_page(title, preamble, sections))
+    return out
 
-    figures: list[tuple[str, Path]] = []
+
+def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
+                    conditions: pd.DataFrame, floors: pd.DataFrame, problems: Problems,
+                    figures: ReportFigures) -> list[Section]:
+    """Every section of the report, in :data:`ligwf.report.sections.SECTION_ORDER`."""
+    fig_dir = layout.FIGURES_DIR
+    tables = (markdown_tables(cases, conditions, flow) if not cases.empty
+              else "## Cases\n\nNo usable case.")
+    parts = [*verdict_sections(study, conditions),
+             *split_markdown(tables),
+             *split_markdown(noise_markdown(conditions, floors, flow)),
+             *split_markdown(pooling_markdown(study.analysis_dir, study.analysis.error_band)),
+             Section("Steady window", "steady-window",
+                     f"{steady_line(flow, cases)}. Flow metrics, GSDs and the noise floor "
+                     "use the frames of this window only."),
+             *split_markdown(controls_markdown(study.analysis_dir)),
+             *([figure_section("GSD", "gsd", "Volume-weighted granule size distributions of "
+                               "the steady window, each condition with its bootstrap band.",
+                               figures.gsd, fig_dir)] if figures.gsd else []),
+             *([figure_section("Granulation kinetics", "kinetics", "", figures.kinetics,
+                               fig_dir)] if figures.kinetics else []),
+             *flow_field_sections(study),
+             *split_markdown(problems.markdown()),
+             figure_section("Figures", "figures", "", figures.flow + figures.snapshots, fig_dir),
+             *split_markdown(stability_markdown(study.usable_cases()[0])),
+             *split_markdown(paraview_markdown(figures.paraview))]
+    return ordered(parts)
+
+
+def verdict_sections(study: Study, conditions: pd.DataFrame) -> list[Section]:
+    """The verdict per sweep group, first in the report (the verdict stage's
+    ``verdict_section`` plugs in here)."""
+    return [Section("Verdict", "verdict", NO_VERDICT)]
+
+
+def flow_field_sections(study: Study) -> list[Section]:
+    """The flow-field maps and errors (the field stage's section plugs in here)."""
+    return []
+
+
+def report_figures(study: Study, flow: FlowRecord, cases: pd.DataFrame,
+                   conditions: pd.DataFrame, out: Path, snapshots: bool) -> ReportFigures:
+    """Write every figure and ParaView collection of the report; what was written."""
+    fig_dir, pv_dir = out / layout.FIGURES_DIR, out / layout.PARAVIEW_DIR
+    found = ReportFigures()
     if not conditions.empty:
-        figures.append(("Error vs run time", figs.pareto(
+        found.flow.append(Figure("Error vs run time", figs.pareto(
             conditions, fig_dir / layout.FIGURE_ERROR_VS_RUNTIME)))
-        figures.append(("Velocity profiles", figs.velocity_profiles(
+        found.flow.append(Figure("Velocity profiles", figs.velocity_profiles(
             cases, flow.cases, fig_dir / layout.FIGURE_VELOCITY_PROFILES)))
     gsd_path = study.analysis_dir / layout.GSD_TABLE
     if gsd_path.is_file() and gsd_path.stat().st_size > 1:
         gsd = pd.read_csv(gsd_path)
         if not gsd.empty:
-            figures.append(("GSD overlay", figs.gsd_overlay(
-                gsd, fig_dir / layout.FIGURE_GSD_OVERLAY, study.analysis.gsd_volume)))
-    figures += granule_figures(study.analysis_dir, fig_dir)
-    pvds = []
+            found.gsd.append(Figure("GSD overlay", figs.gsd_overlay(
+                gsd, fig_dir / layout.FIGURE_GSD_OVERLAY, study.analysis.gsd_volume,
+                size_limits(study.analysis_dir))))
+    starts = {c.case_id: c.production_start_step * c.scaled.dt for c in study.usable_cases()[0]}
+    found.kinetics += [Figure(t, p) for t, p in granule_figures(study.analysis_dir, fig_dir,
+                                                                starts)]
     by_id = {c.case_id: c for c in study.usable_cases()[0]}
+    shots = []   # (case, step, dump) of each case's snapshot frame
     for case_id in cases.get("case_id", []):
         case: CaseFolder = by_id[case_id]
         record = flow.cases.get(case_id)
         pvd = case_collection(case, record.frames if record else (), study.analysis_dir, pv_dir)
         if pvd:
-            pvds.append(pvd)
-        last = record.snapshot if snapshots and record is not None else None
-        if last is not None:
-            step, dump = last
-            axis, mesh = case.scaled.axis, case.path / MESH_NAME
-            figures.append((f"{case_id}: speed", figs.snapshot(
-                case.path / dump, mesh, axis, case.drum_angle(step), "speed",
-                fig_dir / layout.snapshot_figure(case_id, "speed"),
-                f"{case_id} step {step}: speed [m/s]")))
-            labelled = last_labelled(study.analysis_dir / case_id, step)
-            if labelled is not None:
-                step, path = labelled
-                figures.append((f"{case_id}: granules", figs.snapshot(
-                    path, mesh, axis, case.drum_angle(step), "granule",
-                    fig_dir / layout.snapshot_figure(case_id, "granules"),
-                    f"{case_id} step {step}: granule id")))
+            found.paraview.append(pvd)
+        if snapshots and record is not None and record.snapshot is not None:
+            shots.append((case, *record.snapshot))
+    found.snapshots = snapshot_figures(study, shots, fig_dir)
+    return found
 
-    name = study.name
-    md = "\n".join([
-        f"# {name}: error against run time", "",
-        f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are relative to the "
-        "CG1 cases of the same sweep group; speedup is CG1 production core-seconds per simulated "
-        "second of production per 1,000 particles of the original (CG1) system over the case's, "
-        "so a CG level run on a shorter slice compares on the same footing (fill and settle "
-        "costs in their own columns).", "",
-        f"Steady window: {steady_line(flow, cases)}.", "",
-        markdown_tables(cases, conditions, flow) if not cases.empty else "No usable case.", "",
-        *noise_markdown(conditions, floors, flow),
-        *controls_markdown(study.analysis_dir),
-        *pooling_markdown(study.analysis_dir, study.analysis.error_band),
-        *problems.markdown(),
-        "## Figures", "",
-        *[f"![{t}]({layout.FIGURES_DIR}/{p.name})" for t, p in figures], "",
-        "## ParaView", "",
-        *[f"- `{layout.PARAVIEW_DIR}/{p.name}`" for p in pvds], ""])
-    atomic_write_text(out / layout.SUMMARY_REPORT, md)
-    atomic_write_text(out / layout.HTML_REPORT, _html(name, cases, conditions, figures, problems,
-                                                      controls_html(study.analysis_dir), flow))
+
+def size_limits(analysis_dir: Path) -> dict[str, float]:
+    """condition -> located lower GSD size limit (m^3, nan: none located) of each CG-n
+    condition in gsd_summary.csv (what the GSD errors below / above are measured at)."""
+    path = analysis_dir / layout.GSD_SUMMARY_TABLE
+    if not path.is_file() or path.stat().st_size <= 1:
+        return {}
+    summary = pd.read_csv(path)
+    if LOWER_LIMIT not in summary:
+        return {}
+    compared = summary[summary["cg"] != REFERENCE_CG]    # CG1 has no limit against itself
+    return dict(zip(compared["condition"].astype(str), compared[LOWER_LIMIT].astype(float)))
+
+
+def snapshot_figures(study: Study, shots: list, fig_dir: Path) -> list[Figure]:
+    """Speed snapshots of every case on one shared colour scale, and the granule snapshot
+    of the newest labelled frame at or before it; titles give the time from the start of
+    production (the drum starts turning), the arrow the drum's direction."""
+    scale = speed_scale(case.path / dump for case, _, dump in shots) if shots else None
+    out = []
+    for case, step, dump in shots:
+        axis, mesh, omega = case.scaled.axis, case.path / MESH_NAME, case.scaled.omega
+
+        def title(at: int, what: str) -> str:
+            t = (at - case.production_start_step) * case.scaled.dt
+            return f"{case.case_id}, {t:.2f} s after production start: {what}"
+        out.append(Figure(f"{case.case_id}: speed", snapshot(
+            case.path / dump, mesh, axis, case.drum_angle(step), "speed",
+            fig_dir / layout.snapshot_figure(case.case_id, "speed"), title(step, "speed"),
+            omega, scale)))
+        labelled = last_labelled(study.analysis_dir / case.case_id, step)
+        if labelled is not None:
+            at, path = labelled
+            out.append(Figure(f"{case.case_id}: granules", snapshot(
+                path, mesh, axis, case.drum_angle(at), "granule",
+                fig_dir / layout.snapshot_figure(case.case_id, "granules"),
+                title(at, "granule id"), omega)))
     return out
 
 
@@ -326,34 +262,3 @@ def nothing_to_report(study: Study, flow: FlowRecord) -> None:
     raise NothingToReport(f"nothing to report in {study.path}: no frame of the {len(usable)} "
                           f"usable case(s) could be used; first: {first}")
 
-
-def steady_line(flow: FlowRecord, cases: pd.DataFrame) -> str:
-    """The steady-window rule of the study and the fractions it gave."""
-    setting = flow.steady_after
-    fr = cases.get("steady_fraction", pd.Series(dtype=float)).dropna()
-    if flow.steady_auto:
-        span = (f"{100 * fr.min():.0f}-{100 * fr.max():.0f} %" if len(fr) else "–")
-        return (f"`steady_after: auto` (the first frame after which running means of the flow "
-                f"angle and kinetic energy stay within their steady scatter, "
-                f"ligwf.analysis.flow.steady): {span} of production left out")
-    return f"`steady_after: {setting}`: the first {100 * float(setting):.0f} % of production left out"
-
-
-def _html(name, cases, conditions, figures, problems, controls: str, flow: FlowRecord) -> str:
-    def table(df: pd.DataFrame) -> str:
-        if df.empty:
-            return "<p>none</p>"
-        return df.to_html(index=False, float_format=lambda v: f"{v:.3g}", na_rep="–", border=0)
-    imgs = "\n".join(f'<figure><img src="{layout.FIGURES_DIR}/{p.name}" alt="{html.escape(t)}">'
-                     f"<figcaption>{html.escape(t)}</figcaption></figure>" for t, p in figures)
-    cols = [c for c, _ in case_columns(flow)]
-    return f"""<!doctype html><html><head><meta charset="utf-8"><title>{html.escape(name)}</title>
-<style>body{{font-family:sans-serif;margin:2em}}table{{border-collapse:collapse;font-size:12px}}
-td,th{{padding:2px 6px;border-bottom:1px solid #ddd}}img{{max-width:720px}}</style></head><body>
-<h1>{html.escape(name)}: error against run time</h1>
-<h2>Cases</h2>{table(cases[cols] if not cases.empty else cases)}
-<h2>Conditions (mean, 95 % CI bounds over replicas)</h2>{table(conditions)}
-{controls}
-{problems.html()}
-<h2>Figures</h2>{imgs}</body></html>
-"""
