@@ -15,6 +15,7 @@ sizes as equivalent diameters in mm.
 from __future__ import annotations
 
 import io
+import json
 import math
 from pathlib import Path
 
@@ -24,10 +25,13 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
+from ligwf.analysis.records.conditions import REFERENCE_CG
 from ligwf.fsio import atomic_write_bytes
 
 #: phases of a run's cost, as the conditions table names them (``<phase>_core_seconds``)
 PHASES = ("fill", "settle", "production")
+#: relative x offset between the CG-n points of an error plot (their costs are often equal)
+DODGE = 0.04
 
 
 def save(fig: Figure, path: Path, dpi: int = 110) -> Path:
@@ -59,43 +63,77 @@ def log_ticks(ax: Axes, axis: str = "x") -> None:
     target.set_minor_formatter(NullFormatter())
 
 
-def condition_label(cg: float, rule: str) -> str:
-    return "CG1" if cg == 1 else f"CG{cg:g} {rule}"
+def group_suffix(group) -> str:
+    """" (cohesionless)" for a sweep group recorded as JSON (``{"control": "cohesionless"}``),
+    "" for the study's main group (``{}``)."""
+    try:
+        values = json.loads(group) if isinstance(group, str) and group else {}
+    except ValueError:
+        return f" ({group})"
+    return f" ({', '.join(str(v) for v in values.values())})" if values else ""
+
+
+def condition_label(cg: float, rule: str, group="") -> str:
+    """CG1, CG2 weber, CG1 (cohesionless): a condition as the figures name it."""
+    return ("CG1" if cg == REFERENCE_CG else f"CG{cg:g} {rule}") + group_suffix(group)
+
+
+def _label(r) -> str:
+    return condition_label(r["cg"], r["rule"], r.get("group", ""))
+
+
+def floor_label(source) -> str:
+    """Legend entry of a noise floor: short, "indicative" when it is."""
+    return "CG1 noise floor" + (" (indicative)" if "indicative" in str(source) else "")
 
 
 def error_ax(ax: Axes, conditions: pd.DataFrame, col: str, title: str) -> Axes:
-    """One error against the production cost per condition: points with their 95 %
-    interval, the CG1 noise floor as a dotted line; x: production core-s per simulated s
-    per 1,000 original particles (the speedup's footing), log scale."""
+    """One error against the production cost per CG-n condition: points with their 95 %
+    interval (points of equal cost nudged apart by :data:`DODGE`), the CG1 noise floor of
+    each compared group as a dotted line, each CG1 reference's own cost as a
+    dashed vertical line (the distance to it is the speedup); x: production core-s per
+    simulated s per 1,000 original particles (the speedup's footing), log scale."""
+    compared = int((conditions["cg"] != REFERENCE_CG).sum())
+    j = 0
     for i, (_, r) in enumerate(conditions.iterrows()):
         y, x = r[col], r["production_core_rate_k"]
-        if not (np.isfinite(y) and np.isfinite(x)):
+        if not np.isfinite(x):
+            continue
+        if r["cg"] == REFERENCE_CG:
+            ax.axvline(x, ls="--", lw=1, color=f"C{i}", label=f"{_label(r)} cost (reference)")
+            continue
+        x *= 1 + DODGE * (j - (compared - 1) / 2)   # nudged apart: overlapping bars stay legible
+        j += 1
+        if not np.isfinite(y):
             continue
         lo, hi = r.get(f"{col}_lo", np.nan), r.get(f"{col}_hi", np.nan)
         yerr = (100 * np.array([[max(y - lo, 0)], [max(hi - y, 0)]])
                 if np.isfinite(lo) and np.isfinite(hi) else None)
-        ax.errorbar(x, 100 * y, yerr=yerr, fmt="o", capsize=3, color=f"C{i}",
-                    label=condition_label(r["cg"], r["rule"]))
-    floors = conditions.get(f"{col}_floor", pd.Series(dtype=float)).dropna()
-    if len(floors):
-        source = conditions.loc[floors.index[0], f"{col}_floor_source"]
-        ax.axhline(100 * floors.iloc[0], ls=":", color="grey",
-                   label=f"CG1 noise floor ({source})")
+        ax.errorbar(x, 100 * y, yerr=yerr, fmt="o", capsize=3, color=f"C{i}", label=_label(r))
+    if f"{col}_floor" in conditions:   # one floor per sweep group (its CG1 replicas)
+        with_floor = conditions[conditions[f"{col}_floor"].notna()
+                                & (conditions["cg"] != REFERENCE_CG)]
+        groups = with_floor.drop_duplicates("group") if "group" in with_floor else with_floor[:1]
+        for k, (_, r) in enumerate(groups.iterrows()):
+            suffix = group_suffix(r.get("group", "")) if len(groups) > 1 else ""
+            ax.axhline(100 * r[f"{col}_floor"], ls=":", color="grey", lw=1 + k / 2,
+                       label=floor_label(r[f"{col}_floor_source"]) + suffix)
     ax.set_xscale("log")
     ax.margins(x=0.15)
     log_ticks(ax, "x")
+    ax.set_ylim(bottom=0)
     ax.set_xlabel("production core-s / simulated s / 1k original particles")
     ax.set_ylabel("error [%]")
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
-    legend_below(ax, ncol=2)
+    legend_below(ax, ncol=1)
     return ax
 
 
 def run_cost_ax(ax: Axes, conditions: pd.DataFrame) -> Axes:
     """Core-seconds of each phase per condition as grouped bars (each from the axis, so a
     small phase never vanishes under a large one on the log scale), the value on top."""
-    labels = [condition_label(r["cg"], r["rule"]) for _, r in conditions.iterrows()]
+    labels = [_label(r).replace(" (", "\n(") for _, r in conditions.iterrows()]
     x = np.arange(len(labels))
     width = 0.8 / len(PHASES)
     for k, phase in enumerate(PHASES):
@@ -122,7 +160,7 @@ def pareto(conditions: pd.DataFrame, path: Path) -> Path:
     error_ax(axes[0], conditions, "angle_error", "angle of repose error vs CG1")
     error_ax(axes[1], conditions, "profile_error", "velocity profile error (rel. L2) vs CG1")
     run_cost_ax(axes[2], conditions)
-    fig.subplots_adjust(wspace=0.3)
+    fig.subplots_adjust(wspace=0.32)
     return save(fig, path)
 
 

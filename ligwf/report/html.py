@@ -4,8 +4,8 @@ The page shows exactly the sections of summary.md (:mod:`ligwf.report.sections`)
 same order, the verdict first, with a table of contents. Section bodies are the markdown
 rendered by markdown-it (CommonMark + tables, raw HTML off: a case id or a reason can never
 inject markup); a section may bring its own HTML instead. Tables wider than
-:data:`WIDE_COLUMNS` fold into a ``<details>`` element (the header row says what they
-hold), every table scrolls sideways on its own instead of widening the page, and figures
+:data:`WIDE_COLUMNS` fold into a ``<details>`` element (open up to :data:`OPEN_ROWS`
+rows), every table scrolls sideways on its own instead of widening the page, and figures
 are inline ``<figure>`` elements with their captions. No network: the CSS is inline and
 the images are relative paths into the report folder, so the folder can be moved or
 zipped.
@@ -21,8 +21,10 @@ from markdown_it import MarkdownIt
 
 from ligwf.report.sections import Section
 
-#: tables with more columns than this fold into a <details> element
+#: tables with more columns than this fold into a <details> element ...
 WIDE_COLUMNS = 8
+#: ... shown open when it has at most this many rows (a short table is read, not hunted)
+OPEN_ROWS = 8
 
 _MD = MarkdownIt("commonmark", {"html": False}).enable("table")
 _TABLE = re.compile(r"<table>.*?</table>", re.S)
@@ -59,8 +61,9 @@ def _fold(match: re.Match) -> str:
     box = f'<div class="scroll">{table}</div>'
     if columns <= WIDE_COLUMNS:
         return box
-    return (f"<details><summary>table of {rows} row(s) and {columns} columns "
-            f"(click to show)</summary>{box}</details>")
+    state = " open" if rows <= OPEN_ROWS else ""
+    return (f"<details{state}><summary>table of {rows} row(s) and {columns} columns "
+            f"(click to fold or unfold)</summary>{box}</details>")
 
 
 def markdown_html(text: str) -> str:

@@ -124,14 +124,15 @@ def snapshot_ax(ax: Axes, image: np.ndarray, title: str, sense: int = 0,
     ax.set_axis_off()
     ax.set_title(title, fontsize=9)
     h, w = image.shape[:2]
-    if sense:
-        start, end = ((0.62 * w, 0.05 * h), (0.38 * w, 0.05 * h))
-        if sense < 0:
-            start, end = end, start
+    if sense:   # an arc over the drum's top, pointing the way the top moves
+        left, right = (0.38 * w, 0.07 * h), (0.62 * w, 0.07 * h)
+        start, end = (left, right) if sense < 0 else (right, left)
         ax.annotate("", xy=end, xytext=start, arrowprops=dict(
-            arrowstyle="-|>", lw=2, color="crimson", connectionstyle="arc3,rad=0.35"))
-        ax.text(0.5 * w, 0.0, "drum turns " + ("counter-clockwise" if sense > 0 else "clockwise"),
-                ha="center", va="bottom", fontsize=8, color="crimson")
+            arrowstyle="-|>", lw=2, color="crimson",
+            connectionstyle=f"arc3,rad={-0.35 if sense < 0 else 0.35}"))
+        ax.text(0.65 * w, 0.07 * h, "drum turns\n" + ("counter-clockwise" if sense > 0
+                                                     else "clockwise"),
+                ha="left", va="center", fontsize=8, color="crimson")
     if scale is not None:
         bar = ax.figure.colorbar(ScalarMappable(Normalize(0.0, scale.vmax), SPEED_CMAP), ax=ax,
                                  orientation="horizontal", fraction=0.05, pad=0.02,

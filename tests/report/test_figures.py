@@ -63,7 +63,11 @@ def test_error_plot_keeps_the_legend_off_the_data_and_labels_the_log_axis():
     legend = ax.get_legend().get_window_extent()
     assert legend.y1 < ax.get_window_extent().y0        # below the axes
     assert len(visible_labels(ax, ax.xaxis)) >= 2        # a short span still reads
-    assert "CG1 noise floor (CG1 replicas)" in [t.get_text() for t in ax.get_legend().texts]
+    texts = [t.get_text() for t in ax.get_legend().texts]
+    assert "CG1 noise floor" in texts and "CG1 cost (reference)" in texts
+    assert len(ax.containers) == 2            # the CG-n points; CG1 is the reference line
+    xs = [c.lines[0].get_xdata()[0] for c in ax.containers]
+    assert xs[0] != xs[1] and xs == pytest.approx([8.0, 7.0], rel=0.05)   # nudged, not moved
 
 
 def test_pareto_writes_a_png(tmp_path):

@@ -60,7 +60,9 @@ def test_wide_tables_fold_and_narrow_ones_do_not():
     text = ("| " + " | ".join(f"c{i}" for i in range(wide)) + " |\n" + "|---" * wide + "|\n"
             + "| " + " | ".join("1" for _ in range(wide)) + " |\n")
     out = markdown_html(text)
-    assert out.startswith("<details><summary>table of 1 row(s) and") and "<table>" in out
+    assert out.startswith("<details open><summary>table of 1 row(s) and") and "<table>" in out
+    many = text + ("| " + " | ".join("2" for _ in range(wide)) + " |\n") * 20
+    assert markdown_html(many).startswith("<details><summary>table of 21 row(s)")
     narrow = markdown_html("| a | b |\n|---|---|\n| 1 | 2 |\n")
     assert "<details>" not in narrow and 'class="scroll"' in narrow
 
