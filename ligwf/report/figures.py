@@ -192,10 +192,12 @@ def gsd_ax(ax: Axes, gsd: pd.DataFrame, volume: str = "physical",
         ax.fill_between(d, sub["volume_lo"], sub["volume_hi"], alpha=0.2, color=line.get_color())
         limit = limits.get(name)
         if limit is not None and np.isfinite(limit) and limit > 0:
-            ax.axvline(float(equivalent_diameter_mm(limit)), ls="--", lw=1, color=line.get_color(),
-                       label=f"{name}: lower size limit {float(equivalent_diameter_mm(limit)):.2g} mm")
+            at = float(equivalent_diameter_mm(limit))
+            ax.axvline(at, ls="--", lw=1, color=line.get_color(),
+                       label=f"{name}: lower size limit {at:.2g} mm")
         elif name in limits:
-            ax.plot([], [], ls="--", color=line.get_color(), label=f"{name}: no lower size limit located")
+            ax.plot([], [], ls="--", color=line.get_color(),
+                    label=f"{name}: no lower size limit located")
     ax.set_xscale("log")
     log_ticks(ax, "x")
     ax.set_xlabel(xlabel)
