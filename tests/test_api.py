@@ -108,6 +108,40 @@ def test_settings_paths_profiles_and_flow_record(reported):
     assert prof["depth"].between(0, 1).all() and np.isfinite(prof["v_mean"]).any()
 
 
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_plots_draw_into_the_given_axes_and_return_it(reported):
+    from matplotlib.figure import Figure
+
+    s = ligwf.open_study(reported)
+    axes = Figure().subplots(1, 5)
+    assert s.plot_pareto(axes[0]) is axes[0]
+    compared = s.conditions[(s.conditions["cg"] != 1) & s.conditions["angle_error"].notna()]
+    assert len(axes[0].containers) == len(compared) > 0        # one error bar per CG-n row
+    assert s.plot_pareto(axes[1], metric="profile_error") is axes[1]
+    assert s.plot_gsd(axes[2]) is axes[2]
+    assert len(axes[2].lines) >= s.gsd["condition"].nunique()
+    assert s.plot_profiles(axes[3]) is axes[3]
+    assert len(axes[3].lines) >= len(s.profiles["case_id"].unique())
+    assert s.plot_kinetics(axes[4], quantity="granules") is axes[4]
+    assert len(axes[4].lines) == s.kinetics_summary["condition"].nunique()
+    with pytest.raises(LigwfError, match=r"metric = 'nonsense' is not an error .*angle_error"):
+        s.plot_pareto(metric="nonsense")
+    with pytest.raises(LigwfError, match="quantity = 'd51' is not one of"):
+        s.plot_kinetics(quantity="d51")
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_a_plot_without_axes_makes_its_own_pyplot_figure(reported):
+    import matplotlib.pyplot as plt
+
+    before = set(plt.get_fignums())
+    ax = ligwf.open_study(reported).plot_run_cost()
+    assert ax.figure.number in set(plt.get_fignums()) - before and ax.patches
+    plt.close(ax.figure)
+
+
 # ---------------------------------------------------------------- missing outputs
 def test_a_rendered_study_names_the_command_for_every_table(rendered):
     s = ligwf.open_study(rendered)

@@ -10,17 +10,21 @@ import json
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
 from ligwf.analysis.records.flow import FlowRecord
+from ligwf.api import plots
 from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec, read_table,
                               typed)
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.study import Study
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 _BY_NAME = {t.attribute: t for t in TABLES}
 
@@ -206,6 +210,41 @@ class StudyResults:
                                             "v_mean", "v_std"])
         return typed(frame.astype({"cg": float, "replica": int, "depth": float,
                                    "v_mean": float, "v_std": float}))
+
+    # ------------------------------------------------------------- plots
+    def plot_pareto(self, ax: Axes | None = None, metric: str = "angle_error") -> Axes:
+        """One error of every CG-n condition against its production cost (core-s per
+        simulated s per 1,000 original particles, the speedup's footing), with its 95 %
+        interval and the CG1 noise floor: the report's error-vs-run-time panel. ``metric``:
+        an error column of :attr:`conditions` (``angle_error``, ``profile_error``, ...)."""
+        conditions = self._read("conditions")
+        if metric not in conditions:
+            errors = [c[: -len("_vs_floor")] for c in conditions if c.endswith("_vs_floor")]
+            raise LigwfError(f"plot_pareto: metric = {metric!r} is not an error of this "
+                             f"study's conditions table (one of {', '.join(errors)})")
+        return plots.error_vs_cost(ax, conditions, metric, self.flow_record)
+
+    def plot_run_cost(self, ax: Axes | None = None) -> Axes:
+        """Fill, settle and production core-seconds of every condition."""
+        return plots.run_cost(ax, self._read("conditions"))
+
+    def plot_gsd(self, ax: Axes | None = None) -> Axes:
+        """The volume-weighted GSD of every condition (steady window, bootstrap bands),
+        against the equivalent diameter, with each CG level's located size limit."""
+        return plots.gsd(ax, self._read("gsd"), self.settings.gsd_volume, self.analysis_dir)
+
+    def plot_profiles(self, ax: Axes | None = None) -> Axes:
+        """The velocity profile of every case against the depth below the free surface."""
+        return plots.profiles(ax, self._read("cases"), self.flow_record)
+
+    def plot_kinetics(self, ax: Axes | None = None, quantity: str = "d50") -> Axes:
+        """One granule-kinetics quantity per condition (``granules``, ``d50``,
+        ``largest_granule``, ``granule_share``) against the time from production start,
+        with its band over replicas."""
+        starts = {c.case_id: c.production_start_step * c.scaled.dt
+                  for c in self.study.usable_cases()[0]}
+        return plots.kinetics(ax, self._read("kinetics_summary"), self._read("kinetics"),
+                              quantity, starts)
 
     # ------------------------------------------------------------- reading
     def _path(self, spec: TableSpec) -> Path:

@@ -68,10 +68,12 @@ TABLES: tuple[TableSpec, ...] = (
 )
 
 #: text columns by name (also when every value is missing, where a CSV reader sees nan)
-TEXT_COLUMNS = frozenset({"case_id", "condition", "group", "rule", "status", "reason",
-                          "metric", "source", "variant", "definition", "control", "twin",
-                          "twin_id", "twin_case_id", "verdict", "criterion", "outcome",
-                          "sentence", "method", "velocity_frame", "pool", "reference"})
+TEXT_COLUMNS = frozenset({
+    "case_id", "condition", "group", "rule", "status", "reason", "metric", "source",
+    "variant", "definition", "control", "twin_id", "twin_case_id", "verdict", "method",
+    "velocity_frame", "pool", "reference",
+    # the verdict table (ligwf.report.verdict)
+    "criterion", "label", "unit", "state", "condition_state", "budget_source", "note"})
 TEXT_SUFFIXES = ("_floor_source", "_vs_floor", "_reason", "_verdict")
 
 
