@@ -51,8 +51,8 @@ def test_the_example_notebook_runs_on_a_real_study(engine, tmp_path_factory, mon
     assert not errors, errors
     probe = "".join(o.get("text", "") for o in nb.cells[-1].outputs)
     read = json.loads(re.search(r"READ (.*)", probe).group(1))
-    assert set(read) >= {t.attribute for t in TABLES} | {"verdict"}, read
+    assert set(read) >= {t.attribute for t in TABLES}, read
     assert int(re.search(r"FIGS (\d+)", probe).group(1)) >= 2
-    verdict = next(c for c in nb.cells if c.source.strip() == "study.verdict")
-    assert any("text/html" in o.get("data", {}) for o in verdict.outputs)
+    conditions = next(c for c in nb.cells if "study.conditions[" in c.source)
+    assert any("text/html" in o.get("data", {}) for o in conditions.outputs)
     assert os.environ["LIGWF_STUDY"] == str(study)
