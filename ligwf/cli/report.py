@@ -12,8 +12,10 @@ from ligwf.study.study import Study
 
 
 def print_report(study_dir: Path, out: Path) -> None:
-    """Where the report is, and on stderr how much it lists as not used."""
+    """Where the report is, its verdict, and on stderr how much it lists as not used."""
     from ligwf.report.problems import study_problems
+    from ligwf.report.verdict_records import read_verdict
+    from ligwf.report.verdict_text import verdict_renderables
 
     console.print(f"report: {out / 'summary.md'} and {out / 'index.html'}")
     p = study_problems(Study.open(study_dir))
@@ -22,6 +24,10 @@ def print_report(study_dir: Path, out: Path) -> None:
                           f"case(s), {len(p.frames)} skipped or missing frame(s) and "
                           f"{len(p.outputs)} analysis output problem(s) (see summary.md)",
                           highlight=False)
+    verdict = read_verdict(out)
+    if verdict is not None:   # last: the answer is what the user reads
+        for item in verdict_renderables(verdict):
+            console.print(item, highlight=False)
 
 
 def cmd_report(args: argparse.Namespace) -> int:

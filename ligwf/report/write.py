@@ -37,6 +37,9 @@ from ligwf.report.sections import (Figure, Section, figure_section, ordered, ren
 from ligwf.report.table_sections import (markdown_tables, noise_markdown, paraview_markdown,
                                          pooling_markdown, stability_markdown, steady_line)
 from ligwf.report.tables import build_tables
+from ligwf.report.verdict import Verdict
+from ligwf.report.verdict_records import study_verdict, write_verdict
+from ligwf.report.verdict_text import verdict_section
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import MESH_NAME
@@ -71,8 +74,11 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
+    verdict = study_verdict(cases, conditions, study.accept, study.analysis_dir)
+    write_verdict(verdict, out)
     figures = report_figures(study, flow, cases, conditions, out, snapshots)
-    sections = report_sections(study, flow, cases, conditions, floors, problems, figures)
+    sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
+                               verdict)
     title = f"{study.name}: error against run time"
     preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "
                 "relative to the CG1 cases of the same sweep group; speedup is CG1 production "
@@ -86,12 +92,12 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
 
 def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
                     conditions: pd.DataFrame, floors: pd.DataFrame, problems: Problems,
-                    figures: ReportFigures) -> list[Section]:
+                    figures: ReportFigures, verdict: Verdict | None = None) -> list[Section]:
     """Every section of the report, in :data:`ligwf.report.sections.SECTION_ORDER`."""
     fig_dir = layout.FIGURES_DIR
     tables = (markdown_tables(cases, conditions, flow) if not cases.empty
               else "## Cases\n\nNo usable case.")
-    parts = [*verdict_sections(study, conditions),
+    parts = [*verdict_sections(verdict),
              *split_markdown(tables),
              *split_markdown(noise_markdown(conditions, floors, flow)),
              *split_markdown(pooling_markdown(study.analysis_dir, study.analysis.error_band)),
@@ -112,10 +118,11 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
     return ordered(parts)
 
 
-def verdict_sections(study: Study, conditions: pd.DataFrame) -> list[Section]:
-    """The verdict per sweep group, first in the report (the verdict stage's
-    ``verdict_section`` plugs in here)."""
-    return [Section("Verdict", "verdict", NO_VERDICT)]
+def verdict_sections(verdict: Verdict | None) -> list[Section]:
+    """The verdict per sweep group (:mod:`ligwf.report.verdict`), first in the report."""
+    if verdict is None:
+        return [Section("Verdict", "verdict", NO_VERDICT)]
+    return split_markdown(verdict_section(verdict))
 
 
 def flow_field_sections(study: Study) -> list[Section]:

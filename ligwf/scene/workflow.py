@@ -11,6 +11,7 @@ sweep:
   scene.process.rotation.rpm: [20, 30]   # any scene field as a list
   per_cg: {2: {process.run_time: 6.0}}    # scene fields for one CG level only
 analysis: {steady_after: 0.25, max_velocity_angle: 30}   # ligwf.scene.settings
+accept: {angle_deg: 1.0, profile_error: 0.1}   # the error budget, ligwf.scene.accept
 ```
 
 CLI overrides (``--set scene.drum.lifters.count=12``) are applied to the raw mapping before
@@ -32,12 +33,13 @@ from pydantic import Field, TypeAdapter, ValidationError
 
 from ligwf.errors import ConfigError
 from ligwf.yamlio import parse_yaml, read_yaml_mapping
+from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
 from ligwf.scene.messages import format_validation_error, short_repr
 from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene
 from ligwf.scene.settings import AnalysisSettings, build_analysis_settings
 
-_TOP_KEYS = {"name", "description", "scene", "sweep", "analysis"}
+_TOP_KEYS = {"name", "description", "scene", "sweep", "analysis", "accept"}
 #: replicas per CG level and cases per study ligwf prepares (a typo such as 300000 replicas
 #: would otherwise spend minutes validating before anything is said)
 MAX_REPLICAS = 1000
@@ -89,6 +91,7 @@ class Workflow:
     raw: dict[str, Any]
     cases: tuple[Case, ...]
     analysis: AnalysisSettings = AnalysisSettings()
+    accept: AcceptSettings = AcceptSettings()
 
 
 # ---------------------------------------------------------------------------------------
@@ -287,6 +290,7 @@ def expand(raw: dict[str, Any]) -> Workflow:
         raise ConfigError(f"name = {name!r}: {exc.errors()[0]['msg']}") from None
     sweep, varied = _split_sweep(raw.get("sweep"))
     analysis = build_analysis_settings(raw.get("analysis") or {})
+    accept = build_accept_settings(raw.get("accept"))
 
     base_scene = copy.deepcopy(_mapping(raw["scene"], "scene", "scene fields (drum:, "
                                         "particles:, liquid:, process:, ...)"))
@@ -339,7 +343,7 @@ def expand(raw: dict[str, Any]) -> Workflow:
                                               rep, values + ((CONTROL_KEY, control),)))
     _unique_case_ids(cases)
     return Workflow(name=name, description=str(raw.get("description", "")), raw=raw,
-                    cases=tuple(cases), analysis=analysis)
+                    cases=tuple(cases), analysis=analysis, accept=accept)
 
 
 #: the ``varied`` entry that marks a control twin (its own comparison group)

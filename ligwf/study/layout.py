@@ -94,6 +94,9 @@ def granule_frame_step(name: str) -> int | None:
 CASES_REPORT = "cases.csv"
 CONDITIONS_REPORT = "conditions.csv"
 NOISE_FLOOR_REPORT = "noise_floor.csv"
+#: the verdict per sweep group, CG level, rule and criterion (ligwf.report.verdict)
+VERDICT_TABLE = "verdict.csv"
+VERDICT_RECORD = "verdict.json"
 SUMMARY_REPORT = "summary.md"
 HTML_REPORT = "index.html"
 FIGURES_DIR = "figures"

@@ -1,4 +1,5 @@
-"""A study folder as one object: its name, its analysis settings, its cases in order.
+"""A study folder as one object: its name, its analysis settings and error budget, its
+cases in order.
 
 :meth:`Study.open` takes a study folder (with its study record) or a single case folder
 (a foreign case run by hand: one case, default analysis settings). Every command that
@@ -16,6 +17,7 @@ from pathlib import Path
 from ligwf.errors import ConfigError
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import ANALYSIS_DIR, REPORT_DIR, STUDY_FILE, is_case_folder, is_study_folder
+from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.settings import AnalysisSettings, build_analysis_settings
 
 
@@ -28,6 +30,8 @@ class Study:
     analysis: AnalysisSettings
     case_ids: tuple[str, ...]          # in case-index order
     single_case: bool = False
+    #: the workflow's ``accept:`` block (the defaults for a case folder or an older study)
+    accept: AcceptSettings = AcceptSettings()
 
     @classmethod
     def open(cls, path: Path | str) -> "Study":
@@ -44,8 +48,11 @@ class Study:
             if twice:
                 raise ConfigError(f"{path / STUDY_FILE}: lists case {', '.join(twice)} more than "
                                   "once (edited or merged by hand?): render the study again")
+            workflow = rec.get("workflow") if isinstance(rec.get("workflow"), dict) else {}
+            accept = rec["accept"] if "accept" in rec else workflow.get("accept")
             return cls(path, str(rec.get("name", path.name)),
-                       build_analysis_settings(rec.get("analysis"), "study analysis"), ids)
+                       build_analysis_settings(rec.get("analysis"), "study analysis"), ids,
+                       accept=build_accept_settings(accept, "study accept"))
         if is_case_folder(path):
             case = CaseFolder.open(path)
             return cls(path, case.case_id, AnalysisSettings(), (case.case_id,), True)

@@ -1,0 +1,90 @@
+"""The verdict's records in the report folder: a table (one row per sweep group, CG level,
+rule and criterion) and a JSON record the terminal and the Python API read back; and the
+verdict of a study's report tables (:func:`study_verdict`, with the granule control
+verdicts of its analysis folder). File names: :mod:`ligwf.study.layout`."""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict
+from pathlib import Path
+
+import pandas as pd
+
+from ligwf.fsio import atomic_write_json, atomic_write_text
+from ligwf.report.controls import read_controls
+from ligwf.report.verdict import (ConditionVerdict, CriterionResult, GroupVerdict, Verdict,
+                                  decide, granule_gates)
+from ligwf.scene.accept import AcceptSettings
+from ligwf.study import layout
+
+
+def _clean(obj):
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    return obj
+
+
+def verdict_rows(verdict: Verdict) -> pd.DataFrame:
+    """One row per (group, CG level, rule, criterion): what verdict.csv holds."""
+    rows = []
+    for g in verdict.groups:
+        for c in g.conditions:
+            for r in c.criteria:
+                rows.append({"group": g.group, "cg": c.cg, "rule": c.rule,
+                             "condition": c.name, "replicas": c.replicas,
+                             "condition_state": c.state, "speedup_core": c.speedup,
+                             "speedup_core_lo": c.speedup_lo, "speedup_core_hi": c.speedup_hi,
+                             "criterion": r.name, "label": r.label, "unit": r.unit,
+                             "state": r.state, "value": r.value, "lo": r.lo, "hi": r.hi,
+                             "budget": r.budget, "budget_source": r.budget_source,
+                             "note": r.note, "cheapest": g.cheapest == c.name})
+    return pd.DataFrame(rows)
+
+
+def write_verdict(verdict: Verdict, out: Path) -> None:
+    """``verdict.csv`` and ``verdict.json`` into the report folder ``out`` (atomically)."""
+    record = {"accept": verdict.accept, "groups": [
+        {**_clean(asdict(g)), "conditions": [{**_clean(asdict(c)), "state": c.state,
+                                              "name": c.name} for c in g.conditions]}
+        for g in verdict.groups]}
+    atomic_write_text(out / layout.VERDICT_TABLE, verdict_rows(verdict).to_csv(index=False))
+    atomic_write_json(out / layout.VERDICT_RECORD, record)
+
+
+def _nan(v) -> float:
+    return math.nan if v is None else float(v)
+
+
+def read_verdict(out: Path) -> Verdict | None:
+    """The verdict written into the report folder ``out`` (None when there is none)."""
+    try:
+        rec = json.loads((Path(out) / layout.VERDICT_RECORD).read_text())
+        groups = []
+        for g in rec["groups"]:
+            conds = []
+            for c in g["conditions"]:
+                crit = tuple(CriterionResult(**{**r, **{k: _nan(r[k]) for k in
+                                                        ("value", "lo", "hi", "budget")}})
+                             for r in c["criteria"])
+                conds.append(ConditionVerdict(c["group"], float(c["cg"]), c["rule"],
+                                              int(c["replicas"]), _nan(c["speedup"]),
+                                              _nan(c["speedup_lo"]), _nan(c["speedup_hi"]), crit))
+            groups.append(GroupVerdict(g["group"], tuple(conds), g["sentence"], g["cheapest"]))
+        return Verdict(tuple(groups), rec.get("accept", {}))
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def study_verdict(cases: pd.DataFrame, conditions: pd.DataFrame, accept: AcceptSettings,
+                  analysis_dir: Path) -> Verdict:
+    """The verdict of a study's report tables, with its granule control verdicts read from
+    the analysis folder."""
+    if cases.empty or conditions.empty:
+        return Verdict((), accept.model_dump(mode="json"))
+    return decide(conditions, accept, granule_gates(cases, read_controls(analysis_dir)))

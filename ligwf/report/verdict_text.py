@@ -1,0 +1,122 @@
+"""The verdict (:mod:`ligwf.report.verdict`) as the report's first section (markdown:
+summary.md shows it, index.html renders it, :mod:`ligwf.report.sections`) and as the
+terminal lines ``ligwf study`` and ``ligwf report`` end with (rich).
+
+All three show the same facts: per sweep group its sentence (the cheapest level that meets
+the budget, or that none does and why), then per CG level and rule the speedup with its
+interval and each criterion's state with its value, 95 % interval and budget; undecided
+criteria say what would decide them, unassessed ones why.
+"""
+
+from __future__ import annotations
+
+import math
+
+from rich.table import Table
+from rich.text import Text
+
+from ligwf.report.verdict import (CRITERIA, FAIL, FAILS, MEETS, PASS, UNDECIDED,
+                                  ConditionVerdict, CriterionResult, GroupVerdict, Verdict,
+                                  band_text)
+
+TITLE = "Verdict"
+#: rich styles of the states
+STYLE = {PASS: "green", FAIL: "red", UNDECIDED: "yellow", MEETS: "bold green",
+         FAILS: "bold red"}
+
+
+def _num(v: float) -> str:
+    return "–" if not math.isfinite(v) else f"{v:.3g}"
+
+
+def group_title(group: str) -> str:
+    """A sweep group for a reader: ``all cases`` for the study without swept values."""
+    return "all cases" if group in ("{}", "") else group
+
+
+def budget_line(accept: dict) -> str:
+    """The tolerances the verdict was decided with, in the block's order."""
+    spec = {s.name: s for s in CRITERIA}
+    parts = []
+    for name, tol in accept.items():
+        s = spec.get(name)
+        if s is None:
+            continue
+        if tol is None:
+            parts.append(f"{s.label}: not in the budget")
+            continue
+        unit = f" {s.unit}" if s.unit else ""
+        floored = " (or the CG1 noise floor, if larger)" if s.floored else ""
+        parts.append(f"{s.label} <= {tol:g}{unit}{floored}")
+    return "; ".join(parts)
+
+
+def cell(r: CriterionResult) -> str:
+    """A criterion as one table cell: state, value [interval] <= budget."""
+    if not r.assessed:
+        return r.state
+    return f"{r.state}: {band_text(r.value, r.lo, r.hi, r.unit)} vs {_num(r.budget)}"
+
+
+def _notes(c: ConditionVerdict) -> list[str]:
+    return [f"{c.name}, {r.label}: {r.note}" for r in c.criteria if r.note]
+
+
+def _columns(g: GroupVerdict) -> list[str]:
+    first = g.conditions[0] if g.conditions else None
+    return [r.label for r in first.criteria] if first else []
+
+
+def group_markdown(g: GroupVerdict, several: bool) -> list[str]:
+    lines = ([f"### {group_title(g.group)}", ""] if several else [])
+    lines += [f"**{g.sentence}**", ""]
+    if not g.conditions:
+        return lines
+    cols = _columns(g)
+    lines += ["| condition | replicas | speedup (core-s) | verdict | " + " | ".join(cols) + " |",
+              "|---|---|---|---|" + "---|" * len(cols)]
+    for c in g.conditions:
+        lines.append(f"| {c.name} | {c.replicas} | "
+                     f"{band_text(c.speedup, c.speedup_lo, c.speedup_hi)} | {c.state} | "
+                     + " | ".join(cell(r) for r in c.criteria) + " |")
+    notes = [n for c in g.conditions for n in _notes(c)]
+    if notes:
+        lines += [""] + [f"- {n}" for n in notes]
+    return lines + [""]
+
+
+def verdict_section(verdict: Verdict) -> str:
+    """The verdict as the report's first markdown section."""
+    lines = [f"## {TITLE}", "",
+             f"Budget (`accept:` block): {budget_line(verdict.accept)}. A criterion passes when "
+             "its whole 95 % interval lies within the budget, fails when it lies wholly "
+             "outside, and is undecided otherwise; a level meets the budget when every "
+             "criterion it was assessed on passes. Control twins are not candidates.", ""]
+    if not verdict.groups:
+        return "\n".join(lines + ["No sweep group with a CG1 reference and a CG level to "
+                                  "judge.", ""])
+    several = len(verdict.groups) > 1
+    for g in verdict.groups:
+        lines += group_markdown(g, several)
+    return "\n".join(lines)
+
+
+def verdict_renderables(verdict: Verdict) -> list:
+    """Rich renderables for the terminal: per group its sentence and a table."""
+    out: list = [Text(f"{TITLE} ({budget_line(verdict.accept)})", style="bold")]
+    for g in verdict.groups:
+        title = group_title(g.group)
+        out.append(Text(f"{title}: {g.sentence}" if len(verdict.groups) > 1 else g.sentence,
+                        style="bold green" if g.cheapest else "bold"))
+        if not g.conditions:
+            continue
+        table = Table(show_header=True, header_style="bold", box=None, pad_edge=False)
+        for col in ("condition", "speedup", "verdict", *_columns(g)):
+            table.add_column(col)
+        for c in g.conditions:
+            table.add_row(c.name, band_text(c.speedup, c.speedup_lo, c.speedup_hi),
+                          Text(c.state, style=STYLE.get(c.state, "yellow")),
+                          *[Text(cell(r), style=STYLE.get(r.state, "dim")) for r in c.criteria])
+        out.append(table)
+        out += [Text(f"  {n}", style="dim") for c in g.conditions for n in _notes(c)]
+    return out
