@@ -266,8 +266,9 @@ def _speedup(c: ConditionVerdict) -> str:
 
 
 def _not_in_budget(c: ConditionVerdict) -> str:
+    """``; GSD ... not assessed (why); ...`` for the criteria left out of a decision."""
     left = [f"{r.label} {r.note}" for r in c.criteria if not r.assessed]
-    return f" ({'; '.join(left)})" if left else ""
+    return "".join(f"; {x}" for x in left)
 
 
 def group_sentence(conditions: list[ConditionVerdict]) -> tuple[str, str | None]:
@@ -278,8 +279,8 @@ def group_sentence(conditions: list[ConditionVerdict]) -> tuple[str, str | None]
     meets = [c for c in by_cost if c.state == MEETS]
     if meets:
         best = meets[0]
-        text = (f"{best.name} is the cheapest level that meets the budget "
-                f"({_speedup(best)}){_not_in_budget(best)}.")
+        text = (f"{best.name} is the cheapest level that meets the budget: "
+                f"{_speedup(best)}{_not_in_budget(best)}.")
         cheaper = [c for c in by_cost[:by_cost.index(best)] if c.state == UNDECIDED]
         if cheaper:
             c = cheaper[0]

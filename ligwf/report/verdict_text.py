@@ -1,6 +1,5 @@
-"""The verdict (:mod:`ligwf.report.verdict`) as the report's first section (markdown:
-summary.md shows it, index.html renders it, :mod:`ligwf.report.sections`) and as the
-terminal lines ``ligwf study`` and ``ligwf report`` end with (rich).
+"""The verdict (:mod:`ligwf.report.verdict`) as the report's first section (markdown and
+HTML) and as the terminal lines ``ligwf study`` and ``ligwf report`` end with (rich).
 
 All three show the same facts: per sweep group its sentence (the cheapest level that meets
 the budget, or that none does and why), then per CG level and rule the speedup with its
@@ -10,6 +9,7 @@ criteria say what would decide them, unassessed ones why.
 
 from __future__ import annotations
 
+import html
 import math
 
 from rich.table import Table
@@ -20,6 +20,7 @@ from ligwf.report.verdict import (CRITERIA, FAIL, FAILS, MEETS, PASS, UNDECIDED,
                                   band_text)
 
 TITLE = "Verdict"
+ANCHOR = "verdict"
 #: rich styles of the states
 STYLE = {PASS: "green", FAIL: "red", UNDECIDED: "yellow", MEETS: "bold green",
          FAILS: "bold red"}
@@ -52,19 +53,36 @@ def budget_line(accept: dict) -> str:
 
 
 def cell(r: CriterionResult) -> str:
-    """A criterion as one table cell: state, value [interval] <= budget."""
+    """A criterion as one table cell: its state and value [interval] (the budget is in
+    the column's header)."""
     if not r.assessed:
         return r.state
-    return f"{r.state}: {band_text(r.value, r.lo, r.hi, r.unit)} vs {_num(r.budget)}"
+    return f"{r.state} {band_text(r.value, r.lo, r.hi)}"
 
 
-def _notes(c: ConditionVerdict) -> list[str]:
-    return [f"{c.name}, {r.label}: {r.note}" for r in c.criteria if r.note]
+def _notes(g: GroupVerdict) -> list[str]:
+    """What would decide each undecided criterion; why a criterion was not assessed or
+    measured, once per group when it is the same for every condition."""
+    out: list[str] = []
+    for c in g.conditions:
+        out += [f"{c.name}, {r.label}: {r.note}" for r in c.criteria if r.assessed and r.note]
+    seen: list[str] = []
+    for c in g.conditions:
+        seen += [f"{r.label}: {r.note}" for r in c.criteria if not r.assessed and r.note]
+    return out + list(dict.fromkeys(seen))
 
 
 def _columns(g: GroupVerdict) -> list[str]:
-    first = g.conditions[0] if g.conditions else None
-    return [r.label for r in first.criteria] if first else []
+    """The criteria's headers with their budget (one per group: the floor is the group's)."""
+    if not g.conditions:
+        return []
+    heads = []
+    for k, r in enumerate(g.conditions[0].criteria):
+        budgets = [c.criteria[k].budget for c in g.conditions
+                   if math.isfinite(c.criteria[k].budget)]
+        unit = f" {r.unit}" if r.unit else ""
+        heads.append(f"{r.label} (<= {_num(max(budgets))}{unit})" if budgets else r.label)
+    return heads
 
 
 def group_markdown(g: GroupVerdict, several: bool) -> list[str]:
@@ -79,7 +97,7 @@ def group_markdown(g: GroupVerdict, several: bool) -> list[str]:
         lines.append(f"| {c.name} | {c.replicas} | "
                      f"{band_text(c.speedup, c.speedup_lo, c.speedup_hi)} | {c.state} | "
                      + " | ".join(cell(r) for r in c.criteria) + " |")
-    notes = [n for c in g.conditions for n in _notes(c)]
+    notes = _notes(g)
     if notes:
         lines += [""] + [f"- {n}" for n in notes]
     return lines + [""]
@@ -101,6 +119,35 @@ def verdict_section(verdict: Verdict) -> str:
     return "\n".join(lines)
 
 
+def verdict_html(verdict: Verdict) -> str:
+    """The same section as HTML (``id="verdict"``)."""
+    e = html.escape
+    out = [f'<section id="{ANCHOR}"><h2>{TITLE}</h2>',
+           f"<p>Budget (<code>accept:</code> block): {e(budget_line(verdict.accept))}. "
+           "Pass: the whole 95 % interval within the budget; fail: wholly outside; "
+           "otherwise undecided.</p>"]
+    if not verdict.groups:
+        out.append("<p>No sweep group with a CG1 reference and a CG level to judge.</p>")
+    for g in verdict.groups:
+        if len(verdict.groups) > 1:
+            out.append(f"<h3>{e(group_title(g.group))}</h3>")
+        out.append(f'<p class="verdict-sentence"><b>{e(g.sentence)}</b></p>')
+        if not g.conditions:
+            continue
+        head = "".join(f"<th>{e(t)}</th>" for t in
+                       ("condition", "replicas", "speedup (core-s)", "verdict", *_columns(g)))
+        body = "".join(
+            f"<tr><td>{e(c.name)}</td><td>{c.replicas}</td><td>"
+            f"{e(band_text(c.speedup, c.speedup_lo, c.speedup_hi))}</td><td>{e(c.state)}</td>"
+            + "".join(f'<td class="{e(r.state)}">{e(cell(r))}</td>' for r in c.criteria)
+            + "</tr>" for c in g.conditions)
+        out.append(f"<table><tr>{head}</tr>{body}</table>")
+        notes = _notes(g)
+        if notes:
+            out.append("<ul>" + "".join(f"<li>{e(n)}</li>" for n in notes) + "</ul>")
+    return "\n".join(out + ["</section>"])
+
+
 def verdict_renderables(verdict: Verdict) -> list:
     """Rich renderables for the terminal: per group its sentence and a table."""
     out: list = [Text(f"{TITLE} ({budget_line(verdict.accept)})", style="bold")]
@@ -118,5 +165,5 @@ def verdict_renderables(verdict: Verdict) -> list:
                           Text(c.state, style=STYLE.get(c.state, "yellow")),
                           *[Text(cell(r), style=STYLE.get(r.state, "dim")) for r in c.criteria])
         out.append(table)
-        out += [Text(f"  {n}", style="dim") for c in g.conditions for n in _notes(c)]
+        out += [Text(f"  {n}", style="dim") for n in _notes(g)]
     return out

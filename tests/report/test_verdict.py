@@ -19,7 +19,7 @@ from ligwf.errors import ConfigError
 from ligwf.report.verdict import (FAIL, FAILS, MEETS, NOT_ASSESSED, NOT_MEASURED, PASS,
                                   UNDECIDED, Gate, decide, granule_gates)
 from ligwf.report.verdict_records import read_verdict, write_verdict
-from ligwf.report.verdict_text import verdict_renderables, verdict_section
+from ligwf.report.verdict_text import verdict_html, verdict_renderables, verdict_section
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.workflow import load_workflow
 from ligwf.yamlio import read_yaml_mapping
@@ -83,8 +83,8 @@ def test_all_pass_and_the_cheapest_level_is_named():
     (g,) = v.groups
     assert all(c.state == MEETS for c in g.conditions)
     assert g.cheapest == "cg3-weber"
-    assert g.sentence.startswith("cg3-weber is the cheapest level that meets the budget "
-                                 "(speedup 25 [20, 31.2])")
+    assert g.sentence.startswith("cg3-weber is the cheapest level that meets the budget: "
+                                 "speedup 25 [20, 31.2]; continuum fields not measured")
     assert set(states(v, "cg3-weber").values()) == {PASS, NOT_MEASURED}   # no field_error
 
 
@@ -227,7 +227,9 @@ def test_records_round_trip_and_renderings(tmp_path):
     assert record["accept"]["angle_deg"] == 1.0
     md = verdict_section(v)
     assert md.startswith("## Verdict") and v.groups[0].sentence in md
-    assert "fail: 0.3 [0.2, 0.4] vs 0.05" in md
+    assert "| fail 0.3 [0.2, 0.4] |" in md and "rigid-block frames (<= 0.05) |" in md
+    assert "angle of repose (<= 1 deg) |" in md
+    assert 'id="verdict"' in verdict_html(v)
     assert len(verdict_renderables(v)) >= 3
     assert read_verdict(tmp_path / "nowhere") is None
 
