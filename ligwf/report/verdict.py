@@ -76,7 +76,7 @@ CRITERIA = (
                   floored=True),
     CriterionSpec("rigid_share", "rigid-block frames", "", "rigid_frame_share", EXCESS),
     CriterionSpec("flowing_layer", "flowing layer", "", "flowing_layer_thickness_mean", RELATIVE),
-    CriterionSpec("gsd_error", "GSD below size limit", "", "gsd_error_below", ERROR, gated=True),
+    CriterionSpec("gsd_error", "GSD", "", "gsd_error_all", ERROR, gated=True),
     CriterionSpec("field_error", "continuum fields", "", "field_error", ERROR, floored=True),
 )
 ANGLE_COLUMN = "angle_of_repose"
@@ -297,7 +297,8 @@ def group_sentence(conditions: list[ConditionVerdict]) -> tuple[str, str | None]
                          f"{_num(failed.budget)})")
         elif (open_ := [r for r in c.criteria if r.state == UNDECIDED]):
             parts.append(f"{c.name} is undecided on the "
-                         + ", ".join(r.label for r in open_) + f" ({open_[0].note})")
+                         + ", ".join(r.label for r in open_)
+                         + f" (the {open_[0].label}: {open_[0].note})")
         else:
             parts.append(f"{c.name} was assessed on no criterion{_not_in_budget(c)}")
     return "No CG level meets the whole budget: " + "; ".join(parts) + ".", None

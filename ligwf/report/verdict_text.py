@@ -37,12 +37,11 @@ def group_title(group: str) -> str:
 
 def budget_line(accept: dict) -> str:
     """The tolerances the verdict was decided with, in the block's order."""
-    spec = {s.name: s for s in CRITERIA}
     parts = []
-    for name, tol in accept.items():
-        s = spec.get(name)
-        if s is None:
+    for s in CRITERIA:
+        if s.name not in accept:
             continue
+        tol = accept[s.name]
         if tol is None:
             parts.append(f"{s.label}: not in the budget")
             continue

@@ -15,8 +15,9 @@ ask of a coarse-grained drum before trusting it in place of the original:
   CG1's;
 - ``flowing_layer`` 0.15: the mean flowing-layer thickness within 15 % of CG1's;
 - ``gsd_error`` 0.20: relative L1 difference of the volume-weighted granule size
-  distribution below the size limit; counted only where the granules beat their
-  cohesionless control (otherwise the sizes measure the bed's tiling, not granules);
+  distribution over all its bins (``gsd_error_all``, no size limit); counted only where
+  the granules beat their cohesionless control (otherwise the sizes measure the bed's
+  tiling, not granules);
 - ``field_error`` 0.10: the error of the coarse-grained continuum fields on the drum
   cross-section against CG1's (relative; "not measured" when the study has none).
 
@@ -54,7 +55,7 @@ class AcceptSettings(_Frozen):
         "1| (relative)")
     gsd_error: float | None = Field(
         0.20, ge=0.0, le=10.0, description="largest relative L1 error of the volume-"
-        "weighted GSD below the size limit; assessed only where the granules beat their "
+        "weighted GSD over all bins; assessed only where the granules beat their "
         "cohesionless control")
     field_error: float | None = Field(
         0.10, ge=0.0, le=10.0, description="largest error of the continuum fields on the "
