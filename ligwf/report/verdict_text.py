@@ -1,5 +1,6 @@
-"""The verdict (:mod:`ligwf.report.verdict`) as the report's first section (markdown and
-HTML) and as the terminal lines ``ligwf study`` and ``ligwf report`` end with (rich).
+"""The verdict (:mod:`ligwf.report.verdict`) as the report's first section (markdown:
+summary.md shows it, index.html renders it, :mod:`ligwf.report.sections`) and as the
+terminal lines ``ligwf study`` and ``ligwf report`` end with (rich).
 
 All three show the same facts: per sweep group its sentence (the cheapest level that meets
 the budget, or that none does and why), then per CG level and rule the speedup with its
@@ -9,18 +10,16 @@ criteria say what would decide them, unassessed ones why.
 
 from __future__ import annotations
 
-import html
 import math
 
 from rich.table import Table
 from rich.text import Text
 
 from ligwf.report.verdict import (CRITERIA, FAIL, FAILS, MEETS, PASS, UNDECIDED,
-                                  ConditionVerdict, CriterionResult, GroupVerdict, Verdict,
+                                  CriterionResult, GroupVerdict, Verdict,
                                   band_text)
 
 TITLE = "Verdict"
-ANCHOR = "verdict"
 #: rich styles of the states
 STYLE = {PASS: "green", FAIL: "red", UNDECIDED: "yellow", MEETS: "bold green",
          FAILS: "bold red"}
@@ -116,35 +115,6 @@ def verdict_section(verdict: Verdict) -> str:
     for g in verdict.groups:
         lines += group_markdown(g, several)
     return "\n".join(lines)
-
-
-def verdict_html(verdict: Verdict) -> str:
-    """The same section as HTML (``id="verdict"``)."""
-    e = html.escape
-    out = [f'<section id="{ANCHOR}"><h2>{TITLE}</h2>',
-           f"<p>Budget (<code>accept:</code> block): {e(budget_line(verdict.accept))}. "
-           "Pass: the whole 95 % interval within the budget; fail: wholly outside; "
-           "otherwise undecided.</p>"]
-    if not verdict.groups:
-        out.append("<p>No sweep group with a CG1 reference and a CG level to judge.</p>")
-    for g in verdict.groups:
-        if len(verdict.groups) > 1:
-            out.append(f"<h3>{e(group_title(g.group))}</h3>")
-        out.append(f'<p class="verdict-sentence"><b>{e(g.sentence)}</b></p>')
-        if not g.conditions:
-            continue
-        head = "".join(f"<th>{e(t)}</th>" for t in
-                       ("condition", "replicas", "speedup (core-s)", "verdict", *_columns(g)))
-        body = "".join(
-            f"<tr><td>{e(c.name)}</td><td>{c.replicas}</td><td>"
-            f"{e(band_text(c.speedup, c.speedup_lo, c.speedup_hi))}</td><td>{e(c.state)}</td>"
-            + "".join(f'<td class="{e(r.state)}">{e(cell(r))}</td>' for r in c.criteria)
-            + "</tr>" for c in g.conditions)
-        out.append(f"<table><tr>{head}</tr>{body}</table>")
-        notes = _notes(g)
-        if notes:
-            out.append("<ul>" + "".join(f"<li>{e(n)}</li>" for n in notes) + "</ul>")
-    return "\n".join(out + ["</section>"])
 
 
 def verdict_renderables(verdict: Verdict) -> list:

@@ -19,7 +19,7 @@ from ligwf.errors import ConfigError
 from ligwf.report.verdict import (FAIL, FAILS, MEETS, NOT_ASSESSED, NOT_MEASURED, PASS,
                                   UNDECIDED, Gate, decide, granule_gates)
 from ligwf.report.verdict_records import read_verdict, write_verdict
-from ligwf.report.verdict_text import verdict_html, verdict_renderables, verdict_section
+from ligwf.report.verdict_text import verdict_renderables, verdict_section
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.workflow import load_workflow
 from ligwf.yamlio import read_yaml_mapping
@@ -229,7 +229,6 @@ def test_records_round_trip_and_renderings(tmp_path):
     assert md.startswith("## Verdict") and v.groups[0].sentence in md
     assert "| fail 0.3 [0.2, 0.4] |" in md and "rigid-block frames (<= 0.05) |" in md
     assert "angle of repose (<= 1 deg) |" in md
-    assert 'id="verdict"' in verdict_html(v)
     assert len(verdict_renderables(v)) >= 3
     assert read_verdict(tmp_path / "nowhere") is None
     # the budget reads in the block's order, also from the record (stored with sorted keys)
