@@ -43,8 +43,8 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, 
 from ligwf.engine.plan import CasePlan
 from ligwf.pipeline.prepare import prepared_loads
 from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_submit
-from ligwf.slurm.budget import (PlanRow, hours_minutes, over_time_warning, plan_rows,
-                                slab_note, slurm_time_seconds)
+from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
+                                plan_rows, slab_note, slurm_time_seconds)
 from ligwf.slurm.jobs import PlannedJob, recorded_site, study_status
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
@@ -110,7 +110,7 @@ def plan_caption(plans: tuple[CasePlan, ...], jobs: list[PlannedJob], rows: tupl
     else:
         lines.append(f"nodes = ceil(ranks / {site.cores_per_node} cores per node), not asked "
                      "for: on --ntasks / site ntasks the scripts ask for --ntasks only")
-    lines += [slab_note(row) for row in rows if row.slab_bound]
+    lines += [slab_note(row) for row in rows if row.slab_bound] + estimate_basis(rows)
     if any(len(row.cases) > 1 for row in rows):
         lines.append("'+N more': N more replicas of that CG level and rule, same load and plan")
     core_hours = sum(p.ranks * p.estimated_seconds for p in plans) / 3600

@@ -1,15 +1,17 @@
 """Rank planning: how many MPI ranks each case gets, and how a study's cases share the cores.
 
 Pure functions over frozen dataclasses; the one reader of the environment is
-:func:`machine_cores`, at the end. Three rules decide, each from a measurement on the
+:func:`machine_cores` (:mod:`ligwf.engine.cores`). Three rules decide, each from a measurement on the
 project's 2-core machine (``docs/results/README.md``, issue 15):
 
-* **Slabs along the drum axis only.** A case is cut into slabs along its axis, never along
-  gravity (a settled bed lies in the lower half: 96 % of it on one of 2 ranks) and not
-  across the drum (a turning bed shifts to its rising side: 82/18 %, 1.4x slower than the
-  axial cut); each slab is at least ``MIN_AXIAL_SLAB`` (4) of the case's LARGEST diameters
-  long (:func:`ligwf.engine.render.axial_slab_limit`, the same rule the runner's processor
-  grid keeps). A 9 mm slice of 3 mm CG3 particles therefore runs on one rank.
+* **Slabs along the drum axis first, then columns across.** A case is cut into slabs along
+  its axis, never along gravity (a settled bed lies in the lower half: 96 % of it on one of
+  2 ranks); each slab is at least ``MIN_AXIAL_SLAB`` (4) of the case's LARGEST diameters
+  long (:func:`ligwf.engine.decomposition.axial_slab_limit`): a 9 mm slice of 3 mm CG3
+  particles runs on one rank. A case that could use more ranks than slabs is also cut
+  across the drum (:mod:`ligwf.engine.decomposition`: 3.8.0 cannot balance the load, a
+  turning bed fills uniform columns unevenly) while the modelled efficiency stays >=
+  ``MIN_GRID_EFFICIENCY`` and the run gets shorter; the runner uses the same grid.
 * **Enough particles per rank.** Each step of a case costs a fixed ~0.08 ms (turning mesh,
   fixes) besides its pair work, and every extra rank adds exchanges; a rank should carry
   thousands of particles, or splitting buys little and costs core-seconds. Measured
@@ -38,11 +40,13 @@ phase one array of side-by-side allocations.
 from __future__ import annotations
 
 import heapq
-import os
+import math
 from dataclasses import dataclass
 from typing import Mapping, Sequence
 
-from ligwf.engine.render import axial_slab_limit
+from ligwf.engine.decomposition import (Bed, GridCost, axial_slab_limit, best_grid,
+                                        scene_bed)
+from ligwf.engine.cores import _at_least, available_cores, machine_cores  # noqa: F401
 from ligwf.errors import ConfigError
 from ligwf.scene.scaling import ScaledScene
 
@@ -61,23 +65,21 @@ WET_RATE = 1.8e6
 DRY_SPEEDUP = 1.8
 #: Share of the ideal speed-up a case keeps on more than one rank (11,963 particles:
 #: 379.5 production core-s on 2 axial ranks against 334.8 on one). Measured at 2 ranks
-#: only: a cluster estimate at tens of ranks is an extrapolation.
+#: only; other grids take theirs from the decomposition model calibrated on it
+#: (:func:`ligwf.engine.decomposition.grid_cost`, scaling_model.md).
 MULTI_RANK_EFFICIENCY = 0.88
+#: Lowest modelled efficiency of a grid cut across the drum the planner accepts: more
+#: ranks at less than a quarter of their ideal speed cost 4x the core-hours for their gain
+MIN_GRID_EFFICIENCY = 0.25
 
 #: What limited a case's ranks (:attr:`CasePlan.bound`).
 BOUND_PARTICLES, BOUND_SLAB, BOUND_CORES = "particles", "slab", "cores"
+#: a grid across the drum set the ranks (fastest one within MIN_GRID_EFFICIENCY)
+BOUND_GRID = "grid"
 BOUND_NP, BOUND_ENSEMBLE = "--np", "--ensemble"
 #: most MPI ranks ligwf launches for one case or ensemble (2**20, beyond the largest
 #: machines' jobs): an absurd --np would otherwise spin in the processor-grid search
 MAX_RANKS = 2**20
-
-
-def _at_least(field: str, value: object, lowest: int) -> int:
-    """``value`` as a whole number >= ``lowest``; ConfigError naming the field otherwise."""
-    if isinstance(value, bool) or not isinstance(value, int) or value < lowest:
-        raise ConfigError(f"{field} = {value!r}: must be a whole number (allowed range "
-                          f"[{lowest}, inf))")
-    return value
 
 
 @dataclass(frozen=True)
@@ -90,6 +92,9 @@ class CaseLoad:
     drum_length: float      # m, along the axis (the periodic slice)
     d_max: float            # m, the largest scaled diameter
     wet: bool = True
+    #: the cross-section (drum diameter, fill): None keeps the case to axial slabs
+    bed: Bed | None = None
+    periodic: bool = True
 
     def __post_init__(self) -> None:
         where = f"case {self.name!r}: " if self.name else ""
@@ -116,16 +121,37 @@ def particle_steps(scaled: ScaledScene) -> int:
 def case_load(name: str, scaled: ScaledScene) -> CaseLoad:
     """The planner's view of a scaled case."""
     return CaseLoad(name, scaled.particle_count, scaled.total_steps, scaled.drum_length,
-                    scaled.d_max, scaled.wet)
+                    scaled.d_max, scaled.wet, scene_bed(scaled), scaled.periodic)
+
+
+def case_grid(load: CaseLoad, ranks: int) -> GridCost:
+    """The processor grid ``load`` runs on at ``ranks`` ranks and its modelled cost (the
+    runner's grid: :func:`ligwf.engine.render.processor_grid`)."""
+    return best_grid(_at_least("ranks", ranks, 1), load.drum_length, load.d_max,
+                     load.periodic, load.bed)
+
+
+def efficiency(load: CaseLoad, ranks: int) -> float:
+    """Share of the ideal speed-up ``load`` keeps on ``ranks`` ranks: 1 on one rank, else
+    the decomposition model's for the case's grid (calibrated on the one measurement, 0.88
+    on 2 axial ranks); :data:`MULTI_RANK_EFFICIENCY` where no grid fits or its cost is
+    unknown (a cut across a drum whose bed is not given, e.g. ``--np`` beyond the slabs)."""
+    if _at_least("ranks", ranks, 1) == 1:
+        return 1.0
+    try:
+        value = case_grid(load, ranks).efficiency
+    except ConfigError:
+        return MULTI_RANK_EFFICIENCY
+    return value if math.isfinite(value) else MULTI_RANK_EFFICIENCY
 
 
 def estimated_seconds(load: CaseLoad, ranks: int) -> float:
-    """Wall seconds of ``load`` on ``ranks`` ranks from the measured rates (an estimate:
-    the fill phase has fewer particles, and the rates are one machine's)."""
-    _at_least("ranks", ranks, 1)
+    """Wall seconds of ``load`` on ``ranks`` ranks from the measured rates and
+    :func:`efficiency` (an estimate: the fill phase has fewer particles, and the rates are
+    one machine's)."""
     rate = WET_RATE * (1.0 if load.wet else DRY_SPEEDUP)
-    efficiency = 1.0 if ranks == 1 else MULTI_RANK_EFFICIENCY
-    return load.steps * (STEP_OVERHEAD_SECONDS + load.particles / (ranks * rate * efficiency))
+    return load.steps * (STEP_OVERHEAD_SECONDS
+                         + load.particles / (ranks * rate * efficiency(load, ranks)))
 
 
 @dataclass(frozen=True)
@@ -137,6 +163,19 @@ class CasePlan:
     bound: str                  # BOUND_* names that set ``ranks`` ("slab, particles")
     particle_steps: int
     estimated_seconds: float
+    efficiency: float = 1.0     # share of the ideal speed-up (:func:`efficiency`)
+    grid: tuple[int, int] = (1, 1)   # ranks (along the axis, across); (0, 0): none fits
+
+
+def case_plan(load: CaseLoad, ranks: int, bound: str) -> CasePlan:
+    """The :class:`CasePlan` of ``load`` on ``ranks`` ranks (its grid, efficiency, time)."""
+    try:
+        grid = case_grid(load, ranks)
+        axes = (grid.axial, grid.across)
+    except ConfigError:             # --np no grid fits: the runner cuts it as it can
+        axes = (0, 0)
+    return CasePlan(load.name, ranks, bound, load.particle_steps,
+                    estimated_seconds(load, ranks), efficiency(load, ranks), axes)
 
 
 def rank_limits(load: CaseLoad, cores: int | None,
@@ -154,12 +193,39 @@ def rank_limits(load: CaseLoad, cores: int | None,
 def plan_ranks(load: CaseLoad, cores: int | None,
                min_particles_per_rank: int = MIN_PARTICLES_PER_RANK) -> CasePlan:
     """Ranks for one case: the smallest of :func:`rank_limits` (``cores`` None: no core
-    limit, as for a Slurm array task that gets its own allocation)."""
+    limit, as for a Slurm array task that gets its own allocation); beyond the slabs, when
+    the particles and cores allow more, the fastest grid across the drum
+    (:func:`across_ranks`)."""
     limits = rank_limits(load, cores, min_particles_per_rank)
     ranks = min(limits.values())
     bound = ", ".join(name for name, value in limits.items() if value == ranks)
-    return CasePlan(load.name, ranks, bound, load.particle_steps,
-                    estimated_seconds(load, ranks))
+    others = [v for k, v in limits.items() if k != BOUND_SLAB]
+    if load.bed is not None and ranks == limits[BOUND_SLAB] and min(others) > ranks:
+        wider = across_ranks(load, min(others))
+        if wider > ranks:
+            ranks = wider
+            bound = ", ".join([BOUND_GRID] + [k for k, v in limits.items()
+                                               if k != BOUND_SLAB and v == ranks])
+    return case_plan(load, ranks, bound)
+
+
+def across_ranks(load: CaseLoad, most: int) -> int:
+    """The rank count up to ``most`` with the shortest estimated wall time among grids that
+    fit (slabs and columns of >= MIN_AXIAL_SLAB diameters) and keep at least
+    MIN_GRID_EFFICIENCY; ties go to fewer ranks. At least the slab limit."""
+    best = axial_slab_limit(load.drum_length, load.d_max)
+    best_time = estimated_seconds(load, best)
+    for ranks in range(best + 1, most + 1):
+        try:
+            grid = case_grid(load, ranks)
+        except ConfigError:         # no grid of this many ranks fits the case
+            continue
+        if grid.efficiency < MIN_GRID_EFFICIENCY:
+            continue
+        seconds = estimated_seconds(load, ranks)
+        if seconds < best_time * (1 - 1e-9):
+            best, best_time = ranks, seconds
+    return best
 
 
 @dataclass(frozen=True)
@@ -268,8 +334,7 @@ def allocation_schedule(loads: Sequence[CaseLoad], cores_per_case: int | None = 
 def fixed_ranks(loads: Sequence[CaseLoad], ranks: int, bound: str) -> tuple[CasePlan, ...]:
     """Every case on ``ranks`` ranks because option ``bound`` says so (no planning)."""
     _at_least(bound, ranks, 1)
-    return tuple(CasePlan(l.name, ranks, bound, l.particle_steps, estimated_seconds(l, ranks))
-                 for l in loads)
+    return tuple(case_plan(l, ranks, bound) for l in loads)
 
 
 def override_schedule(loads: Sequence[CaseLoad], nprocs: int, ensemble: int = 0,
@@ -293,33 +358,3 @@ def override_schedule(loads: Sequence[CaseLoad], nprocs: int, ensemble: int = 0,
               if plans else ())
     used = cores if cores is not None else (ensemble or nprocs)
     return Schedule(_at_least("cores", used, 1), plans, phases, planned=False)
-
-
-def available_cores(explicit: int | None, environ: Mapping[str, str],
-                    affinity: int) -> tuple[int, str]:
-    """Cores a local run may fill, and where the number came from: ``explicit`` (an
-    option), else the tasks of the Slurm allocation this runs in (``SLURM_NTASKS``: the
-    ranks ``mpirun`` may start there), else the CPUs this process may run on."""
-    if explicit is not None:
-        return _at_least("--cores", explicit, 1), "--cores"
-    if environ.get("SLURM_JOB_ID") and environ.get("SLURM_NTASKS"):
-        text = environ["SLURM_NTASKS"]
-        try:
-            value = int(text)
-        except ValueError:
-            value = 0
-        if value < 1:
-            raise ConfigError(f"SLURM_NTASKS = {text!r}: must be a whole number (allowed "
-                              "range [1, inf))")
-        return value, "SLURM_NTASKS"
-    return _at_least("CPU affinity", affinity, 1), "CPUs this process may use"
-
-
-def machine_cores(explicit: int | None = None) -> tuple[int, str]:
-    """:func:`available_cores` of this process (reads the environment and CPU affinity)."""
-    try:
-        affinity = len(os.sched_getaffinity(0))
-    except AttributeError:          # not on Linux
-        affinity = os.cpu_count() or 1
-    return available_cores(explicit, os.environ, affinity)
-

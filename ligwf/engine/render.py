@@ -23,6 +23,7 @@ import jinja2
 from ligwf import __version__
 from ligwf.errors import RenderError
 from ligwf.liquids.contact_angle import input_angle
+from ligwf.engine.decomposition import MIN_AXIAL_SLAB, axial_slab_limit, runner_grid  # noqa: F401
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.model import GRAVITY, unsafe_chars
@@ -159,25 +160,14 @@ def _xyz(ia: int, iu: int, iv: int, sphere) -> dict:
     return {"x": xyz[0], "y": xyz[1], "z": xyz[2], "r": sphere[3]}
 
 
-#: thinnest slab of the domain along the drum axis one rank gets, in largest diameters
-MIN_AXIAL_SLAB = 4.0
-
-
-def axial_slab_limit(drum_length: float, d_max: float) -> int:
-    """Most ranks along the drum axis (m, m) that leave every slab at least MIN_AXIAL_SLAB
-    largest diameters long; at least 1. (A length of exactly k slabs counts as k: the
-    division is not left to round 2.9999 down.)"""
-    return max(1, math.floor(drum_length / (MIN_AXIAL_SLAB * d_max) * (1.0 + 1e-9)))
-
-
 def processor_grid(s: ScaledScene, nprocs: int) -> tuple[int, int]:
-    """Ranks (across the drum, along the axis) for ``nprocs``: as many along the axis as
-    divide ``nprocs`` and leave slabs of at least MIN_AXIAL_SLAB largest diameters (pure)."""
+    """Ranks (across the drum, along the axis) for ``nprocs``: the rank planner's grid
+    (:func:`ligwf.engine.decomposition.runner_grid`: slabs along the axis of at least
+    MIN_AXIAL_SLAB largest diameters, then columns across where they pay) (pure)."""
     if nprocs < 1:
         raise ValueError(f"nprocs = {nprocs}: need at least 1")
-    max_axial = axial_slab_limit(s.drum_length, s.d_max)
-    axial = max(k for k in range(1, nprocs + 1) if nprocs % k == 0 and k <= max_axial)
-    return nprocs // axial, axial
+    axial, across = runner_grid(s, nprocs)
+    return across, axial
 
 
 def grid_vars(s: ScaledScene, nprocs: int) -> list[str]:

@@ -15,8 +15,11 @@ import math
 from dataclasses import dataclass
 from typing import Hashable, Sequence
 
-from ligwf.engine.plan import BOUND_PARTICLES, BOUND_SLAB, CaseLoad, CasePlan, rank_limits
-from ligwf.engine.render import MIN_AXIAL_SLAB
+from ligwf.engine.decomposition import (GHOST_COST, HALO_DIAMETERS, MIN_AXIAL_SLAB,
+                                        PLANNING_SURFACE_DEG)
+from ligwf.engine.plan import (BOUND_PARTICLES, BOUND_SLAB, MIN_GRID_EFFICIENCY,
+                               MULTI_RANK_EFFICIENCY, WET_RATE, CaseLoad, CasePlan, case_grid,
+                               rank_limits)
 from ligwf.errors import ConfigError
 from ligwf.slurm.site import SLURM_TIME
 
@@ -84,6 +87,7 @@ class PlanRow:
     bound: str                  # what limited the ranks (CasePlan.bound)
     nodes: int | None           # None: cores per node unknown
     estimated_seconds: float    # wall seconds of ONE of the cases (each is its own task)
+    efficiency: float = 1.0     # modelled share of the ideal speed-up (CasePlan.efficiency)
 
     @property
     def label(self) -> str:
@@ -118,7 +122,8 @@ def plan_rows(loads: Sequence[CaseLoad], plans: Sequence[CasePlan],
                plan.ranks, plan.bound)
         rows.setdefault(key, (load, plan, []))[2].append(load.name)
     return tuple(PlanRow(tuple(names), load, plan.ranks, plan.bound,
-                         nodes_for(plan.ranks, cores_per_node), plan.estimated_seconds)
+                         nodes_for(plan.ranks, cores_per_node), plan.estimated_seconds,
+                         plan.efficiency)
                  for load, plan, names in rows.values())
 
 
@@ -130,6 +135,48 @@ def slab_note(row: PlanRow) -> str:
             f"{load.drum_length * 1e3:g} mm / ({MIN_AXIAL_SLAB:g} x {load.d_max * 1e3:g} mm "
             f"largest diameter); particles alone would allow {by_particles} (slabs along "
             "the axis only)")
+
+
+def grid_note(row: PlanRow) -> str | None:
+    """The grid of a multi-rank row and what its estimated wall time and efficiency rest
+    on, in numbers (None for a one-rank row or a grid the model cannot cost)."""
+    if row.ranks == 1:
+        return None
+    load = row.load
+    try:
+        grid = case_grid(load, row.ranks)
+    except ConfigError:
+        return None
+    slab = load.drum_length / grid.axial * 1e3
+    text = (f"{row.label}: {row.ranks} ranks = {grid.axial} slab(s) along the axis "
+            f"({slab:.3g} mm, >= {MIN_AXIAL_SLAB:g} x {load.d_max * 1e3:g} mm)")
+    if grid.across > 1 and load.bed is not None:
+        width = load.bed.box_width / grid.across * 1e3
+        text += (f" x {grid.across} columns across ({width:.3g} mm); efficiency "
+                 f"{row.efficiency:.2f} = uniform columns (LIGGGHTS 3.8.0 has no load "
+                 f"balancing) over a bed filling {load.bed.fill_fraction:g} of the drum with "
+                 f"its surface at {PLANNING_SURFACE_DEG:g} deg: largest rank "
+                 f"{grid.imbalance:.2f}x the average")
+    else:
+        text += f"; efficiency {row.efficiency:.2f}"
+    text += (f"; halo {grid.ghost_ratio:.2f} ghosts per particle ({HALO_DIAMETERS:g} "
+             f"diameters deep, 1 rank: {grid.ghost_ratio_one:.2f}) at {GHOST_COST:g} of a "
+             f"particle's cost (fit to {MULTI_RANK_EFFICIENCY:g} measured on 2 axial ranks); "
+             f"grids below {MIN_GRID_EFFICIENCY:g} are not used")
+    return text
+
+
+def estimate_basis(rows: Sequence[PlanRow]) -> list[str]:
+    """What every estimate of ``rows`` rests on: per multi-rank row its grid and efficiency
+    (:func:`grid_note`), then the rates and where the model is written down."""
+    notes = [n for n in (grid_note(r) for r in rows) if n]
+    if notes:
+        notes.append(f"estimates: {WET_RATE:.2g} wet particle-steps per core-second measured "
+                     "on a 2-core machine (ligwf.engine.plan) / efficiency; the efficiency "
+                     "beyond 2 ranks is the model of docs/results/performance/"
+                     "scaling_model.md, not a measurement: measure it with "
+                     "benchmarks/bench_scaling_slurm.py")
+    return notes
 
 
 def over_time_warning(row: PlanRow, time: str) -> str:

@@ -165,22 +165,33 @@ def _plan_row(text: str) -> list[str]:
 
 def test_dry_run_of_paper_scale_cg1_shows_ranks_nodes_and_estimate(tmp_path, monkeypatch,
                                                                    capsys):
+    # issue #24: past the 15 axial slabs, a 2-D grid on >= 64 ranks over >= 2 nodes, with the
+    # estimate and what it rests on
     code, out, err = _submit(tmp_path, monkeypatch, capsys, "--dry-run",
                              "--cores-per-node", "64", "--time", "00:10:00")
     assert code == 0, err
     (load,) = prepared_loads(prepare_workflow(PAPER, [a for a in CG1_ONLY if a != "--set"],
                                               [], False))
-    estimate = hours_minutes(plan_ranks(load, None).estimated_seconds)
+    plan = plan_ranks(load, None)
+    estimate = hours_minutes(plan.estimated_seconds)
+    nodes = -(-plan.ranks // 64)
+    assert plan.ranks >= 64 and nodes >= 2 and plan.grid[1] > 1
     row = _plan_row(out)
-    assert row == ["cg1-none-r0", "2.54e+11", "15", "slab", "1", estimate,
+    assert row == ["cg1-none-r0", "2.54e+11", str(plan.ranks), "grid", str(nodes), estimate,
                    "00:10:00 (too short)", "360,000", f"{load.steps:,}"]
     assert re.fullmatch(r"\d+:\d\d", estimate)
-    assert "array-1.sh: 1 case(s), --ntasks=15, --nodes=1" in out
+    assert f"array-1.sh: 1 case(s), --ntasks={plan.ranks}, --nodes={nodes}" in out
     assert "nodes = ceil(ranks / 64 cores per node), asked for with --nodes" in out
-    assert "15 ranks is the axial slab limit" in out
-    assert "#SBATCH --ntasks=15\n#SBATCH --nodes=1\n" in out
-    assert (f"ligwf: warning: cg1-none-r0: estimated {estimate} (h:mm) on 15 rank(s) exceeds "
-            "--time 00:10:00") in err
+    text = " ".join(out.split())            # the notes wrap at the console width
+    axial, across = plan.grid
+    assert (f"cg1-none-r0: {plan.ranks} ranks = {axial} slab(s) along the axis") in text
+    assert f"x {across} columns across" in text
+    assert f"efficiency {plan.efficiency:.2f}" in text and "no load balancing" in text
+    assert "fit to 0.88 measured on 2 axial ranks" in text
+    assert "scaling_model.md" in text and "bench_scaling_slurm.py" in text
+    assert f"#SBATCH --ntasks={plan.ranks}\n#SBATCH --nodes={nodes}\n" in out
+    assert (f"ligwf: warning: cg1-none-r0: estimated {estimate} (h:mm) on {plan.ranks} rank(s) "
+            "exceeds --time 00:10:00") in err
     assert "Traceback" not in err
 
 
@@ -198,8 +209,9 @@ def test_site_cores_per_node_and_time_are_used(tmp_path, monkeypatch, capsys):
     code, out, err = _submit(tmp_path, monkeypatch, capsys, "--dry-run", site_file=(
         "slurm:\n  cores_per_node: 8\n  time: 7-00:00:00\n"))
     assert code == 0, err
-    assert _plan_row(out)[4] == "2" and _plan_row(out)[6] == "7-00:00:00"
-    assert "#SBATCH --ntasks=15\n#SBATCH --nodes=2\n" in out
+    ranks = int(_plan_row(out)[2])
+    assert _plan_row(out)[4] == str(-(-ranks // 8)) and _plan_row(out)[6] == "7-00:00:00"
+    assert f"#SBATCH --ntasks={ranks}\n#SBATCH --nodes={-(-ranks // 8)}\n" in out
     assert "exceeds --time" not in err
 
 
