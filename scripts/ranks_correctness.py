@@ -4,7 +4,8 @@
 The criterion was registered before the runs: ``docs/results/performance/ranks_criterion.md``.
 This script runs the case with ligwf's own runner (``ligwf run``) and writes the table:
 
-    LIGWF_MPIRUN_ARGS=--oversubscribe .venv/bin/python scripts/ranks_correctness.py run --out /tmp/ranks
+    LIGWF_MPIRUN_ARGS="--oversubscribe --bind-to none" \
+        .venv/bin/python scripts/ranks_correctness.py run --out /tmp/ranks
     .venv/bin/python scripts/ranks_correctness.py table --out /tmp/ranks \
         --write docs/results/performance/ranks.md
 
