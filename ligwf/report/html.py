@@ -6,7 +6,8 @@ rendered by markdown-it (CommonMark + tables, raw HTML off: a case id or a reaso
 inject markup); a section may bring its own HTML instead. Tables wider than
 :data:`WIDE_COLUMNS` fold into a ``<details>`` element (open up to :data:`OPEN_ROWS`
 rows), every table scrolls sideways on its own instead of widening the page, and figures
-are inline ``<figure>`` elements with their captions. No network: the CSS is inline and
+are inline ``<figure>`` elements with their captions (a click opens the PNG at full
+size; snapshots two a row). No network: the CSS is inline and
 the images are relative paths into the report folder, so the folder can be moved or
 zipped.
 """
@@ -49,6 +50,7 @@ tr:nth-child(even) td{background:#fafbfc}
 details{margin:.6em 0}summary{cursor:pointer;color:#245;font-size:.95em}
 figure{margin:1em 0}figure img{max-width:100%;height:auto;border:1px solid #eee}
 figcaption{font-size:.9em;color:#555}
+section#snapshots figure{display:inline-block;vertical-align:top;width:48%;margin:.5em 1%}
 code{background:#f3f3f3;padding:0 .2em;border-radius:3px}
 """
 
@@ -70,7 +72,8 @@ def markdown_html(text: str) -> str:
     """HTML of a section's markdown: tables boxed (wide ones folded), images as figures."""
     out = _MD.render(text)
     out = _TABLE.sub(_fold, out)
-    return _FIGURE.sub(lambda m: f'<figure><img src="{m.group(1)}" alt="{m.group(2)}">'
+    return _FIGURE.sub(lambda m: f'<figure><a href="{m.group(1)}"><img src="{m.group(1)}" '
+                                 f'alt="{m.group(2)}"></a>'
                                  f"<figcaption>{m.group(2)}</figcaption></figure>", out)
 
 

@@ -23,7 +23,7 @@ from typing import Iterable
 SECTION_ORDER = ("verdict", "cases", "conditions", "cg1-noise-floor", "size-limit",
                  "steady-window", "granule-controls", "gsd", "kinetics", "flow-fields",
                  "skipped-cases", "skipped-or-missing-frames", "analysis-outputs", "granules",
-                 "figures", "stability", "paraview")
+                 "figures", "snapshots", "stability", "paraview")
 
 #: anchors of sections whose title does not slug to their anchor
 ANCHORS = {"Conditions (value [95 % interval])": "conditions",

@@ -49,6 +49,10 @@ NO_VERDICT = ("No acceptance budget was evaluated for this study, so there is no
               "verdict per CG level: read the errors against the CG1 noise floor in the "
               "conditions below.")
 
+SNAPSHOTS = ("The last frame of each case seen along the drum axis (the arrow: the way the drum "
+             "turns), coloured by speed on one scale shared by all cases, and by granule id "
+             "(its newest labelled frame).")
+
 
 @dataclass
 class ReportFigures:
@@ -112,7 +116,9 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
                                fig_dir)] if figures.kinetics else []),
              *flow_field_sections(study),
              *split_markdown(problems.markdown()),
-             figure_section("Figures", "figures", "", figures.flow + figures.snapshots, fig_dir),
+             figure_section("Figures", "figures", "", figures.flow, fig_dir),
+             *([figure_section("Snapshots", "snapshots", SNAPSHOTS, figures.snapshots, fig_dir)]
+               if figures.snapshots else []),
              *split_markdown(stability_markdown(study.usable_cases()[0])),
              *split_markdown(paraview_markdown(figures.paraview))]
     return ordered(parts)

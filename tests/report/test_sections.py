@@ -77,5 +77,5 @@ def test_figures_are_inline_with_captions():
                          "figures")
     assert "![GSD overlay](figures/g.png)" in sec.markdown
     out = markdown_html(sec.markdown)
-    assert '<figure><img src="figures/g.png" alt="GSD overlay">' in out
+    assert '<figure><a href="figures/g.png"><img src="figures/g.png" alt="GSD overlay"></a>' in out
     assert "<figcaption>GSD overlay</figcaption>" in out
