@@ -82,6 +82,14 @@ def _label(r) -> str:
     return condition_label(r["cg"], r["rule"], r.get("group", ""))
 
 
+def table_label(name: str, rows: pd.DataFrame) -> str:
+    """The figure label of a condition of a per-condition table (gsd.csv, kinetics): from
+    its cg / rule / group columns when it has them, else the table's condition name."""
+    if rows.empty or not {"cg", "rule"} <= set(rows.columns):
+        return str(name)
+    return _label(rows.iloc[0])
+
+
 def floor_label(source) -> str:
     """Legend entry of a noise floor: short, "indicative" when it is."""
     return "CG1 noise floor" + (" (indicative)" if "indicative" in str(source) else "")
@@ -188,16 +196,16 @@ def gsd_ax(ax: Axes, gsd: pd.DataFrame, volume: str = "physical",
     for name, sub in gsd.groupby("condition", sort=True):
         sub = sub.sort_values("v_mid")
         d = equivalent_diameter_mm(sub["v_mid"])
-        line, = ax.plot(d, sub["volume_fraction"], marker=".", label=name)
+        line, = ax.plot(d, sub["volume_fraction"], marker=".", label=table_label(name, sub))
         ax.fill_between(d, sub["volume_lo"], sub["volume_hi"], alpha=0.2, color=line.get_color())
         limit = limits.get(name)
         if limit is not None and np.isfinite(limit) and limit > 0:
             at = float(equivalent_diameter_mm(limit))
             ax.axvline(at, ls="--", lw=1, color=line.get_color(),
-                       label=f"{name}: lower size limit {at:.2g} mm")
+                       label=f"{table_label(name, sub)}: lower size limit {at:.2g} mm")
         elif name in limits:
             ax.plot([], [], ls="--", color=line.get_color(),
-                    label=f"{name}: no lower size limit located")
+                    label=f"{table_label(name, sub)}: no lower size limit located")
     ax.set_xscale("log")
     log_ticks(ax, "x")
     ax.set_xlabel(xlabel)

@@ -17,7 +17,7 @@ import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ligwf.report.figures import save
+from ligwf.report.figures import save, table_label
 from ligwf.study import layout
 
 #: (column, panel title, y label)
@@ -64,8 +64,9 @@ def kinetics_ax(ax: Axes, summary: pd.DataFrame, quantity: str, title: str, ylab
         d = d.sort_values("time")
         t0 = origins.get(name)
         t = d["time"] - (t0 if t0 is not None else 0.0)
+        label = table_label(name, d)
         line, = ax.plot(t, d[quantity] * scale,
-                        label=name if t0 is not None else f"{name} (time from start)")
+                        label=label if t0 is not None else f"{label} (time from start)")
         ax.fill_between(t, d[f"{quantity}_lo"] * scale, d[f"{quantity}_hi"] * scale,
                         color=line.get_color(), alpha=0.2)
     ax.set_title(title, fontsize=10)

@@ -80,17 +80,19 @@ def test_gsd_is_drawn_against_the_equivalent_diameter_with_the_size_limit():
     v = np.pi / 6 * (1e-3 * np.array([1.0, 2.0, 4.0])) ** 3
     gsd = pd.DataFrame({"condition": ["cg1"] * 3 + ["cg2-weber"] * 3, "v_mid": [*v, *v],
                         "volume_fraction": [0.5, 0.3, 0.2, 0.4, 0.4, 0.2],
-                        "volume_lo": [0.4, 0.2, 0.1] * 2, "volume_hi": [0.6, 0.4, 0.3] * 2})
+                        "volume_lo": [0.4, 0.2, 0.1] * 2, "volume_hi": [0.6, 0.4, 0.3] * 2,
+                        "cg": [1.0] * 3 + [2.0] * 3, "rule": ["none"] * 3 + ["weber"] * 3,
+                        "group": ["{}"] * 6})
     fig = Figure()
     ax = gsd_ax(fig.subplots(), gsd, size_limits={"cg2-weber": v[1]})
     assert "[mm]" in ax.get_xlabel() and "diameter" in ax.get_xlabel()
     assert np.allclose(ax.lines[0].get_xdata(), [1.0, 2.0, 4.0])
     texts = [t.get_text() for t in ax.get_legend().texts]
-    assert "cg2-weber: lower size limit 2 mm" in texts
+    assert "CG2 weber: lower size limit 2 mm" in texts
     fig.canvas.draw()
     assert len(visible_labels(ax, ax.xaxis)) >= 3
     ax2 = gsd_ax(Figure().subplots(), gsd, size_limits={"cg2-weber": float("nan")})
-    assert "cg2-weber: no lower size limit located" in [t.get_text() for t in ax2.get_legend().texts]
+    assert "CG2 weber: no lower size limit located" in [t.get_text() for t in ax2.get_legend().texts]
 
 
 def test_kinetics_count_time_from_production_start():
