@@ -301,7 +301,8 @@ def group_sentence(conditions: list[ConditionVerdict]) -> tuple[str, str | None]
                          + f" (the {open_[0].label}: {open_[0].note})")
         else:
             parts.append(f"{c.name} was assessed on no criterion{_not_in_budget(c)}")
-    return "No CG level meets the whole budget: " + "; ".join(parts) + ".", None
+    verb = "meets" if all(c.state == FAILS for c in conditions) else "is shown to meet"
+    return f"No CG level {verb} the whole budget: " + "; ".join(parts) + ".", None
 
 
 def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[str, Gate]:

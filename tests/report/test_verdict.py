@@ -118,8 +118,15 @@ def test_undecided_says_how_many_cg1_replicas_would_decide():
     assert profile.state == UNDECIDED and c.state == UNDECIDED
     assert profile.note == "about 18 CG1 replicas would decide"
     assert v.groups[0].cheapest is None
+    assert v.groups[0].sentence.startswith("No CG level is shown to meet the whole budget: ")
     assert "cg2-bond is undecided on the velocity profile (the velocity profile: about 18 " \
         "CG1 replicas would decide)" in v.groups[0].sentence
+    # a value within the budget whose interval crosses it is not a pass (nor is the angle:
+    # 0.02 x 40 = 0.8 deg within 1 deg, but its interval reaches 1.6 deg)
+    row = cgn(2, "bond", 9.0, profile=(0.08, 0.03, 0.14), angle_error=(0.02, 0.0, 0.04),
+              angle_floor=0.0)
+    st = states(decide(table(cg1(), row), AcceptSettings(), {GROUP: PASSING}), "cg2-bond")
+    assert st["profile_error"] == UNDECIDED and st["angle_deg"] == UNDECIDED
     # one CG-n replica: no interval, nothing decided
     one = cgn(2, "bond", 9.0, replicas=1, profile=(0.01, NAN, NAN))
     profile = next(r for r in decide(table(cg1(), one), AcceptSettings(), {GROUP: PASSING}
