@@ -62,9 +62,13 @@ def test_every_table_reads_with_its_rows(reported):
             if pd.api.types.is_numeric_dtype(table[col]) and not is_text_column(col):
                 assert np.allclose(table[col].to_numpy(float), raw[col].to_numpy(float),
                                    equal_nan=True), (spec.attribute, col)
-    usable = [c for c in s.case_ids]
-    assert sorted(s.cases["case_id"]) == sorted(usable)
+    assert sorted(s.cases["case_id"]) == sorted(s.case_ids)
     assert set(s.conditions["cg"]) == {1.0, 2.0}
+    verdict = s.verdict
+    assert set(verdict["state"]) <= {"pass", "fail", "undecided", "not assessed", "not measured"}
+    assert verdict["cheapest"].dtype == "boolean" and set(verdict["condition"]) == {"cg2-weber"}
+    groups = s.verdict_result.groups
+    assert groups and all(g.sentence for g in groups)
     assert s.cases is not s.cases                          # a copy each time
     cases = s.cases
     cases["cg"] = -1
@@ -152,7 +156,8 @@ def test_a_rendered_study_names_the_command_for_every_table(rendered):
         text = str(err.value)
         assert "\n" not in text and f"`{spec.command} {rendered}`" in text, text
         assert spec.file in text
-    for attribute, command in (("summary", "ligwf report"), ("flow_record", "ligwf analyse"),
+    for attribute, command in (("summary", "ligwf report"), ("verdict_result", "ligwf report"),
+                               ("flow_record", "ligwf analyse"),
                                ("profiles", "ligwf analyse")):
         with pytest.raises(MissingOutput, match=command):
             getattr(s, attribute)

@@ -51,8 +51,11 @@ def test_the_example_notebook_runs_on_a_real_study(engine, tmp_path_factory, mon
     assert not errors, errors
     probe = "".join(o.get("text", "") for o in nb.cells[-1].outputs)
     read = json.loads(re.search(r"READ (.*)", probe).group(1))
-    assert set(read) >= {t.attribute for t in TABLES}, read
+    assert set(read) >= {t.attribute for t in TABLES}, read     # the verdict included
     assert int(re.search(r"FIGS (\d+)", probe).group(1)) >= 2
-    conditions = next(c for c in nb.cells if "study.conditions[" in c.source)
-    assert any("text/html" in o.get("data", {}) for o in conditions.outputs)
+    for shown in ("study.conditions[", "study.verdict["):
+        cell = next(c for c in nb.cells if shown in c.source)
+        assert any("text/html" in o.get("data", {}) for o in cell.outputs), shown
+    verdict = next(c for c in nb.cells if "verdict_result" in c.source)
+    assert "->" in "".join(o.get("text", "") for o in verdict.outputs)
     assert os.environ["LIGWF_STUDY"] == str(study)

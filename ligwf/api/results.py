@@ -19,6 +19,8 @@ from ligwf.api import plots
 from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec, read_table,
                               typed)
 from ligwf.errors import ConfigError, LigwfError
+from ligwf.report.verdict import Verdict
+from ligwf.report.verdict_records import read_verdict
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.study import Study
@@ -121,6 +123,24 @@ class StudyResults:
         """One row per (sweep group, CG level, rule); per metric ``m``: ``m``, ``m_lo``,
         ``m_hi``, ``m_se``; errors also ``m_floor``, ``m_floor_source``, ``m_vs_floor``."""
         return self.table("conditions")
+
+    @property
+    def verdict(self) -> pd.DataFrame:
+        """The verdict: per sweep group, CG level, rule and criterion of the ``accept:``
+        block its ``state`` (pass / fail / undecided), ``value`` [``lo``, ``hi``] against the
+        ``budget``, the speedup; ``cheapest`` marks the condition the sentence names."""
+        return self.table("verdict")
+
+    @cached_property
+    def verdict_result(self) -> Verdict:
+        """The verdict as typed objects (``ligwf.report.verdict.Verdict``): per group its
+        conditions and criteria and the sentence naming the cheapest level that meets the
+        whole budget (``groups[i].sentence``, ``groups[i].cheapest``)."""
+        found = read_verdict(self.report_dir)
+        if found is None:
+            raise MissingOutput(f"{self.report_dir / layout.VERDICT_RECORD}: no verdict yet: "
+                                f"run `{REPORT} {self.path}`")
+        return found
 
     @property
     def noise_floor(self) -> pd.DataFrame:

@@ -43,6 +43,9 @@ TABLES: tuple[TableSpec, ...] = (
     TableSpec("conditions", layout.REPORT_DIR, layout.CONDITIONS_REPORT, REPORT, False,
               "one row per (sweep group, CG level, rule): m, m_lo, m_hi, m_se per metric, "
               "errors also m_floor, m_floor_source, m_vs_floor"),
+    TableSpec("verdict", layout.REPORT_DIR, layout.VERDICT_TABLE, REPORT, False,
+              "one row per (sweep group, CG level, rule, criterion): pass / fail / undecided "
+              "with the value, its 95 % interval and the budget, the speedup"),
     TableSpec("noise_floor", layout.REPORT_DIR, layout.NOISE_FLOOR_REPORT, REPORT, False,
               "one row per (sweep group, metric): the CG1 value and CG1-vs-CG1 scatter"),
     TableSpec("flow", layout.ANALYSIS_DIR, layout.FLOW_TABLE, ANALYSE, False,
