@@ -57,7 +57,7 @@ from pathlib import Path
 
 from ligwf.analysis.granules.case import FrameResult, GranuleAnalysis, RunFacts
 from ligwf.analysis.frames.dumps import FrameFiles
-from ligwf.analysis.flow.stage import flow_cases, flow_record, flow_table
+from ligwf.analysis.flow.stage import field_files, flow_cases, flow_record, flow_table
 from ligwf.analysis.frames.checks import FramePlan, plan_frames
 from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
                                           nothing_analysed, stage_granules)
@@ -125,7 +125,8 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     tasks = [(fi, ff) for fi, f in enumerate(facts) for ff in f.plan.frames]
     mine: list[FrameResult] = []
     try:
-        my_flows = flow_cases(usable[rank::size], settings.steady_after)
+        my_flows = flow_cases(usable[rank::size], settings.steady_after,
+                              settings.field_kernel)
         analyses: dict[int, GranuleAnalysis] = {}   # one per case: held windows share reads
         for fi, ff in tasks[rank::size]:
             f = facts[fi]
@@ -233,3 +234,5 @@ def stage_flow(outputs: OutputSet, flows: FlowRecord) -> None:
     """Stage the flow table and the flow record (:mod:`ligwf.analysis.flow.stage`)."""
     outputs.write(layout.FLOW_TABLE, flow_table(flows).to_csv(index=False).encode())
     outputs.write(layout.FLOW_PROFILES, flows.to_text().encode())
+    for name, data in field_files(flows).items():   # the cross-section fields
+        outputs.write(name, data)

@@ -91,6 +91,11 @@ class AnalysisSettings(_Frozen):
     bootstrap: int = Field(1000, ge=1, le=1_000_000, description="bootstrap draws of the "
                            "GSD confidence bands")
     seed: int = Field(12345, ge=0, le=MAX_SEED, description="seed of the bootstrap draws")
+    field_kernel: float = Field(
+        2.0, ge=0.5, le=50.0, allow_inf_nan=False, description="standard deviation of the "
+        "Gaussian kernel of the cross-section fields (solid fraction, velocity, granular "
+        "temperature), in CG1 mean particle diameters: a physical length, the same at every "
+        "CG level (ligwf.analysis.flow.fields)")
     sensitivity_frames: int = Field(
         4, ge=0, le=1000, description="steady frames of one case re-analysed with each "
         "threshold moved x0.8 / x1.25 (0: no sensitivity table)")

@@ -70,6 +70,9 @@ CONTROLS_TABLE = "controls.csv"
 #: the flow record: per case its steady window, per-frame series of every flow metric,
 #: profiles, velocity field and the frames it read (:mod:`ligwf.analysis.records.flow`)
 FLOW_PROFILES = "flow_profiles.json"
+#: the cross-section fields of every case's steady window: per-frame kernel sums on the
+#: grid (numpy archive, :mod:`ligwf.analysis.records.fields`)
+FIELDS_DATA = "fields.npz"
 #: per case ``ANALYSIS_DIR/<case_id>/``: the granule series (``.pvd``) of its labelled frames
 GRANULE_SERIES = "granules.pvd"
 #: glob of the labelled frames in a case's granule series folder
@@ -79,6 +82,12 @@ GRANULE_FRAME_GLOB = "granules_*.vtu"
 def granule_frame(step: int) -> str:
     """File name of the granule-labelled particles of one frame (in the case's folder)."""
     return f"granules_{step}.vtu"
+
+
+def field_image(case_id: str) -> str:
+    """File name of a case's window-mean fields as VTK ImageData (ParaView), in
+    ``ANALYSIS_DIR``."""
+    return f"fields_{case_id}.vti"
 
 
 def granule_frame_step(name: str) -> int | None:
@@ -107,6 +116,12 @@ FIGURE_VELOCITY_PROFILES = "velocity_profiles.png"
 FIGURE_GSD_OVERLAY = "gsd_overlay.png"
 FIGURE_KINETICS = "granule_kinetics.png"
 FIGURE_SENSITIVITY = "granule_sensitivity.png"
+
+
+def field_figure(name: str, kind: str) -> str:
+    """File name of a field map figure (``name``: a condition or comparison tag,
+    ``kind``: maps or differences)."""
+    return f"fields_{name}_{kind}.png"
 
 
 def snapshot_figure(case_id: str, coloured_by: str) -> str:

@@ -31,8 +31,15 @@ from ligwf.analysis.flow.frame import DrumGeometry, frame_flow, summarise, veloc
 from ligwf.analysis.frames.checks import check_particles, plan_frames
 from ligwf.analysis.records.flow import CaseFlow, FlowRecord
 from ligwf.analysis.flow.steady import auto_fraction, is_auto
+from ligwf.analysis.flow.fields import case_fields, kernel_width
+from ligwf.analysis.records.fields import CaseFields, fields_bytes, image_text
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.errors import ConfigError, DumpReadError
+from ligwf.study import layout
 from ligwf.study.case import CaseFolder
+
+#: the default kernel width of the cross-section fields, CG1 diameters
+FIELD_KERNEL = AnalysisSettings.model_fields["field_kernel"].default
 
 
 def steady_fraction(case: CaseFolder, steady_after, flows: list) -> float:
@@ -84,10 +91,13 @@ def _listed(v) -> list | float:
     return [float(x) for x in np.ravel(v)] if np.ndim(v) else float(v)
 
 
-def case_flow(case: CaseFolder, steady_after) -> tuple[CaseFlow, list[str]]:
+def case_flow(case: CaseFolder, steady_after, field_kernel: float = FIELD_KERNEL
+              ) -> tuple[CaseFlow, list[str]]:
     """The flow of one case folder and its skipped-frame notes (the steady window's); the
     record is ``measured`` only when a frame of the window was usable (else the one note
-    says why). ConfigError when its dump record is unreadable."""
+    says why), and then carries the window's cross-section fields (kernel width
+    ``field_kernel`` CG1 diameters, :mod:`ligwf.analysis.flow.fields`). ConfigError when
+    its dump record is unreadable."""
     plan = plan_frames(case)
     frames, all_flows, all_series, problems = _production_frames(case, plan)
     fraction = steady_fraction(case, steady_after, all_flows)
@@ -104,15 +114,22 @@ def case_flow(case: CaseFolder, steady_after) -> tuple[CaseFlow, list[str]]:
         return CaseFlow(**head), [
             f"{case.path}: no readable particle dump in the steady part (steps >= "
             f"{first:.0f})" + (f"; first refused: {problems[-1]['reason']}" if problems else "")]
-    return measured_flow(head, [frames[k][0] for k in steady], all_flows, all_series, steady,
-                         DrumGeometry.from_scaled(case.scaled)), skipped
+    geo = DrumGeometry.from_scaled(case.scaled)
+    steady_frames = [frames[k][0] for k in steady]
+    fields = case_fields(steady_frames, geo, kernel_width(geo, case.cg, field_kernel),
+                         case.scaled.drum_length,
+                         {k: head[k] for k in ("case_id", "cg", "rule", "replica", "group")})
+    return measured_flow(head, steady_frames, all_flows, all_series, steady, geo,
+                         fields), skipped
 
 
 def measured_flow(head: dict, steady_frames: list, flows: list, series: list[dict],
-                  steady: list[int], geo: DrumGeometry) -> CaseFlow:
+                  steady: list[int], geo: DrumGeometry, fields: CaseFields | None = None
+                  ) -> CaseFlow:
     """The :class:`CaseFlow` of a case (``head``: its identity and window fields) from its
     production frames' flows and registered series, ``steady`` indexing the window's
-    frames (``steady_frames`` their particle frames, for the velocity field)."""
+    frames (``steady_frames`` their particle frames, for the velocity field), with the
+    window's cross-section ``fields``."""
     window = [flows[k] for k in steady]
     summ = summarise(window)
     cu, cv, mu, mv = velocity_field(steady_frames, geo)
@@ -127,17 +144,17 @@ def measured_flow(head: dict, steady_frames: list, flows: list, series: list[dic
         production_times=[f.time for f in flows],
         production_angles=[f.angle_of_repose for f in flows],
         production_kinetic=[f.kinetic_energy for f in flows],
-        summary=summ.scalars())
+        summary=summ.scalars(), fields=fields)
 
 
-def flow_cases(cases: list[CaseFolder], steady_after) -> tuple[dict[str, CaseFlow],
-                                                              dict[str, list[str]]]:
+def flow_cases(cases: list[CaseFolder], steady_after, field_kernel: float = FIELD_KERNEL
+               ) -> tuple[dict[str, CaseFlow], dict[str, list[str]]]:
     """(flow per case, skipped-frame notes per case) of ``cases``; a case whose dump
     record is unreadable is left out with its reason as the note."""
     out, notes = {}, {}
     for c in cases:
         try:
-            flow, skipped = case_flow(c, steady_after)
+            flow, skipped = case_flow(c, steady_after, field_kernel)
         except ConfigError as exc:
             notes[c.case_id] = [str(exc)]
             continue
@@ -168,3 +185,16 @@ def flow_table(record: FlowRecord) -> pd.DataFrame:
             row.setdefault(name, v)
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def field_files(record: FlowRecord) -> dict[str, bytes]:
+    """The analysis files of the cross-section fields: the archive of every measured
+    case's (``layout.FIELDS_DATA``, what the report reads) and per case its ParaView
+    image of the window means; empty without any."""
+    cases = [c.fields for c in record.measured() if c.fields is not None]
+    if not cases:
+        return {}
+    out = {layout.FIELDS_DATA: fields_bytes(cases)}
+    for c in cases:
+        out[layout.field_image(c.case_id)] = image_text(c).encode()
+    return out

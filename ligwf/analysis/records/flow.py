@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ligwf.analysis.records.fields import CaseFields
 from ligwf.analysis.records.metrics import MetricSpec
 
 
@@ -64,6 +65,9 @@ class CaseFlow:
     production_angles: list = field(default_factory=list)
     production_kinetic: list = field(default_factory=list)
     summary: dict[str, float] = field(default_factory=dict)   # the flow table's scalars
+    #: the cross-section fields of the steady window (written to their own archive by the
+    #: analysis, :mod:`ligwf.analysis.records.fields`; not part of this record's JSON)
+    fields: CaseFields | None = field(default=None, repr=False, compare=False)
 
     @property
     def measured(self) -> bool:
@@ -71,6 +75,7 @@ class CaseFlow:
 
     def to_json(self) -> dict:
         d = dict(self.__dict__)
+        d.pop("fields", None)
         d["frames"] = [list(f) for f in self.frames]
         d["snapshot"] = list(self.snapshot) if self.snapshot else None
         d["read_steps"] = list(self.read_steps)
