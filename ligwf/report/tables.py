@@ -31,6 +31,7 @@ from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import GSD_ERRORS, LOWER_LIMIT
 from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
 from ligwf.analysis.records.statistics import MEAN
+from ligwf.report.fields import add_field_errors, case_fields
 from ligwf.report.uncertainty import (ConditionStats, case_series, cost_interval, mark,
                                       report_metrics)
 from ligwf.study import layout
@@ -237,5 +238,7 @@ def build_tables(study: Study, flow: FlowRecord, granules: bool = True
     stats = ConditionStats(case_series(list(merged["case_id"]), flow, frames),
                            settings.bootstrap, settings.seed, report_metrics(flow))
     df = compare_to_cg1(merged, stats, list(flow.error_metrics))
-    return (df, condition_table(df, stats, metric_columns(flow)), skipped,
-            noise_floor_table(df, stats))
+    df, conditions = add_field_errors(df, condition_table(df, stats, metric_columns(flow)),
+                                      case_fields(analysis_dir), settings.bootstrap,
+                                      settings.seed)
+    return df, conditions, skipped, noise_floor_table(df, stats)

@@ -27,6 +27,7 @@ from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
 from ligwf.report.controls import controls_markdown
+from ligwf.report.fields import fields_report
 from ligwf.report.granule_figures import granule_figures
 from ligwf.report.html import render_page
 from ligwf.report.paraview import case_collection
@@ -82,7 +83,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     write_verdict(verdict, out)
     figures = report_figures(study, flow, cases, conditions, out, snapshots)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
-                               verdict)
+                               verdict, flow_field_sections(study, cases, conditions, out))
     title = f"{study.name}: error against run time"
     preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "
                 "relative to the CG1 cases of the same sweep group; speedup is CG1 production "
@@ -96,7 +97,8 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
 
 def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
                     conditions: pd.DataFrame, floors: pd.DataFrame, problems: Problems,
-                    figures: ReportFigures, verdict: Verdict | None = None) -> list[Section]:
+                    figures: ReportFigures, verdict: Verdict | None = None,
+                    fields: list[Section] = ()) -> list[Section]:
     """Every section of the report, in :data:`ligwf.report.sections.SECTION_ORDER`."""
     fig_dir = layout.FIGURES_DIR
     tables = (markdown_tables(cases, conditions, flow) if not cases.empty
@@ -114,7 +116,7 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
                                figures.gsd, fig_dir)] if figures.gsd else []),
              *([figure_section("Granulation kinetics", "kinetics", "", figures.kinetics,
                                fig_dir)] if figures.kinetics else []),
-             *flow_field_sections(study),
+             *fields,
              *split_markdown(problems.markdown()),
              figure_section("Figures", "figures", "", figures.flow, fig_dir),
              *([figure_section("Snapshots", "snapshots", SNAPSHOTS, figures.snapshots, fig_dir)]
@@ -131,9 +133,11 @@ def verdict_sections(verdict: Verdict | None) -> list[Section]:
     return split_markdown(verdict_section(verdict))
 
 
-def flow_field_sections(study: Study) -> list[Section]:
-    """The flow-field maps and errors (the field stage's section plugs in here)."""
-    return []
+def flow_field_sections(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame,
+                        out: Path) -> list[Section]:
+    """The flow-field maps, errors and null check (:mod:`ligwf.report.fields`: writes its
+    figures and table into the report folder ``out``)."""
+    return split_markdown(fields_report(study, cases, conditions, out)[0])
 
 
 def report_figures(study: Study, flow: FlowRecord, cases: pd.DataFrame,

@@ -106,6 +106,8 @@ NOISE_FLOOR_REPORT = "noise_floor.csv"
 #: the verdict per sweep group, CG level, rule and criterion (ligwf.report.verdict)
 VERDICT_TABLE = "verdict.csv"
 VERDICT_RECORD = "verdict.json"
+#: the cohesionless twins' field errors against the wet CG1 cases (ligwf.report.fields)
+FIELD_NULL_REPORT = "fields_null_check.csv"
 SUMMARY_REPORT = "summary.md"
 HTML_REPORT = "index.html"
 FIGURES_DIR = "figures"

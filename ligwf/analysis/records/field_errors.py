@@ -30,6 +30,7 @@ other floors from one run are.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import Callable
@@ -117,6 +118,15 @@ def _condition_draws(cases: list[CaseFields], draws: int, rng: np.random.Generat
     return combined, per.mean(axis=0)
 
 
+def _material_only(cases: list[CaseFields]) -> list[CaseFields]:
+    """The cases with only the nodes where any of them ever has material, as a 1 x K
+    grid: the errors are the same (a node without material in every case adds nothing
+    to either sum) and the bootstrap draws are a fraction of the size."""
+    keep = np.any([c.moments[:, 0].max(axis=0) > 0 for c in cases], axis=0)
+    return [dataclasses.replace(c, moments=c.moments[:, :, keep][:, :, None, :])
+            for c in cases]
+
+
 def field_interval(cases: list[CaseFields], refs: list[CaseFields], name: str, draws: int,
                    seed: int) -> Interval:
     """A field error (``name`` in ``FIELD_ERRORS``) of a condition's replicas ``cases``
@@ -128,6 +138,8 @@ def field_interval(cases: list[CaseFields], refs: list[CaseFields], name: str, d
     if not cases or not refs or not same_grid(cases + refs):
         return Interval(math.nan, math.nan, math.nan, math.nan, len(cases))
     value = float(error(condition_mean(refs), condition_mean(cases)))
+    reduced = _material_only(cases + refs)
+    cases, refs = reduced[:len(cases)], reduced[len(cases):]
     rng = np.random.default_rng(seed)
     comb, within = [], []
     for start in range(0, draws, CHUNK):

@@ -1,0 +1,103 @@
+"""The field errors in the report's tables, the null check and the section (ligwf.report.fields),
+on synthetic fields with known answers: a CG2 condition 10 % faster than CG1 everywhere is
+beyond the CG1 floor, a CG2 condition that is CG1's own flow is not, a cohesionless twin
+that flows differently shows up in the null check; the maps are drawn on shared scales."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from ligwf.analysis.flow.fields import case_fields
+from ligwf.report.field_figures import group_figures, rotation_sense
+from ligwf.report.fields import add_field_errors, fields_section, null_check, twin_cases
+from test_fields import D1, HEAD, LENGTH, WIDTH, geometry, lattice_frame
+
+TWIN_GROUP = json.dumps({"control": "cohesionless"})
+DRAWS = 100
+
+
+def synthetic(case_id: str, cg: float, rule: str, replica: int, group: str, scale: float,
+              seed: int):
+    frames = [lattice_frame(D1, 2e-3, 4, step=k, noise=0.05, seed=seed + k, scale=scale)
+              for k in range(10)]
+    return case_fields(frames, geometry(D1), 2 * WIDTH, LENGTH,     # 61 x 61 nodes
+                       {**HEAD, "case_id": case_id, "cg": cg, "rule": rule,
+                        "replica": replica, "group": group})
+
+
+@pytest.fixture(scope="module")
+def study_fields():
+    spec = [("cg1-none-r0", 1.0, "none", 0, "{}", 1.0),
+            ("cg1-none-r1", 1.0, "none", 1, "{}", 1.0),
+            ("cg2-weber-r0", 2.0, "weber", 0, "{}", 1.0),
+            ("cg2-weber-r1", 2.0, "weber", 1, "{}", 1.0),
+            ("cg2-bond-r0", 2.0, "bond", 0, "{}", 1.1),
+            ("cg2-bond-r1", 2.0, "bond", 1, "{}", 1.1),
+            ("cg1-none-r0_cohesionless", 1.0, "none", 0, TWIN_GROUP, 1.3),
+            ("cg1-none-r1_cohesionless", 1.0, "none", 1, TWIN_GROUP, 1.3)]
+    fields = {s[0]: synthetic(*s, seed=100 * k) for k, s in enumerate(spec)}
+    cases = pd.DataFrame([{"case_id": s[0], "cg": s[1], "rule": s[2], "replica": s[3],
+                           "group": s[4]} for s in spec])
+    conditions = (cases.groupby(["group", "cg", "rule"], sort=True).size()
+                  .rename("replicas").reset_index())
+    return fields, cases, conditions
+
+
+@pytest.fixture(scope="module")
+def tables(study_fields):
+    fields, cases, conditions = study_fields
+    return add_field_errors(cases, conditions, fields, DRAWS, 7)
+
+
+def test_field_errors_enter_the_tables_with_the_contract_columns(tables):
+    cases, cond = tables
+    for name in ("field_error", "field_solid_error"):
+        for sfx in ("", "_lo", "_hi", "_se", "_floor", "_floor_source", "_vs_floor"):
+            assert f"{name}{sfx}" in cond
+        assert name in cases
+    row = cond.set_index(["group", "cg", "rule"])
+    bond, weber = row.loc[("{}", 2.0, "bond")], row.loc[("{}", 2.0, "weber")]
+    assert bond["field_error"] == pytest.approx(0.1, abs=0.02)
+    assert bond["field_error_vs_floor"] == "beyond"
+    assert bond["field_error_floor_source"] == "measured over 2 CG1 replicas"
+    assert weber["field_error"] < bond["field_error_lo"]
+    assert weber["field_error_vs_floor"] != "beyond"
+    assert row.loc[("{}", 1.0, "none")]["field_error_vs_floor"] == "reference"
+    # a case's own error: against the mean of its group's CG1 cases
+    by_id = cases.set_index("case_id")
+    assert by_id.loc["cg2-bond-r0", "field_error"] == pytest.approx(0.1, abs=0.03)
+
+
+def test_null_check_and_section(study_fields, tables, tmp_path):
+    fields = study_fields[0]
+    cases, cond = tables
+    null = null_check(cases, fields, DRAWS, 7)
+    assert len(null) == 1 and null.iloc[0]["wet_group"] == "{}"
+    assert null.iloc[0]["field_error"] == pytest.approx(0.3, abs=0.03)
+    assert null.iloc[0]["field_error_vs_floor"] == "beyond"
+    assert twin_cases(cases) == {"{}": ["cg1-none-r0_cohesionless", "cg1-none-r1_cohesionless"]}
+    figs = group_figures(cases, fields, tmp_path, rotation_sense("y", 3.0), twin_cases(cases))
+    assert [p.name for _, p in figs] == ["fields_study_maps.png", "fields_study_differences.png"]
+    assert all(p.stat().st_size > 10_000 for _, p in figs)
+    md = fields_section(cond, null, fields, [(t, f"figures/{p.name}") for t, p in figs])
+    assert "## Flow fields" in md and "cg2" not in md.split("| group")[0]
+    assert md.count("beyond") >= 2 and "fields_study_maps.png" in md
+    assert "Null check" in md
+
+
+def test_no_fields_no_errors(study_fields):
+    _, cases, conditions = study_fields
+    cases, cond = add_field_errors(cases, conditions, {}, 10, 1)
+    assert cond["field_error"].isna().all() and set(cond["field_error_vs_floor"]) == {"–"}
+    assert "run `ligwf analyse` again" in fields_section(cond, pd.DataFrame(), {}, [])
+
+
+def test_rotation_sense_on_the_maps():
+    # axis y, (u, v) = (x, z): +y points away from the viewer, so omega > 0 is clockwise
+    assert rotation_sense("y", 1.0) == "clockwise"
+    assert rotation_sense("y", -1.0) == "counter-clockwise"
+    assert rotation_sense("x", 1.0) == "counter-clockwise"
