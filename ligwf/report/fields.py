@@ -25,7 +25,7 @@ import pandas as pd
 
 from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.field_errors import (ERRORS, FIELD_ERRORS, MATERIAL_SOLID,
-                                                 condition_mean, field_floor, field_interval,
+                                                 condition_mean, field_floor, field_intervals,
                                                  same_grid)
 from ligwf.analysis.records.fields import CaseFields, read_fields
 from ligwf.fsio import atomic_write_text
@@ -84,8 +84,9 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
         ref_ids = groups.reference_cases(row["group"])
         members, refs = _members(ids, fields), _members(ref_ids, fields)
         reference = bool(ids) and groups.condition(ids[0]).is_reference
+        intervals = field_intervals(members, refs, draws, seed)
         for name in FIELD_ERRORS:
-            iv = field_interval(members, refs, name, draws, seed)
+            iv = intervals[name]
             fl = field_floor(refs, name)
             conditions.at[i, name], conditions.at[i, f"{name}_lo"] = iv.value, iv.lo
             conditions.at[i, f"{name}_hi"], conditions.at[i, f"{name}_se"] = iv.hi, iv.se_within
@@ -137,8 +138,9 @@ def null_check(cases: pd.DataFrame, fields: dict[str, CaseFields], draws: int, s
             continue
         row = {"control": cond.group, "wet_group": wet, "cg": cond.cg,
                "twins": len(twins), "wet_cg1": len(refs)}
+        intervals = field_intervals(twins, refs, draws, seed)
         for name in FIELD_ERRORS:
-            iv = field_interval(twins, refs, name, draws, seed)
+            iv = intervals[name]
             fl = field_floor(refs, name)
             row.update({name: iv.value, f"{name}_lo": iv.lo, f"{name}_hi": iv.hi,
                         f"{name}_floor": fl.value, f"{name}_floor_source": fl.source,

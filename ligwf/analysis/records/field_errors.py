@@ -37,7 +37,7 @@ from typing import Callable
 
 import numpy as np
 
-from ligwf.analysis.records.fields import EMPTY_SOLID, CaseFields, fields_of
+from ligwf.analysis.records.fields import EMPTY_SOLID, CaseFields
 from ligwf.analysis.records.intervals import (Interval, block_indices, block_length,
                                               interval_from_draws)
 from ligwf.analysis.records.metrics import POSITIVE
@@ -47,23 +47,31 @@ from ligwf.analysis.records.metrics import POSITIVE
 MATERIAL_SOLID = 0.1
 #: bootstrap draws evaluated at once (bounds the memory: draws x grid nodes x moments)
 CHUNK = 100
+#: the errors read the first moments only: solid fraction, flux u, flux v
+IN_PLANE = 3
 #: the error columns this module computes, by name
 FIELD_ERRORS = ("field_error", "field_solid_error")
 
 Error = Callable[[np.ndarray, np.ndarray], np.ndarray]
 
 
+def _in_plane(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(phi, u, v) of kernel sums (u, v 0 where phi < EMPTY_SOLID): what the velocity
+    error needs, without the other fields."""
+    phi = sums[..., 0, :, :]
+    ok = phi >= EMPTY_SOLID
+    inv = np.where(ok, 1.0 / np.where(ok, phi, 1.0), 0.0)
+    return phi, sums[..., 1, :, :] * inv, sums[..., 2, :, :] * inv
+
+
 def velocity_error(ref: np.ndarray, sums: np.ndarray) -> np.ndarray:
     """``field_error`` of kernel sums ``sums`` against ``ref`` (both ``(..., moments, n,
     n)``, broadcasting over leading draw axes); nan without a common material node."""
-    r, f = fields_of(ref), fields_of(sums)
-    phi1 = r["solid_fraction"]
-    mask = (phi1 >= MATERIAL_SOLID) & (f["solid_fraction"] >= EMPTY_SOLID)
-    du = np.where(mask, f["velocity_u"] - r["velocity_u"], 0.0)
-    dv = np.where(mask, f["velocity_v"] - r["velocity_v"], 0.0)
-    num = np.sum(np.where(mask, phi1 * (du**2 + dv**2), 0.0), axis=(-2, -1))
-    den = np.sum(np.where(mask, phi1 * (r["velocity_u"]**2 + r["velocity_v"]**2), 0.0),
-                 axis=(-2, -1))
+    phi1, u1, v1 = _in_plane(ref)
+    phi, u, v = _in_plane(sums)
+    weight = np.where((phi1 >= MATERIAL_SOLID) & (phi >= EMPTY_SOLID), phi1, 0.0)
+    num = np.sum(weight * ((u - u1) ** 2 + (v - v1) ** 2), axis=(-2, -1))
+    den = np.sum(weight * (u1**2 + v1**2), axis=(-2, -1))
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(den > 0, np.sqrt(num / np.where(den > 0, den, 1.0)), np.nan)
 
@@ -119,39 +127,49 @@ def _condition_draws(cases: list[CaseFields], draws: int, rng: np.random.Generat
 
 
 def _material_only(cases: list[CaseFields]) -> list[CaseFields]:
-    """The cases with only the nodes where any of them ever has material, as a 1 x K
-    grid: the errors are the same (a node without material in every case adds nothing
-    to either sum) and the bootstrap draws are a fraction of the size."""
+    """The cases with only what the errors read: the solid fraction and the in-plane
+    fluxes (``IN_PLANE`` moments) on the nodes where any of them ever has material, as a
+    1 x K grid. The errors are the same (a node without material in every case adds
+    nothing to either sum) and the bootstrap draws a fraction of the size."""
     keep = np.any([c.moments[:, 0].max(axis=0) > 0 for c in cases], axis=0)
-    return [dataclasses.replace(c, moments=c.moments[:, :, keep][:, :, None, :])
+    return [dataclasses.replace(c, moments=c.moments[:, :IN_PLANE][:, :, keep][:, :, None, :])
             for c in cases]
 
 
-def field_interval(cases: list[CaseFields], refs: list[CaseFields], name: str, draws: int,
-                   seed: int) -> Interval:
-    """A field error (``name`` in ``FIELD_ERRORS``) of a condition's replicas ``cases``
-    against the CG1 replicas ``refs``, with its 95 % interval (module docstring); nan
-    without cases, references or a common grid."""
-    error = ERRORS[name]
+def field_intervals(cases: list[CaseFields], refs: list[CaseFields], draws: int, seed: int,
+                    names: tuple[str, ...] = FIELD_ERRORS) -> dict[str, Interval]:
+    """Each field error ``names`` of a condition's replicas ``cases`` against the CG1
+    replicas ``refs``, with its 95 % interval (module docstring; one set of draws for all
+    of them); nan without cases, references or a common grid."""
     cases = [c for c in cases if c.frames]
     refs = [c for c in refs if c.frames]
     if not cases or not refs or not same_grid(cases + refs):
-        return Interval(math.nan, math.nan, math.nan, math.nan, len(cases))
-    value = float(error(condition_mean(refs), condition_mean(cases)))
+        return {n: Interval(math.nan, math.nan, math.nan, math.nan, len(cases)) for n in names}
+    values = {n: float(ERRORS[n](condition_mean(refs), condition_mean(cases))) for n in names}
     reduced = _material_only(cases + refs)
     cases, refs = reduced[:len(cases)], reduced[len(cases):]
     rng = np.random.default_rng(seed)
-    comb, within = [], []
+    comb: dict[str, list] = {n: [] for n in names}
+    within: dict[str, list] = {n: [] for n in names}
     for start in range(0, draws, CHUNK):
         k = min(CHUNK, draws - start)
         c_comb, c_within = _condition_draws(cases, k, rng)
         r_comb, r_within = _condition_draws(refs, k, rng)
         if len(refs) < 2:
             r_comb = r_within
-        comb.append(error(r_comb, c_comb))
-        within.append(error(r_within, c_within))
-    return interval_from_draws(value, np.concatenate(comb), np.concatenate(within),
-                               len(cases), POSITIVE)
+        for n in names:
+            comb[n].append(ERRORS[n](r_comb, c_comb))
+            within[n].append(ERRORS[n](r_within, c_within))
+    return {n: interval_from_draws(values[n], np.concatenate(comb[n]),
+                                   np.concatenate(within[n]), len(cases), POSITIVE)
+            for n in names}
+
+
+def field_interval(cases: list[CaseFields], refs: list[CaseFields], name: str, draws: int,
+                   seed: int) -> Interval:
+    """One field error (``name`` in ``FIELD_ERRORS``) with its interval
+    (:func:`field_intervals`)."""
+    return field_intervals(cases, refs, draws, seed, (name,))[name]
 
 
 @dataclass(frozen=True)
