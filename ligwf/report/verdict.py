@@ -237,8 +237,10 @@ def criterion(spec: CriterionSpec, tolerance: float, row, ref, gate: Gate,
         return CriterionResult(**base, state=NOT_ASSESSED, note=f"not assessed: {gate.reason}")
     value, lo, hi, floor, source = _measure(spec, row, ref)
     if not math.isfinite(value):
-        return CriterionResult(**base, state=NOT_MEASURED,
-                               note=f"not measured: no {spec.column} value for this condition")
+        why = (f"the CG1 {spec.label} (or its interval) reaches 0: no relative difference"
+               if spec.kind == RELATIVE and math.isfinite(_f(row, spec.column))
+               else f"no {spec.column} value for this condition")
+        return CriterionResult(**base, state=NOT_MEASURED, note=f"not measured: {why}")
     budget, budget_source = tolerance, "tolerance"
     if spec.floored and math.isfinite(floor) and floor > tolerance:
         budget, budget_source = floor, f"CG1 noise floor ({source})" if source else "CG1 noise floor"

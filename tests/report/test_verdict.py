@@ -211,6 +211,15 @@ def test_a_criterion_set_to_null_is_left_out_and_control_twins_are_no_candidates
     assert v.groups[0].cheapest == "cg2-weber"
 
 
+def test_a_relative_difference_to_a_cg1_value_of_zero_is_not_measured():
+    ref = cg1(flowing_layer_thickness_mean=0.0, flowing_layer_thickness_mean_lo=0.0,
+              flowing_layer_thickness_mean_hi=0.001)
+    c = decide(table(ref, cgn(2, "weber", 8.0)), AcceptSettings(), {GROUP: PASSING}
+               ).groups[0].conditions[0]
+    layer = next(r for r in c.criteria if r.name == "flowing_layer")
+    assert layer.state == NOT_MEASURED and "reaches 0" in layer.note
+
+
 def test_groups_without_cg1_or_without_cg_levels_say_so():
     v = decide(table(cgn(2, "weber", 8.0), cg1(group='{"rpm": 20}')), AcceptSettings())
     by = {g.group: g.sentence for g in v.groups}
