@@ -41,6 +41,7 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, 
                               console, duration, err_console, folder_to_write, positive_int,
                               prepare_from_args, rank_count)
 from ligwf.engine.plan import CasePlan
+from ligwf.engine.progress import shown_reason
 from ligwf.pipeline.prepare import prepared_loads
 from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_submit
 from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
@@ -181,7 +182,7 @@ def status_table(study_dir: Path) -> tuple[Table, dict]:
     for c in st.cases:
         counts[c.manifest] = counts.get(c.manifest, 0) + 1
         table.add_row(str(c.index), c.case_id, c.manifest, c.job or "-", c.slurm_state or "-",
-                      c.reason[:60])
+                      shown_reason(c.manifest, c.reason)[:60])
     data = {"cases": [asdict(c) for c in st.cases], "jobs": st.jobs, "counts": counts,
             "scheduler_error": st.scheduler_error}
     return table, data

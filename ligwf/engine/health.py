@@ -282,4 +282,4 @@ def verdict(issues: Sequence[HealthIssue], exit_code: int | None, steps_done: in
         return FAILED, f"engine exit code {exit_code} at step {steps_done} of {total_steps}"
     if steps_done < total_steps:
         return FAILED, f"run ended at step {steps_done} of {total_steps} without an error line"
-    return DONE, f"{steps_done} steps"
+    return DONE, f"finished: all {steps_done} steps"

@@ -68,11 +68,19 @@ class RichMonitor:
             self.progress.update(task, description=f"{case_id} [{style}]{manifest.status}[/]")
 
 
+def shown_reason(status: str, reason: str) -> str:
+    """A case's reason as the status tables print it: a finished case says so (manifests
+    written before said only "106879 steps")."""
+    if status == DONE and (not reason or reason.split()[0].isdigit()):
+        return f"finished: all {reason}" if reason else "finished"
+    return reason
+
+
 def summary_table(cases: Iterable[CaseFolder], title: str = "cases") -> Table:
     """Status of every case folder from its manifest (``ligwf status`` and run summary)."""
     table = Table(title=title)
-    for col in ("case", "status", "steps", "atoms start->end", "wall [s]", "core-s",
-                "settle [s]", "production [s]", "reason"):
+    for col in ("case", "status", "steps", "atoms start->end", "wall [s]",
+                "cores x wall [core-s]", "settle wall [s]", "production wall [s]", "reason"):
         table.add_column(col, justify="left" if col in ("case", "status", "reason") else "right")
     for case in cases:
         m = case.manifest()
@@ -89,5 +97,5 @@ def summary_table(cases: Iterable[CaseFolder], title: str = "cases") -> Table:
             f"{m.wall_seconds:.1f}", f"{m.core_seconds:.1f}",
             f"{phases.get('settle', {}).get('wall_seconds', 0.0):.1f}",
             f"{phases.get('production', {}).get('wall_seconds', 0.0):.1f}",
-            m.reason[:80])
+            shown_reason(status, m.reason)[:80])
     return table

@@ -15,28 +15,28 @@ import pandas as pd
 from ligwf.analysis.records.conditions import REFERENCE_CG
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.metrics import CASE_TABLE, CONDITION_TABLE, GRANULE_METRICS
+from ligwf.report.dictionary import gsd_note, header, shown_value
 from ligwf.study import layout
+from ligwf.study.case import group_label
 
-#: the run columns of the case table in summary.md (the metrics follow, from the record)
-RUN_COLUMNS = [("case_id", "case"), ("cg", "CG"), ("rule", "rule"), ("replica", "rep"),
-               ("particles", "particles"), ("dt", "dt [s]"), ("steps", "steps"),
-               ("wall_seconds", "wall [s]"), ("core_seconds", "core-s"),
-               ("fill_core_seconds", "fill core-s"), ("settle_core_seconds", "settle core-s"),
-               ("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
-               ("speedup_core", "speedup (core-s)"), ("steady_fraction", "steady from")]
-RUN_METRICS = [("production_core_rate_k", "prod. core-s / sim. s / 1k orig. particles"),
-               ("speedup_core", "speedup")]
-GSD_COLUMNS = [("gsd_lower_limit", "GSD lower limit [m^3]"),
-               ("gsd_error_below_lower", "GSD err below lower limit"),
-               ("gsd_error_above_lower", "GSD err above lower limit"),
-               ("gsd_error_all", "GSD err all bins")]
+#: the run columns of the case table in summary.md (the metrics follow, from the record);
+#: headers (label [unit]) from the data dictionary (ligwf.report.dictionary)
+RUN_COLUMNS = [(c, header(c)) for c in (
+    "case_id", "group_label", "cg", "rule", "replica", "particles", "dt", "steps",
+    "wall_seconds", "core_seconds", "fill_core_seconds", "settle_core_seconds",
+    "production_core_rate_k", "speedup_core", "steady_fraction")]
+RUN_METRICS = [(c, header(c)) for c in ("production_core_rate_k", "speedup_core")]
+#: the GSD columns: the limit (as a diameter) and the errors, each naming its limit
+GSD_COLUMNS = [(c, header(c)) for c in ("gsd_lower_limit_diameter", "gsd_error_below_lower",
+                                        "gsd_error_above_lower", "gsd_error_all")]
 
 
 def shown(flow: FlowRecord, table: str) -> list[tuple[str, str]]:
     """(column, header) of the metrics a markdown table shows: the flow record's and the
-    granule metrics marked for it, in order."""
-    return [(m.name, m.header(table)) for m in (*flow.metrics, *GRANULE_METRICS)
-            if table in m.tables]
+    granule metrics marked for it, in order (headers from the data dictionary, a plug-in
+    metric's own label otherwise)."""
+    return [(m.name, header(m.name, fallback=m.header(table)))
+            for m in (*flow.metrics, *GRANULE_METRICS) if table in m.tables]
 
 
 def case_columns(flow: FlowRecord) -> list[tuple[str, str]]:
@@ -58,9 +58,23 @@ def _fmt(v) -> str:
 
 
 def _ci(row, col) -> str:
-    """Value [95 % interval], "(no replica interval)" for one replica, and for an error
-    its mark against the CG1 noise floor."""
-    m, lo, hi = row[col], row.get(f"{col}_lo"), row.get(f"{col}_hi")
+    """Value [95 % interval] in the shown unit, "(no replica interval)" for one replica,
+    for an error its mark against the CG1 noise floor, for a GSD column without a lower
+    limit what that means (:func:`ligwf.report.dictionary.gsd_note`)."""
+    text = _interval(row, col)
+    note = gsd_note(row, col)
+    return text if note is None else (note if text == "–" else f"{text} {note}")
+
+
+def _cell(row, col) -> str:
+    """A case-table cell: the value in the shown unit (GSD: with its no-limit note)."""
+    text = _fmt(shown_value(col, row[col]))
+    note = gsd_note(row, col)
+    return text if note is None else (note if text == "–" else f"{text} {note}")
+
+
+def _interval(row, col) -> str:
+    m, lo, hi = (shown_value(col, row.get(c)) for c in (col, f"{col}_lo", f"{col}_hi"))
     mark = row.get(f"{col}_vs_floor")
     if mark == "reference":   # CG1's error against itself
         return "reference"
@@ -88,16 +102,18 @@ def noise_markdown(conditions: pd.DataFrame, floors: pd.DataFrame, flow: FlowRec
     if not floors.empty:
         lines += ["| group | metric | CG1 value | CG1 scatter | from |", "|---|---|---|---|---|"]
         for _, r in floors.iterrows():
-            lines.append(f"| {r['group']} | {r['metric']} | {_fmt(r['cg1_value'])} | "
-                         f"{_fmt(r['cg1_scatter'])} | {r['source']} |")
+            value, scatter = (shown_value(r["metric"], r[c])
+                              for c in ("cg1_value", "cg1_scatter"))
+            lines.append(f"| {group_label(r['group'])} | {header(r['metric'])} | "
+                         f"{_fmt(value)} | {_fmt(scatter)} | {r['source']} |")
         lines.append("")
     errors = [m for m in flow.error_metrics if f"{m.name}_floor" in conditions]
     if not conditions.empty and errors:
-        lines += ["| CG | rule | " + " ".join(f"{m.header(CONDITION_TABLE)} | floor | |"
-                                              for m in errors),
-                  "|---|---|" + "---|---|---|" * len(errors)]
+        lines += ["| group | CG | rule | " + " ".join(
+                      f"{header(m.name, fallback=m.header(CONDITION_TABLE))} | floor | |"
+                      for m in errors), "|---|---|---|" + "---|---|---|" * len(errors)]
         for _, r in conditions[conditions["cg"] != REFERENCE_CG].iterrows():
-            cells = [f"{r['cg']:g}", r["rule"]]
+            cells = [group_label(r["group"]), f"{r['cg']:g}", r["rule"]]
             for col in (m.name for m in errors):
                 cells += [_fmt(r[col]), f"{_fmt(r[f'{col}_floor'])} ({r[f'{col}_floor_source']})",
                           str(r[f"{col}_vs_floor"])]
@@ -146,19 +162,25 @@ def markdown_tables(cases: pd.DataFrame, conditions: pd.DataFrame, flow: FlowRec
     head = "| " + " | ".join(t for _, t in columns) + " |"
     sep = "|" + "---|" * len(columns)
     lines = ["## Cases", "", head, sep]
+    cases = cases.assign(group_label=cases["group"].map(group_label))   # (readable group)
     for _, r in cases.sort_values(["group", "cg", "rule", "replica"]).iterrows():
-        lines.append("| " + " | ".join(_fmt(r[c]) for c, _ in columns) + " |")
+        lines.append("| " + " | ".join(_cell(r, c) for c, _ in columns) + " |")
     lines += ["", "## Conditions (value [95 % interval])", "",
               "Intervals: block bootstrap over frames (block = 2 x the measured "
               "autocorrelation time) and replicas, never narrower than the within-run error, "
               "bounded to the quantity's range (ligwf.analysis.records.intervals); run costs: t on the "
               "logarithm over replicas; one replica: no replica interval. GSD bands come from "
-              "the GSD stage. Errors are marked `within` / `beyond` / `undecided` against the "
-              "CG1 noise floor by their interval (section CG1 noise floor).", ""]
-    head = "| CG | rule | replicas | particles | core-s | " + " | ".join(t for _, t in metrics) + " |"
-    lines += [head, "|" + "---|" * (5 + len(metrics))]
+              "the GSD stage; GSD errors are against the lower size limit (shown as its "
+              "equivalent diameter: CG-n within the error band of CG1 from it on) or over "
+              "all bins; with no limit located every bin is below it. Errors are marked "
+              "`within` / `beyond` / `undecided` against the CG1 noise floor by their "
+              "interval (section CG1 noise floor).", ""]
+    head = (f"| group | CG | rule | replicas | particles | {header('core_seconds')} | "
+            + " | ".join(t for _, t in metrics) + " |")
+    lines += [head, "|" + "---|" * (6 + len(metrics))]
     for _, r in conditions.iterrows():
-        cells = [f"{r['cg']:g}", r["rule"], str(r["replicas"]), str(r["particles"]),
+        cells = [group_label(r["group"]), f"{r['cg']:g}", r["rule"], str(r["replicas"]),
+                 str(r["particles"]),
                  _ci(r, "core_seconds")] + [_ci(r, c) for c, _ in metrics]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from ligwf.analysis.records.conditions import Conditions
@@ -35,6 +36,7 @@ from ligwf.report.fields import add_field_errors, case_fields
 from ligwf.report.uncertainty import (ConditionStats, case_series, cost_interval, mark,
                                       report_metrics)
 from ligwf.study import layout
+from ligwf.study.case import group_label
 from ligwf.study.study import Study
 
 #: run costs (a Student-t interval on the logarithm over replicas)
@@ -47,7 +49,9 @@ PHASES = ("fill", "settle", "production")
 #: from the data, ligwf.analysis.records.gsd); ``gsd_lower_limit`` (m^3)
 #: is that limit (nan: none located, every bin below it).
 GSD_SUMMARY = {**{e: f"gsd_{e}" for e in GSD_ERRORS}, LOWER_LIMIT: "gsd_lower_limit"}
-GSD_METRICS = tuple(GSD_SUMMARY.values())
+#: ... and the limit's equivalent-sphere diameter (m; the report shows it in mm)
+GSD_LIMIT_DIAMETER = "gsd_lower_limit_diameter"
+GSD_METRICS = (*GSD_SUMMARY.values(), GSD_LIMIT_DIAMETER)
 
 
 def metric_columns(flow: FlowRecord) -> list[str]:
@@ -82,7 +86,8 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
             prod_core, prod_wall = man.core_seconds, man.wall_seconds
             production_seconds = man.steps_done * s.dt
         rows.append({
-            "case_id": c.case_id, "group": c.group, "cg": c.cg, "rule": c.rule,
+            "case_id": c.case_id, "group": c.group, "group_label": group_label(c.group),
+            "cg": c.cg, "rule": c.rule,
             "replica": c.replica, "particles": s.particle_count,
             "original_particles": s.original_particle_count, "dt": s.dt,
             "steps": man.steps_done,
@@ -134,6 +139,10 @@ def merge_analysis(cases: pd.DataFrame, analysis_dir: Path, flow: FlowRecord,
         g = summary[["group", "cg", "rule", *[c for c in cols if c in summary]]].rename(columns=cols)
         g = g.assign(group=g["group"].astype(str))
         df = df.merge(g, on=["group", "cg", "rule"], how="left")
+        for sfx in ("", "_lo", "_hi"):
+            if f"{GSD_SUMMARY[LOWER_LIMIT]}{sfx}" in df:
+                volume = df[f"{GSD_SUMMARY[LOWER_LIMIT]}{sfx}"].astype(float)
+                df[f"{GSD_LIMIT_DIAMETER}{sfx}"] = np.cbrt(6.0 * volume / math.pi)
     for col in [*metric_columns(flow), "steady_fraction", "steady_from_step"]:
         if col not in df:
             df[col] = math.nan
@@ -178,7 +187,8 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats, columns: list[str]
         ids = list(sub["case_id"])
         cond = conditions.condition(ids[0])
         ref_ids = conditions.reference_cases(group)
-        row = {"group": group, "cg": cg, "rule": rule, "replicas": len(sub),
+        row = {"group": group, "group_label": group_label(group), "cg": cg, "rule": rule,
+               "replicas": len(sub),
                "particles": int(sub["particles"].iloc[0]), "dt": float(sub["dt"].iloc[0]),
                "steps": int(sub["steps"].max())}
         for ph in PHASES:
@@ -219,7 +229,8 @@ def noise_floor_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
         for col in (m.name for m in stats.metrics.values() if not m.is_error):
             value = stats.frame_metric(ref_ids, col).value
             scatter, source = stats.scatter(ref_ids, col)
-            rows.append({"group": group, "metric": col, "cg1_value": value,
+            rows.append({"group": group, "group_label": group_label(group), "metric": col,
+                         "cg1_value": value,
                          "cg1_scatter": scatter, "source": source})
     return pd.DataFrame(rows)
 

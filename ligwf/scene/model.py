@@ -123,13 +123,16 @@ class Particles(_Frozen):
 
     density: float = Field(ge=10.0, le=1e5, description="kg/m^3")
     youngs_modulus: float = Field(ge=1e3, le=1e13, description="Pa")
-    poisson_ratio: float = Field(0.3, gt=0.0, lt=0.5)
-    restitution: float = Field(ge=MIN_RESTITUTION, le=1.0)
+    poisson_ratio: float = Field(0.3, gt=0.0, lt=0.5, description="Poisson's ratio")
+    restitution: float = Field(ge=MIN_RESTITUTION, le=1.0, description="coefficient of "
+                               "restitution of particle-particle impacts")
     friction: float = Field(ge=0.0, le=10.0, description="sliding friction coefficient")
     rolling_friction: float = Field(0.0, ge=0.0, le=10.0,
                                     description="rolling friction coefficient (model cdt); "
                                     "0 switches rolling friction off")
-    size_distribution: tuple[SizeClass, ...] = Field(min_length=1)
+    size_distribution: tuple[SizeClass, ...] = Field(
+        min_length=1, description="size classes of the primary particles (number "
+        "fractions summing to 1)")
 
     @model_validator(mode="after")
     def _fractions_sum(self) -> "Particles":
@@ -181,7 +184,8 @@ class Liquid(_Frozen):
     its docs say %). Model-specific limits are the model's own (``validate``).
     """
 
-    model: Annotated[str, AfterValidator(check_liquid_model)] = "none"
+    model: Annotated[str, AfterValidator(check_liquid_model)] = Field(
+        "none", description="liquid-bridge model (ligwf.liquids: none is a dry bed)")
     surface_tension: Annotated[float, zero_or_at_least(1e-6, 1e4, "N/m")] = Field(
         0.072, ge=0.0, le=1e4, description="N/m (0: no cohesion)")
     contact_angle_deg: float = Field(30.0, ge=0.0, le=180.0, description="degrees")
@@ -233,8 +237,9 @@ GRAVITY = 9.81  # m/s^2, the value written to the LIGGGHTS input
 class Rotation(_Frozen):
     """Drum speed, as rpm or as Froude number Fr = omega^2 R / g (give exactly one)."""
 
-    rpm: float | None = Field(None, ge=0.01, le=1e4)
-    froude: float | None = Field(None, ge=1e-6, le=100.0)
+    rpm: float | None = Field(None, ge=0.01, le=1e4, description="revolutions per minute")
+    froude: float | None = Field(None, ge=1e-6, le=100.0, description="Froude number "
+                                 "omega^2 R / g (1: the critical, centrifuging speed)")
 
     @model_validator(mode="after")
     def _one_of(self) -> "Rotation":
@@ -306,7 +311,8 @@ MAX_THERMO_LINES = 2_000_000
 class Scene(_Frozen):
     """One original-size (CG1) drum simulation."""
 
-    name: SafeStr = Field("scene", min_length=1, max_length=80)
+    name: SafeStr = Field("scene", min_length=1, max_length=80, description="scene name "
+                          "(default: the workflow's name)")
     drum: Drum
     particles: Particles
     liquid: Liquid = Field(default_factory=Liquid)

@@ -49,8 +49,12 @@ MAX_CASES = 5000
 class Sweep(_Frozen):
     """What varies between the cases of a workflow (scene-field lists are kept apart)."""
 
-    cg_levels: tuple[float, ...] = Field((1.0,), min_length=1)
-    rules: tuple[Rule, ...] = Field((Rule.WEBER,), min_length=1)
+    cg_levels: tuple[float, ...] = Field((1.0,), min_length=1, description="coarse-graining "
+                                         "levels n (CG particles n times the diameter; 1: the "
+                                         "original, the reference of every comparison)")
+    rules: tuple[Rule, ...] = Field((Rule.WEBER,), min_length=1, description="scaling rules "
+                                    "of the liquid-bridge forces at CG > 1 (CG1 runs once, "
+                                    "rule none)")
     replicas: int | dict[float, int] = Field(1, description="seeds per case, or per CG level")
     per_cg: dict[float, dict[str, Any]] = Field(
         default_factory=dict, description="scene fields set for one CG level only, e.g. "

@@ -26,6 +26,7 @@ from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json
 from ligwf.scene.model import Scene
 from ligwf.scene.scaling import ScaledScene, scale
+from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.layout import (DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME, POST_DIR,
                                 SCENE_FILE, SCREEN_FILE, THERMO_FILE)
 from ligwf.study.manifest import DONE, Manifest, read_manifest, write_manifest
@@ -158,6 +159,29 @@ def group_of(varied: dict[str, Any]) -> str:
     """The sweep group of a case: its swept scene values as canonical JSON (cases of one
     group are compared with the CG1 cases of the same group)."""
     return json.dumps(varied, sort_keys=True)
+
+
+#: the readable name of a group with no swept scene value
+ALL_CASES = "all cases"
+
+
+def group_label(group: str) -> str:
+    """The sweep group as a reader names it: ``all cases`` (nothing swept), the swept
+    values as ``key=value`` (``process.rotation.rpm=20``), and a control twin's group as
+    ``cohesionless control`` (``cohesionless control, process.rotation.rpm=20``); text
+    that is not a group record is returned as it is."""
+    try:
+        varied = json.loads(group)
+    except (TypeError, ValueError):
+        return str(group)
+    if not isinstance(varied, dict):
+        return str(group)
+    control = varied.pop(CONTROL_KEY, None)
+    parts = [f"{key}={value:g}" if isinstance(value, float) else f"{key}={value}"
+             for key, value in varied.items()]
+    if control is not None:
+        return ", ".join([f"{control} control", *parts])
+    return ", ".join(parts) or ALL_CASES
 
 
 @dataclass(frozen=True)

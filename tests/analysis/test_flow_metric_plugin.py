@@ -98,7 +98,7 @@ def test_a_registered_flow_metric_reaches_the_report_tables_on_synthetic_beds(to
         assert lo >= 0                             # bounded: the spec's POSITIVE
     md = markdown_tables(df, cond, flow)
     heads = [line for line in md.splitlines() if line.startswith("| case |")
-             or line.startswith("| CG | rule | replicas")]
+             or line.startswith("| group | CG | rule | replicas")]
     assert len(heads) == 2 and all("bed top [m]" in h for h in heads)
     lines = md.splitlines()
     column = heads[1].split("|").index(" bed top [m] ")

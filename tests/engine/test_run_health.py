@@ -94,7 +94,7 @@ def test_verdict_order():
     exp = Expectation(182, 340, 1000, None)
     issues = assess(parse_screen(SCREEN).rows, SCREEN.splitlines(), exp)
     assert verdict(issues, 0, 510, 1000)[0] == "unstable"
-    assert verdict([], 0, 1000, 1000) == ("done", "1000 steps")
+    assert verdict([], 0, 1000, 1000) == ("done", "finished: all 1000 steps")
     assert verdict([], 0, 500, 1000, killed=True)[0] == "killed"
     assert verdict([], 1, 500, 1000)[0] == "failed"
     assert verdict([], 0, 500, 1000)[0] == "failed"  # exit 0 but short: not success
@@ -142,3 +142,15 @@ def test_resume_mid_fill_keeps_the_top_up_and_its_trim():
     early = list(render_resume(s, RestartFile("r", 5)).values())[0]
     assert "fix ins1 " not in early and f"fix ins{last} " in early
     assert f"({n + TOPUP_MARGIN}-count(all))" in early and "delete_atoms group ligwf_extra" in early
+
+
+def test_a_finished_case_says_finished_in_the_status_tables():
+    """The status tables print 'finished' for a done case, also for manifests written when
+    its reason was only the step count; other reasons stay as they are."""
+    from ligwf.engine.progress import shown_reason
+
+    assert shown_reason("done", "106879 steps") == "finished: all 106879 steps"
+    assert shown_reason("done", "finished: all 1000 steps") == "finished: all 1000 steps"
+    assert shown_reason("done", "") == "finished"
+    assert shown_reason("failed", "engine exit code 1 at step 5 of 10") == \
+        "engine exit code 1 at step 5 of 10"

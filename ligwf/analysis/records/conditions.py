@@ -14,6 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Iterable, Protocol
 
+from ligwf.study.case import group_label
+
 #: the CG level every other level is compared with
 REFERENCE_CG = 1.0
 
@@ -47,8 +49,10 @@ class Condition:
 
     @property
     def name(self) -> str:
+        """``cg2-weber``; with a sweep group its readable name (``cg1 cohesionless
+        control``, ``cg2-weber process.rotation.rpm=20``: :func:`ligwf.study.case.group_label`)."""
         tag = f"cg{self.cg:g}" + ("" if self.is_reference else f"-{self.rule}")
-        return tag if self.group in ("{}", "") else f"{tag} {self.group}"
+        return tag if self.group in ("{}", "") else f"{tag} {group_label(self.group)}"
 
     @property
     def key(self) -> tuple[str, float, str]:

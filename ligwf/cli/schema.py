@@ -1,0 +1,64 @@
+"""``ligwf schema``: the workflow's JSON Schema, its reference and the data dictionary.
+
+Without options it prints the JSON Schema of a workflow file (for a YAML editor:
+``# yaml-language-server: $schema=docs/workflow.schema.json``); ``--out`` writes it,
+``--reference`` writes the markdown workflow reference and ``--dictionary`` the data
+dictionary of every table ligwf writes. The text comes from
+:mod:`ligwf.scene.reference` and :mod:`ligwf.report.dictionary`; the committed copies in
+``docs/`` are regenerated with::
+
+    ligwf schema --out docs/workflow.schema.json --reference docs/workflow_reference.md \\
+        --dictionary docs/data_dictionary.md
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from ligwf.cli.common import console
+from ligwf.fsio import atomic_write_text
+from ligwf.report.dictionary import dictionary_markdown
+from ligwf.scene.reference import reference_markdown, schema_text
+
+
+def file_to_write(text: str) -> Path:
+    """argparse type: a file ligwf may (re)write: not a folder, in an existing writable
+    folder (refused before anything is written)."""
+    path = Path(text)
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a folder, not a file")
+    parent = path.parent
+    if not parent.is_dir():
+        raise argparse.ArgumentTypeError(f"{text}: folder {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise argparse.ArgumentTypeError(f"{text}: folder {parent} is not writable")
+    return path
+
+
+def cmd_schema(args: argparse.Namespace) -> int:
+    outputs = [(args.out, schema_text), (args.reference, reference_markdown),
+               (args.dictionary, dictionary_markdown)]
+    texts = [(path, make()) for path, make in outputs if path is not None]
+    if not texts:
+        print(schema_text(), end="")
+        return 0
+    for path, text in texts:     # every text built before the first file is written
+        atomic_write_text(path, text)
+        console.print(f"wrote {path}", highlight=False)
+    return 0
+
+
+def register(subparsers) -> None:
+    """Add ``schema``."""
+    p = subparsers.add_parser(
+        "schema", help="print the workflow's JSON Schema (for YAML editors); write it, the "
+        "workflow reference and the data dictionary of every table")
+    p.add_argument("--out", type=file_to_write, default=None, metavar="FILE",
+                   help="write the JSON Schema here (e.g. docs/workflow.schema.json)")
+    p.add_argument("--reference", type=file_to_write, default=None, metavar="FILE",
+                   help="write the markdown workflow reference here (docs/workflow_reference.md)")
+    p.add_argument("--dictionary", type=file_to_write, default=None, metavar="FILE",
+                   help="write the data dictionary of every table here (docs/data_dictionary.md)")
+    p.set_defaults(func=cmd_schema)

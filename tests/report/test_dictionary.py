@@ -1,0 +1,175 @@
+"""ligwf.report.dictionary: every column of every table ligwf writes has a unit, a label
+and a meaning; the report headers come from it; docs/data_dictionary.md is generated from
+it. The completeness check runs on the tables' declared columns, on report tables built
+from hand-made inputs, and (engine) on every table of a real tiny study with CG1 replicas,
+CG2 and a cohesionless twin."""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+import pytest
+
+from helpers import ROOT
+from ligwf.analysis.flow.registry import METRICS
+from ligwf.analysis.gsd.kinetics import QUANTITIES
+from ligwf.analysis.gsd.pooling import POOLING_COLUMNS
+from ligwf.analysis.gsd.tables import GSD_COLUMNS, SUMMARY_COLUMNS
+from ligwf.analysis.records.metrics import GRANULE_METRICS
+from ligwf.report import dictionary as dic
+from ligwf.report.tables import compare_to_cg1, condition_table, noise_floor_table
+from ligwf.study import layout
+from ligwf.study.case import group_label
+
+from report.test_tables import METRICS as TEST_METRICS, case_table, stats
+
+
+def undocumented(table: str, columns) -> list[str]:
+    return [c for c in columns if not dic.documented(table, c)]
+
+
+def test_committed_dictionary_is_the_generated_one():
+    text = (ROOT / "docs" / "data_dictionary.md").read_text()
+    assert text == dic.dictionary_markdown(), (
+        "regenerate: ligwf schema --dictionary docs/data_dictionary.md")
+
+
+def test_declared_columns_of_the_analysis_tables_are_documented():
+    assert not undocumented(layout.GSD_TABLE, GSD_COLUMNS)
+    assert not undocumented(layout.GSD_SUMMARY_TABLE, SUMMARY_COLUMNS)
+    assert not undocumented(layout.GSD_POOLING_TABLE, POOLING_COLUMNS)
+    assert not undocumented(layout.KINETICS_TABLE, QUANTITIES)
+
+
+def test_every_registered_metric_is_in_the_dictionary_and_the_report_tables():
+    names = [*METRICS, *(m.name for m in GRANULE_METRICS)]
+    assert set(names) == {*dic.FLOW_METRICS, *dic.GRANULE_METRICS}, (
+        "a metric without a dictionary entry: add (name, unit, label, meaning) to "
+        "ligwf/report/dictionary_entries.py COMMON and the name to dictionary.FLOW_METRICS, "
+        "then `ligwf schema --dictionary docs/data_dictionary.md`")
+    for name in names:
+        assert dic.documented(layout.CONDITIONS_REPORT, name), name
+        assert dic.documented(layout.CASES_REPORT, name), name
+
+
+def test_report_tables_from_hand_made_inputs_are_documented():
+    s = stats()
+    df = compare_to_cg1(case_table(), s, [TEST_METRICS["angle_error"]])
+    conditions = condition_table(df, s, ["core_seconds", "speedup_core",
+                                         "gsd_error_below_lower"])
+    assert "group_label" in conditions and "gsd_error_below_lower_lo" in conditions
+    floors = noise_floor_table(df, s)
+    report_columns = {layout.CONDITIONS_REPORT: conditions, layout.NOISE_FLOOR_REPORT: floors}
+    for table, frame in report_columns.items():
+        known = [c for c in frame.columns if not c.startswith("angle")]   # test metrics
+        assert not undocumented(table, known), table
+
+
+def test_verdict_table_columns_are_documented():
+    from ligwf.report.verdict import (ConditionVerdict, CriterionResult, GroupVerdict,
+                                      Verdict)
+    from ligwf.report.verdict_records import verdict_rows
+
+    crit = CriterionResult("angle_deg", "angle of repose", "deg", "pass", 0.5, 0.1, 0.9, 1.0,
+                           "tolerance")
+    cond = ConditionVerdict("{}", 2.0, "weber", 2, 9.4, 8.8, 10.0, (crit,))
+    rows = verdict_rows(Verdict((GroupVerdict("{}", (cond,), "CG2 weber meets it", cond.name),)))
+    assert len(rows) == 1
+    assert not undocumented(layout.VERDICT_TABLE, rows.columns)
+
+
+def test_headers_carry_units_and_the_shown_unit_scales_values():
+    assert dic.header("angle_of_repose") == "angle [deg]"
+    assert dic.header("core_seconds") == "cores x wall [core-s]"
+    assert dic.header("wall_seconds") == "wall [s]"
+    assert dic.header("d50") == "d50 [mm]"
+    assert dic.header("speedup_core") == "speedup"
+    assert dic.header("gsd_error_below_lower") == "GSD err below lower limit"
+    assert dic.header("gsd_lower_limit_diameter") == "GSD lower limit d [mm]"
+    assert dic.header("my_plugin_metric", fallback="plug-in") == "plug-in"
+    assert dic.shown_value("d50", 0.0023) == pytest.approx(2.3)
+    assert dic.shown_value("angle_of_repose", 31.0) == 31.0
+    assert dic.shown_value("d50", "–") == "–"
+
+
+def test_shown_frame_scales_renames_and_drops_the_raw_group():
+    df = pd.DataFrame({"group": ["{}"], "group_label": ["all cases"], "d50": [0.002],
+                       "angle_of_repose": [31.0], "plugin": [1.0]})
+    shown = dic.shown_frame(df)
+    assert list(shown.columns) == ["group", "d50 [mm]", "angle [deg]", "plugin"]
+    assert shown["d50 [mm]"].iloc[0] == pytest.approx(2.0)
+    assert shown["group"].iloc[0] == "all cases"
+
+
+def test_derived_columns_name_their_base():
+    c = dic.column("angle_error_vs_floor", layout.CONDITIONS_REPORT)
+    assert c.unit == "text" and "angle_error" in c.meaning and "undecided" in c.meaning
+    assert dic.column("d50_lo").unit == "m" and dic.column("d50_lo").shown == "mm"
+    assert dic.column("twin_share_10", layout.CONTROLS_TABLE).meaning.startswith("share_10")
+    assert dic.column("upper_limit_nan_pools").unit == "count"
+    assert dic.column("no_such_column") is None
+    assert not dic.documented(layout.FLOW_TABLE, "no_such_column")
+    # a suffix documents a column only in a table that has that family
+    assert dic.documented(layout.CONDITIONS_REPORT, "angle_error_floor")
+    assert not dic.documented(layout.FLOW_TABLE, "angle_of_repose_mean_floor")
+
+
+@pytest.mark.parametrize("group,label", [
+    ("{}", "all cases"),
+    ('{"control": "cohesionless"}', "cohesionless control"),
+    ('{"process.rotation.rpm": 20}', "process.rotation.rpm=20"),
+    ('{"control": "cohesionless", "process.rotation.rpm": 20.5}',
+     "cohesionless control, process.rotation.rpm=20.5"),
+    ("g", "g"),
+])
+def test_groups_have_readable_names(group, label):
+    assert group_label(group) == label
+
+
+def test_no_lower_limit_is_said_in_the_gsd_cells():
+    compared = {"gsd_lower_limit": math.nan, "gsd_error_all": 1.6}
+    assert dic.gsd_note(compared, "gsd_lower_limit_diameter") == "none located"
+    assert dic.gsd_note(compared, "gsd_error_below_lower") == "(all bins: no lower limit)"
+    assert dic.gsd_note(compared, "gsd_error_above_lower") == "(no lower limit)"
+    located = {"gsd_lower_limit": 2e-7, "gsd_error_all": 1.6}
+    assert dic.gsd_note(located, "gsd_error_below_lower") is None
+    cg1 = {"gsd_lower_limit": math.nan, "gsd_error_all": math.nan}    # nothing compared
+    assert dic.gsd_note(cg1, "gsd_lower_limit_diameter") is None
+    assert dic.gsd_note(compared, "angle_error") is None
+
+
+@pytest.fixture(scope="module")
+def real_study(tmp_path_factory):
+    """A tiny real study: 2 CG1 replicas with their cohesionless twins and 2 We-CG2."""
+    from ligwf.cli.main import main
+
+    out = tmp_path_factory.mktemp("dictionary") / "tiny"
+    rc = main(["study", str(ROOT / "tests" / "workflows" / "tiny_study.yaml"), "--out",
+               str(out), "--no-snapshots", "--set", "sweep.rules=[weber]",
+               "--set", "sweep.replicas={1: 2, 2: 2}",
+               "--set", "sweep.controls=[cohesionless]"])
+    assert rc == 0
+    return out
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+@pytest.mark.slow
+def test_every_column_of_every_real_table_is_documented(real_study):
+    seen = {}
+    for folder in (layout.ANALYSIS_DIR, layout.REPORT_DIR):
+        for path in sorted((real_study / folder).glob("*.csv")) + sorted(
+                (real_study / folder).glob("*.parquet")):
+            frame = (pd.read_parquet(path) if path.suffix == ".parquet"
+                     else pd.read_csv(path))
+            assert path.name in dic.TABLES, f"{path.name}: a table the dictionary lacks"
+            seen[path.name] = undocumented(path.name, frame.columns)
+    assert {layout.CONDITIONS_REPORT, layout.CONTROLS_TABLE, layout.GSD_SUMMARY_TABLE,
+            layout.KINETICS_SUMMARY_TABLE} <= set(seen)
+    assert not {t: cols for t, cols in seen.items() if cols}, (
+        "columns without a dictionary entry: add them to ligwf/report/dictionary_entries.py "
+        "and the table's columns in ligwf/report/dictionary.TABLES")
+    summary = (real_study / layout.REPORT_DIR / layout.SUMMARY_REPORT).read_text()
+    assert "cohesionless control" in summary and "| {} |" not in summary
+    assert "GSD err below lower limit" in summary and "angle [deg]" in summary
