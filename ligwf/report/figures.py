@@ -15,7 +15,6 @@ sizes as equivalent diameters in mm.
 from __future__ import annotations
 
 import io
-import json
 import math
 from pathlib import Path
 
@@ -27,6 +26,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from ligwf.analysis.records.conditions import REFERENCE_CG
 from ligwf.fsio import atomic_write_bytes
+from ligwf.study.case import group_label
 
 #: phases of a run's cost, as the conditions table names them (``<phase>_core_seconds``)
 PHASES = ("fill", "settle", "production")
@@ -64,17 +64,13 @@ def log_ticks(ax: Axes, axis: str = "x") -> None:
 
 
 def group_suffix(group) -> str:
-    """" (cohesionless)" for a sweep group recorded as JSON (``{"control": "cohesionless"}``),
-    "" for the study's main group (``{}``)."""
-    try:
-        values = json.loads(group) if isinstance(group, str) and group else {}
-    except ValueError:
-        return f" ({group})"
-    return f" ({', '.join(str(v) for v in values.values())})" if values else ""
+    """" (cohesionless control)" for a sweep group recorded as JSON, "" for the study's
+    main group (``{}``); the words are :func:`ligwf.study.case.group_label`'s."""
+    return "" if group in ("{}", "", None) or pd.isna(group) else f" ({group_label(group)})"
 
 
 def condition_label(cg: float, rule: str, group="") -> str:
-    """CG1, CG2 weber, CG1 (cohesionless): a condition as the figures name it."""
+    """CG1, CG2 weber, CG1 (cohesionless control): a condition as the figures name it."""
     return ("CG1" if cg == REFERENCE_CG else f"CG{cg:g} {rule}") + group_suffix(group)
 
 
