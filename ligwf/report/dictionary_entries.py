@@ -152,6 +152,18 @@ COMMON: tuple[tuple[str, ...], ...] = (
      "gsd_summary.csv (nan when no lower limit is located)"),
     ("gsd_error_all", "1", "GSD err all bins", "error_all of gsd_summary.csv: the whole GSD's "
      "relative L1 error against CG1"),
+    # flow fields (ligwf.analysis.records.field_errors)
+    ("field_error", "1", "velocity field err (L2)", "relative L2 error of the in-plane "
+     "velocity field on the drum cross-section against CG1, weighted by the CG1 solid "
+     "fraction, over the nodes where CG1 has material"),
+    ("field_solid_error", "1", "solid fraction field err (L1)", "relative L1 error of the "
+     "solid-fraction field over the cross-section against CG1: sum |phi_n - phi_1| / sum "
+     "phi_1"),
+    ("control", "text", "control", "the sweep group of the cohesionless twins"),
+    ("wet_group", "text", "wet group", "the sweep group of the wet CG1 cases they are "
+     "compared with"),
+    ("twins", "count", "twins", "cohesionless twin cases pooled"),
+    ("wet_cg1", "count", "wet CG1", "wet CG1 cases of the comparison"),
     # controls (ligwf.analysis.granules.control_run)
     ("twin_id", "text", "twin", "the cohesionless twin of the case (surface tension and "
      "viscosity / 1000, same seeds)"),

@@ -33,6 +33,7 @@ from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.report.uncertainty import mark
 from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study import layout
+from ligwf.study.case import group_label
 from ligwf.study.study import Study
 
 #: what each field error is called in the report
@@ -159,8 +160,6 @@ def _cell(r, name) -> str:
     return f"{_num(r[name])}{band}"
 
 
-def _group_label(group: str) -> str:
-    return "(no sweep)" if group in ("{}", "") else group
 
 
 def fields_section(conditions: pd.DataFrame, null: pd.DataFrame, fields: dict[str, CaseFields],
@@ -200,7 +199,7 @@ def fields_section(conditions: pd.DataFrame, null: pd.DataFrame, fields: dict[st
             rule += "---|---|---|"
         lines += [head, rule]
         for _, r in cg.iterrows():
-            cells = [_group_label(r["group"]), f"{r['cg']:g}", r["rule"], str(r["replicas"])]
+            cells = [group_label(r["group"]), f"{r['cg']:g}", r["rule"], str(r["replicas"])]
             for name in FIELD_ERRORS:
                 cells += [_cell(r, name), f"{_num(r[f'{name}_floor'])} "
                           f"({r[f'{name}_floor_source']})", r[f"{name}_vs_floor"]]
@@ -215,7 +214,7 @@ def fields_section(conditions: pd.DataFrame, null: pd.DataFrame, fields: dict[st
                       f"{LABELS[n]} [95 % CI] | vs floor" for n in FIELD_ERRORS) + " |",
                   "|---|---|" + "---|---|" * len(FIELD_ERRORS)]
         for _, r in null.iterrows():
-            cells = [_group_label(r["wet_group"]), str(r["twins"])]
+            cells = [group_label(r["wet_group"]), str(r["twins"])]
             for name in FIELD_ERRORS:
                 cells += [_cell(r, name), f"{r[f'{name}_vs_floor']} (floor "
                           f"{_num(r[f'{name}_floor'])})"]

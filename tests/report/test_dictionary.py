@@ -66,6 +66,16 @@ def test_report_tables_from_hand_made_inputs_are_documented():
         assert not undocumented(table, known), table
 
 
+def test_field_error_columns_are_documented():
+    from ligwf.analysis.records.field_errors import FIELD_ERRORS
+
+    assert set(FIELD_ERRORS) == set(dic.FIELD_ERRORS)
+    for name in FIELD_ERRORS:
+        for sfx in ("", "_lo", "_hi", "_se", "_floor", "_floor_source", "_vs_floor"):
+            assert dic.documented(layout.CONDITIONS_REPORT, name + sfx)
+        assert dic.documented(layout.FIELD_NULL_REPORT, name + "_vs_floor")
+
+
 def test_verdict_table_columns_are_documented():
     from ligwf.report.verdict import (ConditionVerdict, CriterionResult, GroupVerdict,
                                       Verdict)
