@@ -1,7 +1,8 @@
 """Maps of the cross-section fields: per condition, and CG-n minus CG1, on shared scales.
 
 Each plotting function draws on a matplotlib ``Axes`` and returns it (the object-oriented
-API: no backend switch at import); :func:`save` writes a figure as PNG atomically.
+API: no backend switch at import); :func:`ligwf.report.figures.save` writes a figure as
+PNG atomically.
 :func:`group_figures` lays out the report's two figures per sweep group: the maps of
 every condition (rows; solid fraction, speed with in-plane arrows, granular temperature)
 and their differences from CG1, each quantity on one colour scale across the rows, so
@@ -10,7 +11,6 @@ the rows compare by eye. The drum wall is outlined and its sense of rotation nam
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +20,7 @@ from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.field_errors import MATERIAL_SOLID, condition_mean
 from ligwf.analysis.records.fields import CaseFields, FieldGrid, fields_of
 from ligwf.engine.mesh import axis_frame
-from ligwf.fsio import atomic_write_bytes
+from ligwf.report.figures import save
 from ligwf.study import layout
 
 #: quantity -> (label, colour map) of the maps
@@ -82,14 +82,6 @@ def field_map(ax, grid: FieldGrid, values: np.ndarray, title: str, vmin: float, 
     ax.figure.colorbar(mesh, ax=ax, label=label, shrink=0.85)
     _frame(ax, grid, title)
     return ax
-
-
-def save(fig: Figure, path: Path) -> Path:
-    """Write ``fig`` as PNG atomically (rendered to memory first)."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=100, bbox_inches="tight")
-    atomic_write_bytes(path, buf.getvalue())
-    return path
 
 
 def _fields(members: list[CaseFields]) -> dict[str, np.ndarray]:
