@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
@@ -93,10 +94,14 @@ def kinetics_figure(summary: pd.DataFrame, out: Path,
 
 def sensitivity_ax(ax: Axes, table: pd.DataFrame, quantity: str, label: str,
                    names: bool = True) -> Axes:
-    """One bar per variant of the definition; the first (black) is the setting used."""
+    """One bar per variant of the definition; the first (black) is the setting used; each
+    bar says its value ("none": no granule counted, e.g. the whole bed one cluster)."""
     scale = 1e3 if quantity == "d50" else 1.0
     y = list(range(len(table)))
-    ax.barh(y, table[quantity] * scale, color=["k"] + ["C0"] * (len(table) - 1))
+    values = pd.to_numeric(table[quantity], errors="coerce").to_numpy(float) * scale
+    bars = ax.barh(y, np.nan_to_num(values), color=["k"] + ["C0"] * (len(table) - 1))
+    ax.bar_label(bars, labels=[f"{v:.3g}" if np.isfinite(v) else "none" for v in values],
+                 fontsize=7, padding=2)
     ax.set_yticks(y, list(table["variant"]) if names else [""] * len(table), fontsize=7)
     ax.invert_yaxis()
     ax.set_xlabel(label)

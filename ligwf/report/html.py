@@ -50,7 +50,7 @@ tr:nth-child(even) td{background:#fafbfc}
 details{margin:.6em 0}summary{cursor:pointer;color:#245;font-size:.95em}
 figure{margin:1em 0}figure img{max-width:100%;height:auto;border:1px solid #eee}
 figcaption{font-size:.9em;color:#555}
-section#snapshots figure{display:inline-block;vertical-align:top;width:48%;margin:.5em 1%}
+section#snapshots figure{display:inline-block;vertical-align:top;width:47%;margin:.5em 1%}
 code{background:#f3f3f3;padding:0 .2em;border-radius:3px}
 """
 

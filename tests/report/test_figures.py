@@ -16,7 +16,7 @@ from matplotlib.figure import Figure
 
 from ligwf.report.figures import (equivalent_diameter_mm, error_ax, gsd_ax, pareto,
                                   run_cost_ax)
-from ligwf.report.granule_figures import kinetics_ax, production_origins
+from ligwf.report.granule_figures import kinetics_ax, production_origins, sensitivity_ax
 from ligwf.report.snapshots import SpeedScale, rotation_sense, snapshot_ax
 
 
@@ -129,3 +129,9 @@ def test_importing_the_report_sets_no_backend():
             "ligwf.report.snapshots; print(matplotlib.get_backend())")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "svg"
+
+
+def test_sensitivity_bars_say_their_value_even_when_nothing_was_counted():
+    table = pd.DataFrame({"variant": ["as set", "x0.8"], "d50": [np.nan, 0.002]})
+    ax = sensitivity_ax(Figure().subplots(), table, "d50", "d50 [mm]")
+    assert [t.get_text() for t in ax.texts] == ["none", "2"]
