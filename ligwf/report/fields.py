@@ -143,9 +143,10 @@ def null_check(cases: pd.DataFrame, fields: dict[str, CaseFields], draws: int, s
         for name in FIELD_ERRORS:
             iv = intervals[name]
             fl = field_floor(refs, name)
+            marked = mark(iv.value, fl.value, iv.lo, iv.hi, len(refs))
             row.update({name: iv.value, f"{name}_lo": iv.lo, f"{name}_hi": iv.hi,
                         f"{name}_floor": fl.value, f"{name}_floor_source": fl.source,
-                        f"{name}_vs_floor": mark(iv.value, fl.value, iv.lo, iv.hi, len(refs))})
+                        f"{name}_vs_floor": marked.replace("CG-n replicas", "twin replicas")})
         rows.append(row)
     return pd.DataFrame(rows)
 
