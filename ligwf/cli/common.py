@@ -138,7 +138,7 @@ def case_table(prepared: Prepared, title: str) -> Table:
     table = Table(title=title)
     for col in ("case", "CG", "rule", "rep", "particles", "dt [s]", "dt/t_R", "steps",
                 "particle-steps"):
-        table.add_column(col, justify="right" if col not in ("case", "rule") else "left")
+        table.add_column(escape(col), justify="right" if col not in ("case", "rule") else "left")
     for rc in prepared.rendered:
         s = rc.scaled
         table.add_row(rc.case.case_id, f"{s.cg:g}", s.rule, str(s.replica),
@@ -167,7 +167,7 @@ def case_plan_table(plans: Sequence[CasePlan], title: str, notes: Sequence[str])
     one line each."""
     table = Table(title=title)
     for col in ("case", "particle-steps", "ranks", "limited by", "est. wall"):
-        table.add_column(col, justify="left" if col in ("case", "limited by") else "right")
+        table.add_column(escape(col), justify="left" if col in ("case", "limited by") else "right")
     for c in plans:
         table.add_row(c.name, f"{c.particle_steps:.3g}", str(c.ranks), c.bound,
                       duration(c.estimated_seconds))

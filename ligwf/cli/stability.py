@@ -12,6 +12,7 @@ import sys
 from pathlib import Path
 
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from ligwf.cli.common import add_mesh_cache, err_console, folder_to_write
@@ -35,7 +36,7 @@ def report_table(reports, title: str) -> Table:
     table = Table(title=title)
     for col in ("case", "pre-flight", "outcome", "agree", "atoms", "KE drift",
                 "overlap obs/exp [d]", "engine dt/t_H", "reason"):
-        table.add_column(col, overflow="fold")
+        table.add_column(escape(col), overflow="fold")
     for r in reports:
         o, pf = r.observation, r.preflight
         s_d = r.d_min

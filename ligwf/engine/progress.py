@@ -12,6 +12,7 @@ from typing import Iterable
 from rich.console import Console
 from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskID, TextColumn,
                            TimeRemainingColumn)
+from rich.markup import escape
 from rich.table import Table
 
 from ligwf.engine.resume import Plan
@@ -81,7 +82,9 @@ def summary_table(cases: Iterable[CaseFolder], title: str = "cases") -> Table:
     table = Table(title=title)
     for col in ("case", "status", "steps", "atoms start->end", "wall [s]",
                 "cores x wall [core-s]", "settle wall [s]", "production wall [s]", "reason"):
-        table.add_column(col, justify="left" if col in ("case", "status", "reason") else "right")
+        # (escape: the units in [ ] are not rich markup, "[s]" would strike the text through)
+        table.add_column(escape(col),
+                         justify="left" if col in ("case", "status", "reason") else "right")
     for case in cases:
         m = case.manifest()
         if m is None:
@@ -97,5 +100,5 @@ def summary_table(cases: Iterable[CaseFolder], title: str = "cases") -> Table:
             f"{m.wall_seconds:.1f}", f"{m.core_seconds:.1f}",
             f"{phases.get('settle', {}).get('wall_seconds', 0.0):.1f}",
             f"{phases.get('production', {}).get('wall_seconds', 0.0):.1f}",
-            shown_reason(status, m.reason)[:80])
+            escape(shown_reason(status, m.reason)[:80]))
     return table

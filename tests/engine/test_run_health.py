@@ -154,3 +154,19 @@ def test_a_finished_case_says_finished_in_the_status_tables():
     assert shown_reason("done", "") == "finished"
     assert shown_reason("failed", "engine exit code 1 at step 5 of 10") == \
         "engine exit code 1 at step 5 of 10"
+
+
+def test_status_table_headers_print_their_units():
+    """The units in [ ] reach the terminal (rich read "[s]" as its strike-through tag and
+    printed "wall" and "core-s" without them)."""
+    import io
+
+    from rich.console import Console
+
+    from ligwf.engine.progress import summary_table
+
+    out = io.StringIO()
+    Console(file=out, width=250).print(summary_table([], "cases"))
+    text = out.getvalue()
+    for head in ("wall [s]", "cores x wall [core-s]", "settle wall [s]", "production wall [s]"):
+        assert head in text
