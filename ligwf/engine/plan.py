@@ -11,7 +11,8 @@ project's 2-core machine (``docs/results/README.md``, issue 15):
   particles runs on one rank. A case that could use more ranks than slabs is also cut
   across the drum (:mod:`ligwf.engine.decomposition`: 3.8.0 cannot balance the load, a
   turning bed fills uniform columns unevenly) while the modelled efficiency stays >=
-  ``MIN_GRID_EFFICIENCY`` and the run gets shorter; the runner uses the same grid.
+  ``MIN_GRID_EFFICIENCY``, every added rank buys ``MIN_MARGINAL_EFFICIENCY`` of a rank's
+  speed and the run gets shorter; the runner uses the same grid.
 * **Enough particles per rank.** Each step of a case costs a fixed ~0.08 ms (turning mesh,
   fixes) besides its pair work, and every extra rank adds exchanges; a rank should carry
   thousands of particles, or splitting buys little and costs core-seconds. Measured
@@ -71,6 +72,11 @@ MULTI_RANK_EFFICIENCY = 0.88
 #: Lowest modelled efficiency of a grid cut across the drum the planner accepts: more
 #: ranks at less than a quarter of their ideal speed cost 4x the core-hours for their gain
 MIN_GRID_EFFICIENCY = 0.25
+#: ... and each rank it adds beyond the slabs must add at least this share of one rank's
+#: ideal speed: a case whose columns buy little stays on its slabs (paper-scale CG2: 15
+#: ranks instead of 7 slabs would be 18 % faster for 76 % more core-hours; CG1's 119 add
+#: 0.23 each)
+MIN_MARGINAL_EFFICIENCY = 0.2
 
 #: What limited a case's ranks (:attr:`CasePlan.bound`).
 BOUND_PARTICLES, BOUND_SLAB, BOUND_CORES = "particles", "slab", "cores"
@@ -211,16 +217,22 @@ def plan_ranks(load: CaseLoad, cores: int | None,
 
 def across_ranks(load: CaseLoad, most: int) -> int:
     """The rank count up to ``most`` with the shortest estimated wall time among grids that
-    fit (slabs and columns of >= MIN_AXIAL_SLAB diameters) and keep at least
-    MIN_GRID_EFFICIENCY; ties go to fewer ranks. At least the slab limit."""
-    best = axial_slab_limit(load.drum_length, load.d_max)
-    best_time = estimated_seconds(load, best)
+    fit (slabs and columns of >= MIN_AXIAL_SLAB diameters), keep at least
+    MIN_GRID_EFFICIENCY, and whose ranks beyond the slabs each add at least
+    MIN_MARGINAL_EFFICIENCY of a rank's ideal speed; ties go to fewer ranks. At least the
+    slab limit."""
+    slabs = best = axial_slab_limit(load.drum_length, load.d_max)
+    one = estimated_seconds(load, 1)
+    best_time = slab_time = estimated_seconds(load, slabs)
     for ranks in range(best + 1, most + 1):
         try:
             grid = case_grid(load, ranks)
         except ConfigError:         # no grid of this many ranks fits the case
             continue
         if grid.efficiency < MIN_GRID_EFFICIENCY:
+            continue
+        seconds = estimated_seconds(load, ranks)
+        if (one / seconds - one / slab_time) / (ranks - slabs) < MIN_MARGINAL_EFFICIENCY:
             continue
         seconds = estimated_seconds(load, ranks)
         if seconds < best_time * (1 - 1e-9):

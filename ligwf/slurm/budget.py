@@ -18,7 +18,7 @@ from typing import Hashable, Sequence
 from ligwf.engine.decomposition import (GHOST_COST, HALO_DIAMETERS, MIN_AXIAL_SLAB,
                                         PLANNING_SURFACE_DEG)
 from ligwf.engine.plan import (BOUND_PARTICLES, BOUND_SLAB, MIN_GRID_EFFICIENCY,
-                               MULTI_RANK_EFFICIENCY, WET_RATE, CaseLoad, CasePlan, case_grid,
+                               MIN_MARGINAL_EFFICIENCY, MULTI_RANK_EFFICIENCY, WET_RATE, CaseLoad, CasePlan, case_grid,
                                rank_limits)
 from ligwf.errors import ConfigError
 from ligwf.slurm.site import SLURM_TIME
@@ -162,7 +162,8 @@ def grid_note(row: PlanRow) -> str | None:
     text += (f"; halo {grid.ghost_ratio:.2f} ghosts per particle ({HALO_DIAMETERS:g} "
              f"diameters deep, 1 rank: {grid.ghost_ratio_one:.2f}) at {GHOST_COST:g} of a "
              f"particle's cost (fit to {MULTI_RANK_EFFICIENCY:g} measured on 2 axial ranks); "
-             f"grids below {MIN_GRID_EFFICIENCY:g} are not used")
+             f"grids below {MIN_GRID_EFFICIENCY:g}, or whose added ranks add less than "
+             f"{MIN_MARGINAL_EFFICIENCY:g} of a rank's speed each, are not used")
     return text
 
 
