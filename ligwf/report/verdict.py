@@ -199,8 +199,8 @@ def _decide(spec: CriterionSpec, value: float, lo: float, hi: float, budget: flo
     if need is None:
         return UNDECIDED, "the value sits on the budget (no number of replicas decides)"
     if need > MAX_SUGGESTED_REPLICAS:
-        return UNDECIDED, (f"close to the budget (over {MAX_SUGGESTED_REPLICAS} {who} "
-                           "replicas would be needed)")
+        return UNDECIDED, (f"over {MAX_SUGGESTED_REPLICAS} {who} replicas would be needed "
+                           "(the value is near the budget for its spread)")
     return UNDECIDED, f"about {need} {who} replicas would decide"
 
 

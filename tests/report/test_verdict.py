@@ -127,6 +127,12 @@ def test_undecided_says_how_many_cg1_replicas_would_decide():
               angle_floor=0.0)
     st = states(decide(table(cg1(), row), AcceptSettings(), {GROUP: PASSING}), "cg2-bond")
     assert st["profile_error"] == UNDECIDED and st["angle_deg"] == UNDECIDED
+    # 2 x (0.25 / 0.01)^2 = 1250 replicas: beyond what the verdict suggests
+    row = cgn(2, "bond", 9.0, profile=(0.11, 0.0, 0.5))
+    note = next(r.note for r in decide(table(cg1(), row), AcceptSettings(), {GROUP: PASSING}
+                                       ).groups[0].conditions[0].criteria
+                if r.name == "profile_error")
+    assert note.startswith("over 64 CG1 replicas would be needed")
     # one CG-n replica: no interval, nothing decided
     one = cgn(2, "bond", 9.0, replicas=1, profile=(0.01, NAN, NAN))
     profile = next(r for r in decide(table(cg1(), one), AcceptSettings(), {GROUP: PASSING}
