@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import json
 import math
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +29,7 @@ from ligwf.analysis.records.field_errors import (ERRORS, FIELD_ERRORS, MATERIAL_
                                                  condition_mean, field_floor, field_intervals,
                                                  same_grid)
 from ligwf.analysis.records.fields import CaseFields, read_fields
+from ligwf.analysis.records.provenance import StaleAnalysis
 from ligwf.fsio import atomic_write_text
 from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.report.uncertainty import mark
@@ -44,12 +46,22 @@ COHESIONLESS = "cohesionless"
 
 
 def case_fields(analysis_dir: Path) -> dict[str, CaseFields]:
-    """The fields of every case the analysis recorded ({} when it recorded none: an
-    analysis from before the fields, or no measured case)."""
+    """The fields of every case the analysis recorded ({} when its record lists no field
+    archive: an analysis from before the fields, or without a measured case; a stale
+    archive an older analysis left is never read). StaleAnalysis (one line) when the
+    listed archive cannot be read."""
     path = Path(analysis_dir) / layout.FIELDS_DATA
-    if not path.is_file():
+    try:
+        record = json.loads((Path(analysis_dir) / layout.ANALYSIS_RECORD).read_text())
+    except (OSError, ValueError):
         return {}
-    return read_fields(path)
+    if layout.FIELDS_DATA not in (record.get("outputs") or {}) or not path.is_file():
+        return {}
+    try:
+        return read_fields(path)
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+        raise StaleAnalysis(f"{path}: not a field archive ligwf wrote ({exc}); run `ligwf "
+                            "analyse` again") from None
 
 
 def _members(ids, fields: dict[str, CaseFields]) -> list[CaseFields]:

@@ -101,3 +101,23 @@ def test_rotation_sense_on_the_maps():
     assert rotation_sense("y", 1.0) == "clockwise"
     assert rotation_sense("y", -1.0) == "counter-clockwise"
     assert rotation_sense("x", 1.0) == "counter-clockwise"
+
+
+def test_only_the_recorded_archive_is_read(study_fields, tmp_path):
+    """The report reads the field archive the analysis record lists, nothing else: a
+    stale archive (not in the record) is ignored, an unreadable listed one is one line."""
+    from ligwf.analysis.records.fields import fields_bytes
+    from ligwf.analysis.records.provenance import StaleAnalysis
+    from ligwf.report.fields import case_fields
+    from ligwf.study import layout
+
+    fields = study_fields[0]
+    (tmp_path / layout.FIELDS_DATA).write_bytes(fields_bytes(list(fields.values())[:2]))
+    (tmp_path / layout.ANALYSIS_RECORD).write_text(json.dumps({"outputs": {}}))
+    assert case_fields(tmp_path) == {}
+    (tmp_path / layout.ANALYSIS_RECORD).write_text(
+        json.dumps({"outputs": {layout.FIELDS_DATA: [0, ""]}}))
+    assert set(case_fields(tmp_path)) == {"cg1-none-r0", "cg1-none-r1"}
+    (tmp_path / layout.FIELDS_DATA).write_bytes(b"not a zip")
+    with pytest.raises(StaleAnalysis, match="not a field archive"):
+        case_fields(tmp_path)
