@@ -9,7 +9,9 @@ from __future__ import annotations
 
 import ast
 import json
+import os
 import re
+import shutil
 import subprocess
 import sys
 
@@ -101,6 +103,7 @@ def test_dtypes_are_typed_and_one_per_column_name(reported):
 @pytest.mark.mpi
 def test_settings_paths_profiles_and_flow_record(reported):
     s = ligwf.open_study(reported)
+    s.check()                                   # analysis and report match the study
     assert s.name == "tiny-study" and s.settings.bootstrap == 50
     assert s.workflow["sweep"]["rules"] == ["weber"]
     assert s.summary.is_file() and s.html.is_file() and s.report_dir == reported / "report"
@@ -162,6 +165,21 @@ def test_a_rendered_study_names_the_command_for_every_table(rendered):
         with pytest.raises(MissingOutput, match=command):
             getattr(s, attribute)
     assert s.paraview == {} and s.figures == {}
+    with pytest.raises(LigwfError, match="run `ligwf analyse` first") as err:
+        s.check()
+    assert "\n" not in str(err.value)
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_check_refuses_a_report_older_than_its_analysis(reported, tmp_path):
+    study = tmp_path / "copy"
+    shutil.copytree(reported, study)
+    record = study / layout.ANALYSIS_DIR / layout.ANALYSIS_RECORD
+    report = study / layout.REPORT_DIR / layout.CONDITIONS_REPORT
+    os.utime(report, (record.stat().st_mtime - 10,) * 2)
+    with pytest.raises(MissingOutput, match="older than the analysis.*run `ligwf report"):
+        ligwf.open_study(study).check()
 
 
 def test_granule_tables_of_a_study_without_granule_data_say_why(rendered, tmp_path):

@@ -20,6 +20,7 @@ from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec,
                               typed)
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.report.verdict import Verdict
+from ligwf.report.write import checked_analysis
 from ligwf.report.verdict_records import read_verdict
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
@@ -230,6 +231,19 @@ class StudyResults:
                                             "v_mean", "v_std"])
         return typed(frame.astype({"cg": float, "replica": int, "depth": float,
                                    "v_mean": float, "v_std": float}))
+
+    def check(self) -> None:
+        """Refuse (one line, a LigwfError) what ``ligwf report`` would refuse: analysis
+        outputs missing or no longer matching the study (re-run or re-rendered cases,
+        changed settings, an edited table, dumps changed since: this hashes the dumps),
+        and a report older than the analysis it was built from. The tables are read
+        without this check; call it when the study may have changed since."""
+        checked_analysis(self.study)
+        record = self.analysis_dir / layout.ANALYSIS_RECORD
+        report = self.report_dir / layout.CONDITIONS_REPORT
+        if report.is_file() and report.stat().st_mtime < record.stat().st_mtime:
+            raise MissingOutput(f"{self.report_dir}: older than the analysis in "
+                                f"{self.analysis_dir}: run `{REPORT} {self.path}` again")
 
     # ------------------------------------------------------------- plots
     def plot_pareto(self, ax: Axes | None = None, metric: str = "angle_error") -> Axes:
