@@ -249,6 +249,18 @@ def test_every_public_name_imports_and_import_ligwf_loads_no_stage():
     assert (ROOT / "ligwf" / "py.typed").is_file()
 
 
+def test_every_table_layout_names_is_an_api_table():
+    """A new table in ligwf.study.layout (a .csv / .parquet name) must reach the API: a
+    TableSpec and its property (the notebook test then reads it too)."""
+    names = {getattr(layout, n) for n in dir(layout) if n.isupper()
+             and isinstance(getattr(layout, n), str)
+             and getattr(layout, n).endswith((".csv", ".parquet"))}
+    names.discard(layout.THERMO_FILE)      # a case's engine log table, not a study output
+    assert names == {t.file for t in TABLES}
+    for spec in TABLES:
+        assert isinstance(getattr(ligwf.StudyResults, spec.attribute), property), spec
+
+
 def test_the_api_names_no_file_itself():
     """Output names belong to ligwf.study.layout: the API asks it for every one (string
     constants other than docstrings hold no file name)."""

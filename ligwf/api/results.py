@@ -177,6 +177,10 @@ class StudyResults:
         return self.table("gsd_pooling")
 
     @property
+    def gsd_pooling_summary(self) -> pd.DataFrame:
+        return self.table("gsd_pooling_summary")
+
+    @property
     def kinetics(self) -> pd.DataFrame:
         """Per case and frame: granule count, d10 / d50 / d90 [m], largest granule."""
         return self.table("kinetics")

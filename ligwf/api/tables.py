@@ -60,6 +60,9 @@ TABLES: tuple[TableSpec, ...] = (
               "one row per condition: GSD size limits and errors against CG1"),
     TableSpec("gsd_pooling", layout.ANALYSIS_DIR, layout.GSD_POOLING_TABLE, ANALYSE, True,
               "one row per condition, pool size and pool: the GSD size limit of pooled replicas"),
+    TableSpec("gsd_pooling_summary", layout.ANALYSIS_DIR, layout.GSD_POOLING_SUMMARY_TABLE,
+              ANALYSE, True, "one row per condition and pool size: the pooled size limit "
+              "and errors, mean [min, max] over pools"),
     TableSpec("kinetics", layout.ANALYSIS_DIR, layout.KINETICS_TABLE, ANALYSE, True,
               "one row per case and frame: granule count, d10/d50/d90, largest granule"),
     TableSpec("kinetics_summary", layout.ANALYSIS_DIR, layout.KINETICS_SUMMARY_TABLE, ANALYSE,
@@ -74,7 +77,7 @@ TABLES: tuple[TableSpec, ...] = (
 TEXT_COLUMNS = frozenset({
     "case_id", "condition", "group", "rule", "status", "reason", "metric", "source",
     "variant", "definition", "control", "twin_id", "twin_case_id", "verdict", "method",
-    "velocity_frame", "pool", "reference",
+    "velocity_frame", "pool", "reference", "wet_group",
     # the verdict table (ligwf.report.verdict)
     "criterion", "label", "unit", "state", "condition_state", "budget_source", "note"})
 TEXT_SUFFIXES = ("_floor_source", "_vs_floor", "_reason", "_verdict")
