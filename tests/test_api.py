@@ -23,6 +23,8 @@ import ligwf
 from apistudy import api_study
 from helpers import ROOT
 from ligwf.api import TABLES, MissingOutput
+from ligwf.analysis.records.fields import CaseFields, FieldGrid
+from ligwf.api.fields import fields_table, plot_field
 from ligwf.api.tables import is_text_column, read_table, typed
 from ligwf.cli.main import main
 from ligwf.errors import ConfigError, LigwfError
@@ -113,6 +115,13 @@ def test_settings_paths_profiles_and_flow_record(reported):
     prof = s.profiles
     assert set(prof["case_id"]) == {c.case_id for c in s.flow_record.measured()}
     assert prof["depth"].between(0, 1).all() and np.isfinite(prof["v_mean"]).any()
+    fields = s.fields
+    assert set(fields["case_id"]) == set(s.field_images) == set(s.cases["case_id"])
+    assert fields["solid_fraction"].between(0, 1).all() and fields["speed"].max() > 0
+    assert (fields["frames"] > 0).all()
+    assert set(s.field_null_check["control"]) == {'{"control": "cohesionless"}'}
+    with pytest.raises(LigwfError, match="case_id = 'cg9' has no fields"):
+        s.plot_field("cg9")
 
 
 @pytest.mark.engine
@@ -160,7 +169,7 @@ def test_a_rendered_study_names_the_command_for_every_table(rendered):
         assert "\n" not in text and f"`{spec.command} {rendered}`" in text, text
         assert spec.file in text
     for attribute, command in (("summary", "ligwf report"), ("verdict_result", "ligwf report"),
-                               ("flow_record", "ligwf analyse"),
+                               ("flow_record", "ligwf analyse"), ("fields", "ligwf analyse"),
                                ("profiles", "ligwf analyse")):
         with pytest.raises(MissingOutput, match=command):
             getattr(s, attribute)
@@ -213,6 +222,38 @@ def test_open_study_refuses_what_is_no_study(tmp_path, rendered):
         ligwf.open_study(rendered / "cg1-none-r0")
     with pytest.raises(LigwfError, match="no table 'gsds'"):
         ligwf.open_study(rendered).table("gsds")
+
+
+# ---------------------------------------------------------------- flow fields
+def synthetic_fields(n: int = 8) -> CaseFields:
+    """A case whose material fills the lower half (v < 0) of the grid: solid fraction
+    0.4, velocity (0.1, 0) m/s, no fluctuation; two identical frames."""
+    grid = FieldGrid(origin=-0.01, spacing=0.02 / (n - 1), nodes=n, width=0.002,
+                     length=0.01, axis="y")
+    sums = np.zeros((2, 5, n, n))
+    lower = grid.coordinates() < 0                    # rows: v (the arrays are (v, u))
+    sums[:, 0, lower, :] = 0.4
+    sums[:, 1, lower, :] = 0.4 * 0.1
+    return CaseFields("cg1-none-r0", 1.0, "none", 0, "{}", grid, np.array([10, 20]), sums)
+
+
+def test_fields_table_puts_each_node_at_its_u_and_v():
+    table = fields_table({"cg1-none-r0": synthetic_fields()})
+    assert len(table) == 64 and set(table["frames"]) == {2}
+    below, above = table[table["v"] < 0], table[table["v"] > 0]
+    assert np.allclose(below["solid_fraction"], 0.4) and np.allclose(above["solid_fraction"], 0)
+    assert np.allclose(below["velocity_u"], 0.1) and above["velocity_u"].isna().all()
+    assert np.allclose(below["temperature"], 0) and table["case_id"].dtype == "string"
+
+
+def test_plot_field_draws_the_report_map_and_refuses_an_unknown_field():
+    from matplotlib.figure import Figure
+
+    ax = Figure().subplots()
+    assert plot_field(ax, synthetic_fields(), "speed") is ax
+    assert ax.collections and "speed" in ax.get_title()
+    with pytest.raises(LigwfError, match="quantity = 'phi' is not one of solid_fraction"):
+        plot_field(None, synthetic_fields(), "phi")
 
 
 # ---------------------------------------------------------------- typing rules

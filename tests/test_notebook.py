@@ -22,7 +22,8 @@ from ligwf.study import layout
 NOTEBOOK = ROOT / "docs" / "example.ipynb"
 #: the names the study object caches its tables under (ligwf.api.results)
 PROBE = ("import json\n"
-         "print('READ ' + json.dumps(sorted(study.__dict__.get('_tables', {}))))\n"
+         "print('READ ' + json.dumps(sorted(study.__dict__.get('_tables', {}))"
+         " + [n for n in ('field_record', 'flow_record') if n in study.__dict__]))\n"
          "print('FIGS ' + str(len(plt.get_fignums())))")
 
 
@@ -31,7 +32,8 @@ def test_the_committed_notebook_has_no_outputs_and_no_file_names():
     code = "\n".join(c.source for c in nb.cells if c.cell_type == "code")
     assert all(not c.get("outputs") and c.get("execution_count") is None
                for c in nb.cells if c.cell_type == "code")
-    names = {t.file for t in TABLES} | {layout.FLOW_PROFILES, layout.ANALYSIS_RECORD}
+    names = {t.file for t in TABLES} | {layout.FLOW_PROFILES, layout.ANALYSIS_RECORD,
+                                         layout.FIELDS_DATA}
     assert not [n for n in names if n in code]
     assert not re.search(r"read_(csv|parquet|json)|open\(", code)
     assert "ligwf.open_study(" in code
@@ -51,8 +53,8 @@ def test_the_example_notebook_runs_on_a_real_study(engine, tmp_path_factory, mon
     assert not errors, errors
     probe = "".join(o.get("text", "") for o in nb.cells[-1].outputs)
     read = json.loads(re.search(r"READ (.*)", probe).group(1))
-    assert set(read) >= {t.attribute for t in TABLES}, read     # the verdict included
-    assert int(re.search(r"FIGS (\d+)", probe).group(1)) >= 2
+    assert set(read) >= {t.attribute for t in TABLES} | {"field_record"}, read
+    assert int(re.search(r"FIGS (\d+)", probe).group(1)) >= 3
     for shown in ("study.conditions[", "study.verdict["):
         cell = next(c for c in nb.cells if shown in c.source)
         assert any("text/html" in o.get("data", {}) for o in cell.outputs), shown

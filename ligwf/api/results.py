@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
+from ligwf.analysis.records.fields import CaseFields, read_fields
 from ligwf.analysis.records.flow import FlowRecord
-from ligwf.api import plots
+from ligwf.api import fields, plots
 from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec, read_table,
                               typed)
 from ligwf.errors import ConfigError, LigwfError
@@ -222,6 +223,35 @@ class StudyResults:
             raise MissingOutput(f"{path}: unreadable flow record ({type(exc).__name__}): run "
                                 f"`{ANALYSE} {self.path}` again") from None
 
+    @cached_property
+    def field_record(self) -> dict[str, CaseFields]:
+        """case id -> its coarse-grained cross-section fields (per steady frame kernel sums
+        on the grid: ``ligwf.analysis.records.fields``)."""
+        path = self._file(layout.ANALYSIS_DIR, layout.FIELDS_DATA, ANALYSE, "flow fields")
+        try:
+            return read_fields(path)
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise MissingOutput(f"{path}: unreadable flow fields ({type(exc).__name__}): run "
+                                f"`{ANALYSE} {self.path}` again") from None
+
+    @property
+    def fields(self) -> pd.DataFrame:
+        """Per case and cross-section grid node the steady-window mean fields: ``u``,
+        ``v`` [m], ``solid_fraction``, ``velocity_u``, ``velocity_v``, ``speed`` [m/s],
+        ``temperature`` [m^2/s^2] (:func:`ligwf.api.fields.fields_table`)."""
+        return fields.fields_table(self.field_record)
+
+    @property
+    def field_null_check(self) -> pd.DataFrame:
+        """Each cohesionless twin's field error against the wet CG1 case, beside the floor."""
+        return self.table("field_null_check")
+
+    @property
+    def field_images(self) -> dict[str, Path]:
+        """case id -> its window-mean fields as VTK ImageData (opens in ParaView)."""
+        found = {cid: self.analysis_dir / layout.field_image(cid) for cid in self.case_ids}
+        return {cid: p for cid, p in found.items() if p.is_file()}
+
     @property
     def profiles(self) -> pd.DataFrame:
         """Per measured case and depth bin: the mean downhill velocity [m/s] (and its std)
@@ -283,6 +313,17 @@ class StudyResults:
                   for c in self.study.usable_cases()[0]}
         return plots.kinetics(ax, self._read("kinetics_summary"), self._read("kinetics"),
                               quantity, starts)
+
+    def plot_field(self, case_id: str, ax: Axes | None = None,
+                   quantity: str = "speed") -> Axes:
+        """One steady-window field of one case on the drum cross-section (``quantity``:
+        ``solid_fraction``, ``velocity_u``, ``velocity_v``, ``speed`` with arrows,
+        ``temperature``)."""
+        record = self.field_record
+        if case_id not in record:
+            raise LigwfError(f"plot_field: case_id = {case_id!r} has no fields (the cases "
+                             f"with fields: {', '.join(record)})")
+        return fields.plot_field(ax, record[case_id], quantity)
 
     # ------------------------------------------------------------- reading
     def _path(self, spec: TableSpec) -> Path:

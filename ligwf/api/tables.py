@@ -48,6 +48,9 @@ TABLES: tuple[TableSpec, ...] = (
               "with the value, its 95 % interval and the budget, the speedup"),
     TableSpec("noise_floor", layout.REPORT_DIR, layout.NOISE_FLOOR_REPORT, REPORT, False,
               "one row per (sweep group, metric): the CG1 value and CG1-vs-CG1 scatter"),
+    TableSpec("field_null_check", layout.REPORT_DIR, layout.FIELD_NULL_REPORT, REPORT, False,
+              "one row per cohesionless twin: its field error against the wet CG1 case "
+              "beside the CG1 floor (the null check of the field error)"),
     TableSpec("flow", layout.ANALYSIS_DIR, layout.FLOW_TABLE, ANALYSE, False,
               "one row per case: its steady window and flow metrics"),
     TableSpec("frames", layout.ANALYSIS_DIR, layout.FRAMES_TABLE, ANALYSE, True,
