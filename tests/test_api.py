@@ -89,8 +89,8 @@ def test_dtypes_are_typed_and_one_per_column_name(reported):
             assert dtype != object, f"{name}.{col} is object"
             if is_text_column(col):
                 assert dtype == "string", f"{name}.{col}: {dtype}"
-            else:
-                assert (pd.api.types.is_numeric_dtype(dtype) or dtype == "boolean"), \
+            else:   # a text column the API does not name is still text, never object
+                assert (pd.api.types.is_numeric_dtype(dtype) or dtype in ("boolean", "string")), \
                     f"{name}.{col}: {dtype}"
             if col in seen and name != "profiles" and col not in TWO_MEANINGS:
                 kind = lambda d: "float" if str(d).startswith(("float", "int")) else str(d)
@@ -108,6 +108,7 @@ def test_settings_paths_profiles_and_flow_record(reported):
     s.check()                                   # analysis and report match the study
     assert s.name == "tiny-study" and s.settings.bootstrap == 50
     assert s.workflow["sweep"]["rules"] == ["weber"]
+    assert s.accept.angle_deg > 0                  # the verdict's budget (defaults here)
     assert s.summary.is_file() and s.html.is_file() and s.report_dir == reported / "report"
     assert set(s.paraview) == set(s.cases["case_id"])
     assert all(p.suffix == ".pvd" and p.is_file() for p in s.paraview.values())

@@ -23,6 +23,7 @@ from ligwf.errors import ConfigError, LigwfError
 from ligwf.report.verdict import Verdict
 from ligwf.report.write import checked_analysis
 from ligwf.report.verdict_records import read_verdict
+from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.study import Study
@@ -45,7 +46,7 @@ def open_study(path: str | Path) -> "StudyResults":
 
 @dataclass(frozen=True)
 class StudyResults:
-    """What a study measured: its tables (pandas, typed as the module docstring says),
+    """What a study measured: its tables (pandas, typed as :mod:`ligwf.api` says),
     its workflow and analysis settings, the paths of its report; plots that take and
     return a matplotlib Axes. Make one with :func:`open_study`."""
 
@@ -65,6 +66,11 @@ class StudyResults:
     def settings(self) -> AnalysisSettings:
         """The study's ``analysis:`` settings (what the analysis ran with)."""
         return self.study.analysis
+
+    @property
+    def accept(self) -> AcceptSettings:
+        """The study's ``accept:`` block: the error budget the verdict decides against."""
+        return self.study.accept
 
     @cached_property
     def record(self) -> dict[str, Any]:

@@ -83,7 +83,7 @@ TEXT_COLUMNS = frozenset({
     "velocity_frame", "pool", "reference", "wet_group",
     # the verdict table (ligwf.report.verdict)
     "criterion", "label", "unit", "state", "condition_state", "budget_source", "note"})
-TEXT_SUFFIXES = ("_floor_source", "_vs_floor", "_reason", "_verdict")
+TEXT_SUFFIXES = ("_floor_source", "_vs_floor", "_reason", "_verdict", "_label")
 
 
 def is_text_column(name: str) -> bool:
