@@ -1,13 +1,25 @@
-"""The default granule definition on a REAL frame tiled to paper scale, one core.
+"""Granule definitions on REAL frames tiled to paper scale, one core: results per second.
 
-A case's last dump (particles + contacts) is repeated ``--tiles`` times along its periodic
+A case's dumps (particles + contacts) are repeated ``--tiles`` times along the periodic
 axis (pairs across the boundary rewired to the neighbouring copy, the helper of
-tests/analysis/test_definitions.py), then the default definition (rupture-work CPM by
-compiled Louvain) and the source study's components are timed (best of 3), and the CPM
-quality of the compiled Louvain is compared with igraph's Leiden on the same graph.
-Target (issue 11): communities >= 0.5 frames/s, components >= 2 frames/s at 360k.
+tests/helpers.py), then timed, best of ``--repeat``:
 
-Usage: python benchmarks/bench_granules_tiled.py CASE_DIR [--tiles 30]
+* the default definition (``AnalysisSettings().granules``: rupture-work CPM communities
+  by compiled Louvain) on the case's last frame, and its parts (bond test, rupture work,
+  CPM);
+* the source study's components (lab frame, 30 deg);
+* ``granules: held`` (the study workflows' setting) in its steady state: per result one
+  new frame's bridge keys, its presence runs and the components of the held bridges, over
+  a window of hold_time / dump interval frames (the keys of the earlier frames are
+  cached, as :class:`ligwf.analysis.granules.case.GranuleAnalysis` does); beside it what
+  intersecting the window's key sets costs (the code before the presence runs);
+* reading: a real dump pair of the case, scaled by the tile count (the tiled frames are
+  never written, so their reading is estimated, not timed).
+
+CPU seconds (``time.process_time``: the machine is shared, wall clock is printed too) are
+the figure to compare. Target (#24): the default >= 1 result/s at ~360k particles.
+
+Usage: python benchmarks/bench_granules_tiled.py CASE_DIR [--tiles 30] [--repeat 3]
 (30 tiles of the 18 mm we_vs_bo CG1 case = 358,890 particles.)
 """
 
@@ -24,55 +36,119 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests"))
 
-from analysis.test_definitions import tiled  # noqa: E402
+from helpers import tiled  # noqa: E402
 from ligwf.analysis import granules_numba  # noqa: E402
+from ligwf.analysis.frames.checks import plan_frames  # noqa: E402
+from ligwf.analysis.frames.dumps import read_contacts, read_particles  # noqa: E402
+from ligwf.analysis.granules.bonds import bonded_contacts  # noqa: E402
+from ligwf.analysis.granules.bridge_law import relative_energy  # noqa: E402
 from ligwf.analysis.granules.case import RunFacts  # noqa: E402
-from ligwf.analysis.granules.communities import cpm_labels, cpm_labels_reference, cpm_quality  # noqa: E402
-from ligwf.analysis.granules.definitions import cpm_weights, identify_granules  # noqa: E402
+from ligwf.analysis.granules.communities import cpm_labels  # noqa: E402
+from ligwf.analysis.granules.definitions import bond_criterion, identify_granules  # noqa: E402
+from ligwf.analysis.granules.persistent import (Frame, bridge_keys, held_through,  # noqa: E402
+                                                persistent_labels, presence_run)
 from ligwf.scene.settings import AnalysisSettings  # noqa: E402
-from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 
 
-def best_of(fn, runs: int = 3):
-    times, out = [], None
-    for _ in range(runs):
-        t = time.perf_counter()
+def timed(fn, repeat: int):
+    """(best CPU s, best wall s, last result) of ``repeat`` calls."""
+    cpu, wall, out = [], [], None
+    for _ in range(repeat):
+        c, w = time.process_time(), time.perf_counter()
         out = fn()
-        times.append(time.perf_counter() - t)
-    return min(times), out
+        cpu.append(time.process_time() - c)
+        wall.append(time.perf_counter() - w)
+    return min(cpu), min(wall), out
+
+
+def line(label: str, cpu: float, wall: float, extra: str = "") -> None:
+    print(f"  {label:>34}: {cpu:6.3f} s CPU = {1 / cpu:6.2f} results/s "
+          f"(wall {wall:6.3f} s){extra}")
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("case", type=Path)
     ap.add_argument("--tiles", type=int, default=30)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--held-results", type=int, default=3,
+                    help="steady-state held results timed (after the window is filled)")
     args = ap.parse_args()
     case = CaseFolder.open(args.case)
     facts = RunFacts.of_case(case)
     granules_numba.warm_up((facts.liquid.model,))
     length = case.scaled.drum_length
-    f = [f for f in discover_frames(args.case) if f.contacts][-1]
-    p, c = read_particles(f.particles, f.step, facts.dt), read_contacts(f.contacts, f.step)
-    pt, ct = tiled(p, c, args.tiles, length) if args.tiles > 1 else (p, c)
+    frames = [f for f in plan_frames(case).frames if f.contacts]
+
+    def load(ff):
+        p = read_particles(ff.particles, ff.step, facts.dt)
+        c = read_contacts(ff.contacts, ff.step)
+        return tiled(p, c, args.tiles, length) if args.tiles > 1 else (p, c)
+
+    pt, ct = load(frames[-1])
     motion = replace(facts.motion, length=length * args.tiles)
-    print(f"{args.case.name} step {f.step} tiled {args.tiles}x: {len(pt):,} particles, "
-          f"{len(ct):,} contacts; one core, best of 3")
-    for label, d in (("communities (default)", AnalysisSettings()),
-                     ("components lab 30 deg", AnalysisSettings(
-                         granules="components", velocity_frame="lab", max_velocity_angle=30.0))):
-        t, ident = best_of(lambda d=d: identify_granules(pt, ct, facts.liquid, d, facts.cg, motion))
-        print(f"  {label:>22}: {t:6.3f} s per frame = {1 / t:6.2f} frames/s, "
-              f"{int(ident.labels.max()) + 1:,} granules")
-    i, j, w, nw = cpm_weights(pt, ct, facts.liquid, facts.cg)
-    gamma = AnalysisSettings().resolution
-    t_fast, fast = best_of(lambda: cpm_labels(len(pt), i, j, w, nw, gamma), 1)
-    t_ref, ref = best_of(lambda: cpm_labels_reference(len(pt), i, j, w, nw, gamma), 1)
-    q_fast, q_ref = cpm_quality(fast, i, j, w, nw, gamma), cpm_quality(ref, i, j, w, nw, gamma)
-    size = lambda lab: np.bincount(lab)[np.bincount(lab) > 1].mean()  # noqa: E731
-    print(f"  CPM alone: compiled Louvain {t_fast:.3f} s, igraph Leiden {t_ref:.3f} s "
-          f"({t_ref / t_fast:.1f}x); quality difference {(q_fast - q_ref) / w.sum():+.4f} of the "
-          f"total edge weight; mean community {size(fast):.1f} vs {size(ref):.1f} particles")
+    default = AnalysisSettings()
+    print(f"{args.case.name} step {frames[-1].step} tiled {args.tiles}x: {len(pt):,} particles, "
+          f"{len(ct):,} contacts; one core, best of {args.repeat}; default definition: "
+          f"{default.granules}")
+    cpu, wall, ident = timed(lambda: identify_granules(pt, ct, facts.liquid, default, facts.cg,
+                                                       motion), args.repeat)
+    line(f"{default.granules} (default)", cpu, wall,
+         f", {int(ident.labels.max()) + 1:,} granules")
+    i, j, _, rows = bonded_contacts(pt, ct, facts.liquid, bond_criterion(default), with_rows=True)
+    for label, fn in (
+            ("  bond test", lambda: bonded_contacts(pt, ct, facts.liquid, bond_criterion(default),
+                                                    with_rows=True)),
+            ("  rupture work", lambda: relative_energy(pt, i, j, -ct.delta[rows], facts.liquid))):
+        c, w, _ = timed(fn, args.repeat)
+        print(f"  {label:>34}: {c:6.3f} s CPU (wall {w:6.3f} s)")
+    weight = relative_energy(pt, i, j, -ct.delta[rows], facts.liquid) * facts.cg ** 2
+    nw = np.full(len(pt), float(facts.cg) ** 3)
+    c, w, _ = timed(lambda: cpm_labels(len(pt), i, j, weight, nw, default.resolution), args.repeat)
+    print(f"  {'  CPM (compiled Louvain)':>34}: {c:6.3f} s CPU (wall {w:6.3f} s)")
+    comp = AnalysisSettings(granules="components", velocity_frame="lab", max_velocity_angle=30.0)
+    cpu, wall, ident = timed(lambda: identify_granules(pt, ct, facts.liquid, comp, facts.cg,
+                                                       motion), args.repeat)
+    line("components lab 30 deg", cpu, wall, f", {int(ident.labels.max()) + 1:,} granules")
+    held_bench(frames, load, facts, motion, args.held_results)
+    c, w, _ = timed(lambda: (read_particles(frames[-1].particles, frames[-1].step, facts.dt),
+                             read_contacts(frames[-1].contacts, frames[-1].step)), args.repeat)
+    print(f"  {'reading one dump pair':>34}: {c:6.3f} s CPU at {len(pt) // args.tiles:,} "
+          f"particles: ~{c * args.tiles:.3f} s at {len(pt):,} (linear estimate)")
+
+
+def held_bench(frames, load, facts, motion, results: int) -> None:
+    """``granules: held`` in its steady state over the case's first frames."""
+    held = AnalysisSettings(granules="held")
+    interval = (frames[1].step - frames[0].step) * facts.dt
+    span = max(1, int(round(held.hold_time / interval)))
+    if len(frames) < span + 1 + results:
+        print(f"  held: the case has {len(frames)} frames, a window needs {span + 1}")
+        return
+    keys, runs = [], []
+    for ff in frames[:span]:                      # fill the window (not timed)
+        p, c = load(ff)
+        keys.append(bridge_keys(Frame(p, c), facts.liquid))
+        runs.append(presence_run(keys[-1], keys[-2] if len(keys) > 1 else None,
+                                 runs[-1] if runs else None))
+    cpu, wall, inter = [], [], []
+    for k in range(results):
+        first = load(frames[k])
+        new = load(frames[k + span])
+        c0, w0 = time.process_time(), time.perf_counter()
+        keys.append(bridge_keys(Frame(*new), facts.liquid))
+        runs.append(presence_run(keys[-1], keys[-2], runs[-1]))
+        bridges = keys[-1][runs[-1] >= span + 1]
+        ident = persistent_labels([Frame(*first)], [bridges], motion)
+        cpu.append(time.process_time() - c0)
+        wall.append(time.perf_counter() - w0)
+        c0 = time.process_time()
+        assert np.array_equal(held_through(keys[-span - 1:]), bridges)
+        inter.append(time.process_time() - c0)
+    line(f"held ({span + 1}-frame window)", min(cpu), min(wall),
+         f", {int(ident.labels.max()) + 1:,} granules; intersecting the window instead: "
+         f"{min(inter):.3f} s CPU more")
 
 
 if __name__ == "__main__":

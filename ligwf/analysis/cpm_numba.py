@@ -53,16 +53,35 @@ def _csr(n, i, j, w):
     return indptr, indices, weights
 
 
+#: relative slack of the stay-proof of :func:`_local_moving` (floating-point rounding of
+#: the gains is ~1e-16 relative; the proof demands a margin 1e7 times larger)
+PROOF_SLACK = 1e-9
+
+
 @cached_jit()
 def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, init):
     """Louvain local moving from the partition ``init`` (ids < n); returns (community per
     node, moves made). A node moves only for a strictly larger gain (relative tolerance
-    1e-12), so every move raises the quality and the passes end."""
+    1e-12), so every move raises the quality and the passes end.
+
+    Nodes whose stay is proven are not re-evaluated (the same partition, bit for bit, as
+    evaluating every node; 10 of the 12 passes of a 360k-particle frame move < 10 % of the
+    nodes): a node that stayed at its last visit by a margin M (its stay gain over the best
+    alternative, and over being alone) stays again while none of its neighbours moved (so
+    its sums ``acc`` are bit-identical) and the weights of its own and its neighbours'
+    communities changed in total by less than (M - slack) / (gamma n_v): each gain moves
+    by gamma n_v times its community's weight change. ``drift`` is that total per community
+    (it only grows), summed at the visit over the communities the node touches; the node's
+    own community weight is still taken out and put back, as the full visit does, so every
+    floating-point sum stays the same."""
     n = len(node_w)
     comm = init.copy()
     comm_w = np.zeros(n, np.float64)
     for v in range(n):
         comm_w[comm[v]] += node_w[v]
+    total_w = 0.0
+    for v in range(n):
+        total_w += node_w[v]
     acc = np.zeros(n, np.float64)          # weight from the node to each community
     stamp = np.full(n, -1, np.int64)       # acc[c] is valid when stamp[c] == this visit
     visit = 0
@@ -76,15 +95,36 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
         if not used[c]:
             free[n_free] = c
             n_free += 1
+    # the stay-proof: per community its total weight change; per node its margin at the
+    # last visit (< 0: not proven), the drift sum then, whether it was alone, the
+    # communities it touched (CSR slots), whether a neighbour moved since
+    drift = np.zeros(n, np.float64)
+    margin = np.full(n, -1.0, np.float64)
+    drift_at = np.zeros(n, np.float64)
+    was_alone = np.zeros(n, np.bool_)
+    seen = np.empty(indptr[n], np.int64)
+    n_seen = np.zeros(n, np.int64)
+    dirty = np.ones(n, np.bool_)
     total_moves = 0
-    for _ in range(max_passes):
+    for pass_no in range(max_passes):
         moved = 0
+        prove = pass_no > 0                # the first pass moves most nodes: no proofs
         for idx in range(n):
             v = order[idx]
             cv = comm[v]
             nv = node_w[v]
+            if not dirty[v] and margin[v] >= 0.0:
+                comm_w[cv] -= nv
+                alone = comm_w[cv] == 0.0
+                now = drift[cv]
+                for t in range(indptr[v], indptr[v] + n_seen[v]):
+                    now += drift[seen[t]]
+                comm_w[cv] += nv
+                if alone == was_alone[v] and gamma * nv * (now - drift_at[v]) < margin[v]:
+                    continue               # proven: the full visit would stay too
             visit += 1                     # (not v: a node's next visit must not reuse
             k = 0                          # the sums of its previous one)
+            spread = 0.0
             for e in range(indptr[v], indptr[v + 1]):
                 c = comm[indices[e]]
                 if stamp[c] != visit:
@@ -93,16 +133,21 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
                     touched[k] = c
                     k += 1
                 acc[c] += weights[e]
+                spread += abs(weights[e])
             comm_w[cv] -= nv
             stay = (acc[cv] if stamp[cv] == visit else 0.0) - gamma * nv * comm_w[cv]
             best, best_gain = cv, stay
+            rival = -np.inf                # the best alternative's gain
             for t in range(k):
                 c = touched[t]
                 if c == cv:
                     continue
                 gain = acc[c] - gamma * nv * comm_w[c]
+                if gain > rival:
+                    rival = gain
                 if gain > best_gain + 1e-12 * (abs(best_gain) + abs(gain)):
                     best, best_gain = c, gain
+            alone = comm_w[cv] == 0.0
             if best_gain < 0.0 and comm_w[cv] > 0.0:
                 # alone (gain 0) beats every community: an empty id (one exists: cv still
                 # holds another node, so at most n - 1 ids are in use)
@@ -117,6 +162,29 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
             if best != cv:
                 comm[v] = best
                 moved += 1
+            if not prove:
+                continue
+            dirty[v] = False
+            if best != cv:
+                drift[cv] += nv
+                drift[best] += nv
+                margin[v] = -1.0
+                for e in range(indptr[v], indptr[v + 1]):
+                    dirty[indices[e]] = True
+                continue
+            # stayed: its margin over every rival (and over being alone, gain 0)
+            m = stay - rival
+            if not alone and stay < m:
+                m = stay
+            m -= PROOF_SLACK * (spread + gamma * nv * total_w)
+            margin[v] = m
+            was_alone[v] = alone
+            now = drift[cv]
+            n_seen[v] = k
+            for t in range(k):
+                seen[indptr[v] + t] = touched[t]
+                now += drift[touched[t]]
+            drift_at[v] = now
         total_moves += moved
         if moved == 0:
             break
@@ -137,6 +205,36 @@ def _renumber(comm):
             k += 1
         out[v] = new[c]
     return out, k
+
+
+@cached_jit()
+def _stable_key_order(keys, k):
+    """The permutation that sorts pair keys a k + b (0 <= a, b < k) stably: the order of
+    ``numpy.argsort(keys, kind="mergesort")``, by two stable counting passes (by b, then
+    by a: linear in the number of keys instead of m log m)."""
+    m = len(keys)
+    count = np.zeros(k + 1, np.int64)
+    for t in range(m):
+        count[keys[t] % k + 1] += 1
+    for c in range(k):
+        count[c + 1] += count[c]
+    by_b = np.empty(m, np.int64)
+    for t in range(m):
+        b = keys[t] % k
+        by_b[count[b]] = t
+        count[b] += 1
+    count[:] = 0
+    for t in range(m):
+        count[keys[t] // k + 1] += 1
+    for c in range(k):
+        count[c + 1] += count[c]
+    order = np.empty(m, np.int64)
+    for s in range(m):
+        t = by_b[s]
+        a = keys[t] // k
+        order[count[a]] = t
+        count[a] += 1
+    return order
 
 
 @cached_jit()
@@ -165,7 +263,7 @@ def _aggregate(indptr, indices, weights, node_w, labels, k):
                 keys[m] = a * k + b
                 ws[m] = weights[e]
                 m += 1
-    order = np.argsort(keys, kind="mergesort")
+    order = _stable_key_order(keys, k)
     out_i = np.empty(m, np.int64)
     out_j = np.empty(m, np.int64)
     out_w = np.empty(m, np.float64)

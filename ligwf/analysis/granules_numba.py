@@ -35,6 +35,7 @@ from numba import njit
 
 from ligwf import liquids
 from ligwf.numba_cache import cached_jit, law_digest, specialised
+from ligwf.analysis.pair_table_numba import find_slot, new_table, remember
 from ligwf.liquids.base import LiquidModel
 
 
@@ -324,16 +325,25 @@ def granule_sums(labels, n_granules, radii, positions, axis, axis_values):
 
 def _rupture_work(r_i, r_j, lo, hi, vol, gamma, theta, nodes, weights):
     """:func:`rupture_work` for the law bound to ``FORCE`` (compiled per law by
-    :func:`_for_law`)."""
+    :func:`_for_law`). Touching pairs (``lo`` = 0) of equal radii and volume do the same
+    arithmetic: done once per bit pattern (:mod:`ligwf.analysis.pair_table_numba`)."""
     cos_theta, sin_theta = math.cos(theta), math.sin(theta)
     out = np.empty(len(r_i), np.float64)
+    bits = (r_i.view(np.int64), r_j.view(np.int64), hi.view(np.int64), vol.view(np.int64))
+    table = new_table()
     for k in range(len(r_i)):
+        slot = find_slot(table, bits, k) if lo[k] == 0.0 else -1
+        if slot >= 0 and table[2][slot]:
+            out[k] = table[1][slot]
+            continue
         half, mid = 0.5 * (hi[k] - lo[k]), 0.5 * (hi[k] + lo[k])
         total = 0.0
         for q in range(len(nodes)):
             total += weights[q] * FORCE(r_i[k], r_j[k], mid + half * nodes[q], gamma, theta,
                                         cos_theta, sin_theta, vol[k])
         out[k] = half * total
+        if slot >= 0:
+            remember(table, bits, k, slot, out[k])
     return out
 
 

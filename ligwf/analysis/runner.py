@@ -1,9 +1,15 @@
 """Whole-study analysis: every usable case, every frame -> flow, granule, GSD tables, series.
 
-The MPI runner (:func:`analyse`) deals (case, frame) tasks round-robin to ranks (a frame
-depends only on its own two dumps), gathers the results on rank 0, which alone sorts them
-and writes the outputs: the same files whatever the number of ranks (each rank writes
-the ``.vtu`` files of its own frames into the staging folder).
+The MPI runner (:func:`analyse`) gives each rank a contiguous run of the (case, frame)
+tasks (a frame depends only on its own dumps, a ``held`` window on the frames after it,
+which then stay on one rank) and the flow of the cases whose middle frame it holds
+(:meth:`AnalysisPlan.share`), gathers the results on rank 0, which alone sorts them and
+writes the outputs: the same files whatever the number of ranks (each rank writes the
+``.vtu`` files of its own frames into the staging folder). The same shares can run as
+the tasks of a Slurm array instead (:func:`analyse_part`, each writing one partial
+output, then :func:`merge_parts`: :mod:`ligwf.analysis.parts`), with the same outputs.
+Within a share each dump is checked once for both stages
+(:func:`~ligwf.analysis.frames.checks.shared_checks`).
 
 Cases are used only when the study says they are usable (manifest ``done`` for the scene
 the folder holds and a thermo table that agrees with it,
@@ -51,6 +57,8 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
 
 from __future__ import annotations
 
+import hashlib
+import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -58,19 +66,20 @@ from pathlib import Path
 from ligwf.analysis.granules.case import FrameResult, GranuleAnalysis, RunFacts
 from ligwf.analysis.frames.dumps import FrameFiles
 from ligwf.analysis.flow.stage import field_files, flow_cases, flow_record, flow_table
-from ligwf.analysis.frames.checks import FramePlan, plan_frames
+from ligwf.analysis.frames.checks import FramePlan, plan_frames, shared_checks
 from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
                                           nothing_analysed, stage_granules)
 from ligwf.analysis.outputs import OutputSet, new_token
+from ligwf.analysis.parts import Share, check_token, drop_parts, read_parts, write_part
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.provenance import study_provenance
 from ligwf.errors import ConfigError
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
-from ligwf.study.case import granules_absent
+from ligwf.study.case import CaseFolder, folder_fingerprint, granules_absent
 from ligwf.study.study import Study
 
-__all__ = ["AnalysisOptions", "analyse"]
+__all__ = ["AnalysisOptions", "AnalysisPlan", "analyse", "analyse_part", "merge_parts"]
 
 def _mpi_comm():
     """MPI.COMM_WORLD when started under mpirun with more than one rank, else None."""
@@ -96,22 +105,60 @@ class AnalysisOptions:
     require_manifest: bool = True
 
 
-def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions = AnalysisOptions(),
-            comm=None) -> dict | None:
-    """Analyse a study (or one case) folder; on rank 0 write the outputs and return the
-    analysis record (other ranks return None). ``comm``: an mpi4py communicator, by
-    default COMM_WORLD when running under mpirun with several ranks. NothingAnalysed
-    (outputs untouched) when no frame could be analysed."""
-    study = Study.open(run_dir)
-    out_dir = Path(out_dir) if out_dir is not None else study.analysis_dir
-    settings = options.settings or study.analysis
-    comm = _mpi_comm() if comm is None else comm
-    rank, size = (comm.Get_rank(), comm.Get_size()) if comm is not None else (0, 1)
-    token = new_token() if comm is None else comm.bcast(new_token() if rank == 0 else None)
-    outputs = OutputSet(out_dir, token)
+@dataclass
+class AnalysisPlan:
+    """What an analysis decides before computing anything, the same on every MPI rank and
+    in every array task (:mod:`ligwf.analysis.parts`): the study, its usable cases, the
+    (case, frame) tasks and the cases' run facts."""
 
+    study: Study
+    settings: AnalysisSettings
+    options: AnalysisOptions
+    usable: list[CaseFolder]
+    unusable: list[dict]            # cases the study does not let any stage use
+    skipped_cases: list[dict]       # ... and those whose frames cannot be planned
+    absent: list[dict]
+    facts: list[RunFacts]
+    tasks: list[tuple[int, FrameFiles]]
+
+    def share(self, rank: int, size: int) -> tuple[list[tuple[int, FrameFiles]], list[CaseFolder]]:
+        """The tasks and flow cases of rank ``rank`` of ``size``: a contiguous run of the
+        tasks (a case's frames stay together, so a ``held`` window reads each frame once
+        per rank), and the flow of every case whose middle frame it holds (that rank has
+        just checked those dumps; cases without granule frames are dealt round-robin)."""
+        n = len(self.tasks)
+        mine = self.tasks[rank * n // size:(rank + 1) * n // size]
+        owner: dict[str, int] = {}
+        for fi, f in enumerate(self.facts):
+            ks = [k for k, (t, _) in enumerate(self.tasks) if t == fi]
+            if ks:
+                middle = ks[len(ks) // 2]
+                owner[f.case_id] = next(r for r in range(size)
+                                        if middle < (r + 1) * n // size)
+        rest = [c.case_id for c in self.usable if c.case_id not in owner]
+        ids = {k for k, r in owner.items() if r == rank}
+        ids |= {cid for k, cid in enumerate(rest) if k % size == rank}
+        return mine, [c for c in self.usable if c.case_id in ids]
+
+    def fingerprint(self) -> str:
+        """SHA-256 of what the shares depend on: cases (scene hash, dump record), frames,
+        settings and options; a part computed for another plan is refused at the merge."""
+        data = {"cases": [[c.case_id, folder_fingerprint(c.path)] for c in self.usable],
+                "skipped": self.skipped_cases,
+                "tasks": [[self.facts[fi].case_id, ff.step, str(ff.particles),
+                           str(ff.contacts)] for fi, ff in self.tasks],
+                "settings": self.settings.model_dump(mode="json"),
+                "options": [self.options.implementation, self.options.write_vtu,
+                            self.options.louvain, self.options.require_manifest]}
+        return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
+
+
+def plan_analysis(run_dir: Path, options: AnalysisOptions = AnalysisOptions()) -> AnalysisPlan:
+    """The :class:`AnalysisPlan` of a study (or one case) folder."""
+    study = Study.open(run_dir)
+    settings = options.settings or study.analysis
     usable, skipped_cases = study.usable_cases(options.require_manifest)
-    flow_skipped = list(skipped_cases)
+    unusable = list(skipped_cases)
     absent = [{"case_id": c.case_id, "reason": why} for c in usable
               if (why := granules_absent(c.scaled)) is not None]
     facts: list[RunFacts] = []
@@ -123,44 +170,102 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
         except ConfigError as exc:
             skipped_cases.append({"case_id": c.case_id, "reason": str(exc)})
     tasks = [(fi, ff) for fi, f in enumerate(facts) for ff in f.plan.frames]
-    mine: list[FrameResult] = []
-    try:
-        my_flows = flow_cases(usable[rank::size], settings.steady_after,
-                              settings.field_kernel)
+    return AnalysisPlan(study, settings, options, usable, unusable, skipped_cases, absent,
+                        facts, tasks)
+
+
+def compute_share(plan: AnalysisPlan, outputs: OutputSet, rank: int, size: int) -> Share:
+    """Rank ``rank`` of ``size``'s frame results and flows (each dump checked once:
+    :func:`~ligwf.analysis.frames.checks.shared_checks`)."""
+    tasks, flow_of = plan.share(rank, size)
+    share = Share()
+    with shared_checks():
+        share.flows, share.notes = flow_cases(flow_of, plan.settings.steady_after,
+                                              plan.settings.field_kernel)
         analyses: dict[int, GranuleAnalysis] = {}   # one per case: held windows share reads
-        for fi, ff in tasks[rank::size]:
-            f = facts[fi]
+        for fi, ff in tasks:
+            f = plan.facts[fi]
             if fi not in analyses:
                 analyses[fi] = GranuleAnalysis(
-                    f, settings, options.implementation,
-                    outputs.case_dir(f.case_id) if options.write_vtu else None, options.louvain)
-            mine.append(analyse_frame(analyses[fi], ff))
+                    f, plan.settings, plan.options.implementation,
+                    outputs.case_dir(f.case_id) if plan.options.write_vtu else None,
+                    plan.options.louvain)
+            share.results.append(analyse_frame(analyses[fi], ff))
+    return share
+
+
+def finish(plan: AnalysisPlan, outputs: OutputSet, shares: list[Share]) -> dict:
+    """Merge the shares (any split: the same outputs) and write the outputs as one set."""
+    results = [r for s in shares for r in s.results]
+    by_case = {k: v for s in shares for k, v in s.flows.items()}
+    notes = {k: v for s in shares for k, v in s.notes.items()}
+    order = [c.case_id for c in plan.usable]
+    flows = flow_record({k: by_case[k] for k in order if k in by_case},
+                        {k: notes[k] for k in order if k in notes},
+                        plan.settings.steady_after, list(plan.unusable))
+    return write_outputs(plan.study, outputs, plan.facts, list(plan.skipped_cases), results,
+                         plan.settings, plan.options, plan.absent, flows)
+
+
+def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions = AnalysisOptions(),
+            comm=None) -> dict | None:
+    """Analyse a study (or one case) folder; on rank 0 write the outputs and return the
+    analysis record (other ranks return None). ``comm``: an mpi4py communicator, by
+    default COMM_WORLD when running under mpirun with several ranks. NothingAnalysed
+    (outputs untouched) when no frame could be analysed."""
+    plan = plan_analysis(run_dir, options)
+    out_dir = Path(out_dir) if out_dir is not None else plan.study.analysis_dir
+    comm = _mpi_comm() if comm is None else comm
+    rank, size = (comm.Get_rank(), comm.Get_size()) if comm is not None else (0, 1)
+    token = new_token() if comm is None else comm.bcast(new_token() if rank == 0 else None)
+    outputs = OutputSet(out_dir, token)
+    try:
+        mine = compute_share(plan, outputs, rank, size)
     except BaseException:
         outputs.discard()
         raise
     if comm is not None:
-        gathered = comm.gather((mine, my_flows), root=0)
+        shares = comm.gather(mine, root=0)
         if rank != 0:
             comm.barrier()
             return None
-        results = [r for part, _ in gathered for r in part]
-        by_case = {k: v for _, (f, _) in gathered for k, v in f.items()}
-        notes = {k: v for _, (_, n) in gathered for k, v in n.items()}
     else:
-        results, (by_case, notes) = mine, my_flows
-    order = [c.case_id for c in usable]
-    flows = flow_record({k: by_case[k] for k in order if k in by_case},
-                        {k: notes[k] for k in order if k in notes}, settings.steady_after,
-                        flow_skipped)
+        shares = [mine]
     try:
-        record = write_outputs(study, outputs, facts, skipped_cases, results, settings, options,
-                               absent, flows)
+        return finish(plan, outputs, shares)
     except BaseException:
         outputs.discard()
         raise
     finally:
         if comm is not None:
             comm.barrier()
+
+
+def analyse_part(run_dir: Path, token: str, index: int, count: int, out_dir: Path | None = None,
+                 options: AnalysisOptions = AnalysisOptions()) -> Path:
+    """Array task ``index`` of ``count``: compute its share and write it as one partial
+    output (its ``.vtu`` frames into the staging folder of ``token``); returns the part's
+    path. The merge (:func:`merge_parts`) writes the outputs."""
+    plan = plan_analysis(run_dir, options)
+    out_dir = Path(out_dir) if out_dir is not None else plan.study.analysis_dir
+    share = compute_share(plan, OutputSet(out_dir, check_token(token)), index, count)
+    return write_part(out_dir, token, index, count, plan.fingerprint(), share)
+
+
+def merge_parts(run_dir: Path, token: str, count: int, out_dir: Path | None = None,
+                options: AnalysisOptions = AnalysisOptions(), rerun: str = "") -> dict:
+    """Merge the ``count`` parts of ``token`` into the outputs (the same bytes as one local
+    run); AnalysisIncomplete (outputs, parts and staged frames kept) when a part is
+    missing or was computed for another plan. ``rerun``: the command that re-runs task
+    ``{index}``, for the message."""
+    plan = plan_analysis(run_dir, options)
+    out_dir = Path(out_dir) if out_dir is not None else plan.study.analysis_dir
+    shares = read_parts(out_dir, token, count, plan.fingerprint(),
+                        rerun or f"ligwf analyse {plan.study.path} --part {{index}}/{count} "
+                                 f"--token {token}")
+    outputs = OutputSet(out_dir, token)
+    record = finish(plan, outputs, shares)
+    drop_parts(out_dir, token)
     return record
 
 

@@ -20,7 +20,7 @@ from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for, 
                                  rotate_screen)
 from ligwf.engine.thermo import parse_screen, phase_group
 from ligwf.scene.scaling import ScaledScene
-from ligwf.study.case import CaseFolder
+from ligwf.study.case import NO_DIGESTS, CaseFolder, KnownDigests
 from ligwf.study.manifest import DONE, FAILED, KILLED, RUNNING, UNSTABLE
 from ligwf.study.processes import start_time
 from ligwf.study.thermo_table import ThermoRow, rows_from_csv, rows_to_csv
@@ -190,13 +190,15 @@ def history(case: CaseFolder, manifest: Manifest, attempt: Attempt) -> list[Ther
 def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
                    exit_code: int | None, wall_seconds: float, killed: bool = False,
                    engine_version_line: str | None = None,
-                   stop_problem: str | None = None, stamp_new: bool = True) -> Manifest:
+                   stop_problem: str | None = None, stamp_new: bool = True,
+                   digests: KnownDigests = NO_DIGESTS) -> Manifest:
     """Judge the attempt from its screen capture and write thermo table + manifest.
     ``stop_problem``: why the live check stopped the run (None: it did not). The restarts
     the attempt wrote get their identity sidecars first (the engine has ended), unless
     ``stamp_new`` is False: a runner recording a DEAD runner's attempt cannot tell the
     engine's files from ones dropped in since (the watchdog stamped them when it stopped
-    that engine)."""
+    that engine). ``digests``: the dumps hashed while the engine ran
+    (:mod:`ligwf.engine.dump_hasher`), so the done record hashes only the rest."""
     s = case.scaled
     if stamp_new:
         stamp_restarts(case, attempt)
@@ -251,7 +253,7 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     except FolderNotWritable:
         pass  # the table is rebuilt from the screens by the next attempt; the manifest counts
     try:
-        case.write_manifest(manifest)
+        case.write_manifest(manifest, digests)
     except FolderNotWritable:
         overwrite_manifest(case.path, manifest)   # read-only: raises FolderNotWritable
     return manifest

@@ -35,11 +35,13 @@ import time
 from pathlib import Path
 
 from ligwf.engine.attempt import DISK_FULL, begin_attempt, finish_attempt, restart_unreadable
+from ligwf.engine.dump_hasher import DumpHasher
 from ligwf.engine.guard import ENSEMBLE_RANK_NAME
 from ligwf.engine.liggghts import Liggghts
 from ligwf.fsio import atomic_write_json
 from ligwf.engine.resume import FRESH, RESUME, SKIP, discard_restart, input_for, plan_case
 from ligwf.study.case import CaseFolder
+from ligwf.study.layout import POST_DIR
 from ligwf.study.manifest import KILLED
 from ligwf.study.processes import process
 
@@ -187,13 +189,20 @@ def main(argv: list[str] | None = None) -> int:
                                                   [f"ensemble group {group}", input_for(plan)])
                 _record_runner(case, manifest, runner, me)
             t0 = time.monotonic()
-            run_file(engine, sub, case, input_for(plan))
-            sub.Barrier()
+            # the group's rank 0 hashes the dumps while the engine runs (the done record
+            # then hashes only the last ones: ligwf.engine.dump_hasher)
+            hasher = DumpHasher(case.path / POST_DIR).__enter__() if sub.rank == 0 else None
+            try:
+                run_file(engine, sub, case, input_for(plan))
+                sub.Barrier()
+            finally:
+                if hasher is not None:
+                    hasher.close()
             again = None
             if sub.rank == 0:
                 quit = quit_requested(engine)
                 manifest = finish_attempt(case, manifest, attempt, 0, time.monotonic() - t0,
-                                          killed=quit)
+                                          killed=quit, digests=hasher.digests)
                 if (not quit and plan.restart is not None
                         and restart_unreadable(manifest, attempt)):
                     # a restart the engine could not read: set it aside, take the next one

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Protocol, Sequence
 
+from ligwf.engine.dump_hasher import DumpHasher
 from ligwf.engine.attempt import (DISK_FULL, begin_attempt, close_lost_attempt, expectation,
                                   finish_attempt, history, merge_rows, restart_unreadable,
                                   stamp_restarts)
@@ -37,7 +38,7 @@ from ligwf.engine.site import EngineConfig
 from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.fsio import NOT_WRITABLE, FolderNotWritable, not_writable
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import SCREEN_FILE
+from ligwf.study.layout import POST_DIR, SCREEN_FILE
 from ligwf.study.manifest import KILLED, RUNNING, Manifest, case_lock, runner_alive
 from ligwf.study.processes import EngineProcess
 from ligwf.study.thermo_table import ThermoRow
@@ -239,11 +240,12 @@ def _run_locked(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Mo
             manifest.engine = [p.to_dict() for p in procs]
             case.write_manifest(manifest)
 
-        result = launch(case.path, cmd, case_id, monitor, stop, poll_seconds, judge, record,
-                        tick=lambda: stamp_restarts(case, attempt, SETTLE_SECONDS))
+        with DumpHasher(case.path / POST_DIR) as hasher:   # the done record hashes the rest
+            result = launch(case.path, cmd, case_id, monitor, stop, poll_seconds, judge,
+                            record, tick=lambda: stamp_restarts(case, attempt, SETTLE_SECONDS))
         manifest = finish_attempt(case, manifest, attempt, result.exit_code,
                                   result.wall_seconds, killed=result.killed,
-                                  stop_problem=result.problem)
+                                  stop_problem=result.problem, digests=hasher.digests)
         if result.killed and manifest.status == KILLED:
             manifest.reason = interrupted_reason(stop, manifest.steps_done,
                                                  manifest.total_steps)

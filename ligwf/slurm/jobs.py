@@ -34,11 +34,14 @@ from ligwf.study.study import Study
 from ligwf.slurm.budget import nodes_for
 from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_parsable,
                                parse_squeue, task_records)
-from ligwf.slurm.script import (LOG_DIR, SLURM_DIR, ScriptContext, analysis_script, array_script,
-                           sbatch_command, scontrol_command, squeue_command)
+from ligwf.slurm.script import (LOG_DIR, SLURM_DIR, ScriptContext, analysis_array_script,
+                                analysis_merge_script, analysis_script, array_script,
+                                sbatch_command, scontrol_command, squeue_command)
 from ligwf.slurm.site import SlurmSite
 
 RECORD_FILE = "slurm/jobs.json"
+#: kinds of planned jobs that are arrays the job after them waits for
+ARRAY_KINDS = ("array", "analysis-array")
 Runner = Callable[[Sequence[str]], subprocess.CompletedProcess]
 
 
@@ -99,7 +102,7 @@ class PlannedJob:
     again, on ``plan_cores``), not from ``--ntasks`` / the site setting; ``nodes``: the
     ``--nodes`` each array task asks for (None: not asked, Slurm places the ranks)."""
 
-    kind: str  # "array" or "analysis"
+    kind: str  # "array", "analysis", "analysis-array" or "analysis-merge"
     script_path: Path
     script_text: str
     indices: tuple[int, ...] = ()
@@ -153,9 +156,24 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
     return jobs
 
 
+def plan_analysis_array(study_dir: Path, study_name: str, site: SlurmSite, count: int,
+                        token: str, steps: Sequence[str] = ()) -> list[PlannedJob]:
+    """A split analysis (pure): the array of ``count`` analysis tasks and the merge job
+    after it (``afterany``: the merge names a task that failed), scripts named by the
+    token (``analysis-array-TOKEN.sh``, ``analysis-merge-TOKEN.sh``)."""
+    study = PurePosixPath(Path(study_dir).resolve())
+    ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
+    return [PlannedJob("analysis-array", Path(study) / SLURM_DIR / f"analysis-array-{token}.sh",
+                       analysis_array_script(ctx, site, count, token),
+                       tuple(range(count)), site=site),
+            PlannedJob("analysis-merge", Path(study) / SLURM_DIR / f"analysis-merge-{token}.sh",
+                       analysis_merge_script(ctx, site, count, token, steps),
+                       after_array=True, site=site)]
+
+
 def dry_run_text(jobs: Sequence[PlannedJob]) -> str:
     """What ``--dry-run`` prints: each script, then the sbatch command that would submit it."""
-    arrays = sum(1 for job in jobs if job.kind == "array")
+    arrays = sum(1 for job in jobs if job.kind in ARRAY_KINDS)
     ids = (["<array job id>"] if arrays == 1
            else [f"<array job id {n}>" for n in range(1, arrays + 1)])
     out = []
@@ -189,7 +207,7 @@ def submit_jobs(study_dir: Path, jobs: Sequence[PlannedJob], site: SlurmSite,
             raise SubmitError(f"{' '.join(cmd)} exited {out.returncode}: "
                               f"{(out.stderr or out.stdout).strip()}")
         job_id = parse_sbatch_parsable(out.stdout)
-        if job.kind == "array":
+        if job.kind in ARRAY_KINDS:
             array_ids.append(job_id)
         entry = {"kind": job.kind, "job_id": job_id, "indices": list(job.indices),
                  "script": str(job.script_path.relative_to(Path(study_dir).resolve())),

@@ -166,6 +166,45 @@ def analysis_script(ctx: ScriptContext, site: SlurmSite, steps: Sequence[str]) -
     return "\n".join(lines)
 
 
+def analysis_array_script(ctx: ScriptContext, site: SlurmSite, count: int, token: str) -> str:
+    """The array of a split analysis: task K of ``count`` runs ``ligwf analyse STUDY
+    --part K/count --token TOKEN`` (one partial output each, :mod:`ligwf.analysis.parts`)."""
+    study = ctx.study_dir
+    log = f"{study}/{LOG_DIR}/{ctx.job_name}_%A_%a.out"
+    lines = ["#!/bin/bash",
+             *_directives(site, ctx.job_name, log, site.analysis_time or site.time, 1,
+                          [f"#SBATCH --array={array_spec(range(count), site.max_concurrent)}"]),
+             f"# Written by ligwf {ctx.ligwf_version}: the analysis of {study} split into",
+             f"# {count} array task(s) (task K analyses share K; the merge job writes the tables).",
+             "set -eo pipefail",
+             *_environment(site),
+             f"cd {_q(study)}",
+             f"exec {site.ligwf} analyse {_q(study)} --part \"$SLURM_ARRAY_TASK_ID/{count}\""
+             f" --token {_q(token)}",
+             ""]
+    return "\n".join(lines)
+
+
+def analysis_merge_script(ctx: ScriptContext, site: SlurmSite, count: int, token: str,
+                          steps: Sequence[str] = ()) -> str:
+    """The job after a split analysis' array (``afterany``): ``ligwf analyse STUDY --merge
+    count --token TOKEN`` (it names any task that left no part and fails), then ``ligwf
+    <step> STUDY`` for each of ``steps`` (e.g. ``report``)."""
+    study = ctx.study_dir
+    log = f"{study}/{LOG_DIR}/{ctx.job_name}_%j.out"
+    lines = ["#!/bin/bash",
+             *_directives(site, ctx.job_name, log, site.analysis_time or site.time, 1, []),
+             f"# Written by ligwf {ctx.ligwf_version}: merge of the {count} analysis task(s)",
+             f"# of {study} (submitted with --dependency=afterany on their array).",
+             "set -eo pipefail",
+             *_environment(site),
+             f"cd {_q(study)}",
+             f"{site.ligwf} analyse {_q(study)} --merge {count} --token {_q(token)}",
+             *[f"{site.ligwf} {step} {_q(study)}" for step in steps],
+             ""]
+    return "\n".join(lines)
+
+
 def sbatch_command(script: str | PurePosixPath,
                    after_any: str | Sequence[str] | None = None) -> list[str]:
     """``sbatch --parsable [--dependency=afterany:ID[:ID...]] SCRIPT`` as argv (one id, or

@@ -43,6 +43,27 @@ def file_digest(path: Path) -> str:
 
 
 @dataclass(frozen=True)
+class KnownDigests:
+    """SHA-256 of files hashed earlier (by the running case's dump hasher,
+    :mod:`ligwf.engine.dump_hasher`), each with the file's identity then (inode, size,
+    modification time ns): a digest is used only for a file that still has that identity,
+    any other file is hashed now."""
+
+    files: dict[str, tuple[tuple[int, int, int], str]]
+
+    def digest(self, path: Path) -> str:
+        known = self.files.get(path.name)
+        if known is not None:
+            st = path.stat()
+            if known[0] == (st.st_ino, st.st_size, st.st_mtime_ns):
+                return known[1]
+        return file_digest(path)
+
+
+NO_DIGESTS = KnownDigests({})
+
+
+@dataclass(frozen=True)
 class DumpRecord:
     """The files a finished run left in ``post/``: name -> (size in bytes, SHA-256)."""
 
@@ -231,14 +252,15 @@ class CaseFolder:
         """The runner's manifest now (None: not run, or unreadable)."""
         return read_manifest(self.path)
 
-    def write_manifest(self, manifest: Manifest) -> None:
+    def write_manifest(self, manifest: Manifest, digests: KnownDigests = NO_DIGESTS) -> None:
         """Write the manifest; a ``done`` one after the dump record of the run's ``post/``
-        (so a done case always identifies its dumps), any other removes a stale record."""
+        (so a done case always identifies its dumps), any other removes a stale record.
+        ``digests``: files hashed while the case ran (used where the file is unchanged)."""
         record = self.path / DUMP_RECORD
         if manifest.status == DONE:
             post = self.path / POST_DIR
-            files = ({p.name: [p.stat().st_size, file_digest(p)] for p in sorted(post.iterdir())
-                      if p.is_file()} if post.is_dir() else {})
+            files = ({p.name: [p.stat().st_size, digests.digest(p)]
+                      for p in sorted(post.iterdir()) if p.is_file()} if post.is_dir() else {})
             atomic_write_json(record, {"scene_hash": manifest.scene_hash,
                                        "steps_done": manifest.steps_done, "files": files})
         else:

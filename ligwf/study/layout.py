@@ -99,6 +99,17 @@ def granule_frame_step(name: str) -> int | None:
     return int(step)
 
 
+
+def analysis_parts_dir(token: str) -> str:
+    """Folder (in the analysis output folder) of the partial outputs of one analysis split
+    over array tasks (``ligwf analyse --part``), named by its staging token."""
+    return f".parts-{token}"
+
+
+def analysis_part(index: int, count: int) -> str:
+    """File name of array task ``index``'s partial output (of ``count`` tasks)."""
+    return f"part-{index:05d}-of-{count:05d}.pkl"
+
 # ---- files in REPORT_DIR (written by the report stage)
 CASES_REPORT = "cases.csv"
 CONDITIONS_REPORT = "conditions.csv"

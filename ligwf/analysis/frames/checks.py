@@ -21,11 +21,21 @@ frames and report the same reasons:
   two centres (nearest periodic image). Permuted ids, a contact dump of another frame or
   flipped bits in positions fail these; flipped bits elsewhere fail the record or the
   value range LIGGGHTS wrote into the array header (:mod:`ligwf.analysis.frames.vtu`).
+
+Checked once per analysis: inside :func:`shared_checks` (one analysis, or one rank's
+share of it) the verdict of each file's record check and of each particle frame's check
+is kept, keyed by the file's identity (device, inode, size, modification time), so the
+flow stage and the granule stage, which read the same dumps, hash and check each once; a
+file replaced in between has another identity and is checked again.
 """
 
 from __future__ import annotations
 
+import os
+from contextlib import contextmanager
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterator
 
 import numpy as np
 
@@ -58,8 +68,53 @@ class FramePlan:
         if self.record is None:
             return
         for path in (ff.particles, ff.contacts):
-            if path is not None and (why := self.record.mismatch(path)):
-                raise DumpReadError(why)
+            if path is not None:
+                _once(("record",), path, lambda path=path: self._check_file(path))
+
+    def _check_file(self, path: Path) -> None:
+        if why := self.record.mismatch(path):
+            raise DumpReadError(why)
+
+
+#: verdicts of the checks inside :func:`shared_checks` (None outside: every call checks)
+_VERDICTS: dict | None = None
+
+
+@contextmanager
+def shared_checks() -> Iterator[None]:
+    """Within: each file's record check and each particle frame's check runs once (see
+    the module doc); nested uses share the outermost's verdicts."""
+    global _VERDICTS
+    outer = _VERDICTS is not None
+    if not outer:
+        _VERDICTS = {}
+    try:
+        yield
+    finally:
+        if not outer:
+            _VERDICTS = None
+
+
+def _once(kind: tuple, path: Path, check: Callable[[], None]) -> None:
+    """``check()`` (raising DumpReadError), or its kept verdict for this file."""
+    if _VERDICTS is None:
+        return check()
+    try:
+        st = os.stat(path)
+    except OSError:
+        return check()
+    key = (*kind, str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    if key in _VERDICTS:
+        if _VERDICTS[key] is not None:
+            raise DumpReadError(_VERDICTS[key])
+        return None
+    try:
+        check()
+    except DumpReadError as exc:
+        _VERDICTS[key] = str(exc)
+        raise
+    _VERDICTS[key] = None
+    return None
 
 
 def end_step(case: CaseFolder) -> int:
@@ -116,6 +171,10 @@ def _fail(p: ParticleFrame | ContactFrame, what: str) -> None:
 
 def check_particles(case: CaseFolder, p: ParticleFrame) -> None:
     """DumpReadError when the particle frame is not one of this run's (see module doc)."""
+    _once(("particles", str(case.path)), Path(p.path), lambda: _check_particles(case, p))
+
+
+def _check_particles(case: CaseFolder, p: ParticleFrame) -> None:
     s = case.scaled
     n = s.particle_count
     if len(p) != n:

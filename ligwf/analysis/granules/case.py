@@ -21,7 +21,7 @@ import pandas as pd
 
 from ligwf.analysis.frames.dumps import (ContactFrame, FrameFiles, ParticleFrame, read_contacts,
                                   read_particles)
-from ligwf.analysis.granules.persistent import Frame, bridge_keys, held_through, persistent_labels
+from ligwf.analysis.granules.persistent import Frame, bridge_keys, persistent_labels, presence_run
 from ligwf.analysis.frames.checks import FramePlan, check_contacts, check_particles, plan_frames
 from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
 from ligwf.analysis.granules.bonds import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
@@ -206,7 +206,7 @@ class GranuleAnalysis:
                                  "(or over a missing one): no granules can be held through it")
         if not hasattr(self, "_keys"):
             self._keys: dict[int, np.ndarray] = {}
-        window = []
+            self._runs: dict[int, np.ndarray] = {}
         for q in range(k, k + span + 1):
             step = steps[q]
             if step not in self._keys:
@@ -214,12 +214,16 @@ class GranuleAnalysis:
                 if not np.array_equal(p.ids, particles.ids):
                     raise DumpReadError(f"{frames[q].particles}: not the particles of step "
                                         f"{ff.step} (a hold window needs the same particles)")
-                self._keys[step] = bridge_keys(Frame(p, c), f.liquid)
-            window.append(self._keys[step])
+                keys = bridge_keys(Frame(p, c), f.liquid)
+                before = steps[q - 1] if q > 0 else None      # cached: the count goes on
+                self._runs[step] = presence_run(keys, self._keys.get(before),
+                                                self._runs.get(before))
+                self._keys[step] = keys
         for old in [s for s in self._keys if s < ff.step]:
-            del self._keys[old]
-        return persistent_labels([Frame(particles, contacts)], [held_through(window)],
-                                 f.motion)
+            del self._keys[old], self._runs[old]
+        last = steps[k + span]
+        held = self._keys[last][self._runs[last] >= span + 1]
+        return persistent_labels([Frame(particles, contacts)], [held], f.motion)
 
     def _conclude(self) -> None:
         self.results.sort(key=lambda r: r.step)
