@@ -46,7 +46,10 @@ def bridge_keys(frame: Frame, liquid: Liquid) -> np.ndarray:
     i, j, _ = bonded_contacts(frame.particles, frame.contacts, liquid, ALL_BRIDGES)
     n = len(frame.particles)
     lo, hi = np.minimum(i, j).astype(np.int64), np.maximum(i, j).astype(np.int64)
-    return np.unique(lo * n + hi)
+    keys = np.sort(lo * n + hi)
+    # = np.unique(keys), whose hashing path in numpy 2.4 took 1.4 s at 1.2 M bridges
+    # against 0.02 s for this sort and compare
+    return keys[np.concatenate(([True], keys[1:] != keys[:-1]))] if len(keys) else keys
 
 
 def held_through(keys: list[np.ndarray]) -> np.ndarray:
