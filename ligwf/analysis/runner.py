@@ -128,13 +128,15 @@ class AnalysisPlan:
         just checked those dumps; cases without granule frames are dealt round-robin)."""
         n = len(self.tasks)
         mine = self.tasks[rank * n // size:(rank + 1) * n // size]
+        where: dict[int, list[int]] = {}
+        for k, (fi, _) in enumerate(self.tasks):
+            where.setdefault(fi, []).append(k)
         owner: dict[str, int] = {}
-        for fi, f in enumerate(self.facts):
-            ks = [k for k, (t, _) in enumerate(self.tasks) if t == fi]
-            if ks:
-                middle = ks[len(ks) // 2]
-                owner[f.case_id] = next(r for r in range(size)
-                                        if middle < (r + 1) * n // size)
+        for fi, ks in where.items():
+            middle = ks[len(ks) // 2]
+            # the rank r with r n // size <= middle < (r + 1) n // size
+            owner[self.facts[fi].case_id] = next(r for r in range(size)
+                                                 if middle < (r + 1) * n // size)
         rest = [c.case_id for c in self.usable if c.case_id not in owner]
         ids = {k for k, r in owner.items() if r == rank}
         ids |= {cid for k, cid in enumerate(rest) if k % size == rank}
