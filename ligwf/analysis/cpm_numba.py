@@ -105,10 +105,15 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
     seen = np.empty(indptr[n], np.int64)
     n_seen = np.zeros(n, np.int64)
     dirty = np.ones(n, np.bool_)
+    singletons = True                      # from singletons the first pass moves most
+    for v in range(n):                     # nodes: no proofs in it
+        if init[v] != v:
+            singletons = False
+            break
     total_moves = 0
     for pass_no in range(max_passes):
         moved = 0
-        prove = pass_no > 0                # the first pass moves most nodes: no proofs
+        prove = pass_no > 0 or not singletons
         for idx in range(n):
             v = order[idx]
             cv = comm[v]
@@ -300,15 +305,19 @@ def level_order(size, level_no):
 
 
 @cached_jit()
-def _levels(n, i, j, w, node_w, gamma, start, max_passes, max_levels):
-    """One Louvain run: local moving on the graph from partition ``start``, then on the
-    aggregated graphs from singletons, until a level moves nothing."""
+def _levels(n, graph, node_w, gamma, start, max_passes, max_levels):
+    """One Louvain run: local moving on the graph (``graph``: its CSR, :func:`_csr`) from
+    partition ``start``, then on the aggregated graphs from singletons, until a level
+    moves nothing."""
     labels = np.arange(n)
-    ci, cj, cw, cnw = i, j, w, node_w
+    cnw = node_w
     size = n
     init = start.copy()
+    indptr, indices, weights = graph
+    ci, cj, cw = np.empty(0, np.int64), np.empty(0, np.int64), np.empty(0, np.float64)
     for level_no in range(max_levels):
-        indptr, indices, weights = _csr(size, ci, cj, cw)
+        if level_no > 0:
+            indptr, indices, weights = _csr(size, ci, cj, cw)
         order = level_order(size, level_no)
         comm, moves = _local_moving(indptr, indices, weights, cnw, gamma, order, max_passes,
                                     init)
@@ -334,8 +343,9 @@ def louvain_cpm(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50, ma
     ci, cj = i.astype(np.int64), j.astype(np.int64)
     cw, cnw = w.astype(np.float64), node_w.astype(np.float64)
     labels = np.arange(n)
+    graph = _csr(n, ci, cj, cw)            # the particle graph: built once for every run
     for _ in range(iterations):
-        labels = _levels(n, ci, cj, cw, cnw, gamma, labels, max_passes, max_levels)
+        labels = _levels(n, graph, cnw, gamma, labels, max_passes, max_levels)
     return labels
 
 
