@@ -103,6 +103,20 @@ def test_dtypes_are_typed_and_one_per_column_name(reported):
 
 @pytest.mark.engine
 @pytest.mark.mpi
+def test_every_column_of_every_table_is_described_by_the_data_dictionary(reported):
+    s = ligwf.open_study(reported)
+    for name, table in s.tables().items():
+        d = s.describe(name)
+        assert list(d["column"]) == list(table.columns)
+        assert list(d["dtype"]) == [str(t) for t in table.dtypes]
+        undocumented = d.loc[d["meaning"].isna() | (d["meaning"] == ""), "column"].tolist()
+        assert not undocumented, (name, undocumented)
+    speed = s.describe("conditions").set_index("column").loc["speedup_core"]
+    assert speed["label"] and "CG1" in speed["meaning"]
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
 def test_settings_paths_profiles_and_flow_record(reported):
     s = ligwf.open_study(reported)
     s.check()                                   # analysis and report match the study

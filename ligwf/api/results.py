@@ -20,6 +20,7 @@ from ligwf.api import fields, plots
 from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec, read_table,
                               typed)
 from ligwf.errors import ConfigError, LigwfError
+from ligwf.report import dictionary
 from ligwf.report.verdict import Verdict
 from ligwf.report.write import checked_analysis
 from ligwf.report.verdict_records import read_verdict
@@ -209,6 +210,20 @@ class StudyResults:
     def table(self, name: str) -> pd.DataFrame:
         """The table called ``name`` (an attribute of :data:`TABLES`), as a copy."""
         return self._read(name).copy()
+
+    def describe(self, name: str) -> pd.DataFrame:
+        """The columns of the table ``name`` as the data dictionary documents them
+        (``docs/data_dictionary.md``, :mod:`ligwf.report.dictionary`): ``column``,
+        ``dtype``, ``unit`` (as stored, SI), ``label`` and ``meaning`` (empty for a
+        column the dictionary does not know)."""
+        table, file = self._read(name), _BY_NAME[name].file
+        rows = []
+        for col, dtype in table.dtypes.items():
+            entry = dictionary.column(str(col), file)
+            rows.append({"column": col, "dtype": str(dtype),
+                         **{k: getattr(entry, k) if entry else "" for k in
+                            ("unit", "label", "meaning")}})
+        return typed(pd.DataFrame(rows, columns=["column", "dtype", "unit", "label", "meaning"]))
 
     def tables(self) -> dict[str, pd.DataFrame]:
         """Every table the study has now, by name (copies; the missing ones left out)."""

@@ -82,7 +82,9 @@ TEXT_COLUMNS = frozenset({
     "variant", "definition", "control", "twin_id", "twin_case_id", "verdict", "method",
     "velocity_frame", "pool", "reference", "wet_group",
     # the verdict table (ligwf.report.verdict)
-    "criterion", "label", "unit", "state", "condition_state", "budget_source", "note"})
+    "criterion", "label", "unit", "state", "condition_state", "budget_source", "note",
+    # describe(): the data dictionary's columns
+    "column", "dtype", "meaning"})
 TEXT_SUFFIXES = ("_floor_source", "_vs_floor", "_reason", "_verdict", "_label")
 
 
