@@ -70,6 +70,12 @@ def _read_csv(path: Path) -> pd.DataFrame:
     return pd.DataFrame()
 
 
+def _per(cost: float, seconds: float) -> float:
+    """Cost per simulated second; nan when the manifest records no simulated time (a case
+    marked done by hand or by an older ligwf without step counts: no rate, not a crash)."""
+    return cost / seconds if seconds > 0 else math.nan
+
+
 def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
     """One row per usable case with run facts; and the skipped cases with reasons."""
     usable, skipped = study.usable_cases()
@@ -97,12 +103,12 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
             "core_seconds": man.core_seconds,
             **{f"{ph}_core_seconds": phases.get(ph, {}).get("core_seconds", math.nan)
                for ph in PHASES},
-            "production_core_rate": prod_core / production_seconds,
+            "production_core_rate": _per(prod_core, production_seconds),
             # per 1,000 particles of the ORIGINAL system: slices of different length (and
             # CG levels) on one footing
-            "production_core_rate_k": prod_core / production_seconds
+            "production_core_rate_k": _per(prod_core, production_seconds)
             / s.original_particle_count * 1000.0,
-            "production_wall_rate": prod_wall / production_seconds,
+            "production_wall_rate": _per(prod_wall, production_seconds),
             "nprocs": man.nprocs,
         })
     return pd.DataFrame(rows), skipped
