@@ -41,8 +41,8 @@ from ligwf.study import layout
 #: (an engine with the upstream fix, or an input compensated as ligwf does).
 ANGLE_CONVENTIONS = ("engine", "scene")
 #: what the record says of the two outputs of ``ligwf analyse`` a foreign run cannot have
-NO_FLOW = ("not measured: the flow metrics need the drum (radius, axis, rotation), which "
-           "foreign dumps do not state")
+NO_FLOW = ("not measured: the flow metrics and the cross-section flow fields need the drum "
+           "(radius, axis, rotation), which foreign dumps do not state")
 NO_CONTROLS = "none: a foreign run has no cohesionless twin"
 
 

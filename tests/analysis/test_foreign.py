@@ -47,8 +47,8 @@ def test_analyse_dumps_matches_the_case_analysis(dumps, tmp_path, capsys):
 def test_analyse_dumps_writes_every_output_analyse_does(dumps, engine, tmp_path_factory,
                                                        tmp_path):
     """The same granule stage for both frame sources: analyse-dumps writes every output of
-    ``ligwf analyse`` but the two a foreign run cannot have (flow: no drum; controls: no
-    twin), which its record names."""
+    ``ligwf analyse`` but those a foreign run cannot have (the flow stage's metrics and
+    fields: no drum; controls: no twin), which its record names."""
     study = tmp_path / "study"
     shutil.copytree(wet_study(engine, tmp_path_factory), study)
     assert main(["analyse", str(study)]) == 0
@@ -56,7 +56,10 @@ def test_analyse_dumps_writes_every_output_analyse_does(dumps, engine, tmp_path_
     assert main(["analyse-dumps", str(dumps), "--out", str(out), "--cg", "3", *ARGS]) == 0
     ours = {p.name for p in (study / "analysis").iterdir() if p.is_file()}
     theirs = {p.name for p in out.iterdir() if p.is_file()}
-    assert theirs == ours - {layout.FLOW_TABLE, layout.FLOW_PROFILES}, (ours, theirs)
+    flow_stage = {layout.FLOW_TABLE, layout.FLOW_PROFILES, layout.FIELDS_DATA,
+                  *(layout.field_image(c) for c in ("cg3-weber-r0", "cg3-weber-r1"))}
+    assert flow_stage <= ours, ours                     # the flow stage's outputs, fields too
+    assert theirs == ours - flow_stage, (ours, theirs)
     assert {layout.KINETICS_TABLE, layout.KINETICS_SUMMARY_TABLE, layout.SENSITIVITY_TABLE,
             layout.GSD_POOLING_TABLE} <= theirs
     assert len(pd.read_csv(out / layout.KINETICS_TABLE)) == len(pd.read_csv(out / "frames.csv"))
