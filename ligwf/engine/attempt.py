@@ -16,8 +16,8 @@ from ligwf.fsio import LOW_SPACE_BYTES, FolderNotWritable, atomic_write_text, sp
 from ligwf.engine.health import (Expectation, assess, engine_signal, kinetic_energy_ceiling,
                                  verdict)
 from ligwf.engine.restart_id import CaseIdentity, stamp
-from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for, render_resume,
-                                 rotate_screen)
+from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for,
+                                 phase_steps_between, render_resume, rotate_screen)
 from ligwf.engine.thermo import parse_screen, phase_group
 from ligwf.scene.scaling import ScaledScene
 from ligwf.study.case import NO_DIGESTS, CaseFolder, KnownDigests
@@ -76,6 +76,7 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
         if kept and manifest.attempts and manifest.attempts[-1].screen == SCREEN_FILE:
             manifest.attempts[-1].screen = kept   # its rows are read from there from now on
         from_step, restart_path = plan.restart.step, plan.restart.path
+        credit_restart(case.scaled, manifest, from_step)
     else:
         raise ValueError(f"begin_attempt: nothing to run for plan {plan}")
     manifest.status, manifest.reason, manifest.reason_step = RUNNING, plan.reason, None
@@ -91,6 +92,30 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
     manifest.attempts.append(attempt)
     case.write_manifest(manifest)
     return manifest, attempt
+
+
+def credit_restart(s: ScaledScene, manifest: Manifest, restart_step: int) -> None:
+    """Count the steps up to ``restart_step`` as run by the attempt that wrote the restart.
+
+    An attempt's steps come from the last thermo row of its screen. A run killed with
+    SIGKILL (or recorded by the next runner while its orphaned engine was still writing
+    the forced restart) can have written a restart past the last row its screen shows:
+    the engine's buffered screen output is lost. The restart proves the run got there, so
+    the latest attempt that started before it is credited the missing steps, in the phases
+    they belong to, and the manifest's per-phase totals stay the sums over the attempts.
+    """
+    reached = max((a.from_step + a.steps for a in manifest.attempts), default=0)
+    if restart_step <= reached:
+        return
+    writer = next((a for a in reversed(manifest.attempts) if a.from_step < restart_step), None)
+    if writer is None:
+        return
+    lo = writer.from_step + writer.steps
+    for phase, n in phase_steps_between(s, lo, restart_step).items():
+        rec = writer.phases.setdefault(phase, {"wall_seconds": 0.0, "steps": 0})
+        rec["steps"] = int(rec.get("steps", 0)) + n
+    writer.steps = restart_step - writer.from_step
+    manifest.add_up_attempts()
 
 
 _DUMP_STEP_RE = re.compile(r"_(\d+)\.vt[ur]$")

@@ -155,6 +155,22 @@ def resume_phase(s: ScaledScene, step: int) -> tuple[str, int, bool]:
     return "production", 0, False
 
 
+def phase_steps_between(s: ScaledScene, lo: int, hi: int) -> dict[str, int]:
+    """Steps ``lo+1 .. hi`` of case ``s`` per phase group (fill, settle, production): what a
+    run that went from step ``lo`` to step ``hi`` spent in each (pure; empty when hi <= lo)."""
+    fill_end = s.insertion_steps
+    settle_end = fill_end + s.settle_steps
+    # step k belongs to the phase whose span (a, b] holds it; past the end is production
+    spans = (("fill", 0, fill_end), ("settle", fill_end, settle_end),
+             ("production", settle_end, max(hi, s.total_steps)))
+    out: dict[str, int] = {}
+    for phase, a, b in spans:
+        n = min(hi, b) - max(lo, a)
+        if n > 0:
+            out[phase] = n
+    return out
+
+
 def render_resume(s: ScaledScene, restart: RestartFile, template_dirs=()) -> dict[str, str]:
     """Input continuing case ``s`` from ``restart``: ``{RESUME_INPUT: text}`` (pure)."""
     phase, wave, inserted = resume_phase(s, restart.step)

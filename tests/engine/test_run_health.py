@@ -11,7 +11,7 @@ from ligwf.engine.health import (Expectation, assess, atom_loss, insertion_short
                           kinetic_energy_blowup, kinetic_energy_ceiling, log_errors,
                           log_warnings, non_finite, verdict)
 from ligwf.study.manifest import Manifest, read_manifest, write_manifest
-from ligwf.engine.resume import resume_phase
+from ligwf.engine.resume import phase_steps_between, resume_phase
 from ligwf.engine.thermo import parse_screen
 from ligwf.study.thermo_table import ThermoRow, rows_from_csv, rows_to_csv
 
@@ -170,3 +170,37 @@ def test_status_table_headers_print_their_units():
     text = out.getvalue()
     for head in ("wall [s]", "cores x wall [core-s]", "settle wall [s]", "production wall [s]"):
         assert head in text
+
+
+def test_steps_between_split_at_the_phase_boundaries():
+    class S:  # fill 0-300, settle 300-350, production 350-500
+        insertion_steps, settle_steps, total_steps = 300, 50, 500
+    assert phase_steps_between(S, 290, 360) == {"fill": 10, "settle": 50, "production": 10}
+    assert phase_steps_between(S, 0, 500) == {"fill": 300, "settle": 50, "production": 150}
+    assert phase_steps_between(S, 300, 300) == {} and phase_steps_between(S, 400, 350) == {}
+
+
+def test_a_restart_past_the_killed_attempts_last_row_is_credited_to_it():
+    """kill -9 loses the engine's buffered screen: attempt 2's screen ends at step 310 but
+    it wrote the restart at 340 that attempt 3 resumes from. The 30 missing steps are its
+    (in settling), the per-phase totals stay the sums over the attempts, no step is
+    skipped, and a restart the record already reaches changes nothing."""
+    from ligwf.engine.attempt import credit_restart
+    from ligwf.study.manifest import Attempt
+
+    class S:
+        insertion_steps, settle_steps, total_steps = 300, 50, 500
+    m = Manifest(case_id="c", index=0, scene_hash="h", ligwf_version="", liggghts_version="")
+    m.attempts = [Attempt(number=1, started="", steps=120, from_step=0,
+                          phases={"fill": {"wall_seconds": 1.0, "steps": 120}}),
+                  Attempt(number=2, started="", steps=210, from_step=100,
+                          phases={"fill": {"wall_seconds": 2.0, "steps": 200},
+                                  "settle": {"wall_seconds": 0.5, "steps": 10}})]
+    credit_restart(S, m, 340)
+    assert m.attempts[1].steps == 240 and m.attempts[0].steps == 120
+    assert m.attempts[1].phases["settle"]["steps"] == 40
+    assert m.attempts[1].phases["settle"]["wall_seconds"] == 0.5
+    assert sum(p["steps"] for p in m.phases.values()) == sum(a.steps for a in m.attempts)
+    assert m.phases["fill"]["steps"] == 320
+    credit_restart(S, m, 200)            # already reached: nothing changes
+    assert [a.steps for a in m.attempts] == [120, 240]
