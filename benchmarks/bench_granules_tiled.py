@@ -4,15 +4,15 @@ A case's dumps (particles + contacts) are repeated ``--tiles`` times along the p
 axis (pairs across the boundary rewired to the neighbouring copy, the helper of
 tests/helpers.py), then timed, best of ``--repeat``:
 
-* the default definition (``AnalysisSettings().granules``: rupture-work CPM communities
-  by compiled Louvain) on the case's last frame, and its parts (bond test, rupture work,
-  CPM);
-* the source study's components (lab frame, 30 deg);
-* ``granules: held`` (the study workflows' setting) in its steady state: per result one
+* the default definition (``AnalysisSettings()``: ``granules: held``, hold_time 1 s) in its
+  steady state: per result one
   new frame's bridge keys, its presence runs and the components of the held bridges, over
   a window of hold_time / dump interval frames (the keys of the earlier frames are
   cached, as :class:`ligwf.analysis.granules.case.GranuleAnalysis` does); beside it what
   intersecting the window's key sets costs (the code before the presence runs);
+* rupture-work CPM communities by compiled Louvain (``granules: communities``, the earlier
+  default) on the case's last frame, and its parts (bond test, rupture work, CPM);
+* the source study's components (lab frame, 30 deg);
 * reading: a real dump pair of the case, scaled by the tile count (the tiled frames are
   never written, so their reading is estimated, not timed).
 
@@ -91,36 +91,37 @@ def main() -> None:
     default = AnalysisSettings()
     print(f"{args.case.name} step {frames[-1].step} tiled {args.tiles}x: {len(pt):,} particles, "
           f"{len(ct):,} contacts; one core, best of {args.repeat}; default definition: "
-          f"{default.granules}")
-    cpu, wall, ident = timed(lambda: identify_granules(pt, ct, facts.liquid, default, facts.cg,
+          f"{default.granules}, hold_time {default.hold_time:g} s")
+    held_bench(frames, load, facts, motion, args.held_results, default)
+    cpm = AnalysisSettings(granules="communities")
+    cpu, wall, ident = timed(lambda: identify_granules(pt, ct, facts.liquid, cpm, facts.cg,
                                                        motion), args.repeat)
-    line(f"{default.granules} (default)", cpu, wall,
+    line("communities (earlier default)", cpu, wall,
          f", {int(ident.labels.max()) + 1:,} granules")
-    i, j, _, rows = bonded_contacts(pt, ct, facts.liquid, bond_criterion(default), with_rows=True)
+    i, j, _, rows = bonded_contacts(pt, ct, facts.liquid, bond_criterion(cpm), with_rows=True)
     for label, fn in (
-            ("  bond test", lambda: bonded_contacts(pt, ct, facts.liquid, bond_criterion(default),
+            ("  bond test", lambda: bonded_contacts(pt, ct, facts.liquid, bond_criterion(cpm),
                                                     with_rows=True)),
             ("  rupture work", lambda: relative_energy(pt, i, j, -ct.delta[rows], facts.liquid))):
         c, w, _ = timed(fn, args.repeat)
         print(f"  {label:>34}: {c:6.3f} s CPU (wall {w:6.3f} s)")
     weight = relative_energy(pt, i, j, -ct.delta[rows], facts.liquid) * facts.cg ** 2
     nw = np.full(len(pt), float(facts.cg) ** 3)
-    c, w, _ = timed(lambda: cpm_labels(len(pt), i, j, weight, nw, default.resolution), args.repeat)
+    c, w, _ = timed(lambda: cpm_labels(len(pt), i, j, weight, nw, cpm.resolution), args.repeat)
     print(f"  {'  CPM (compiled Louvain)':>34}: {c:6.3f} s CPU (wall {w:6.3f} s)")
     comp = AnalysisSettings(granules="components", velocity_frame="lab", max_velocity_angle=30.0)
     cpu, wall, ident = timed(lambda: identify_granules(pt, ct, facts.liquid, comp, facts.cg,
                                                        motion), args.repeat)
     line("components lab 30 deg", cpu, wall, f", {int(ident.labels.max()) + 1:,} granules")
-    held_bench(frames, load, facts, motion, args.held_results)
     c, w, _ = timed(lambda: (read_particles(frames[-1].particles, frames[-1].step, facts.dt),
                              read_contacts(frames[-1].contacts, frames[-1].step)), args.repeat)
     print(f"  {'reading one dump pair':>34}: {c:6.3f} s CPU at {len(pt) // args.tiles:,} "
           f"particles: ~{c * args.tiles:.3f} s at {len(pt):,} (linear estimate)")
 
 
-def held_bench(frames, load, facts, motion, results: int) -> None:
-    """``granules: held`` in its steady state over the case's first frames."""
-    held = AnalysisSettings(granules="held")
+def held_bench(frames, load, facts, motion, results: int, held: AnalysisSettings) -> None:
+    """``granules: held`` (``held``'s hold_time) in its steady state over the case's first
+    frames: per result the work a new frame adds once the window is filled."""
     interval = (frames[1].step - frames[0].step) * facts.dt
     span = max(1, int(round(held.hold_time / interval)))
     if len(frames) < span + 1 + results:
@@ -146,7 +147,7 @@ def held_bench(frames, load, facts, motion, results: int) -> None:
         c0 = time.process_time()
         assert np.array_equal(held_through(keys[-span - 1:]), bridges)
         inter.append(time.process_time() - c0)
-    line(f"held ({span + 1}-frame window)", min(cpu), min(wall),
+    line(f"held, {held.hold_time:g} s ({span + 1}-frame window)", min(cpu), min(wall),
          f", {int(ident.labels.max()) + 1:,} granules; intersecting the window instead: "
          f"{min(inter):.3f} s CPU more")
 

@@ -42,7 +42,9 @@ def test_sensitivity_varies_only_the_thresholds_in_use_and_states_the_setting():
     from ligwf.analysis.granules.definitions import variants
     from ligwf.scene.settings import AnalysisSettings
 
-    labels = [lab for lab, _ in variants(AnalysisSettings())]
+    assert [lab for lab, _ in variants(AnalysisSettings())] == [
+        "as set: held, bridges through 1 s", "hold 0.8 s", "hold 1.25 s"]      # the default
+    labels = [lab for lab, _ in variants(AnalysisSettings(granules="communities"))]
     assert labels[0] == "as set: communities, resolution 0.002 (energy weight)"
     assert labels[1:] == ["resolution x0.8", "resolution x1.25"]       # angle, f_rel are off
     held = variants(AnalysisSettings(granules="held", hold_time=0.5))

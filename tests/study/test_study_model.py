@@ -31,8 +31,8 @@ def rendered(tmp_path, monkeypatch):
 
 def test_analysis_block_is_validated_with_field_and_range(capsys, tmp_path):
     wf = load_workflow(DRUM, ["analysis.bootstrap=50"])
-    assert wf.analysis == AnalysisSettings(bootstrap=50)
-    assert load_workflow(DRUM).analysis == AnalysisSettings()
+    assert wf.analysis == AnalysisSettings(granules="communities", bootstrap=50)
+    assert load_workflow(DRUM).analysis == AnalysisSettings(granules="communities")
     for override, text in [("analysis.steady_after=1.5", "allowed range [0, 1)"),
                            ("analysis.max_velocity_angle=200", "allowed range [0, 180]"),
                            ("analysis.bins=3", "analysis.bins: unknown key")]:
@@ -47,7 +47,8 @@ def test_analysis_block_is_validated_with_field_and_range(capsys, tmp_path):
 
 def test_study_stores_and_reads_the_analysis_settings(rendered):
     study = Study.open(rendered)
-    assert study.analysis == AnalysisSettings(max_velocity_angle=10, steady_after=0.5)
+    assert study.analysis == AnalysisSettings(granules="communities", max_velocity_angle=10,
+                                              steady_after=0.5)   # drum.yaml's block + --set
     record = json.loads((rendered / layout.STUDY_FILE).read_text())
     assert record["analysis"]["max_velocity_angle"] == 10
     # a study written before the analysis block existed: the defaults
