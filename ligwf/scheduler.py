@@ -96,10 +96,13 @@ class Scheduler(Protocol):
 
     def plan_jobs(self, study_dir: Path, study_name: str, indices: Iterable[int],
                   ranks: Mapping[int, int] | None, post_steps: Sequence[str], round_no: int,
-                  plan_cores: int | None = None) -> Sequence[BatchJob]:
+                  plan_cores: int | None = None, analysis_tasks: int = 1,
+                  token: str | None = None) -> Sequence[BatchJob]:
         """The scripts of one submission round (pure): one array per rank count of
         ``ranks`` (case index -> MPI ranks; None: the site's fixed task count) and, with
-        ``post_steps``, the follow-up job running ``ligwf <step> STUDY`` for each."""
+        ``post_steps``, the follow-up job running ``ligwf <step> STUDY`` for each
+        (``analysis_tasks`` > 1: ``analyse`` as an array of that many tasks staged under
+        ``token``, then a merge job running the other steps)."""
 
     def dry_run_text(self, jobs: Sequence[BatchJob]) -> str:
         """Every script and the command that would submit it."""

@@ -35,7 +35,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     wf = prepared.workflow
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
     for line in analysis_plan(prepared):
-        console.print(line, highlight=False)
+        console.print(line, highlight=False, soft_wrap=True)
     settings = run_settings(cores=args.cores)
     schedule = planned_schedule(prepared, settings)
     console.print(plan_table(schedule, f"rank plan for {settings.cores} core(s) "
@@ -67,14 +67,21 @@ def analysis_plan(prepared) -> list[str]:
     """What `ligwf study` will and will not analyse, case by case, before anything runs."""
     absent = {rc.case.case_id: why for rc in prepared.rendered
               if (why := granules_absent(rc.scaled)) is not None}
+    from ligwf.analysis.granules.definitions import describe
+    from ligwf.report.verdict_text import budget_line
+
+    wf = prepared.workflow
     lines = [f"analysis: flow metrics (angle of repose, rigid-block share, velocity profile, "
              f"flowing layer) for all {len(prepared.rendered)} case(s)"]
+    granules = f"granules ({describe(wf.analysis)}), GSD and kinetics"
+    budget = [f"verdict budget (accept: block): {budget_line(wf.accept.model_dump())}"]
     if not absent:
-        return lines + ["analysis: granules, GSD and kinetics for every case"]
+        return lines + [f"analysis: {granules} for every case"] + budget
     if len(absent) == len(prepared.rendered) and len(set(absent.values())) == 1:
-        return lines + [f"analysis: NO granules, GSD or kinetics: {next(iter(absent.values()))}"]
+        return lines + [f"analysis: NO granules, GSD or kinetics: "
+                        f"{next(iter(absent.values()))}"] + budget
     return lines + [f"analysis: no granules, GSD or kinetics for {cid}: {why}"
-                    for cid, why in absent.items()]
+                    for cid, why in absent.items()] + budget
 
 
 def cmd_render(args: argparse.Namespace) -> int:

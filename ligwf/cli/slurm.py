@@ -66,6 +66,10 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
                    help="at most K cases at once (--array=...%%K)")
     p.add_argument("--no-analysis", action="store_true",
                    help="do not submit the dependent analysis job")
+    p.add_argument("--analysis-tasks", type=positive_int, default=1, metavar="N",
+                   help="split the analysis over an array of N tasks after the cases, merged "
+                   "by a job that then writes the report: the tables of one analysis job "
+                   "(default 1: one job; for big studies, see 'ligwf analyse --slurm')")
     p.add_argument("--dry-run", action="store_true",
                    help="print the scripts and sbatch commands; submit and write nothing")
 
@@ -150,7 +154,8 @@ def cmd_submit(args: argparse.Namespace) -> int:
     scheduler = SlurmScheduler(site)
     fixed = args.ntasks is not None or ntasks_configured()   # every case on site.ntasks ranks
     submission = plan_submission(prepared, args.out.resolve(), scheduler, args.cores,
-                                 site.ntasks if fixed else None, not args.no_analysis)
+                                 site.ntasks if fixed else None, not args.no_analysis,
+                                 args.analysis_tasks)
     plans, jobs = submission.schedule.cases, list(submission.jobs)
     title = ("rank plan" + (f" (at most {args.cores} per case)" if args.cores else "")
              if submission.planned else "ranks as asked (--ntasks / site ntasks)")
@@ -214,7 +219,8 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
     plan = scheduler.recorded_plan(study_dir) if args.ntasks is None else None
     again = plan_resubmission(study_dir, scheduler, args.include_unstable, args.cores,
                               planned=plan is not None, recorded_cores=(plan or {}).get("cores"),
-                              analysis=not args.no_analysis)
+                              analysis=not args.no_analysis,
+                              analysis_tasks=args.analysis_tasks)
     if again.busy:
         console.print(f"{len(again.busy)} case(s) still queued or running, not resubmitted: "
                       + ", ".join(c.job or "?" for c in again.busy))

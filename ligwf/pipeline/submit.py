@@ -52,17 +52,29 @@ class Submission:
 
 
 def plan_submission(prepared: Prepared, out: Path, scheduler: Scheduler, cores: int | None,
-                    ntasks: int | None, analysis: bool = True) -> Submission:
+                    ntasks: int | None, analysis: bool = True,
+                    analysis_tasks: int = 1) -> Submission:
     """The schedule and scripts of a first submission of ``prepared`` into ``out`` (pure
-    apart from reading an earlier submission record to number the scripts)."""
+    apart from reading an earlier submission record to number the scripts and drawing a
+    staging token when the analysis is split over ``analysis_tasks`` array tasks)."""
     schedule = submission_schedule(prepared_loads(prepared), cores, ntasks)
     ranks = None if not schedule.planned else {
         rc.case.index: schedule.ranks_of(rc.case.case_id) for rc in prepared.rendered}
     steps = list(POSTPROCESS_COMMANDS) if analysis else []
     jobs = scheduler.plan_jobs(out, prepared.workflow.name,
                                [rc.case.index for rc in prepared.rendered], ranks, steps,
-                               scheduler.next_round(out), cores)
+                               scheduler.next_round(out), cores, analysis_tasks,
+                               _token(analysis_tasks))
     return Submission(out, schedule, tuple(jobs))
+
+
+def _token(analysis_tasks: int) -> str | None:
+    """A fresh staging token for a split analysis (None for one analysis job)."""
+    if analysis_tasks <= 1:
+        return None
+    from ligwf.analysis.outputs import new_token
+
+    return new_token()
 
 
 def write_for_submit(prepared: Prepared, submission: Submission, scheduler: Scheduler,
@@ -96,7 +108,7 @@ class Resubmission:
 
 def plan_resubmission(study_dir: Path, scheduler: Scheduler, include_unstable: bool,
                       cores: int | None, planned: bool, recorded_cores: int | None = None,
-                      analysis: bool = True) -> Resubmission:
+                      analysis: bool = True, analysis_tasks: int = 1) -> Resubmission:
     """The cases that are missing, failed or killed (``include_unstable``: unstable too)
     and not queued, with their scripts. ``planned``: a planned submission is planned
     again, on ``cores`` or else the cores it was planned on (``recorded_cores``);
@@ -116,6 +128,7 @@ def plan_resubmission(study_dir: Path, scheduler: Scheduler, include_unstable: b
             ranks = {c.index: schedule.ranks_of(c.path.name) for c in again}
         steps = list(POSTPROCESS_COMMANDS) if analysis else []
         jobs = scheduler.plan_jobs(study_dir, study.name, indices, ranks, steps,
-                                   scheduler.next_round(study_dir), plan_cores)
+                                   scheduler.next_round(study_dir), plan_cores, analysis_tasks,
+                                   _token(analysis_tasks))
     return Resubmission(Path(study_dir), tuple(st.cases), tuple(indices), tuple(busy),
                         tuple(jobs))

@@ -116,8 +116,14 @@ class PlannedJob:
 def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterable[int],
               analysis_steps: Sequence[str], round_no: int,
               ranks: Mapping[int, int] | None = None,
-              plan_cores: int | None = None) -> list[PlannedJob]:
+              plan_cores: int | None = None, analysis_tasks: int = 1,
+              token: str | None = None) -> list[PlannedJob]:
     """The array job over ``indices`` and (if steps are given) its analysis job (pure).
+
+    ``analysis_tasks`` > 1 (a big study): the ``analyse`` step is split over an array of
+    that many analysis tasks, after the case arrays, and the merge job after them runs the
+    remaining steps (``report``): :func:`plan_analysis_array` with staging ``token``, the
+    same scripts and tables as ``ligwf analyse --slurm N``.
 
     ``ranks`` (case index -> MPI ranks, from the rank plan): one array per rank count,
     widest first, each with ``--ntasks`` of its cases (``array-R-npK.sh``; ``array-R.sh``
@@ -148,7 +154,13 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
                                site=job_site, planned=ranks is not None,
                                plan_cores=plan_cores if ranks is not None else None,
                                nodes=nodes))
-    if analysis_steps:
+    if analysis_steps and analysis_tasks > 1 and "analyse" in analysis_steps:
+        if token is None:
+            raise ConfigError("a split analysis needs a staging token")
+        rest = [step for step in analysis_steps if step != "analyse"]
+        split = plan_analysis_array(study_dir, study_name, site, analysis_tasks, token, rest)
+        jobs += [replace(split[0], after_array=True), split[1]]   # the array after the runs
+    elif analysis_steps:
         ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
         jobs.append(PlannedJob("analysis", Path(study) / SLURM_DIR / f"analysis-{round_no}.sh",
                                analysis_script(ctx, site, analysis_steps), idx,
@@ -174,13 +186,16 @@ def plan_analysis_array(study_dir: Path, study_name: str, site: SlurmSite, count
 def dry_run_text(jobs: Sequence[PlannedJob]) -> str:
     """What ``--dry-run`` prints: each script, then the sbatch command that would submit it."""
     arrays = sum(1 for job in jobs if job.kind in ARRAY_KINDS)
-    ids = (["<array job id>"] if arrays == 1
-           else [f"<array job id {n}>" for n in range(1, arrays + 1)])
-    out = []
+    names = (["<array job id>"] if arrays == 1
+             else [f"<array job id {n}>" for n in range(1, arrays + 1)])
+    out: list[str] = []
+    ids: list[str] = []                     # the arrays before a job: what it waits for
     for job in jobs:
         cmd = sbatch_command(job.script_path)
         if job.after_array:
             cmd.insert(2, "--dependency=afterany:" + ":".join(ids))
+        if job.kind in ARRAY_KINDS:
+            ids.append(names[len(ids)])
         out += [f"# ----- {job.script_path} -----", job.script_text.rstrip("\n"),
                 f"# would run: {' '.join(cmd)}", ""]
     return "\n".join(out)

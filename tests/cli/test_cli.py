@@ -60,6 +60,20 @@ def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, overr
     assert not out.exists()
 
 
+def test_check_names_the_granule_definition_and_the_verdict_budget(tmp_path, monkeypatch,
+                                                                  capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["check", str(DRUM), "--set", "analysis.granules=held",
+                 "--set", "analysis.hold_time=0.3", "--set", "accept.angle_deg=2",
+                 "--set", "accept.gsd_error=null"]) == 0
+    out = capsys.readouterr().out
+    assert "analysis: granules (held, bridges through 0.3 s), GSD and kinetics for every " \
+        "case" in out
+    budget = next(ln for ln in out.splitlines() if ln.startswith("verdict budget"))
+    assert "angle of repose <= 2 deg (or the CG1 noise floor, if larger)" in budget
+    assert "not in the budget" in budget and "<= 0.1" in budget
+
+
 def test_console_entry_point():
     out = subprocess.run([sys.executable, "-m", "ligwf.cli.main", "--help"], capture_output=True, text=True)
     assert out.returncode == 0

@@ -1,6 +1,8 @@
 """index.html in a real headless browser (Debian's Chromium): the report of a tiny real study
-(CG1 and a Weber CG2 beside a cohesionless twin, real LIGGGHTS runs) opens, shows the
-verdict first and the same sections as summary.md, and every figure loads.
+(CG1 and two Weber CG2 beside a cohesionless twin, real LIGGGHTS runs: the session's API
+study of tests/apistudy.py, reported again here with snapshots into a folder of this test's
+own) opens, shows the verdict first and the same sections as summary.md, and every figure
+loads.
 
 Chromium screenshots the page (checked to be a real picture, not a blank page) and dumps
 the DOM after a small script, added to a copy of the page in the same folder (so relative
@@ -20,12 +22,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from helpers import ROOT
+from apistudy import api_study
 from ligwf.cli.main import main
 
 pytestmark = [pytest.mark.browser, pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
 
-TINY = ROOT / "tests" / "workflows" / "tiny_study.yaml"
 #: headless Chromium on a machine without network (see the machine notes: without the
 #: background-networking flags it keeps trying to reach Google's hosts)
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
@@ -39,11 +40,12 @@ PROBE = """<script>window.addEventListener("load", () => {
 
 @pytest.fixture(scope="module")
 def report(engine, tmp_path_factory) -> Path:
-    out = tmp_path_factory.mktemp("page") / "tiny"
-    rc = main(["study", str(TINY), "--out", str(out), "--set", "sweep.rules=[weber]",
-               "--set", "sweep.replicas={1: 1, 2: 1}", "--set", "sweep.controls=[cohesionless]"])
-    assert rc == 0
-    return out / "report"
+    """The shared tiny study's report with its snapshots, in a folder of this test's own
+    (the probe page written next to index.html never touches the shared study)."""
+    study = api_study(engine, tmp_path_factory)
+    out = tmp_path_factory.mktemp("page") / "report"
+    assert main(["report", str(study), "--out", str(out)]) == 0
+    return out
 
 
 def run_chromium(chromium: str, profile: Path, *args: str) -> subprocess.CompletedProcess:

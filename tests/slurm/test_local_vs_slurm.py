@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 
 from ligwf.pipeline.post import POSTPROCESS_COMMANDS, postprocess
+from ligwf.slurm.jobs import read_record
 from ligwf.study.study import Study
 
 from test_slurm_integration import _logs, wait_until_idle
@@ -79,15 +80,28 @@ def _record(study: Path) -> dict:
 
 
 def test_local_and_slurm_give_identical_analysis(slurm_cluster, tmp_path, env):
-    local, slurm = tmp_path / "local", tmp_path / "slurm"
+    local, slurm, split = tmp_path / "local", tmp_path / "slurm", tmp_path / "split"
     ligwf("slurm", "submit", str(WORKFLOW), "--out", str(slurm), "--ntasks", "1",
           "--time", "00:10:00", *SETS, env=env)
     script = (slurm / "slurm" / "analysis-1.sh").read_text()
     assert [f"{LIGWF} {c} {slurm}" for c in POSTPROCESS_COMMANDS] == \
         [ln for ln in script.splitlines() if ln.startswith(LIGWF)]
+    # the same study with its analysis split over 3 array tasks after the cases, merged
+    ligwf("slurm", "submit", str(WORKFLOW), "--out", str(split), "--ntasks", "1",
+          "--time", "00:10:00", "--analysis-tasks", "3", *SETS, env=env)
+    record = read_record(split)
+    assert [e["kind"] for e in record] == ["array", "analysis-array", "analysis-merge"]
+    assert record[1]["after"] == record[0]["job_id"]                 # the tasks after the runs
+    assert record[2]["after"] == f"{record[0]['job_id']}:{record[1]['job_id']}"
     ligwf("study", str(WORKFLOW), "--out", str(local), "--no-snapshots", *SETS, env=env)
     wait_until_idle(slurm, timeout=300)
     assert (slurm / "report" / "summary.md").is_file(), _logs(slurm)
+    wait_until_idle(split, timeout=300)
+    assert (split / "report" / "summary.md").is_file(), _logs(split)
+    for name in TABLES:                       # split over tasks = one analysis job, bytewise
+        assert (split / "analysis" / name).read_bytes() == \
+            (slurm / "analysis" / name).read_bytes(), name
+    assert not list((split / "analysis").glob(".parts-*"))
 
     for study in (local, slurm):
         s = Study.open(study)

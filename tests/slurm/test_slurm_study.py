@@ -55,6 +55,30 @@ def test_plan_has_array_of_exact_indices_and_dependent_analysis(tmp_path):
     assert plan_jobs(tmp_path, "s", site, [0], [], 1)[-1].kind == "array"
 
 
+def test_a_split_analysis_is_an_array_after_the_cases_then_a_merge_that_reports(tmp_path):
+    site = SlurmSite(ligwf="/venv/bin/ligwf")
+    jobs = plan_jobs(tmp_path, "s", site, [0, 1], ["analyse", "report"], 1, ranks={0: 2, 1: 1},
+                     analysis_tasks=3, token="abc123")
+    assert [j.kind for j in jobs] == ["array", "array", "analysis-array", "analysis-merge"]
+    tasks, merge = jobs[2:]
+    assert tasks.after_array and merge.after_array and tasks.indices == (0, 1, 2)
+    assert "#SBATCH --array=0-2\n" in tasks.script_text
+    assert '--part "$SLURM_ARRAY_TASK_ID/3" --token abc123' in tasks.script_text
+    lines = [ln for ln in merge.script_text.splitlines() if ln.startswith("/venv/bin/ligwf")]
+    study = tmp_path.resolve()
+    assert lines == [f"/venv/bin/ligwf analyse {study} --merge 3 --token abc123",
+                     f"/venv/bin/ligwf report {study}"]       # analyse is the split, not again
+    text = dry_run_text(jobs).splitlines()
+    runs = [ln for ln in text if ln.startswith("# would run:")]
+    assert "--dependency" not in runs[0] + runs[1]
+    assert "--dependency=afterany:<array job id 1>:<array job id 2> " in runs[2]
+    assert "--dependency=afterany:<array job id 1>:<array job id 2>:<array job id 3> " in runs[3]
+    one = plan_jobs(tmp_path, "s", site, [0], ["analyse", "report"], 1, analysis_tasks=1)
+    assert [j.kind for j in one] == ["array", "analysis"]
+    with pytest.raises(ConfigError, match="token"):
+        plan_jobs(tmp_path, "s", site, [0], ["analyse"], 1, analysis_tasks=2)
+
+
 def test_record_round_and_recorded_site(tmp_path):
     assert read_record(tmp_path) == [] and next_round(tmp_path) == 1
     append_record(tmp_path, {"kind": "array", "job_id": "5", "indices": [0, 1],
