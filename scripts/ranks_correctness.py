@@ -7,7 +7,7 @@ This script runs the case with ligwf's own runner (``ligwf run``) and writes the
     LIGWF_MPIRUN_ARGS="--oversubscribe --bind-to none" \
         .venv/bin/python scripts/ranks_correctness.py run --out /tmp/ranks
     .venv/bin/python scripts/ranks_correctness.py table --out /tmp/ranks \
-        --write docs/results/performance/ranks.md
+        --write docs/results/performance/ranks.md --marker table2
 
 ``run``: study ``OUT/seeds`` (replicas r0-r7 of the demo CG1, 1 rank each, side by side as the
 planner packs them) and ``OUT/np{K}`` (replicas r0-r2 on K ranks, ``--np K``, one after the other) for each ``--ranks``.
@@ -163,7 +163,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--ranks", type=int, nargs="+", default=[1, 2, 4, 8])
     ap.add_argument("--write", type=Path, help="(table) also write the table into this file "
-                    "between its '<!-- table -->' markers")
+                    "between its '<!-- MARKER -->' and '<!-- /MARKER -->' lines")
+    ap.add_argument("--marker", default="table2", help="(table) the markers' name (table2: "
+                    "the second registration's table; the first one's, 'table', stays as run)")
     a = ap.parse_args(argv)
     if a.what == "run":
         if "--oversubscribe" not in os.environ.get("LIGWF_MPIRUN_ARGS", ""):
@@ -175,10 +177,10 @@ def main(argv: list[str] | None = None) -> int:
     print(text)
     if a.write:
         doc = a.write.read_text()
-        head, sep, rest = doc.partition("<!-- table -->\n")
-        _, sep2, tail = rest.partition("<!-- /table -->\n")
+        head, sep, rest = doc.partition(f"<!-- {a.marker} -->\n")
+        _, sep2, tail = rest.partition(f"<!-- /{a.marker} -->\n")
         if not (sep and sep2):
-            print(f"{a.write}: no '<!-- table -->' ... '<!-- /table -->' markers",
+            print(f"{a.write}: no '<!-- {a.marker} -->' ... '<!-- /{a.marker} -->' markers",
                   file=sys.stderr)
             return 2
         a.write.write_text(head + sep + text + sep2 + tail)

@@ -216,6 +216,7 @@ def submit_jobs(study_dir: Path, jobs: Sequence[PlannedJob], site: SlurmSite,
         job.script_path.chmod(0o755)
         if job.after_array and not array_ids:
             raise SubmitError("analysis job planned without an array job")
+        after = ":".join(array_ids) if job.after_array else None   # the arrays before it
         cmd = sbatch_command(job.script_path, array_ids if job.after_array else None)
         out = run(cmd)
         if out.returncode != 0:
@@ -226,7 +227,7 @@ def submit_jobs(study_dir: Path, jobs: Sequence[PlannedJob], site: SlurmSite,
             array_ids.append(job_id)
         entry = {"kind": job.kind, "job_id": job_id, "indices": list(job.indices),
                  "script": str(job.script_path.relative_to(Path(study_dir).resolve())),
-                 "command": cmd, "after": ":".join(array_ids) if job.after_array else None,
+                 "command": cmd, "after": after,
                  "site": asdict(job.site or site),
                  "submitted": datetime.now(timezone.utc).isoformat(timespec="seconds")}
         if job.planned:
