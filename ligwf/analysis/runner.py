@@ -285,6 +285,20 @@ def analyse_frame(ana: GranuleAnalysis, ff: FrameFiles) -> FrameResult:
                                  f"({type(exc).__name__}: {exc})")
 
 
+def window_reason(f: RunFacts, results, settings: AnalysisSettings) -> str | None:
+    """Why a case has no granules when from every one of its frames the hold window ran
+    past the run's end (``granules: held`` on a run shorter than ``hold_time``): a setting,
+    not a fault, so the case keeps its flow metrics and the record says why and what to
+    change. None when any frame of the case had another fate."""
+    mine = [r for r in results if r.case_id == f.case_id]
+    if not mine or any(r.kind != "window" for r in mine):
+        return None
+    return (f"from each of its {len(mine)} frame(s) the hold window (analysis.hold_time = "
+            f"{settings.hold_time:g} s, granules: held) runs past the last frame; shorten "
+            "analysis.hold_time or lengthen process.run_time (ligwf check warns of this "
+            "before a run)")
+
+
 def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipped_cases,
                   results, settings: AnalysisSettings, options: AnalysisOptions,
                   absent: list[dict], flows: FlowRecord) -> dict:
@@ -296,9 +310,12 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     tables = frame_tables(facts, results)
     skipped_frames, frame_index = tables.skipped_frames, tables.frame_index
     analysed = [f for f in facts if frame_index.get(f.case_id, 0) > 0]
+    unanalysed = [(f, window_reason(f, results, settings)) for f in facts if f not in analysed]
+    absent = list(absent) + [{"case_id": f.case_id, "reason": why}
+                             for f, why in unanalysed if why is not None]
     skipped_cases = skipped_cases + [
         {"case_id": f.case_id, "reason": f"no analysable frame ({f.plan.expected} expected; "
-         "see the skipped frames)"} for f in facts if f not in analysed]
+         "see the skipped frames)"} for f, why in unanalysed if why is None]
     base = {
         "run_dir": str(study.path),
         "settings": settings.model_dump(mode="json"),
@@ -315,7 +332,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
             raise nothing_analysed(study.path, skipped_cases, skipped_frames)
         record = {**base, "cases": []}
         stage_flow(outputs, flows)
-        commit(outputs, record, obsolete=GRANULE_OUTPUTS)
+        commit(outputs, record, obsolete=GRANULE_OUTPUTS + field_outputs(outputs.out_dir))
         return record
     cases = [f.case for f in analysed]
     steady_from = {c.case_id: flows.cases[c.case_id].steady_from_step for c in cases}
@@ -333,8 +350,21 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
                    "steady_from_step": steady_from[c.case_id],
                    "steady_frames": int(steady_frames.get(c.case_id, 0))} for c in cases],
     }
-    commit(outputs, record, obsolete=GRANULE_OUTPUTS)    # e.g. no twins now: no controls.csv
+    # e.g. no twins now: no controls.csv; a case no longer measured: no fields_<case>.vti
+    commit(outputs, record, obsolete=GRANULE_OUTPUTS + field_outputs(outputs.out_dir))
     return record
+
+
+def field_outputs(out_dir: Path) -> tuple[str, ...]:
+    """The field files an earlier analysis left in ``out_dir`` (the archive and every
+    case's ParaView image): replaced by this analysis' or dropped with it, so no image of
+    a case the study no longer measures outlives it."""
+    names = [layout.FIELDS_DATA]
+    if Path(out_dir).is_dir():
+        prefix, suffix = layout.field_image("\0").split("\0")
+        names += sorted(p.name for p in Path(out_dir).iterdir()
+                        if p.is_file() and p.name.startswith(prefix) and p.name.endswith(suffix))
+    return tuple(names)
 
 
 def stage_flow(outputs: OutputSet, flows: FlowRecord) -> None:

@@ -23,7 +23,7 @@ from ligwf.study.case import CaseFolder
 from ligwf.scene.settings import AnalysisSettings
 from wetdump import wet_study
 
-FAST = AnalysisOptions(settings=AnalysisSettings(bootstrap=100))
+FAST = AnalysisOptions(settings=AnalysisSettings(granules="communities", bootstrap=100))
 OUTPUTS = ("granules.parquet", "frames.csv", "gsd.csv", "gsd_summary.csv", "analysis.json")
 
 
@@ -34,7 +34,7 @@ def study(engine, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("analysed") / "study"
     shutil.copytree(wet_study(engine, tmp_path_factory), out)
     record = json.loads((out / "study.json").read_text())
-    record["analysis"] = {"bootstrap": 100}
+    record["analysis"] = {"granules": "communities", "bootstrap": 100}
     (out / "study.json").write_text(json.dumps(record))
     return out
 
@@ -70,7 +70,7 @@ def test_outputs_of_a_study(study, serial):
     pd.testing.assert_frame_equal(a, b)
     # the table equals a direct run of the life-cycle class
     case = CaseFolder.open(study / "cg3-weber-r0")
-    ref = GranuleAnalysis(case, AnalysisSettings()).run()   # vs reference: test_definitions
+    ref = GranuleAnalysis(case, AnalysisSettings(granules="communities")).run()   # the study's
     for r in ref.results:
         got = a[a.step == r.step].reset_index(drop=True)
         np.testing.assert_array_equal(got["members"], r.table["members"])
@@ -141,7 +141,7 @@ def test_manifest_gates_cases(study, tmp_path):
         analyse(copy, tmp_path / "out", FAST)
     assert not (tmp_path / "out").exists()
     opened = analyse(copy, tmp_path / "out2", AnalysisOptions(
-        settings=AnalysisSettings(bootstrap=10), require_manifest=False))
+        settings=AnalysisSettings(granules="communities", bootstrap=10), require_manifest=False))
     analysed = {c["case_id"]: c["analysed"] for c in opened["cases"]}
     n = len(discover_frames(copy / "cg3-weber-r0"))
     # the bond case was never run: skipped with its missing frames; the others fully analysed

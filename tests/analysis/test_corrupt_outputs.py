@@ -34,7 +34,7 @@ def study(engine, tmp_path_factory) -> Path:
     assert main(["run", str(TINY), "--out", str(out), "--set", "sweep.rules=[weber]",
                  "--set", "sweep.replicas=2", "--set", "scene.process.run_time=0.2"]) == 0
     rec = json.loads((out / "study.json").read_text())
-    rec["analysis"] = {"bootstrap": 20}
+    rec["analysis"] = {"granules": "communities", "bootstrap": 20}
     (out / "study.json").write_text(json.dumps(rec))
     assert (out / R0 / "dumps.json").is_file(), "a done manifest comes with its dump record"
     return out

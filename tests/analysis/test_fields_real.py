@@ -27,7 +27,7 @@ def test_fields_of_real_wet_dumps(engine, tmp_path_factory, tmp_path):
     study = tmp_path / "study"
     shutil.copytree(wet_study(engine, tmp_path_factory), study)
     record = json.loads((study / "study.json").read_text())
-    record["analysis"] = {"bootstrap": 50, "sensitivity_frames": 0}
+    record["analysis"] = {"granules": "communities", "bootstrap": 50, "sensitivity_frames": 0}
     (study / "study.json").write_text(json.dumps(record))
     assert main(["analyse", str(study), "--no-vtu"]) == 0
     analysis = study / layout.ANALYSIS_DIR
@@ -44,6 +44,11 @@ def test_fields_of_real_wet_dumps(engine, tmp_path_factory, tmp_path):
         # every particle's volume is on the grid but what the kernel spreads past its edge
         total = f["solid_fraction"].sum() * cf.grid.spacing**2 * cf.grid.length
         assert 0.8 < total / bed_volume(study / cid) <= 1.0 + 1e-6
+    # the image of a case the study no longer measures does not outlive a new analysis
+    stale = analysis / layout.field_image("cg3-weber-r9")
+    stale.write_text("an image of an earlier analysis")
+    assert main(["analyse", str(study), "--no-vtu"]) == 0
+    assert not stale.exists() and all((analysis / layout.field_image(c)).is_file() for c in fields)
     r0, r1 = fields["cg3-weber-r0"], fields["cg3-weber-r1"]
     assert np.array_equal(r0.moments, r1.moments)
     assert field_floor([r0, r1], "field_error").value == 0.0

@@ -116,7 +116,7 @@ def test_a_registered_flow_metric_reaches_the_report_tables_on_a_real_study(
     study = tmp_path_factory.mktemp("toy_metric") / "study"
     shutil.copytree(wet_study(engine, tmp_path_factory), study)
     record = json.loads((study / "study.json").read_text())
-    record["analysis"] = {"bootstrap": 50, "sensitivity_frames": 0}
+    record["analysis"] = {"granules": "communities", "bootstrap": 50, "sensitivity_frames": 0}
     (study / "study.json").write_text(json.dumps(record))
     assert main(["analyse", str(study), "--no-vtu"]) == 0
 

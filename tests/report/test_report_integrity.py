@@ -52,7 +52,7 @@ def study(engine, tmp_path_factory) -> Path:
     out = tmp_path_factory.mktemp("integrity") / "study"
     assert main(["run", str(TINY), "--out", str(out), "--np", "1", *BOND]) == 0
     rec = json.loads((out / "study.json").read_text())
-    rec["analysis"] = {"bootstrap": 20, "sensitivity_frames": 0}
+    rec["analysis"] = {"granules": "communities", "bootstrap": 20, "sensitivity_frames": 0}
     (out / "study.json").write_text(json.dumps(rec))
     assert main(["analyse", str(out), "--no-vtu"]) == 0
     return out
