@@ -37,7 +37,21 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     title = (f"rank plan for {settings.cores} core(s) ({settings.cores_source})"
              if settings.planned else "ranks as asked (--np / --ensemble)")
     console.print(plan_table(run.schedule, title))
+    for line in elsewhere(run.study.cases, settings.retry_unstable):
+        console.print(line, highlight=False, soft_wrap=True)
     return run
+
+
+def elsewhere(cases, retry_unstable: bool) -> list[str]:
+    """The cases another live ligwf process is running (left to it, not in the plan)."""
+    from ligwf.engine.resume import SKIP, plan_case
+
+    out = []
+    for c in cases:
+        plan = plan_case(c, retry_unstable)
+        if plan.action == SKIP and plan.reason.startswith("running in process"):
+            out.append(f"{c.path.name}: {plan.reason}: left to that runner")
+    return out
 
 
 def run_with_progress(run: StudyRun, args: argparse.Namespace) -> bool:

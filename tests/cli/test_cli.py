@@ -131,3 +131,33 @@ def test_run_plans_unless_np_or_ensemble_is_given(tmp_path, argv, planned, nproc
 def test_cores_must_be_a_positive_whole_number(capsys):
     assert main(["check", str(DRUM), "--cores", "0"]) == 2
     assert "--cores" in capsys.readouterr().err
+
+
+def test_run_names_the_cases_another_live_runner_holds(tmp_path, monkeypatch):
+    """A second ``ligwf run`` on a study leaves a case another live ligwf process is
+    running to it and says so (not just "nothing to run")."""
+    import socket
+
+    from ligwf.cli.run import elsewhere
+    from ligwf.study.manifest import Manifest
+    from ligwf.study.processes import start_time
+    from ligwf.study.study import Study
+
+    monkeypatch.setenv("LIGWF_MESH_CACHE", str(tmp_path / "cache"))
+    out = tmp_path / "study"
+    assert main(["render", str(DRUM), "--out", str(out), "--set", "sweep.cg_levels=[3]",
+                 "--set", "sweep.rules=[weber]"]) == 0
+    case = Study.open(out).cases[0]
+    other = subprocess.Popen(["sleep", "60"])            # stands for the other runner
+    try:
+        m = Manifest(case_id=case.case_id, index=case.index, scene_hash=case.scene_hash,
+                     ligwf_version="", liggghts_version="", status="running",
+                     host=socket.gethostname(), pid=other.pid, pid_start=start_time(other.pid))
+        case.write_manifest(m)
+        assert elsewhere(Study.open(out).cases, False) == [
+            f"{case.case_id}: running in process {other.pid} on {socket.gethostname()}: "
+            "left to that runner"]
+    finally:
+        other.kill()
+        other.wait()
+    assert elsewhere(Study.open(out).cases, False) == []     # its runner is gone: resumable
