@@ -184,11 +184,11 @@ def report(label: str, p, c, length, liquid, folder: Path | None, step: int,
 
 
 def report_communities(label: str, p, c, length: float, liquid: Liquid) -> None:
-    """Time per frame of the default definition (Leiden CPM of the rupture-work-weighted
+    """Time per frame of the communities definition (the default until 2026-12-02; Leiden CPM of the rupture-work-weighted
     bridges, igraph, graph built from numpy arrays) with its split: bond test with forces,
     the rupture-work quadrature, the CPM partition, the components of the intra-community
     bonds; frames/s on one core (target >= 0.5 at 360k)."""
-    definition = AnalysisSettings()
+    definition = AnalysisSettings(granules="communities")
     motion = Motion(1, None, 1, length)
     t_all, ident = timed(lambda: identify_granules(p, c, liquid, definition, 1.0, motion), 1)
     t_bond, (i, j, force, rows) = timed(

@@ -37,10 +37,11 @@ from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.study import Study
 
 DEFINITIONS = {
-    "cpm-energy (default)": AnalysisSettings(),
+    "cpm-energy (default until 2026-12-02)": AnalysisSettings(granules="communities"),
     "components lab 30 (source)": AnalysisSettings(granules="components", velocity_frame="lab",
                                                    max_velocity_angle=30.0),
-    "cpm-force 0.02 (old default)": AnalysisSettings(resolution=0.02, community_weight="force"),
+    "cpm-force 0.02 (old default)": AnalysisSettings(granules="communities", resolution=0.02,
+                                                     community_weight="force"),
 }
 
 

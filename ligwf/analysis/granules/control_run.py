@@ -33,7 +33,7 @@ from ligwf.study.case import CaseFolder
 
 #: definitions measured by default: name -> (kind, parameter)
 DEFAULT_CANDIDATES = (
-    ("communities", "frame", AnalysisSettings()),
+    ("communities", "frame", AnalysisSettings(granules="communities")),
     ("source_components_angle30", "frame",
      AnalysisSettings(granules="components", max_velocity_angle=30.0)),
     ("bridge_components", "frame", AnalysisSettings(granules="components")),
