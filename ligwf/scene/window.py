@@ -20,6 +20,9 @@ from ligwf.scene.workflow import Workflow
 AUTO_LATEST = 0.5
 #: fewer usable frames than this leave the block bootstrap and the survival measure nothing
 MIN_USABLE_FRAMES = 10
+#: hold times the regime map measured, in revolutions of its drum (0.1-1 s at T = 2 s):
+#: held granules beat their cohesionless twin at about half a revolution
+HOLD_REVOLUTIONS = (0.25, 1.0)
 
 
 def held_window_warnings(wf: Workflow) -> list[str]:
@@ -51,4 +54,28 @@ def held_window_warnings(wf: Workflow) -> list[str]:
                         f"({case.case_id}); lengthen process.run_time to at least "
                         f"{(settings.hold_time + period / 4.0 + MIN_USABLE_FRAMES * every) / (1.0 - start):.3g} s "
                         "or shorten analysis.hold_time")
+    return list(out.values()) + hold_period_warnings(wf)
+
+
+def hold_period_warnings(wf: Workflow) -> list[str]:
+    """One warning per drum speed at which ``hold_time`` is far from half a revolution
+    (outside :data:`HOLD_REVOLUTIONS`): the default 1 s is half a revolution at the regime
+    map's 30 rpm only, so a slower or faster drum holds its bridges for another share of a
+    turn than the one that was measured (pure)."""
+    settings = wf.analysis
+    out: dict[float, str] = {}
+    lo, hi = HOLD_REVOLUTIONS
+    for case in wf.cases:
+        scene = case.scene
+        if not (scene.analysis.granules and scene.liquid.wet):
+            continue
+        period = 2.0 * math.pi / scene.process.rotation.omega(scene.drum.diameter / 2.0)
+        turns = settings.hold_time / period
+        if not lo <= turns <= hi and period not in out:
+            out[period] = (f"analysis.hold_time = {settings.hold_time:g} s is {turns:.2g} "
+                           f"revolution(s) of this drum (period {period:.3g} s, "
+                           f"{case.case_id}); the regime map's held granules beat their "
+                           f"cohesionless twin at about half a revolution: analysis.hold_time "
+                           f"= {period / 2.0:.3g} s (allowed without warning: "
+                           f"{lo * period:.3g}-{hi * period:.3g} s)")
     return list(out.values())

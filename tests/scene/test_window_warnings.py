@@ -46,3 +46,17 @@ def test_other_definitions_and_dry_scenes_do_not_warn():
     raw["scene"]["analysis"] = {"granules": False}
     raw["sweep"].update(controls=[], rules=["weber"])
     assert held_window_warnings(expand(raw)) == []
+
+
+def test_a_hold_time_far_from_half_a_revolution_of_this_drum_is_named():
+    """The default 1 s is half a revolution at the demo's 30 rpm (T = 2 s): fine there; at
+    6 rpm (T = 10 s) it is a tenth of a turn, and the warning gives the half-turn value."""
+    assert warnings_for(5.0) == []
+    raw = copy.deepcopy(DEMO)
+    raw["scene"]["process"]["run_time"] = 30.0
+    raw["scene"]["process"]["rotation"] = {"rpm": 6}
+    (w,) = held_window_warnings(expand(raw))
+    assert w.startswith("analysis.hold_time = 1 s is 0.1 revolution(s)")
+    assert "period 10 s" in w and "analysis.hold_time = 5 s" in w and "2.5-10 s" in w
+    raw["analysis"]["hold_time"] = 5.0
+    assert held_window_warnings(expand(raw)) == []
