@@ -13,6 +13,7 @@ import re
 
 from ligwf import __version__
 from ligwf.fsio import LOW_SPACE_BYTES, FolderNotWritable, atomic_write_text, space_left
+from ligwf.engine.dump_hasher import dump_problem
 from ligwf.engine.health import (Expectation, assess, engine_signal, kinetic_energy_ceiling,
                                  verdict)
 from ligwf.engine.restart_id import CaseIdentity, stamp
@@ -119,23 +120,6 @@ def credit_restart(s: ScaledScene, manifest: Manifest, restart_step: int) -> Non
 
 
 _DUMP_STEP_RE = re.compile(r"_(\d+)\.vt[ur]$")
-#: how every complete XML VTK file LIGGGHTS writes ends
-_VTK_END = b"</VTKFile>"
-
-
-def _dump_problem(path) -> str | None:
-    """Why a dump file is not whole (empty, or cut before its closing tag), None if it is."""
-    try:
-        size = path.stat().st_size
-        if size == 0:
-            return f"empty dump {path.name}"
-        with open(path, "rb") as fh:
-            fh.seek(max(0, size - 64))
-            if _VTK_END not in fh.read():
-                return f"truncated dump {path.name}"
-    except OSError as exc:
-        return f"unreadable dump {path.name} ({exc.strerror})"
-    return None
 
 
 def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | None:
@@ -163,7 +147,7 @@ def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | No
             names.add(f.name)
             m = _DUMP_STEP_RE.search(f.name)
             if m and f.is_file() and int(m.group(1)) <= reached:
-                why = _dump_problem(f)
+                why = dump_problem(f)
                 if why is not None:
                     holes.append((int(m.group(1)) - 1, why))
         for step in case.expected_dump_steps(reached):

@@ -23,7 +23,7 @@ import re
 import threading
 from pathlib import Path
 
-from ligwf.study.case import KnownDigests, file_digest
+from ligwf.study.case import KnownDigests, file_digest, file_identity
 
 #: ``<series>_<step>.vtu`` / ``.vtr``: the dump file names LIGGGHTS writes into post/
 _DUMP = re.compile(r"^(?P<series>.+)_(?P<step>\d+)\.vt[ur]$")
@@ -46,39 +46,36 @@ def complete_dumps(post: Path) -> list[Path]:
     out = []
     for files in series.values():
         files.sort()
-        out += [p for _, p in files[:-1] if _ends_whole(p)]
+        out += [p for _, p in files[:-1] if dump_problem(p) is None]
     return sorted(out, key=lambda p: (int(_DUMP.match(p.name).group("step")), p.name))
 
 
-def _ends_whole(path: Path) -> bool:
+def dump_problem(path: Path) -> str | None:
+    """Why a dump file is not whole (empty, or cut before its closing tag), None if it is
+    (also what the runner's record check calls a hole: :func:`ligwf.engine.attempt.record_hole`)."""
     try:
+        size = path.stat().st_size
+        if size == 0:
+            return f"empty dump {path.name}"
         with open(path, "rb") as fh:
-            fh.seek(0, os.SEEK_END)
-            fh.seek(max(0, fh.tell() - 64))
-            return _VTK_END in fh.read()
-    except OSError:
-        return False
-
-
-def identity(path: Path) -> tuple[int, int, int] | None:
-    """(inode, size, modification time ns) of a file, None when it cannot be read."""
-    try:
-        st = os.stat(path)
-    except OSError:
-        return None
-    return st.st_ino, st.st_size, st.st_mtime_ns
+            fh.seek(max(0, size - 64))
+            if _VTK_END not in fh.read():
+                return f"truncated dump {path.name}"
+    except OSError as exc:
+        return f"unreadable dump {path.name} ({exc.strerror})"
+    return None
 
 
 def hash_if_unchanged(path: Path) -> tuple[tuple[int, int, int], str] | None:
     """(identity, SHA-256) of ``path`` when it did not change while it was hashed."""
-    before = identity(path)
+    before = file_identity(path)
     if before is None:
         return None
     try:
         digest = file_digest(path)
     except OSError:
         return None
-    return (before, digest) if identity(path) == before else None
+    return (before, digest) if file_identity(path) == before else None
 
 
 class DumpHasher:
@@ -116,7 +113,7 @@ class DumpHasher:
             if self._stop.is_set():
                 break
             known = self._known.get(path.name)
-            if known is not None and known[0] == identity(path):
+            if known is not None and known[0] == file_identity(path):
                 continue
             got = hash_if_unchanged(path)
             if got is not None:

@@ -16,6 +16,7 @@ edited, copied in from another replica or added afterwards no longer matches it.
 from __future__ import annotations
 
 import hashlib
+import os
 import json
 import re
 from dataclasses import dataclass
@@ -42,6 +43,16 @@ def file_digest(path: Path) -> str:
     return h.hexdigest()
 
 
+def file_identity(path: Path) -> tuple[int, int, int] | None:
+    """(inode, size, modification time ns) of a file, None when it cannot be read: a file
+    with the same identity is taken to hold the same bytes it was hashed with."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_ino, st.st_size, st.st_mtime_ns
+
+
 @dataclass(frozen=True)
 class KnownDigests:
     """SHA-256 of files hashed earlier (by the running case's dump hasher,
@@ -53,10 +64,8 @@ class KnownDigests:
 
     def digest(self, path: Path) -> str:
         known = self.files.get(path.name)
-        if known is not None:
-            st = path.stat()
-            if known[0] == (st.st_ino, st.st_size, st.st_mtime_ns):
-                return known[1]
+        if known is not None and known[0] == file_identity(path):
+            return known[1]
         return file_digest(path)
 
 
