@@ -53,3 +53,17 @@ def wet_study(engine, tmp_path_factory) -> Path:
     (out / "study.json").write_text(json.dumps(study))
     _CACHE["study"] = out
     return out
+
+
+def wet_case_frames(engine, tmp_path_factory):
+    """(case folder, run facts, [(particles, contacts)] of every frame) of the run case of
+    :func:`wet_study` (``cg3-weber-r0``), the frames read afresh for each caller."""
+    from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
+    from ligwf.analysis.granules.case import RunFacts
+    from ligwf.study.case import CaseFolder
+
+    case = CaseFolder.open(wet_study(engine, tmp_path_factory) / "cg3-weber-r0")
+    facts = RunFacts.of_case(case)
+    frames = [(read_particles(f.particles, dt=facts.dt), read_contacts(f.contacts))
+              for f in discover_frames(case.path)]
+    return case, facts, frames

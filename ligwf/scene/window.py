@@ -28,18 +28,15 @@ HOLD_REVOLUTIONS = (0.25, 1.0)
 def held_window_warnings(wf: Workflow) -> list[str]:
     """One warning per distinct (run time, speed, dump interval) whose held-granule window is
     too short: production - steady start - hold_time - T/4 holds fewer than
-    :data:`MIN_USABLE_FRAMES` dump intervals (pure)."""
+    :data:`MIN_USABLE_FRAMES` dump intervals, then those of :func:`hold_period_warnings`
+    (pure)."""
     settings = wf.analysis
     if settings.granules != "held":
         return []
     start = AUTO_LATEST if settings.steady_after == "auto" else float(settings.steady_after)
     out: dict[tuple[float, float, float], str] = {}
-    for case in wf.cases:
-        scene = case.scene
-        if not (scene.analysis.granules and scene.liquid.wet):
-            continue
-        run, every = scene.process.run_time, scene.numerics.dump_interval
-        period = 2.0 * math.pi / scene.process.rotation.omega(scene.drum.diameter / 2.0)
+    for case, period in _granule_cases(wf):
+        run, every = case.scene.process.run_time, case.scene.numerics.dump_interval
         usable = run * (1.0 - start) - settings.hold_time - period / 4.0
         frames = math.floor(max(usable, 0.0) / every + 1e-9)
         key = (run, period, every)
@@ -65,11 +62,7 @@ def hold_period_warnings(wf: Workflow) -> list[str]:
     settings = wf.analysis
     out: dict[float, str] = {}
     lo, hi = HOLD_REVOLUTIONS
-    for case in wf.cases:
-        scene = case.scene
-        if not (scene.analysis.granules and scene.liquid.wet):
-            continue
-        period = 2.0 * math.pi / scene.process.rotation.omega(scene.drum.diameter / 2.0)
+    for case, period in _granule_cases(wf):
         turns = settings.hold_time / period
         if not lo <= turns <= hi and period not in out:
             out[period] = (f"analysis.hold_time = {settings.hold_time:g} s is {turns:.2g} "
@@ -79,3 +72,12 @@ def hold_period_warnings(wf: Workflow) -> list[str]:
                            f"= {period / 2.0:.3g} s (allowed without warning: "
                            f"{lo * period:.3g}-{hi * period:.3g} s)")
     return list(out.values())
+
+
+def _granule_cases(wf: Workflow):
+    """(case, rotation period s) of every case whose granules are analysed (contact dumps
+    on, a wet liquid)."""
+    for case in wf.cases:
+        scene = case.scene
+        if scene.analysis.granules and scene.liquid.wet:
+            yield case, 2.0 * math.pi / scene.process.rotation.omega(scene.drum.diameter / 2.0)

@@ -16,14 +16,11 @@ from ligwf.scene.settings import AnalysisSettings
 from ligwf.analysis.granules.definitions import (Motion, bond_criterion, cpm_weights,
                                         drum_frame_velocities, flow_frame_velocities,
                                         identify_granules)
-from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
 from ligwf.analysis.granules.bonds import bonded_contacts
 from ligwf.analysis.granules.bridge_law import relative_force
 from ligwf.analysis.gsd import bins as gsd
-from ligwf.analysis.granules.case import RunFacts
-from ligwf.study.case import CaseFolder
 from helpers import tiled
-from wetdump import wet_study
+from wetdump import wet_case_frames
 
 pytestmark = [pytest.mark.engine, pytest.mark.mpi]
 
@@ -31,10 +28,7 @@ pytestmark = [pytest.mark.engine, pytest.mark.mpi]
 @pytest.fixture(scope="module")
 def real(engine, tmp_path_factory):
     """(scaled scene, liquid, motion, [(particles, contacts)]) of the shared CG3 wet case."""
-    case = CaseFolder.open(wet_study(engine, tmp_path_factory) / "cg3-weber-r0")
-    facts = RunFacts.of_case(case)
-    frames = [(read_particles(f.particles, dt=facts.dt), read_contacts(f.contacts))
-              for f in discover_frames(case.path)]
+    case, facts, frames = wet_case_frames(engine, tmp_path_factory)
     return case.scaled, facts.liquid, facts.motion, frames
 
 

@@ -4,7 +4,6 @@ against a per-contact scalar evaluation; volumes and periodic CoM."""
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
@@ -16,22 +15,18 @@ from hypothesis import given, settings, strategies as st
 from ligwf import liquids
 from ligwf.liquids import washino
 from ligwf.liquids.capillary import rupture_distance
-from ligwf.scene.scaling import ScaledScene
-from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame, discover_frames, read_contacts, read_particles
+from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
 from ligwf.errors import DumpReadError
 from ligwf.analysis.granules.bonds import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
                             comoving, force_law_positive, granule_table, identify_fast,
                             identify_reference, label_fast, label_reference, louvain_labels)
-from wetdump import wet_study
+from wetdump import wet_case_frames
 
 
 @pytest.fixture(scope="module")
 def real(engine, tmp_path_factory):
-    case = wet_study(engine, tmp_path_factory) / "cg3-weber-r0"
-    scaled = ScaledScene.from_dict(json.loads((case / "scene.json").read_text())["scaled"])
-    frames = [(read_particles(f.particles, dt=scaled.dt), read_contacts(f.contacts))
-              for f in discover_frames(case)]
-    return scaled, frames
+    case, _, frames = wet_case_frames(engine, tmp_path_factory)
+    return case.scaled, frames
 
 
 @pytest.mark.engine

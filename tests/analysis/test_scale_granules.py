@@ -17,15 +17,12 @@ import pytest
 
 from helpers import tiled
 from ligwf.analysis.cpm_numba import _stable_key_order
-from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
 from ligwf.analysis.granules.bonds import bonded_contacts
 from ligwf.analysis.granules.bridge_law import relative_energy
-from ligwf.analysis.granules.case import RunFacts
 from ligwf.analysis.granules.communities import cpm_labels, cpm_labels_reference
 from ligwf.analysis.granules.definitions import BondCriterion, cpm_weights
 from ligwf.analysis.granules.persistent import Frame, bridge_keys, held_through, presence_run
-from ligwf.study.case import CaseFolder
-from wetdump import wet_study
+from wetdump import wet_case_frames
 
 
 @pytest.mark.parametrize("k", [1, 2, 7, 300])
@@ -52,10 +49,7 @@ def test_presence_runs_equal_window_intersections():
 
 @pytest.fixture(scope="module")
 def real(engine, tmp_path_factory):
-    case = CaseFolder.open(wet_study(engine, tmp_path_factory) / "cg3-weber-r0")
-    facts = RunFacts.of_case(case)
-    frames = [(read_particles(f.particles, dt=facts.dt), read_contacts(f.contacts))
-              for f in discover_frames(case.path)]
+    case, facts, frames = wet_case_frames(engine, tmp_path_factory)
     return case.scaled, facts, frames
 
 
