@@ -179,7 +179,7 @@ TABLES: dict[str, Table] = {
                                 "criterion of the verdict", (
         "group", "cg", "rule", "condition", "replicas", "condition_state", "speedup_core",
         "speedup_core_lo", "speedup_core_hi", "criterion", "label", "unit", "state", "value",
-        "lo", "hi", "budget", "budget_source", "note", "cheapest")),
+        "lo", "hi", "budget", "shown_within", "budget_source", "note", "cheapest")),
     layout.FIELD_NULL_REPORT: Table(layout.REPORT_DIR, "CG1 cohesionless-twin condition: "
                                     "its field errors against the wet CG1 cases", (
         "control", "wet_group", "cg", "twins", "wet_cg1", *FIELD_ERRORS),

@@ -214,15 +214,18 @@ VERDICT = (
      "profile_error, rigid_share, flowing_layer, gsd_error, field_error)"),
     ("label", "text", "criterion label", "the criterion as the report names it"),
     ("unit", "text", "unit", "unit of value, lo, hi and budget (empty: a ratio)"),
-    ("state", "text", "verdict", "pass (the whole 95 % interval within the budget), fail "
-     "(the whole interval beyond it), undecided, or not assessed (with a note)"),
-    ("value", "unit", "value", "the criterion's measured value (in the row's unit)"),
-    ("lo", "unit", "lo", "lower bound of its 95 % interval"),
-    ("hi", "unit", "hi", "upper bound of its 95 % interval"),
-    ("budget", "unit", "budget", "the tolerance it is held to: the accept: value, or the "
-     "CG1 noise floor when larger"),
-    ("budget_source", "text", "budget from", "where the budget came from (accept: block or "
-     "CG1 noise floor)"),
+    ("state", "text", "verdict", "pass (signed criteria: the 90 % interval of CG-n - CG1 "
+     "inside +-budget, two one-sided tests; norms: the upper bound within the budget), fail "
+     "(wholly outside, surviving Holm over the level's criteria), undecided, or not "
+     "assessed (with a note)"),
+    ("value", "unit", "value", "the criterion's measured value (in the row's unit): the "
+     "signed difference CG-n - CG1, or the noise-corrected distance"),
+    ("lo", "unit", "lo", "lower bound of its interval (90 % for signed criteria)"),
+    ("hi", "unit", "hi", "upper bound of its interval"),
+    ("budget", "unit", "budget", "the tolerance it is held to: the accept: value"),
+    ("shown_within", "unit", "shown within", "the largest |error| its interval allows: the "
+     "error this level is shown to stay within"),
+    ("budget_source", "text", "budget from", "where the budget came from (the accept: block)"),
     ("note", "text", "note", "why a criterion was not assessed, or what decides it"),
     ("cheapest", "flag", "cheapest", "this condition is the cheapest of its group that meets "
      "the whole budget"),

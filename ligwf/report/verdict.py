@@ -1,47 +1,46 @@
 """The answer of a study: per sweep group, which CG level and rule meets the error budget,
-and at what speedup.
+the error each level is shown to stay within, and at what speedup.
 
-Pure functions of the report's condition table (:mod:`ligwf.report.tables`, one row per
-sweep group, CG level and rule; every metric ``m`` with ``m_lo``/``m_hi``/``m_se``, every
-error also ``m_floor``), the workflow's ``accept:`` block
-(:class:`~ligwf.scene.accept.AcceptSettings`) and the granule control verdicts
-(:func:`granule_gates`). Each criterion of a CG-n condition is decided by its 95 %
-interval [lo, hi] against its budget (the tolerance, or for an error with a CG1 noise
-floor ``max(tolerance, floor)``):
+Pure functions of the report's case table (one row per run), its condition table (one row
+per sweep group, CG level and rule), the runs' velocity profiles, the workflow's
+``accept:`` block (:class:`~ligwf.scene.accept.AcceptSettings`) and the granule control
+verdicts (:func:`granule_gates`). The statistics are
+:mod:`ligwf.analysis.records.equivalence` (their coverage: ``benchmarks/bench_coverage.py``):
 
-- ``pass`` when the whole interval lies within the budget (hi <= budget),
-- ``fail`` when the whole interval lies outside it (lo > budget),
-- ``undecided`` otherwise (or with one CG-n replica: no interval), saying what would
-  decide it (the CG1 replicas of :func:`ligwf.report.uncertainty.replicas_to_decide`),
-- ``not assessed`` (the GSD where the granules did not beat their cohesionless control:
-  their sizes then measure the bed's tiling) or ``not measured`` (no value in the table).
+- **signed criteria** (angle of repose in deg, rigid-block share, flowing-layer thickness
+  relative to CG1) are the difference of run means CG-n - CG1 with Welch's interval, decided
+  by two one-sided tests against +-budget: ``pass`` when the 90 % interval lies inside,
+  ``fail`` when it lies wholly outside, else ``undecided`` (saying which arm's replicas
+  would decide it);
+- the **velocity profile** is the relative L2 distance of the mean profiles, less the noise
+  of both arms, with bin-wise (Bonferroni) bounds: ``pass`` when the upper bound is within
+  the budget, ``fail`` when the lower bound exceeds it;
+- the GSD and field errors keep the analysis' intervals against the tolerance;
+- ``not assessed`` (the GSD where the granules did not beat their cohesionless control)
+  or ``not measured`` (no value).
 
-A condition meets the budget when every criterion it was assessed on passes. The group's
-sentence names the cheapest condition (largest speedup) that meets it, or says that none
-does and, per condition, the first criterion (in the order of the ``accept:`` block) that
-fails, or what to add where it is undecided. Control twins are null controls, never
-candidates. Written into the report folder by :mod:`ligwf.report.verdict_records` and
-shown by :mod:`ligwf.report.verdict_text`.
-
-The angle criterion is in degrees: the table's ``angle_error`` is relative to the CG1
-angle, so its value, interval and floor are multiplied by the CG1 angle of the group
-(the relative error's interval holds the CG1 reference's noise; the scale's own, a few
-per cent of the angle, is left out). Frame-metric criteria (rigid-block share,
-flowing-layer thickness) compare the CG-n value with the CG1 value by interval
-arithmetic on both intervals (a CG1 condition of one run: its value +- z x its
-within-run error).
+The CG1 noise floor no longer widens a budget: each signed criterion says whether its
+difference is distinguishable from CG1 seed noise at the replicas run. Family rule: a
+level meets the budget when every assessed criterion passes (an intersection-union test,
+each at alpha); it fails when a criterion fails after Holm's step-down over the level's
+criteria. Every criterion also carries ``bound``: the largest error its interval allows
+(the error the level is shown to stay within), so a user with another budget reads the
+answer without a rerun. Written by :mod:`ligwf.report.verdict_records`, shown by
+:mod:`ligwf.report.verdict_text`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
 import pandas as pd
 
+from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
-from ligwf.report.uncertainty import MAX_SUGGESTED_REPLICAS, replicas_to_decide
 from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.workflow import CONTROL_KEY
 
@@ -49,11 +48,9 @@ PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
 NOT_ASSESSED, NOT_MEASURED = "not assessed", "not measured"
 #: condition states
 MEETS, FAILS = "meets the budget", "fails"
-#: z of a 95 % interval (a one-run CG1 value +- z x its within-run error)
-Z95 = 1.959963984540054
 
-#: how a criterion reads the condition table
-ERROR, ANGLE, EXCESS, RELATIVE = "error", "angle", "excess", "relative difference"
+#: how a criterion reads the tables
+SIGNED, RELATIVE, PROFILE, ERROR = "signed", "relative difference", "profile", "error"
 
 
 @dataclass(frozen=True)
@@ -63,23 +60,20 @@ class CriterionSpec:
     name: str           # the AcceptSettings field (its tolerance)
     label: str
     unit: str           # of the value and the budget ("" for a ratio)
-    column: str         # the condition-table column it reads
-    kind: str           # ERROR | ANGLE (error x CG1 angle) | EXCESS | RELATIVE (to CG1)
-    floored: bool = False  # accepted up to max(tolerance, the CG1 noise floor)
+    column: str         # the case-table (signed) or condition-table (error) column it reads
+    kind: str           # SIGNED | RELATIVE (to the CG1 mean) | PROFILE | ERROR
     gated: bool = False    # only where the granules beat their control
 
 
 #: The budget's criteria, in the order "fails first" refers to.
 CRITERIA = (
-    CriterionSpec("angle_deg", "angle of repose", "deg", "angle_error", ANGLE, floored=True),
-    CriterionSpec("profile_error", "velocity profile", "", "profile_error", ERROR,
-                  floored=True),
-    CriterionSpec("rigid_share", "rigid-block frames", "", "rigid_frame_share", EXCESS),
+    CriterionSpec("angle_deg", "angle of repose", "deg", "angle_of_repose", SIGNED),
+    CriterionSpec("profile_error", "velocity profile", "", "profile_error", PROFILE),
+    CriterionSpec("rigid_share", "rigid-block frames", "", "rigid_frame_share", SIGNED),
     CriterionSpec("flowing_layer", "flowing layer", "", "flowing_layer_thickness_mean", RELATIVE),
     CriterionSpec("gsd_error", "GSD", "", "gsd_error_all", ERROR, gated=True),
-    CriterionSpec("field_error", "continuum fields", "", "field_error", ERROR, floored=True),
+    CriterionSpec("field_error", "continuum fields", "", "field_error", ERROR),
 )
-ANGLE_COLUMN = "angle_of_repose"
 
 
 @dataclass(frozen=True)
@@ -101,8 +95,9 @@ class CriterionResult:
     lo: float = math.nan
     hi: float = math.nan
     budget: float = math.nan
-    budget_source: str = ""   # "tolerance" | "CG1 noise floor (...)"
+    budget_source: str = ""   # "tolerance"
     note: str = ""            # what would decide it, or why it is not assessed
+    bound: float = math.nan   # the largest |error| its interval allows (shown within)
 
     @property
     def assessed(self) -> bool:
@@ -164,15 +159,6 @@ def _band(row, col: str) -> tuple[float, float, float]:
     return _f(row, col), _f(row, f"{col}_lo"), _f(row, f"{col}_hi")
 
 
-def _reference_band(row, col: str) -> tuple[float, float, float]:
-    """A CG1 value's interval; one run: value +- z x its within-run error."""
-    v, lo, hi = _band(row, col)
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        se = _f(row, f"{col}_se")
-        lo, hi = (v - Z95 * se, v + Z95 * se) if math.isfinite(se) else (v, v)
-    return v, lo, hi
-
-
 def is_control_group(group: str) -> bool:
     """A group of control twins (its swept values hold the control key)."""
     try:
@@ -183,71 +169,140 @@ def is_control_group(group: str) -> bool:
 
 
 # ------------------------------------------------------------------ deciding one criterion
-def _decide(spec: CriterionSpec, value: float, lo: float, hi: float, budget: float,
-            cg1_replicas: int, replicas: int) -> tuple[str, str]:
-    """(state, note) of an interval against its budget."""
-    if not (math.isfinite(lo) and math.isfinite(hi)):
-        return UNDECIDED, (f"{replicas} CG-n replica{'s' if replicas != 1 else ''}, no "
-                           "interval (add CG-n replicas)")
-    if hi <= budget:
-        return PASS, ""
-    if lo > budget:
-        return FAIL, ""
-    who = "CG1" if spec.kind in (ERROR, ANGLE) else "CG-n and CG1"
-    need = replicas_to_decide(value, lo, hi, budget,
-                              cg1_replicas if who == "CG1" else max(replicas, 1))
+def _state(test_state: str) -> str:
+    return {eq.PASS: PASS, eq.FAIL: FAIL}.get(test_state, UNDECIDED)
+
+
+def _per_run(runs: pd.DataFrame, column: str) -> np.ndarray:
+    return pd.to_numeric(runs[column], errors="coerce").to_numpy(float) if (
+        runs is not None and column in runs) else np.array([])
+
+
+def _replica_note(x: np.ndarray, y: np.ndarray, budget: float, alpha: float,
+                  scale: float = 1.0) -> str:
+    """What would decide an undecided signed criterion: replicas of the arm that
+    dominates the width (from the measured variances)."""
+    if len(x) < 2 or len(y) < 2:
+        who = "CG-n" if len(x) < 2 else "CG1"
+        return f"{who} has one run: no variance, no interval (run at least 2 replicas)"
+    need = eq.replicas_to_decide(x * scale, y * scale, budget, alpha)
     if need is None:
-        return UNDECIDED, "the value sits on the budget (no number of replicas decides)"
-    if need > MAX_SUGGESTED_REPLICAS:
-        return UNDECIDED, (f"over {MAX_SUGGESTED_REPLICAS} {who} replicas would be needed "
-                           "(the value is near the budget for its spread)")
-    return UNDECIDED, f"about {need} {who} replicas would decide"
+        return ("the difference sits near the budget for its spread: over 64 replicas of "
+                "either arm would be needed")
+    arm, n = need
+    return f"about {n} {arm} replicas would decide (the {arm} scatter dominates the width)"
 
 
-def _measure(spec: CriterionSpec, row, ref) -> tuple[float, float, float, float, str]:
-    """(value, lo, hi, floor, floor source) of a criterion in its own unit."""
-    if spec.kind in (ERROR, ANGLE):
-        value, lo, hi = _band(row, spec.column)
-        floor, source = _f(row, f"{spec.column}_floor"), str(row.get(f"{spec.column}_floor_source", ""))
-        if spec.kind == ANGLE:
-            scale = abs(_f(ref, ANGLE_COLUMN))
-            value, lo, hi, floor = (x * scale for x in (value, lo, hi, floor))
-        return value, lo, hi, floor, source
-    x, x_lo, x_hi = _band(row, spec.column)
-    r, r_lo, r_hi = _reference_band(ref, spec.column)
-    if spec.kind == EXCESS:   # CG-n above CG1, interval arithmetic
-        return x - r, x_lo - r_hi, x_hi - r_lo, math.nan, ""
-    if not (r > 0 and r_lo > 0):   # relative to a CG1 value that may be 0: undefined
-        return math.nan, math.nan, math.nan, math.nan, ""
-    d, d_lo, d_hi = x / r - 1.0, x_lo / r_hi - 1.0, x_hi / r_lo - 1.0
-    if d_lo <= 0.0 <= d_hi:      # |.| of an interval holding 0
-        return abs(d), 0.0, max(-d_lo, d_hi), math.nan, ""
-    return abs(d), min(abs(d_lo), abs(d_hi)), max(abs(d_lo), abs(d_hi)), math.nan, ""
-
-
-def criterion(spec: CriterionSpec, tolerance: float, row, ref, gate: Gate,
-              cg1_replicas: int) -> CriterionResult:
-    """One criterion of one CG-n condition (``row``) against its group's CG1 row ``ref``."""
-    base = dict(name=spec.name, label=spec.label, unit=spec.unit)
-    of_ref = {ERROR: None, ANGLE: ANGLE_COLUMN}.get(spec.kind, spec.column)
-    if spec.column not in row.index or (of_ref is not None and of_ref not in ref.index):
+def _signed(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
+            alpha: float) -> tuple[CriterionResult, float]:
+    """A signed criterion: the difference of run means CG-n - CG1 (relative to the CG1
+    mean for RELATIVE), two one-sided tests at alpha. Returns the result and the p-value
+    of its fail test (for Holm over the level)."""
+    base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
+                budget_source="tolerance")
+    scale = 1.0
+    if spec.kind == RELATIVE:
+        ref = float(np.nanmean(y)) if np.isfinite(y).any() else math.nan
+        if not ref > 0:
+            return CriterionResult(**base, state=NOT_MEASURED, note=(
+                f"not measured: the CG1 {spec.label} is 0: no relative difference")), math.nan
+        scale = 1.0 / ref
+    e = eq.scaled(eq.difference_estimate(x, y, alpha), scale)
+    if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED,
-                               note=f"not measured: the study has no {spec.column}")
-    if spec.gated and gate.passes is not True:
-        return CriterionResult(**base, state=NOT_ASSESSED, note=f"not assessed: {gate.reason}")
-    value, lo, hi, floor, source = _measure(spec, row, ref)
+                               note=f"not measured: no {spec.column} value"), math.nan
+    test = eq.equivalence(e, tolerance, alpha)
+    noise = eq.difference_estimate(x, y, alpha / 2)
+    vs_noise = ("" if not noise.has_interval else
+                "differs from CG1 beyond seed noise" if (noise.lo > 0 or noise.hi < 0)
+                else "indistinguishable from CG1 seed noise at these replicas")
+    note = vs_noise
+    if test.state == eq.UNDECIDED:
+        note = "; ".join(x for x in (_replica_note(x, y, tolerance, alpha, scale), vs_noise) if x)
+    bound = max(abs(e.lo), abs(e.hi)) if e.has_interval else math.nan
+    return CriterionResult(**base, state=_state(test.state), value=e.value, lo=e.lo, hi=e.hi,
+                           bound=bound, note=note), test.p_fail
+
+
+def _norm(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
+          alpha: float) -> CriterionResult:
+    """The velocity profile: the noise-corrected relative L2 distance between the arms'
+    mean profiles, decided by its bin-wise bounds."""
+    base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
+                budget_source="tolerance")
+    e = eq.norm_estimate(x, y, alpha)
+    if not math.isfinite(e.value):
+        return CriterionResult(**base, state=NOT_MEASURED, note="not measured: no profiles")
+    state = _state(eq.norm_decision(e, tolerance))
+    note = (f"raw distance {e.raw:.3g} before the noise of both arms is taken off"
+            if state != UNDECIDED else
+            f"raw distance {e.raw:.3g}; the bin-wise bounds [{e.lo:.3g}, {e.hi:.3g}] straddle "
+            "the budget: more replicas of both arms narrow them")
+    if not e.has_interval:
+        note = "an arm has one run: no variance, no bounds (run at least 2 replicas)"
+    return CriterionResult(**base, state=state, value=e.value, lo=e.lo, hi=e.hi, bound=e.hi,
+                           note=note)
+
+
+def _legacy(spec: CriterionSpec, tolerance: float, row) -> CriterionResult:
+    """GSD and field errors: their interval from the analysis against the tolerance."""
+    base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
+                budget_source="tolerance")
+    value, lo, hi = _band(row, spec.column)
     if not math.isfinite(value):
-        why = (f"the CG1 {spec.label} (or its interval) reaches 0: no relative difference"
-               if spec.kind == RELATIVE and math.isfinite(_f(row, spec.column))
-               else f"no {spec.column} value for this condition")
-        return CriterionResult(**base, state=NOT_MEASURED, note=f"not measured: {why}")
-    budget, budget_source = tolerance, "tolerance"
-    if spec.floored and math.isfinite(floor) and floor > tolerance:
-        budget, budget_source = floor, f"CG1 noise floor ({source})" if source else "CG1 noise floor"
-    state, note = _decide(spec, value, lo, hi, budget, cg1_replicas,
-                          int(_f(row, "replicas")) if math.isfinite(_f(row, "replicas")) else 1)
-    return CriterionResult(**base, state=state, value=value, lo=lo, hi=hi, budget=budget,
-                           budget_source=budget_source, note=note)
+        return CriterionResult(**base, state=NOT_MEASURED,
+                               note=f"not measured: no {spec.column} value for this condition")
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return CriterionResult(**base, state=UNDECIDED, value=value,
+                               note="no interval (add replicas)")
+    state = PASS if hi <= tolerance else FAIL if lo > tolerance else UNDECIDED
+    return CriterionResult(**base, state=state, value=value, lo=lo, hi=hi, bound=hi,
+                           note="" if state != UNDECIDED else "more replicas of both arms")
+
+
+def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs: pd.DataFrame,
+                       profiles: dict, gate: Gate, alpha: float = eq.ALPHA
+                       ) -> tuple[CriterionResult, ...]:
+    """Every criterion of the budget for one CG-n condition (``row`` of the condition table,
+    ``runs`` its cases, ``ref_runs`` its group's CG1 cases), with Holm's step-down over the
+    level's fail tests: a criterion fails only if its fail test survives Holm."""
+    out, p_fail = [], []
+    for spec in CRITERIA:
+        tol = getattr(accept, spec.name)
+        if tol is None:
+            continue
+        base = dict(name=spec.name, label=spec.label, unit=spec.unit)
+        if spec.gated and gate.passes is not True:
+            out.append(CriterionResult(**base, state=NOT_ASSESSED,
+                                       note=f"not assessed: {gate.reason}"))
+            p_fail.append(math.nan)
+        elif spec.kind in (SIGNED, RELATIVE):
+            r, p = _signed(spec, tol, _per_run(runs, spec.column),
+                           _per_run(ref_runs, spec.column), alpha)
+            out.append(r)
+            p_fail.append(p)
+        elif spec.kind == PROFILE:
+            x = [profiles.get(c) for c in runs["case_id"]] if runs is not None else []
+            y = [profiles.get(c) for c in ref_runs["case_id"]] if ref_runs is not None else []
+            try:
+                xa = np.array([p for p in x if p is not None and len(p)], dtype=float)
+                ya = np.array([p for p in y if p is not None and len(p)], dtype=float)
+            except ValueError:
+                xa = ya = np.array([])
+            out.append(_norm(spec, tol, xa, ya, alpha))
+            p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
+        elif spec.column not in row.index:
+            out.append(CriterionResult(**base, state=NOT_MEASURED,
+                                       note=f"not measured: the study has no {spec.column}"))
+            p_fail.append(math.nan)
+        else:
+            out.append(_legacy(spec, tol, row))
+            p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
+    rejected = eq.holm_rejects(p_fail, alpha)
+    return tuple(r if r.state != FAIL or ok else dataclasses.replace(
+        r, state=UNDECIDED, note=(f"outside the budget on its own, not after Holm over the "
+                                  f"level's {len(out)} criteria; " + r.note).rstrip("; "))
+                 for r, ok in zip(out, rejected))
 
 
 # ------------------------------------------------------------------ groups and the sentence
@@ -295,8 +350,8 @@ def group_sentence(conditions: list[ConditionVerdict]) -> tuple[str, str | None]
         failed = next((r for r in c.criteria if r.state == FAIL), None)
         if failed is not None:
             parts.append(f"{c.name} fails the {failed.label} first "
-                         f"({band_text(failed.value, failed.lo, failed.hi, failed.unit)} > "
-                         f"{_num(failed.budget)})")
+                         f"({band_text(failed.value, failed.lo, failed.hi, failed.unit)} "
+                         f"beyond the budget {_num(failed.budget)})")
         elif (open_ := [r for r in c.criteria if r.state == UNDECIDED]):
             parts.append(f"{c.name} is undecided on the "
                          + ", ".join(r.label for r in open_)
@@ -330,29 +385,33 @@ def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[st
 
 
 def decide(conditions: pd.DataFrame, accept: AcceptSettings,
-           gates: dict[str, Gate] | None = None) -> Verdict:
-    """The verdict of every sweep group of a condition table (control groups left out)."""
-    gates = gates or {}
+           gates: dict[str, Gate] | None = None, cases: pd.DataFrame | None = None,
+           profiles: dict | None = None, alpha: float = eq.ALPHA) -> Verdict:
+    """The verdict of every sweep group of a condition table (control groups left out);
+    ``cases`` (one row per run) and ``profiles`` (case id -> mean velocity profile) hold
+    the run values the signed and profile criteria are decided on."""
+    gates, profiles = gates or {}, profiles or {}
     groups = []
     if conditions.empty:
         return Verdict((), accept.model_dump(mode="json"))
+    if cases is None:
+        cases = pd.DataFrame(columns=["case_id", "group", "cg", "rule"])
     for group, sub in conditions.groupby("group", sort=True):
         group = str(group)
         if is_control_group(group):
             continue
-        refs = sub[sub["cg"] == REFERENCE_CG]
-        if refs.empty:
+        if sub[sub["cg"] == REFERENCE_CG].empty:
             groups.append(GroupVerdict(group, (), "No CG1 case in this group: nothing to "
                                                   "compare the CG levels with."))
             continue
-        ref = refs.iloc[0]
-        cg1_replicas = int(ref["replicas"])
+        in_group = cases[cases["group"].astype(str) == group]
+        ref_runs = in_group[in_group["cg"] == REFERENCE_CG]
         gate = gates.get(group, Gate(None, "no cohesionless control ran"))
         out = []
         for _, row in sub[sub["cg"] != REFERENCE_CG].sort_values(["cg", "rule"]).iterrows():
-            results = tuple(criterion(spec, getattr(accept, spec.name), row, ref, gate,
-                                      cg1_replicas)
-                            for spec in CRITERIA if getattr(accept, spec.name) is not None)
+            runs = in_group[(in_group["cg"] == row["cg"])
+                            & (in_group["rule"].astype(str) == str(row["rule"]))]
+            results = condition_criteria(accept, row, runs, ref_runs, profiles, gate, alpha)
             out.append(ConditionVerdict(group, float(row["cg"]), str(row["rule"]),
                                         int(row["replicas"]), *_band(row, "speedup_core"),
                                         results))

@@ -42,7 +42,8 @@ def verdict_rows(verdict: Verdict) -> pd.DataFrame:
                              "speedup_core_lo": c.speedup_lo, "speedup_core_hi": c.speedup_hi,
                              "criterion": r.name, "label": r.label, "unit": r.unit,
                              "state": r.state, "value": r.value, "lo": r.lo, "hi": r.hi,
-                             "budget": r.budget, "budget_source": r.budget_source,
+                             "budget": r.budget, "shown_within": r.bound,
+                             "budget_source": r.budget_source,
                              "note": r.note, "cheapest": g.cheapest == c.name})
     return pd.DataFrame(rows)
 
@@ -69,8 +70,9 @@ def read_verdict(out: Path) -> Verdict | None:
         for g in rec["groups"]:
             conds = []
             for c in g["conditions"]:
-                crit = tuple(CriterionResult(**{**r, **{k: _nan(r[k]) for k in
-                                                        ("value", "lo", "hi", "budget")}})
+                crit = tuple(CriterionResult(**{**r, **{k: _nan(r.get(k)) for k in
+                                                        ("value", "lo", "hi", "budget",
+                                                         "bound")}})
                              for r in c["criteria"])
                 conds.append(ConditionVerdict(c["group"], float(c["cg"]), c["rule"],
                                               int(c["replicas"]), _nan(c["speedup"]),
@@ -82,9 +84,10 @@ def read_verdict(out: Path) -> Verdict | None:
 
 
 def study_verdict(cases: pd.DataFrame, conditions: pd.DataFrame, accept: AcceptSettings,
-                  analysis_dir: Path) -> Verdict:
+                  analysis_dir: Path, profiles: dict | None = None) -> Verdict:
     """The verdict of a study's report tables, with its granule control verdicts read from
     the analysis folder."""
     if cases.empty or conditions.empty:
         return Verdict((), accept.model_dump(mode="json"))
-    return decide(conditions, accept, granule_gates(cases, read_controls(analysis_dir)))
+    return decide(conditions, accept, granule_gates(cases, read_controls(analysis_dir)),
+                  cases, profiles)

@@ -16,10 +16,12 @@ from rich.table import Table
 from rich.text import Text
 
 from ligwf.report.verdict import (CRITERIA, FAIL, FAILS, MEETS, PASS, UNDECIDED,
-                                  CriterionResult, GroupVerdict, Verdict,
+                                  ConditionVerdict, CriterionResult, GroupVerdict, Verdict,
                                   band_text)
 
 TITLE = "Verdict"
+#: criteria judged on a signed difference (their budget is +-tolerance)
+SIGNED_NAMES = frozenset(s.name for s in CRITERIA if s.kind in ("signed", "relative difference"))
 #: rich styles of the states
 STYLE = {PASS: "green", FAIL: "red", UNDECIDED: "yellow", MEETS: "bold green",
          FAILS: "bold red"}
@@ -45,8 +47,8 @@ def budget_line(accept: dict) -> str:
             parts.append(f"{s.label}: not in the budget")
             continue
         unit = f" {s.unit}" if s.unit else ""
-        floored = " (or the CG1 noise floor, if larger)" if s.floored else ""
-        parts.append(f"{s.label} <= {tol:g}{unit}{floored}")
+        sign = "+-" if s.name in SIGNED_NAMES else "<= "
+        parts.append(f"{s.label} {sign}{tol:g}{unit}")
     return "; ".join(parts)
 
 
@@ -56,6 +58,14 @@ def cell(r: CriterionResult) -> str:
     if not r.assessed:
         return r.state
     return f"{r.state} {band_text(r.value, r.lo, r.hi)}"
+
+
+def shown_within(c: ConditionVerdict) -> str:
+    """The errors a level is shown to stay within: each assessed criterion's largest
+    |error| its interval allows, in its unit (``angle of repose 2.9 deg, ...``)."""
+    parts = [f"{r.label} {_num(r.bound)}{' ' + r.unit if r.unit else ''}"
+             for r in c.criteria if r.assessed and math.isfinite(r.bound)]
+    return ", ".join(parts) if parts else "nothing (no interval)"
 
 
 def _notes(g: GroupVerdict) -> list[str]:
@@ -79,7 +89,8 @@ def _columns(g: GroupVerdict) -> list[str]:
         budgets = [c.criteria[k].budget for c in g.conditions
                    if math.isfinite(c.criteria[k].budget)]
         unit = f" {r.unit}" if r.unit else ""
-        heads.append(f"{r.label} (<= {_num(max(budgets))}{unit})" if budgets else r.label)
+        sign = "+-" if r.unit == "deg" or r.name in SIGNED_NAMES else "<= "
+        heads.append(f"{r.label} ({sign}{_num(max(budgets))}{unit})" if budgets else r.label)
     return heads
 
 
@@ -95,6 +106,10 @@ def group_markdown(g: GroupVerdict, several: bool) -> list[str]:
         lines.append(f"| {c.name} | {c.replicas} | "
                      f"{band_text(c.speedup, c.speedup_lo, c.speedup_hi)} | {c.state} | "
                      + " | ".join(cell(r) for r in c.criteria) + " |")
+    lines += ["", "Shown to stay within (the largest error each interval allows, speedup "
+              "beside):", ""]
+    lines += [f"- **{c.name}** (speedup {_num(c.speedup)}): {shown_within(c)}"
+              for c in g.conditions]
     notes = _notes(g)
     if notes:
         lines += [""] + [f"- {n}" for n in notes]
@@ -104,10 +119,15 @@ def group_markdown(g: GroupVerdict, several: bool) -> list[str]:
 def verdict_section(verdict: Verdict) -> str:
     """The verdict as the report's first markdown section."""
     lines = [f"## {TITLE}", "",
-             f"Budget (`accept:` block): {budget_line(verdict.accept)}. A criterion passes when "
-             "its whole 95 % interval lies within the budget, fails when it lies wholly "
-             "outside, and is undecided otherwise; a level meets the budget when every "
-             "criterion it was assessed on passes. Control twins are not candidates.", ""]
+             f"Budget (`accept:` block): {budget_line(verdict.accept)}. The unit is the run "
+             "(its steady-window mean). Signed criteria (angle, rigid-block share, flowing "
+             "layer) are the difference of run means CG-n - CG1 with Welch's 90 % interval: "
+             "they pass when it lies inside +-budget and fail when it lies wholly outside "
+             "(two one-sided tests, 5 % each); the velocity profile is the distance of the "
+             "mean profiles less the noise of both arms, with bin-wise bounds. A level meets "
+             "the budget when every criterion it was assessed on passes, and fails when one "
+             "fails after Holm's step-down over its criteria; coverage measured by "
+             "`benchmarks/bench_coverage.py`. Control twins are not candidates.", ""]
     if not verdict.groups:
         return "\n".join(lines + ["No sweep group with a CG1 reference and a CG level to "
                                   "judge.", ""])
@@ -134,5 +154,7 @@ def verdict_renderables(verdict: Verdict) -> list:
                           Text(c.state, style=STYLE.get(c.state, "yellow")),
                           *[Text(cell(r), style=STYLE.get(r.state, "dim")) for r in c.criteria])
         out.append(table)
+        out += [Text(f"  {c.name} is shown to stay within: {shown_within(c)}")
+                for c in g.conditions]
         out += [Text(f"  {n}", style="dim") for n in _notes(g)]
     return out

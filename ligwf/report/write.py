@@ -79,7 +79,8 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
-    verdict = study_verdict(cases, conditions, study.accept, study.analysis_dir)
+    verdict = study_verdict(cases, conditions, study.accept, study.analysis_dir,
+                            {cid: c.profile_v_mean for cid, c in flow.cases.items()})
     write_verdict(verdict, out)
     figures = report_figures(study, flow, cases, conditions, out, snapshots)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,

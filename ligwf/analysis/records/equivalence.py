@@ -1,0 +1,235 @@
+"""Decisions from few replicas: intervals on run means, two one-sided tests, norms of
+noisy profiles corrected for their noise.
+
+The unit of replication is the run. A run's steady-window mean carries both its frames'
+correlated noise and its seed's offset, so the sample variance of run means estimates the
+whole variance of a condition value, whatever the autocorrelation of the frames; a Student
+t interval on run means is exact for normal run means, which frame-level intervals with a
+bootstrap over two or three replicas are not (their coverage, measured by
+``benchmarks/bench_coverage.py``, fell to 0.71 at two replicas). Differences of two arms
+use Welch's standard error and Satterthwaite's degrees of freedom.
+
+A criterion is then decided by **two one-sided tests** (Schuirmann 1987) on the signed
+difference CG-n - CG1 against +-budget: ``pass`` when the (1 - 2 alpha) interval lies
+inside +-budget, ``fail`` when it lies wholly outside, otherwise ``undecided``. Norm
+criteria (the velocity profile) use bin-wise Welch intervals (Bonferroni over the bins):
+their norm bounds hold whenever every bin's interval holds, and the point estimate is the
+squared distance less the noise of both arms.
+
+Everything here is pure (arrays in, numbers out) and is what the benchmark measures.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+#: a decision's error rate per side (the two one-sided tests each at ALPHA: a 90 % interval)
+ALPHA = 0.05
+PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A value with its (1 - 2 alpha) interval, standard error and degrees of freedom;
+    ``lo``/``hi`` nan when an arm has fewer than two runs (no variance to estimate)."""
+
+    value: float
+    lo: float
+    hi: float
+    se: float
+    df: float
+
+    @property
+    def has_interval(self) -> bool:
+        return math.isfinite(self.lo) and math.isfinite(self.hi)
+
+
+NO_ESTIMATE = Estimate(math.nan, math.nan, math.nan, math.nan, math.nan)
+
+
+def _finite(x) -> np.ndarray:
+    a = np.asarray(x, float).ravel()
+    return a[np.isfinite(a)]
+
+
+def _t(df: float, alpha: float) -> float:
+    return float(stats.t.ppf(1.0 - alpha, df)) if math.isfinite(df) else float(
+        stats.norm.ppf(1.0 - alpha))
+
+
+def mean_estimate(runs, alpha: float = ALPHA) -> Estimate:
+    """The mean of the run values with its Student t interval at R - 1 degrees of freedom."""
+    x = _finite(runs)
+    if len(x) == 0:
+        return NO_ESTIMATE
+    m = float(x.mean())
+    if len(x) < 2:
+        return Estimate(m, math.nan, math.nan, math.nan, math.nan)
+    se = float(x.std(ddof=1) / math.sqrt(len(x)))
+    half = _t(len(x) - 1, alpha) * se
+    return Estimate(m, m - half, m + half, se, float(len(x) - 1))
+
+
+def welch_df(v1: float, n1: int, v2: float, n2: int) -> float:
+    """Satterthwaite's degrees of freedom of s1^2/n1 + s2^2/n2 (inf when both are 0)."""
+    a, b = v1 / n1, v2 / n2
+    den = (a * a / (n1 - 1) if a > 0 else 0.0) + (b * b / (n2 - 1) if b > 0 else 0.0)
+    return (a + b) ** 2 / den if den > 0 else math.inf
+
+
+def difference_estimate(runs, reference, alpha: float = ALPHA) -> Estimate:
+    """mean(runs) - mean(reference) with Welch's interval; nan bounds unless both arms
+    have at least two runs."""
+    x, y = _finite(runs), _finite(reference)
+    if len(x) == 0 or len(y) == 0:
+        return NO_ESTIMATE
+    d = float(x.mean() - y.mean())
+    if len(x) < 2 or len(y) < 2:
+        return Estimate(d, math.nan, math.nan, math.nan, math.nan)
+    vx, vy = float(x.var(ddof=1)), float(y.var(ddof=1))
+    se = math.sqrt(vx / len(x) + vy / len(y))
+    df = welch_df(vx, len(x), vy, len(y))
+    half = _t(df, alpha) * se
+    return Estimate(d, d - half, d + half, se, df)
+
+
+def scaled(e: Estimate, factor: float) -> Estimate:
+    """The estimate in another unit (a positive factor: relative to a reference value)."""
+    return Estimate(e.value * factor, e.lo * factor, e.hi * factor, e.se * factor, e.df)
+
+
+@dataclass(frozen=True)
+class Test:
+    """The two one-sided tests of a signed difference against +-budget."""
+
+    state: str
+    p_pass: float   # the larger p of the two one-sided tests of |delta| >= budget
+    p_fail: float   # p of the one-sided test of |delta| <= budget
+
+
+def equivalence(e: Estimate, budget: float, alpha: float = ALPHA) -> Test:
+    """``pass`` when the (1 - 2 alpha) interval lies in [-budget, budget], ``fail`` when it
+    lies wholly outside, else ``undecided`` (also without an interval)."""
+    if not e.has_interval or not math.isfinite(budget):
+        return Test(UNDECIDED, math.nan, math.nan)
+    if e.se == 0:
+        inside = abs(e.value) <= budget
+        return Test(PASS if inside else FAIL, 0.0 if inside else 1.0, 1.0 if inside else 0.0)
+    cdf = lambda z: float(stats.t.cdf(z, e.df)) if math.isfinite(e.df) else float(
+        stats.norm.cdf(z))
+    p_pass = max(1.0 - cdf((e.value + budget) / e.se), cdf((e.value - budget) / e.se))
+    p_fail = 1.0 - cdf((abs(e.value) - budget) / e.se)
+    state = PASS if e.lo >= -budget and e.hi <= budget else (
+        FAIL if e.lo > budget or e.hi < -budget else UNDECIDED)
+    return Test(state, p_pass, p_fail)
+
+
+def holm_rejects(p_values: list[float], alpha: float = ALPHA) -> list[bool]:
+    """Holm's step-down over a family of one-sided tests: which nulls are rejected (family
+    error <= alpha); nan p-values (criteria not tested) are never rejected and are not
+    part of the family."""
+    m = sum(math.isfinite(p) for p in p_values)
+    order = sorted(range(len(p_values)), key=lambda i: (math.inf if not math.isfinite(p_values[i])
+                                            else p_values[i]))
+    out = [False] * len(p_values)
+    for rank, i in enumerate(order):
+        p = p_values[i]
+        if not (math.isfinite(p) and p <= alpha / (m - rank)):
+            break
+        out[i] = True
+    return out
+
+
+@dataclass(frozen=True)
+class NormEstimate:
+    """A distance between two mean profiles relative to the reference profile's norm:
+    ``value`` noise-corrected (0 when the noise explains it), ``lo``/``hi`` its bounds,
+    ``raw`` the uncorrected distance."""
+
+    value: float
+    lo: float
+    hi: float
+    raw: float
+
+    @property
+    def has_interval(self) -> bool:
+        return math.isfinite(self.lo) and math.isfinite(self.hi)
+
+
+def norm_estimate(runs, reference, alpha: float = ALPHA) -> NormEstimate:
+    """Relative L2 distance between the mean profiles of two arms ((runs, bins) arrays),
+    on the bins every run fills.
+
+    Estimate: sqrt(max(0, sum_k d_k^2 - v_k)) / ||m_ref||, with v_k the variance of the
+    difference of the bin means (both arms' noise). Bounds: the norms of the nearest and
+    farthest points of the box of bin-wise Welch intervals at alpha / bins per side (two
+    sided 1 - 2 alpha / bins): they hold whenever every bin's interval holds."""
+    x, y = np.asarray(runs, float), np.asarray(reference, float)
+    if x.ndim != 2 or y.ndim != 2 or x.shape[1] != y.shape[1] or not len(x) or not len(y):
+        return NormEstimate(math.nan, math.nan, math.nan, math.nan)
+    ok = np.isfinite(x).all(axis=0) & np.isfinite(y).all(axis=0)
+    x, y = x[:, ok], y[:, ok]
+    ref_norm = float(np.sqrt(np.sum(y.mean(axis=0) ** 2)))
+    if x.shape[1] == 0 or ref_norm <= 0:
+        return NormEstimate(math.nan, math.nan, math.nan, math.nan)
+    d = x.mean(axis=0) - y.mean(axis=0)
+    raw = float(np.sqrt(np.sum(d * d)) / ref_norm)
+    if len(x) < 2 or len(y) < 2:
+        return NormEstimate(raw, math.nan, math.nan, raw)
+    vx, vy = x.var(axis=0, ddof=1) / len(x), y.var(axis=0, ddof=1) / len(y)
+    v = vx + vy
+    value = math.sqrt(max(0.0, float(np.sum(d * d - v)))) / ref_norm
+    k = x.shape[1]
+    near = np.empty(k)
+    far = np.empty(k)
+    for j in range(k):
+        df = welch_df(float(vx[j] * len(x)), len(x), float(vy[j] * len(y)), len(y))
+        half = _t(df, alpha / k) * math.sqrt(float(v[j]))
+        lo_j, hi_j = d[j] - half, d[j] + half
+        far[j] = max(abs(lo_j), abs(hi_j))
+        near[j] = 0.0 if lo_j <= 0.0 <= hi_j else min(abs(lo_j), abs(hi_j))
+    return NormEstimate(value, float(np.sqrt(np.sum(near**2)) / ref_norm),
+                        float(np.sqrt(np.sum(far**2)) / ref_norm), raw)
+
+
+def norm_decision(e: NormEstimate, budget: float) -> str:
+    """``pass`` when the upper bound is within the budget, ``fail`` when the lower bound
+    exceeds it, else ``undecided``."""
+    if not e.has_interval or not math.isfinite(budget):
+        return UNDECIDED
+    if e.hi <= budget:
+        return PASS
+    if e.lo > budget:
+        return FAIL
+    return UNDECIDED
+
+
+def replicas_to_decide(runs, reference, budget: float, alpha: float = ALPHA,
+                       most: int = 64) -> tuple[str, int] | None:
+    """The cheapest way to decide a signed criterion by adding replicas to one arm: (arm,
+    total replicas of that arm) such that, with the arms' variances and the difference
+    as measured, the interval would clear the budget on one side; the arm whose variance
+    of the mean dominates first. None when no count up to ``most`` would do it."""
+    x, y = _finite(runs), _finite(reference)
+    if len(x) < 2 or len(y) < 2:
+        return None
+    d = float(x.mean() - y.mean())
+    vx, vy = float(x.var(ddof=1)), float(y.var(ddof=1))
+    gap = abs(abs(d) - budget)
+    if gap == 0:
+        return None
+    best = None
+    for arm, (v_arm, n_arm, v_other, n_other) in (("CG-n", (vx, len(x), vy, len(y))),
+                                                   ("CG1", (vy, len(y), vx, len(x)))):
+        for n in range(n_arm, most + 1):
+            se = math.sqrt(v_arm / n + v_other / n_other)
+            df = welch_df(v_arm, n, v_other, n_other) if se > 0 else math.inf
+            if _t(df, alpha) * se < gap:
+                if best is None or n - n_arm < best[1] - best[2]:
+                    best = (arm, n, n_arm)
+                break
+    return None if best is None else (best[0], best[1])
