@@ -31,7 +31,8 @@ def print_report(study_dir: Path, out: Path) -> None:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    print_report(args.study, report_study(args.study, args.out, snapshots=not args.no_snapshots))
+    print_report(args.study, report_study(args.study, args.out, snapshots=not args.no_snapshots,
+                                          accept_overrides=tuple(args.overrides)))
     return 0
 
 
@@ -46,5 +47,9 @@ def register(subparsers) -> None:
                               "of a finished study (steady window from its analysis settings)")
     p.add_argument("study", type=Path, help="study folder")
     p.add_argument("--out", type=Path, default=None, help="report folder (default STUDY/report)")
+    p.add_argument("--set", dest="overrides", action="append", default=[],
+                   metavar="accept.KEY=VALUE",
+                   help="re-decide the verdict under another budget from the stored analysis "
+                        "(e.g. --set accept.angle_deg=2); only accept: keys")
     add_snapshots(p)
     p.set_defaults(func=cmd_report)

@@ -10,9 +10,14 @@ and :func:`report_study`, in that order).
 
 from __future__ import annotations
 
+import dataclasses
+
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ligwf.errors import ConfigError
+from ligwf.scene.accept import AcceptSettings, build_accept_settings
+from ligwf.scene.workflow import apply_override, parse_override
 from ligwf.study.study import Study
 
 if TYPE_CHECKING:  # the analysis and report stages load numba / matplotlib: imported on use
@@ -33,11 +38,31 @@ def analyse_study(path: Path, out: Path | None = None,
     return analyse(path, out, options or AnalysisOptions(), comm)
 
 
-def report_study(path: Path, out: Path | None = None, snapshots: bool = True) -> Path:
-    """Flow metrics (the study's steady window) and the report folder; returns it."""
+def report_study(path: Path, out: Path | None = None, snapshots: bool = True,
+                 accept_overrides: tuple[str, ...] = ()) -> Path:
+    """Flow metrics (the study's steady window) and the report folder; returns it.
+    ``accept_overrides`` (``accept.angle_deg=2``, ...) re-decide the verdict under another
+    budget from the stored analysis (validated before anything is written)."""
     from ligwf.report.write import write_report
 
-    return write_report(Study.open(path), out, snapshots=snapshots)
+    study = Study.open(path)
+    if accept_overrides:
+        study = dataclasses.replace(study, accept=overridden_accept(study.accept,
+                                                                    accept_overrides))
+    return write_report(study, out, snapshots=snapshots)
+
+
+def overridden_accept(accept: AcceptSettings, overrides: tuple[str, ...]) -> AcceptSettings:
+    """The budget with ``--set accept.KEY=VALUE`` applied; any other key is refused in one
+    line (the report re-decides; the runs and the analysis stay what they were)."""
+    raw = {"accept": accept.model_dump(mode="json")}
+    for text in overrides:
+        key, value = parse_override(text)
+        if key.split(".")[0] != "accept" or key.count(".") != 1:
+            raise ConfigError(f"--set {key}: ligwf report only re-decides the budget: "
+                              "accept.<criterion>=VALUE (the rest needs a new run or analysis)")
+        apply_override(raw, key, value)
+    return build_accept_settings(raw["accept"], "accept")
 
 
 def postprocess(path: Path, snapshots: bool = True) -> tuple[dict | None, Path]:

@@ -14,8 +14,8 @@ import pandas as pd
 
 from ligwf.fsio import atomic_write_json, atomic_write_text
 from ligwf.report.controls import read_controls
-from ligwf.report.verdict import (ConditionVerdict, CriterionResult, GroupVerdict, Verdict,
-                                  decide, granule_gates)
+from ligwf.report.criteria import CriterionResult
+from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict, decide, granule_gates
 from ligwf.scene.accept import AcceptSettings
 from ligwf.study import layout
 

@@ -15,13 +15,13 @@ import math
 from rich.table import Table
 from rich.text import Text
 
-from ligwf.report.verdict import (CRITERIA, FAIL, FAILS, MEETS, PASS, UNDECIDED,
-                                  ConditionVerdict, CriterionResult, GroupVerdict, Verdict,
-                                  band_text)
+from ligwf.report.criteria import (CRITERIA, FAIL, PASS, RELATIVE, SIGNED, UNDECIDED,
+                                   CriterionResult)
+from ligwf.report.verdict import FAILS, MEETS, ConditionVerdict, GroupVerdict, Verdict, band_text
 
 TITLE = "Verdict"
 #: criteria judged on a signed difference (their budget is +-tolerance)
-SIGNED_NAMES = frozenset(s.name for s in CRITERIA if s.kind in ("signed", "relative difference"))
+SIGNED_NAMES = frozenset(s.name for s in CRITERIA if s.kind in (SIGNED, RELATIVE))
 #: rich styles of the states
 STYLE = {PASS: "green", FAIL: "red", UNDECIDED: "yellow", MEETS: "bold green",
          FAILS: "bold red"}

@@ -77,8 +77,8 @@ def test_field_error_columns_are_documented():
 
 
 def test_verdict_table_columns_are_documented():
-    from ligwf.report.verdict import (ConditionVerdict, CriterionResult, GroupVerdict,
-                                      Verdict)
+    from ligwf.report.criteria import CriterionResult
+    from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict
     from ligwf.report.verdict_records import verdict_rows
 
     crit = CriterionResult("angle_deg", "angle of repose", "deg", "pass", 0.5, 0.1, 0.9, 1.0,

@@ -19,8 +19,9 @@ import pandas as pd
 import pytest
 
 from ligwf.errors import ConfigError
-from ligwf.report.verdict import (FAIL, FAILS, MEETS, NOT_ASSESSED, NOT_MEASURED, PASS,
-                                  UNDECIDED, Gate, decide, granule_gates)
+from ligwf.report.criteria import (FAIL, NOT_ASSESSED, NOT_MEASURED, PASS, UNDECIDED,
+                                   Gate)
+from ligwf.report.verdict import FAILS, MEETS, decide, granule_gates
 from ligwf.report.verdict_records import read_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_renderables, verdict_section
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
@@ -254,3 +255,17 @@ def test_accept_through_the_workflow_and_set():
     raw = read_yaml_mapping(DEMO, "workflow")
     assert "accept" in raw, "workflows/demo.yaml shows its accept: block"
     assert load_workflow(DEMO).accept == AcceptSettings(), "the demo's block shows the defaults"
+
+
+def test_report_set_re_decides_only_the_budget():
+    from ligwf.pipeline.post import overridden_accept
+    a = overridden_accept(AcceptSettings(), ("accept.angle_deg=3", "accept.gsd_error=null"))
+    assert a.angle_deg == 3.0 and a.gsd_error is None and a.rigid_share == 0.05
+    with pytest.raises(ConfigError, match=r"only re-decides the budget"):
+        overridden_accept(AcceptSettings(), ("analysis.hold_time=2",))
+    with pytest.raises(ConfigError, match=r"accept\.angle_deg = 100: .*allowed range \[0, 90\]"):
+        overridden_accept(AcceptSettings(), ("accept.angle_deg=100",))
+    # a wider budget turns the +2 deg fail into a pass, from the same runs
+    arms = (CG1, runs(2, "weber", [42.0, 42.2, 41.9]))
+    assert crit(verdict(*arms), "cg2-weber")["angle_deg"].state == FAIL
+    assert crit(verdict(*arms, accept=a), "cg2-weber")["angle_deg"].state == PASS
