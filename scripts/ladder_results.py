@@ -1,0 +1,121 @@
+#!/usr/bin/env python3
+"""docs/results/ladder/: the committed tables of the ladder study and the README whose every
+number is read from them.
+
+    ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots
+    .venv/bin/python scripts/ladder_results.py runs/ladder          # copies tables, writes README
+    .venv/bin/python scripts/ladder_results.py --check               # README == text from tables
+
+``--check`` (what tests/report/test_committed_ladder.py runs) rebuilds the README from the
+committed tables and fails when the committed README differs: a sentence cannot drift
+from its table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import shutil
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "docs" / "results" / "ladder"
+TABLES = ("verdict.csv", "cases.csv", "conditions.csv", "summary.md")
+COMMAND = "ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots"
+
+
+def _n(v: float, digits: int = 3) -> str:
+    return "–" if not (isinstance(v, float) and math.isfinite(v)) and not isinstance(v, int) \
+        else f"{v:.{digits}g}"
+
+
+def readme(verdict: pd.DataFrame, cases: pd.DataFrame) -> str:
+    """The README text, every number from ``verdict`` (verdict.csv) and ``cases``."""
+    lines = ["# The ladder: which CG level and rule keeps the flow of the we_vs_bo drum",
+             "",
+             "Pre-registration (budget, statistics, looks, cap), committed before the runs: "
+             "[criterion.md](criterion.md). Made by:",
+             "",
+             "```", COMMAND, ".venv/bin/python scripts/ladder_results.py runs/ladder", "```",
+             "",
+             "Tables: `verdict.csv` (one row per CG level, rule and criterion), `cases.csv` "
+             "(one row per run), `conditions.csv`, the report's `summary.md`. This README is "
+             "written from them by `scripts/ladder_results.py` and checked against them by "
+             "`tests/report/test_committed_ladder.py`.",
+             "", "## Runs", ""]
+    runs = cases.groupby(["cg", "rule"], sort=True)
+    lines += ["| condition | runs | particles | angle of repose per run [deg] | rigid-block "
+              "share per run | core-s per run |", "|---|---|---|---|---|---|"]
+    for (cg, rule), sub in runs:
+        lines.append(f"| cg{cg:g}-{rule} | {len(sub)} | {int(sub['particles'].iloc[0]):,} | "
+                     + ", ".join(f"{a:.2f}" for a in sub["angle_of_repose"]) + " | "
+                     + ", ".join(f"{a:.2f}" for a in sub["rigid_frame_share"]) + " | "
+                     + ", ".join(f"{a:.0f}" for a in sub["core_seconds"]) + " |")
+    lines += ["", "## Verdict (budget: the workflow's `accept:` block)", ""]
+    lines += ["| condition | speedup (core-s) | verdict | criterion | state | CG-n - CG1 "
+              "[90 % interval] | shown within | budget |", "|---|---|---|---|---|---|---|---|"]
+    for _, r in verdict.iterrows():
+        unit = f" {r['unit']}" if isinstance(r["unit"], str) and r["unit"] else ""
+        lines.append(f"| {r['condition']} | {_n(r['speedup_core'])} | {r['condition_state']} | "
+                     f"{r['label']} | {r['state']} | {_n(r['value'])} [{_n(r['lo'])}, "
+                     f"{_n(r['hi'])}]{unit} | {_n(r['shown_within'])}{unit} | "
+                     f"{_n(r['budget'])}{unit} |")
+    lines += ["", "## Reading", ""]
+    flow = verdict[verdict["criterion"].isin(["angle_deg", "rigid_share", "flowing_layer",
+                                              "profile_error"])]
+    decided = flow[flow["state"].isin(["pass", "fail"])]
+    lines.append(f"- Flow criteria decided: {len(decided)} of {len(flow)} "
+                 "(angle, velocity profile, rigid-block share, flowing layer of every level).")
+    meets = verdict[verdict["cheapest"].astype(str) == "True"]
+    if len(meets):
+        c = meets.iloc[0]
+        lines.append(f"- The cheapest level that meets the budget: {c['condition']} "
+                     f"(speedup {_n(c['speedup_core'])}).")
+    else:
+        lines.append("- No level meets the whole budget. Per level, the criteria that "
+                     "decidedly fail:")
+        for cond, sub in verdict.groupby("condition", sort=True):
+            fails = sub[sub["state"] == "fail"]
+            what = "; ".join(f"{r['label']} {_n(r['value'])} [{_n(r['lo'])}, {_n(r['hi'])}]"
+                             for _, r in fails.iterrows()) or "none (undecided only)"
+            lines.append(f"  - {cond}: {what}")
+    rigid = verdict[verdict["criterion"] == "rigid_share"].set_index("condition")["state"]
+    bond_fail = [c for c in rigid.index if "bond" in c and rigid[c] == "fail"]
+    weber_pass = [c for c in rigid.index if "weber" in c and rigid[c] == "pass"]
+    lines.append(f"- Against the source study (We keeps the flow, Bo does not), registered on "
+                 f"the rigid-block share: Bond fails it in {len(bond_fail)} of "
+                 f"{sum('bond' in c for c in rigid.index)} levels, Weber passes it in "
+                 f"{len(weber_pass)} of {sum('weber' in c for c in rigid.index)}.")
+    open_ = flow[flow["state"] == "undecided"]
+    for _, r in open_.iterrows():
+        lines.append(f"- Undecided: {r['condition']} {r['label']}: {r['note']}.")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("study", nargs="?", type=Path, help="the ladder's study folder")
+    ap.add_argument("--check", action="store_true")
+    args = ap.parse_args(argv)
+    if not args.check:
+        if args.study is None:
+            ap.error("give the study folder (or --check)")
+        for name in TABLES:
+            shutil.copyfile(args.study / "report" / name, OUT / name)
+    text = readme(pd.read_csv(OUT / "verdict.csv"), pd.read_csv(OUT / "cases.csv"))
+    if args.check:
+        if (OUT / "README.md").read_text() != text:
+            print("docs/results/ladder/README.md differs from its tables: run "
+                  "scripts/ladder_results.py runs/ladder", file=sys.stderr)
+            return 1
+        return 0
+    (OUT / "README.md").write_text(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

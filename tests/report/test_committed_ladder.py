@@ -1,0 +1,34 @@
+"""The committed ladder (docs/results/ladder): its README is the text its tables give
+(scripts/ladder_results.py --check), and every signed criterion of its verdict.csv
+recomputes from the per-run values of its cases.csv with the verdict's statistics."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from ligwf.analysis.records import equivalence as eq
+from scripts.ladder_results import OUT, main
+
+pytestmark = pytest.mark.skipif(not (OUT / "verdict.csv").exists(),
+                                reason="the ladder's tables are not committed yet")
+
+
+def test_readme_is_what_the_tables_say():
+    assert main(["--check"]) == 0
+
+
+def test_signed_criteria_recompute_from_the_runs():
+    verdict = pd.read_csv(OUT / "verdict.csv")
+    cases = pd.read_csv(OUT / "cases.csv")
+    cg1 = cases[cases["cg"] == 1.0]
+    for _, r in verdict[verdict["criterion"].isin(["angle_deg", "rigid_share"])].iterrows():
+        col = {"angle_deg": "angle_of_repose", "rigid_share": "rigid_frame_share"}[r["criterion"]]
+        arm = cases[(cases["cg"] == r["cg"]) & (cases["rule"] == r["rule"])]
+        e = eq.difference_estimate(arm[col], cg1[col])
+        assert e.value == pytest.approx(r["value"], abs=1e-9)
+        if e.has_interval:
+            assert (e.lo, e.hi) == (pytest.approx(r["lo"], abs=1e-9),
+                                    pytest.approx(r["hi"], abs=1e-9))
+        state = eq.equivalence(e, r["budget"]).state
+        assert r["state"] == state or (state == eq.FAIL and "Holm" in str(r["note"]))
