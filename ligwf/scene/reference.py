@@ -104,8 +104,9 @@ CROSS_FIELD_RULES: dict[str, tuple[str, ...]] = {
         "`controls` needs a wet scene; one rule on a dry scene.",
     ),
     "analysis": ("`steady_after`: `auto` or a fraction in [0, 1).",),
-    "accept": ("`null` leaves a criterion out of the budget; the angle, profile and field "
-               "errors are accepted up to max(tolerance, the CG1 noise floor); `gsd_error` "
+    "accept": ("`null` leaves a criterion out of the budget; the signed criteria (angle, "
+               "rigid share, flowing layer) are held to +-tolerance by two one-sided tests "
+               "and the CG1 noise floor never widens a tolerance; `gsd_error` "
                "counts only where the granules beat their cohesionless control.",),
 }
 
