@@ -45,6 +45,13 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame) -> str:
              "(one row per run), `conditions.csv`, the report's `summary.md`. This README is "
              "written from them by `scripts/ladder_results.py` and checked against them by "
              "`tests/report/test_committed_ladder.py`.",
+             "",
+             "Timings: the runs shared the machine with the developer's tests (niced) and the "
+             "CG1 runs used 2 ranks, the CG-n runs 1: the speedups (production core-seconds "
+             "per simulated second, CG1 over CG-n) are indicative, not a benchmark "
+             "(benchmarks/bench_cg_speedup.py is). The design was amended to two CG1 seeds "
+             "before any result was analysed (criterion.md); the sequential rounds "
+             "(`--until-decided`) are not built, so this is one look at alpha = 0.05.",
              "", "## Runs", ""]
     runs = cases.groupby(["cg", "rule"], sort=True)
     lines += ["| condition | runs | particles | angle of repose per run [deg] | rigid-block "

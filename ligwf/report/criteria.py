@@ -224,7 +224,8 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
             out.append(_legacy(spec, tol, row))
             p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
     rejected = eq.holm_rejects(p_fail, alpha)
+    family = sum(math.isfinite(p) for p in p_fail)
     return tuple(r if r.state != FAIL or ok else dataclasses.replace(
         r, state=UNDECIDED, note=(f"outside the budget on its own, not after Holm over the "
-                                  f"level's {len(out)} criteria; " + r.note).rstrip("; "))
+                                  f"level's {family} tested criteria; " + r.note).rstrip("; "))
                  for r, ok in zip(out, rejected))
