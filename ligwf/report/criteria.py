@@ -110,7 +110,7 @@ def _replica_note(x: np.ndarray, y: np.ndarray, budget: float, alpha: float,
     if len(x) < 2 or len(y) < 2:
         who = "CG-n" if len(x) < 2 else "CG1"
         return f"{who} has one run: no variance, no interval (run at least 2 replicas)"
-    need = eq.replicas_to_decide(x * scale, y * scale, budget, alpha)
+    need = eq.arm_replicas_to_decide(x * scale, y * scale, budget, alpha)
     if need is None:
         return ("the difference sits near the budget for its spread: over 64 replicas of "
                 "either arm would be needed")

@@ -208,7 +208,7 @@ def norm_decision(e: NormEstimate, budget: float) -> str:
     return UNDECIDED
 
 
-def replicas_to_decide(runs, reference, budget: float, alpha: float = ALPHA,
+def arm_replicas_to_decide(runs, reference, budget: float, alpha: float = ALPHA,
                        most: int = 64) -> tuple[str, int] | None:
     """The cheapest way to decide a signed criterion by adding replicas to one arm: (arm,
     total replicas of that arm) such that, with the arms' variances and the difference
