@@ -19,9 +19,10 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis.records import equivalence as eq
+from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.scene.accept import AcceptSettings
 
-PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
+#: the states of a criterion beside the tests' own (pass, fail, undecided)
 NOT_ASSESSED, NOT_MEASURED = "not assessed", "not measured"
 
 #: how a criterion reads the tables
@@ -94,10 +95,6 @@ def band(row, col: str) -> tuple[float, float, float]:
 
 
 # ------------------------------------------------------------------ deciding one criterion
-def _state(test_state: str) -> str:
-    return {eq.PASS: PASS, eq.FAIL: FAIL}.get(test_state, UNDECIDED)
-
-
 def _per_run(runs: pd.DataFrame, column: str) -> np.ndarray:
     return pd.to_numeric(runs[column], errors="coerce").to_numpy(float) if (
         runs is not None and column in runs) else np.array([])
@@ -142,10 +139,11 @@ def _signed(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
                 "differs from CG1 beyond seed noise" if (noise.lo > 0 or noise.hi < 0)
                 else "indistinguishable from CG1 seed noise at these replicas")
     note = vs_noise
-    if test.state == eq.UNDECIDED:
-        note = "; ".join(x for x in (_replica_note(x, y, tolerance, alpha, scale), vs_noise) if x)
+    if test.state == UNDECIDED:
+        note = "; ".join(part for part in (_replica_note(x, y, tolerance, alpha, scale),
+                                           vs_noise) if part)
     bound = max(abs(e.lo), abs(e.hi)) if e.has_interval else math.nan
-    return CriterionResult(**base, state=_state(test.state), value=e.value, lo=e.lo, hi=e.hi,
+    return CriterionResult(**base, state=test.state, value=e.value, lo=e.lo, hi=e.hi,
                            bound=bound, note=note), test.p_fail
 
 
@@ -158,7 +156,7 @@ def _norm(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
     e = eq.norm_estimate(x, y, alpha)
     if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED, note="not measured: no profiles")
-    state = _state(eq.norm_decision(e, tolerance))
+    state = eq.norm_decision(e, tolerance)
     note = (f"raw distance {e.raw:.3g} before the noise of both arms is taken off"
             if state != UNDECIDED else
             f"raw distance {e.raw:.3g}; the bin-wise bounds [{e.lo:.3g}, {e.hi:.3g}] straddle "
@@ -169,7 +167,7 @@ def _norm(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
                            note=note)
 
 
-def _legacy(spec: CriterionSpec, tolerance: float, row) -> CriterionResult:
+def _analysis_interval(spec: CriterionSpec, tolerance: float, row) -> CriterionResult:
     """GSD and field errors: their interval from the analysis against the tolerance."""
     base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
                 budget_source="tolerance")
@@ -215,13 +213,15 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
             except ValueError:
                 xa = ya = np.array([])
             out.append(_norm(spec, tol, xa, ya, alpha))
+            # a fail by its bounds has no p-value: it enters Holm's family as decided
+            # (p = 0), which only makes the signed fails beside it harder to keep
             p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
         elif spec.column not in row.index:
             out.append(CriterionResult(**base, state=NOT_MEASURED,
                                        note=f"not measured: the study has no {spec.column}"))
             p_fail.append(math.nan)
         else:
-            out.append(_legacy(spec, tol, row))
+            out.append(_analysis_interval(spec, tol, row))
             p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
     rejected = eq.holm_rejects(p_fail, alpha)
     family = sum(math.isfinite(p) for p in p_fail)

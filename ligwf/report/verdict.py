@@ -39,8 +39,8 @@ import pandas as pd
 
 from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
-from ligwf.report.criteria import (FAIL, PASS, UNDECIDED, CriterionResult, Gate, band,
-                                   condition_criteria)
+from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.report.criteria import CriterionResult, Gate, band, condition_criteria
 from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.workflow import CONTROL_KEY
 

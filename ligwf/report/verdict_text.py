@@ -15,13 +15,18 @@ import math
 from rich.table import Table
 from rich.text import Text
 
-from ligwf.report.criteria import (CRITERIA, FAIL, PASS, RELATIVE, SIGNED, UNDECIDED,
-                                   CriterionResult)
+from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.report.criteria import CRITERIA, RELATIVE, SIGNED, CriterionResult
 from ligwf.report.verdict import FAILS, MEETS, ConditionVerdict, GroupVerdict, Verdict, band_text
 
 TITLE = "Verdict"
 #: criteria judged on a signed difference (their budget is +-tolerance)
 SIGNED_NAMES = frozenset(s.name for s in CRITERIA if s.kind in (SIGNED, RELATIVE))
+
+
+def _within(name: str) -> str:
+    """How a criterion's budget reads: ``+-`` for a signed difference, else ``<= ``."""
+    return "+-" if name in SIGNED_NAMES else "<= "
 #: rich styles of the states
 STYLE = {PASS: "green", FAIL: "red", UNDECIDED: "yellow", MEETS: "bold green",
          FAILS: "bold red"}
@@ -47,8 +52,7 @@ def budget_line(accept: dict) -> str:
             parts.append(f"{s.label}: not in the budget")
             continue
         unit = f" {s.unit}" if s.unit else ""
-        sign = "+-" if s.name in SIGNED_NAMES else "<= "
-        parts.append(f"{s.label} {sign}{tol:g}{unit}")
+        parts.append(f"{s.label} {_within(s.name)}{tol:g}{unit}")
     return "; ".join(parts)
 
 
@@ -89,8 +93,8 @@ def _columns(g: GroupVerdict) -> list[str]:
         budgets = [c.criteria[k].budget for c in g.conditions
                    if math.isfinite(c.criteria[k].budget)]
         unit = f" {r.unit}" if r.unit else ""
-        sign = "+-" if r.unit == "deg" or r.name in SIGNED_NAMES else "<= "
-        heads.append(f"{r.label} ({sign}{_num(max(budgets))}{unit})" if budgets else r.label)
+        heads.append(f"{r.label} ({_within(r.name)}{_num(max(budgets))}{unit})" if budgets
+                     else r.label)
     return heads
 
 

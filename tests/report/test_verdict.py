@@ -19,8 +19,8 @@ import pandas as pd
 import pytest
 
 from ligwf.errors import ConfigError
-from ligwf.report.criteria import (FAIL, NOT_ASSESSED, NOT_MEASURED, PASS, UNDECIDED,
-                                   Gate)
+from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.report.criteria import NOT_ASSESSED, NOT_MEASURED, Gate
 from ligwf.report.verdict import FAILS, MEETS, decide, granule_gates
 from ligwf.report.verdict_records import read_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_renderables, verdict_section
