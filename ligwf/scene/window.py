@@ -20,9 +20,33 @@ from ligwf.scene.workflow import Workflow
 AUTO_LATEST = 0.5
 #: fewer usable frames than this leave the block bootstrap and the survival measure nothing
 MIN_USABLE_FRAMES = 10
-#: hold times the regime map measured, in revolutions of its drum (0.1-1 s at T = 2 s):
-#: held granules beat their cohesionless twin at about half a revolution
-HOLD_REVOLUTIONS = (0.25, 1.0)
+#: a hold window must outlast the co-rotating plug by this factor: bridges of the plug hold
+#: for as long as a particle rides it, in a bed without cohesion as in a wet one (issue 31:
+#: ``held_0.5s`` held 13-15 % of the cohesionless twins of a drum whose plug lasts 0.8 s)
+PLUG_MARGIN = 1.25
+#: ... and be at most this many revolutions (longer windows leave little production)
+MAX_HOLD_REVOLUTIONS = 1.0
+
+
+def plug_arc(fill_fraction: float) -> float:
+    """The angle (rad) of shell a bed of ``fill_fraction`` of the drum's cross-section covers
+    at rest: the circular segment of that area, (theta - sin theta) / (2 pi) = fill (pure)."""
+    if not 0.0 < fill_fraction < 1.0:
+        raise ValueError(f"fill_fraction = {fill_fraction!r}: must lie in (0, 1)")
+    lo, hi = 0.0, 2.0 * math.pi
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if (mid - math.sin(mid)) / (2.0 * math.pi) < fill_fraction:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def plug_residence(fill_fraction: float, period: float) -> float:
+    """Seconds a particle rides the co-rotating plug: the shell arc under the bed over the
+    drum's angular speed (``period`` s per revolution; pure)."""
+    return plug_arc(fill_fraction) / (2.0 * math.pi) * period
 
 
 def held_window_warnings(wf: Workflow) -> list[str]:
@@ -55,22 +79,26 @@ def held_window_warnings(wf: Workflow) -> list[str]:
 
 
 def hold_period_warnings(wf: Workflow) -> list[str]:
-    """One warning per drum speed at which ``hold_time`` is far from half a revolution
-    (outside :data:`HOLD_REVOLUTIONS`): the default 1 s is half a revolution at the regime
-    map's 30 rpm only, so a slower or faster drum holds its bridges for another share of a
-    turn than the one that was measured (pure)."""
+    """One warning per (speed, fill) at which ``hold_time`` does not outlast the co-rotating
+    plug by :data:`PLUG_MARGIN` (bridges of a bed turning with the drum then count as held
+    granules, in a cohesionless twin too) or exceeds :data:`MAX_HOLD_REVOLUTIONS` (pure)."""
     settings = wf.analysis
-    out: dict[float, str] = {}
-    lo, hi = HOLD_REVOLUTIONS
+    out: dict[tuple[float, float], str] = {}
     for case, period in _granule_cases(wf):
-        turns = settings.hold_time / period
-        if not lo <= turns <= hi and period not in out:
-            out[period] = (f"analysis.hold_time = {settings.hold_time:g} s is {turns:.2g} "
-                           f"revolution(s) of this drum (period {period:.3g} s, "
-                           f"{case.case_id}); the regime map's held granules beat their "
-                           f"cohesionless twin at about half a revolution: analysis.hold_time "
-                           f"= {period / 2.0:.3g} s (allowed without warning: "
-                           f"{lo * period:.3g}-{hi * period:.3g} s)")
+        fill = case.scene.process.fill_fraction
+        plug = plug_residence(fill, period)
+        lo, hi = PLUG_MARGIN * plug, MAX_HOLD_REVOLUTIONS * period
+        key = (period, fill)
+        if not lo <= settings.hold_time <= hi and key not in out:
+            why = (f"the co-rotating plug holds its bridges for {plug:.3g} s "
+                   f"({math.degrees(plug_arc(fill)):.0f} deg of shell at fill {fill:g}, "
+                   f"period {period:.3g} s, {case.case_id}), so a shorter window counts the "
+                   "plug as granules" if settings.hold_time < lo else
+                   f"it is more than {MAX_HOLD_REVOLUTIONS:g} revolution of this drum "
+                   f"(period {period:.3g} s, {case.case_id})")
+            out[key] = (f"analysis.hold_time = {settings.hold_time:g} s: {why}; use "
+                        f"analysis.hold_time = {min(lo, hi):.3g} s (allowed without warning: "
+                        f"{lo:.3g}-{hi:.3g} s)")
     return list(out.values())
 
 

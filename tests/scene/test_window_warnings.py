@@ -4,12 +4,14 @@ the survival measure frames (the gsd_cg study's lost measure, said before the ru
 from __future__ import annotations
 
 import copy
+import math
 
 import pytest
 import yaml
 
 from helpers import ROOT
-from ligwf.scene.window import MIN_USABLE_FRAMES, held_window_warnings
+from ligwf.scene.window import (MIN_USABLE_FRAMES, held_window_warnings, plug_arc,
+                                plug_residence)
 from ligwf.scene.workflow import expand
 
 DEMO = yaml.safe_load((ROOT / "workflows" / "demo.yaml").read_text())
@@ -48,15 +50,29 @@ def test_other_definitions_and_dry_scenes_do_not_warn():
     assert held_window_warnings(expand(raw)) == []
 
 
-def test_a_hold_time_far_from_half_a_revolution_of_this_drum_is_named():
-    """The default 1 s is half a revolution at the demo's 30 rpm (T = 2 s): fine there; at
-    6 rpm (T = 10 s) it is a tenth of a turn, and the warning gives the half-turn value."""
+def test_a_hold_time_shorter_than_this_drums_plug_is_named():
+    """The demo's 0.3 fill covers 143 deg of shell: 0.8 s in the plug at 30 rpm (T = 2 s), so
+    its 1 s window (1.25x) is fine; at 6 rpm (T = 10 s) the plug lasts 3.96 s and a 1 s window
+    would count it as granules: the warning gives the plug, the arc and the value to use."""
     assert warnings_for(5.0) == []
     raw = copy.deepcopy(DEMO)
     raw["scene"]["process"]["run_time"] = 30.0
     raw["scene"]["process"]["rotation"] = {"rpm": 6}
     (w,) = held_window_warnings(expand(raw))
-    assert w.startswith("analysis.hold_time = 1 s is 0.1 revolution(s)")
-    assert "period 10 s" in w and "analysis.hold_time = 5 s" in w and "2.5-10 s" in w
+    assert w.startswith("analysis.hold_time = 1 s: the co-rotating plug holds its bridges for 3.96 s")
+    assert "143 deg of shell at fill 0.3" in w and "analysis.hold_time = 4.96 s" in w
+    assert "4.96-10 s" in w
     raw["analysis"]["hold_time"] = 5.0
     assert held_window_warnings(expand(raw)) == []
+    raw["analysis"]["hold_time"] = 12.0
+    (w,) = held_window_warnings(expand(raw))
+    assert "more than 1 revolution" in w
+
+
+def test_plug_arc_is_the_circular_segment_of_the_fill():
+    assert plug_arc(0.5) == pytest.approx(math.pi)
+    theta = plug_arc(0.3)
+    assert (theta - math.sin(theta)) / (2 * math.pi) == pytest.approx(0.3)
+    assert plug_residence(0.5, 2.0) == pytest.approx(1.0)
+    with pytest.raises(ValueError, match="fill_fraction"):
+        plug_arc(1.2)

@@ -1,0 +1,155 @@
+"""Measure the granule-growth study and write its committed tables and README.
+
+    .venv/bin/python scripts/granule_growth_results.py RUNDIR docs/results/granule_growth
+
+RUNDIR is the folder of ``ligwf run workflows/granule_growth.yaml --out RUNDIR``. Writes
+``growth_rows.csv`` (every start frame of every run), ``cadence.csv`` (the held share at
+window cadences 0.01 / 0.02 / 0.05 s), ``flow.csv`` (angle of repose per frame), ``seeds.csv``
+(one row per wet seed beside its control, each criterion judged) and
+``controls_verdict.csv`` (k of n seeds per criterion), then README.md from those tables
+(``tests/report/test_committed_granule_growth.py`` recomputes its numbers from them).
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from ligwf.analysis.granules.growth import GrowthSettings
+from ligwf.analysis.granules.growth_study import (CRITERIA, cadence_table, measure_case,
+                                                  seed_table, verdict)
+from ligwf.study.case import CaseFolder
+
+COMMAND = ("ligwf run workflows/granule_growth.yaml --out runs/granule_growth\n"
+           ".venv/bin/python scripts/granule_growth_results.py runs/granule_growth "
+           "docs/results/granule_growth")
+
+
+def _fmt(x: float, digits: int = 3) -> str:
+    return "–" if pd.isna(x) else f"{x:.{digits}g}"
+
+
+def readme(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame, cases: pd.DataFrame) -> str:
+    """The README, every number from the tables beside it."""
+    s = GrowthSettings()
+    lines = [
+        "# Granule growth against a control that flows like the wet bed (issue 31)",
+        "",
+        "Pre-registration (committed before the runs): [criterion.md](criterion.md). Made by:",
+        "", "```", COMMAND, "```", "",
+        "Tables: `seeds.csv` (one row per wet seed beside its cohesionless twin, every measure and "
+        "criterion), `controls_verdict.csv` (k of n seeds per criterion), `growth_rows.csv` "
+        "(every start frame), `cadence.csv` (held share at three window cadences), `flow.csv` "
+        "(angle of repose per frame), `cases.csv` (the runs). This README is written from them by "
+        "`scripts/granule_growth_results.py` and checked against them by "
+        "`tests/report/test_committed_granule_growth.py`.",
+        "",
+        f"Held granules: bridges present through W = {s.hold_time:g} s sampled every "
+        f"{s.cadence:g} s; start frames every {s.stride:g} s from {s.start_after:g} s; "
+        f"granules of >= {s.min_particles} particles.",
+        "", "## Runs", "",
+        "| case | particles | production [s] | frames | status |", "|---|---|---|---|---|",
+    ]
+    for r in cases.itertuples():
+        lines.append(f"| {r.case_id} | {r.particles:,} | {r.production_s:g} | {r.frames} | {r.status} |")
+    lines += ["", "## Verdict (criterion.md: a criterion passes in >= 4 of 5 seeds)", "",
+              "| criterion | meaning | seeds passing | passes |", "|---|---|---|---|"]
+    for r in ver.itertuples():
+        lines.append(f"| {r.criterion} | {r.meaning} | {r.seeds_pass} of {r.seeds} | "
+                     f"{'yes' if r.passes else 'no'} |")
+    lines += ["", "## Per seed (wet / control)", "",
+              "| seed | share_10 | first rev. | last rev. | slope [1/s] (95 %) | survival | "
+              "spanning frames | wall share (bed) | co-movement | angle [deg] | angle std [deg] |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in seeds.itertuples():
+        lines.append(
+            f"| {r.seed} | {_fmt(r.share_10)} / {_fmt(r.control_share_10)} | "
+            f"{_fmt(r.share_10_first_rev)} | {_fmt(r.share_10_last_rev)} | "
+            f"{_fmt(r.slope_per_s)} [{_fmt(r.slope_low)}, {_fmt(r.slope_high)}] | "
+            f"{_fmt(r.survival)} / {_fmt(r.control_survival)} | "
+            f"{_fmt(r.spanning_frames)} / {_fmt(r.control_spanning_frames)} | "
+            f"{_fmt(r.wall_share)} ({_fmt(r.bed_wall_share)}) / {_fmt(r.control_wall_share)} | "
+            f"{_fmt(r.comove_ratio)} / {_fmt(r.control_comove_ratio)} | "
+            f"{_fmt(r.angle_deg)} / {_fmt(r.control_angle_deg)} | "
+            f"{_fmt(r.angle_std_deg)} / {_fmt(r.control_angle_std_deg)} |")
+    lines += ["", "## Held share against the window cadence", "",
+              "| case | " + " | ".join(f"{c:g} s" for c in sorted(cad.cadence.unique())) + " |",
+              "|---|" + "---|" * cad.cadence.nunique()]
+    for case_id, g in cad.groupby("case_id", sort=True):
+        vals = g.set_index("cadence")["share_10"]
+        lines.append(f"| {case_id} | " + " | ".join(_fmt(vals[c]) for c in sorted(vals.index)) + " |")
+    lines += ["", "## Reading", ""] + reading(seeds, ver)
+    return "\n".join(lines) + "\n"
+
+
+def reading(seeds: pd.DataFrame, ver: pd.DataFrame) -> list[str]:
+    """The finding in sentences, each number from the tables."""
+    v = ver.set_index("criterion")
+    out = []
+    regime = v.loc["regime"]
+    if regime.passes:
+        out.append(f"- The regime passes every pre-registered criterion ({regime.seeds_pass} of "
+                   f"{regime.seeds} seeds pass all of them).")
+    else:
+        failed = [c for c, _ in CRITERIA if not v.loc[c.removeprefix("pass_")].passes]
+        names = ", ".join(f"{c.removeprefix('pass_')} ({v.loc[c.removeprefix('pass_')].seeds_pass} "
+                          f"of {v.loc[c.removeprefix('pass_')].seeds})" for c in failed)
+        out.append(f"- The regime does not pass: it fails {names}. No granule has been shown to "
+                   "exist here, so GSD transfer across CG levels stays unvalidated in this engine "
+                   "for this regime.")
+    fm = v.loc["flow_matched"]
+    out.append(f"- The cohesionless twin flows like the wet bed (angle within 1 deg) in "
+               f"{fm.seeds_pass} of {fm.seeds} seeds; angle wet / twin per seed: "
+               + ", ".join(f"{_fmt(r.angle_deg)} / {_fmt(r.control_angle_deg)}"
+                           for r in seeds.itertuples()) + " deg.")
+    out.append("- Revolutions of production measured per seed: "
+               + ", ".join(f"{r.revolutions:.1f}" for r in seeds.itertuples()) + ".")
+    return out
+
+
+def case_table(run_dir: Path, case_ids: list[str]) -> pd.DataFrame:
+    rows = []
+    for cid in case_ids:
+        case = CaseFolder.open(run_dir / cid)
+        m = case.manifest()
+        rows.append({"case_id": cid, "particles": int(case.scaled.particle_count),
+                     "production_s": round(case.scaled.run_steps * case.scaled.dt, 3),
+                     "frames": len(list((run_dir / cid / "post").glob("particles_[0-9]*.vtu"))),
+                     "status": m.status if m is not None else "not run"})
+    return pd.DataFrame(rows)
+
+
+def main(run_dir: str, out_dir: str) -> int:
+    run, out = Path(run_dir), Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    case_ids = sorted(p.name for p in run.iterdir() if (p / "scene.json").exists())
+    rows, shares, flows = [], [], []
+    for cid in case_ids:
+        print(f"measuring {cid} ...", flush=True)
+        r, s, f = measure_case(run / cid)
+        rows.append(r), shares.append(s), flows.append(f)
+    rows_df, shares_df, flows_df = (pd.concat(x, ignore_index=True) for x in (rows, shares, flows))
+    seeds = seed_table(rows_df, flows_df)
+    ver = verdict(seeds)
+    cad = cadence_table(shares_df)
+    cases = case_table(run, case_ids)
+    rows_df.to_csv(out / "growth_rows.csv", index=False, float_format="%.6g")
+    cad.to_csv(out / "cadence.csv", index=False, float_format="%.6g")
+    flows_df.to_csv(out / "flow.csv", index=False, float_format="%.6g")
+    seeds.to_csv(out / "seeds.csv", index=False, float_format="%.6g")
+    ver.to_csv(out / "controls_verdict.csv", index=False)
+    cases.to_csv(out / "cases.csv", index=False)
+    # the README reads the tables as written (what its test recomputes from)
+    seeds, ver, cad, cases = (pd.read_csv(out / f) for f in
+                              ("seeds.csv", "controls_verdict.csv", "cadence.csv", "cases.csv"))
+    (out / "README.md").write_text(readme(seeds, ver, cad, cases))
+    print(ver.to_string(index=False))
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    sys.exit(main(sys.argv[1], sys.argv[2]))
