@@ -15,7 +15,9 @@ many ranks in one array, as before. With ``--cores-per-node`` (or the site's
 plan is printed (:mod:`ligwf.slurm.budget`): per case (replicas alike share a row) its
 particles, steps, ranks and what bound them, nodes, the estimated wall time against
 ``--time``, with a warning for each case the estimate says would outlive its ``--time``.
-``--dry-run`` prints the plan, the scripts and the sbatch commands and writes nothing.
+``--dry-run`` prints the plan, what it assumed about the site (MPI launcher, cores per node,
+partition limits: :mod:`ligwf.slurm.assumptions`), the scripts and the sbatch commands and
+writes nothing.
 ``status`` joins the runner's manifests with squeue/scontrol; ``resubmit`` submits new
 arrays with exactly the cases that are missing, failed or killed (a planned submission is
 planned again); ``cancel`` scancels the study's queued and running jobs (the runners write
@@ -27,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import shlex
 from dataclasses import asdict, fields
 from functools import partial
 from pathlib import Path
@@ -42,8 +45,10 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, 
                               prepare_from_args, rank_count)
 from ligwf.engine.plan import CasePlan
 from ligwf.engine.progress import shown_reason
+from ligwf.engine.site import EngineConfig
 from ligwf.pipeline.prepare import prepared_loads
 from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_submit
+from ligwf.slurm.assumptions import site_assumptions
 from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
                                 plan_rows, slab_note, slurm_time_seconds)
 from ligwf.slurm.jobs import PlannedJob, recorded_site, study_status
@@ -168,6 +173,9 @@ def cmd_submit(args: argparse.Namespace) -> int:
         console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
         console.print(plan_view)
         _warn(over_time)
+        engine = EngineConfig.from_site()
+        print("\n".join(site_assumptions(site, jobs, shlex.join([engine.mpirun,
+                                                                  *engine.mpirun_args]))))
         print(scheduler.dry_run_text(jobs))
         return 0
     write_for_submit(prepared, submission, scheduler, args.mesh_cache)
