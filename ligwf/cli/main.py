@@ -23,7 +23,7 @@ from rich.markup import escape
 from rich.table import Table
 from ligwf.fsio import NOT_WRITABLE, not_writable
 from ligwf.pipeline.prepare import write
-from ligwf.pipeline.run import Interrupted, planned_schedule, run_settings
+from ligwf.pipeline.run import Interrupted, planned_schedule, run_settings, site_engine
 from ligwf.study.case import granules_absent
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
@@ -42,6 +42,11 @@ def cmd_check(args: argparse.Namespace) -> int:
                              f"({settings.cores_source}): what "
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     console.print(regime_table(prepared))
+    try:
+        console.print(site_engine()[1].describe(), highlight=False, soft_wrap=True)
+    except LigwfError as exc:   # check writes nothing: the run would refuse, say so here
+        err_console.print(f"[yellow]ligwf: warning:[/] engine not usable here: "
+                          f"{escape(str(exc))} ('ligwf run' refuses it)", highlight=False)
     return 0
 
 

@@ -37,6 +37,7 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     title = (f"rank plan for {settings.cores} core(s) ({settings.cores_source})"
              if settings.planned else "ranks as asked (--np / --ensemble)")
     console.print(plan_table(run.schedule, title))
+    console.print(run.identity.describe(), highlight=False, soft_wrap=True)
     for line in elsewhere(run.study.cases, settings.retry_unstable):
         console.print(line, highlight=False, soft_wrap=True)
     return run

@@ -17,6 +17,7 @@ from ligwf.engine.dump_hasher import dump_problem
 from ligwf.engine.health import (Expectation, assess, engine_signal, kinetic_energy_ceiling,
                                  verdict)
 from ligwf.engine.restart_id import CaseIdentity, stamp
+from ligwf.engine.site import EngineIdentity
 from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for,
                                  phase_steps_between, render_resume, rotate_screen)
 from ligwf.engine.thermo import parse_screen, phase_group
@@ -54,9 +55,11 @@ def engine_version(lines: list[str]) -> str | None:
 
 
 def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
-                  command: list[str] | None = None, template_dirs=()) -> tuple[Manifest, Attempt]:
+                  command: list[str] | None = None, template_dirs=(),
+                  engine: EngineIdentity | None = None) -> tuple[Manifest, Attempt]:
     """Prepare the folder for ``plan`` (clean or write the resume input) and record the
-    attempt as ``running`` in the manifest. Returns the manifest and the new attempt."""
+    attempt as ``running`` in the manifest, with the ``engine`` that runs it. Returns the
+    manifest and the new attempt."""
     previous = case.manifest()
     if plan.action == FRESH or previous is None:
         clean_outputs(case.path)
@@ -87,6 +90,9 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
     manifest.command = list(command or [])
     manifest.total_steps = case.scaled.total_steps
     manifest.ended = None
+    if engine is not None:
+        manifest.liggghts_executable, manifest.liggghts_library = engine.executable, engine.library
+        manifest.liggghts_version = engine_version([engine.version]) or engine.version
     attempt = Attempt(number=len(manifest.attempts) + 1, started=now_iso(), nprocs=nprocs,
                       command=list(command or []), input=input_for(plan),
                       from_restart=restart_path, from_step=from_step)

@@ -172,6 +172,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                                f"{group_size}")
     stop = stop or threading.Event()
     monitor = monitor or NullMonitor()
+    identity = engine.identify()    # the library the ranks load: the named executable's
     for case in cases:
         take_over(case)     # a dead runner's engines and attempts (a no-op when there are none)
     todo = [c for c in cases if plan_case(c, retry_unstable).action != SKIP]
@@ -191,7 +192,8 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
         (ens_dir / CLAIMS_DIR).mkdir(parents=True)
         atomic_write_json(ens_dir / QUEUE_FILE, {"cases": [_key(c) for c in todo],
                                                  "retry_unstable": retry_unstable,
-                                                 "runner": runner})
+                                                 "runner": runner,
+                                                 "engine": identity.to_dict()})
         before = {_key(c): (c.manifest().steps_done if c.manifest() else 0) for c in todo}
         cmd = worker_command(engine, nprocs, ens_dir, group_size)
         t_launch = time.time()

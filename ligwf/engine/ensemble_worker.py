@@ -2,7 +2,8 @@
 
 Started by :mod:`ligwf.engine.ensemble` as ONE ``mpirun -np P``. The ranks split into P/K groups
 (``comm.Split``); each group runs one case at a time in the LIGGGHTS shared library
-(``libliggghts.so.3``, LAMMPS C API through ctypes) on its sub-communicator. Assignment is
+(the ``libliggghts`` the named executable links to, as the supervisor found it and wrote
+into the queue; LAMMPS C API through ctypes) on its sub-communicator. Assignment is
 dynamic and needs no master rank: a group leader claims the next case of ``queue.json``
 by creating ``claims/<index>.json`` with O_EXCL (only one creator can win), broadcasts it to
 its group, and takes the next when the case is done.
@@ -38,6 +39,7 @@ from ligwf.engine.attempt import DISK_FULL, begin_attempt, finish_attempt, resta
 from ligwf.engine.dump_hasher import DumpHasher
 from ligwf.engine.guard import ENSEMBLE_RANK_NAME
 from ligwf.engine.liggghts import Liggghts
+from ligwf.engine.site import EngineIdentity
 from ligwf.fsio import atomic_write_json
 from ligwf.engine.resume import FRESH, RESUME, SKIP, discard_restart, input_for, plan_case
 from ligwf.study.case import CaseFolder
@@ -69,7 +71,7 @@ def run_file(engine: Liggghts, comm, case: CaseFolder, input_name: str) -> None:
     _libc.fflush(None)
     if comm.rank == 0:
         saved = os.dup(1)
-        fd = os.open(case.screen, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+        fd = os.open(case.screen, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o666)
         os.dup2(fd, 1)
         os.close(fd)
     os.chdir(case.path)
@@ -127,7 +129,7 @@ def claim_next(ens_dir: Path, cases: list[str], record: dict) -> tuple[int, str]
     for pos, case in enumerate(cases):
         path = claims / f"{pos}.json"
         try:
-            fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
+            fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666)
         except FileExistsError:
             continue
         with os.fdopen(fd, "w") as fh:
@@ -156,7 +158,13 @@ def main(argv: list[str] | None = None) -> int:
     ranks = list(range(group * k, group * k + k))
     queue = json.loads((args.ens_dir / QUEUE_FILE).read_text())
     runner = queue.get("runner", {})
-    engine = Liggghts()
+    identity = EngineIdentity.from_dict(queue["engine"])
+    engine = Liggghts(identity.library)     # the library of the executable the user named
+    mapped = Liggghts.mapped()
+    if mapped != {os.path.realpath(identity.library)}:
+        print(f"ensemble: engine library {identity.library} asked for, {sorted(mapped)} "
+              "loaded", file=sys.stderr)
+        return 2
     install_engine_signals(engine)
     engine.warm_up_vtk()
     world.Barrier()
@@ -186,7 +194,8 @@ def main(argv: list[str] | None = None) -> int:
         while True:
             if sub.rank == 0:
                 manifest, attempt = begin_attempt(case, plan, k, "ensemble",
-                                                  [f"ensemble group {group}", input_for(plan)])
+                                                  [f"ensemble group {group}", input_for(plan)],
+                                                  engine=identity)
                 _record_runner(case, manifest, runner, me)
             t0 = time.monotonic()
             # the group's rank 0 hashes the dumps while the engine runs (the done record

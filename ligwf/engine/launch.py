@@ -226,9 +226,11 @@ def _run_locked(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Mo
         return None
     grid = grid_vars(case.scaled, nprocs)
     expect = expectation(case.scaled)
+    identity = engine.identify()
     while True:
         cmd = engine.command(input_for(plan), nprocs, extra=grid)
-        manifest, attempt = begin_attempt(case, plan, nprocs, "mpirun", cmd, template_dirs)
+        manifest, attempt = begin_attempt(case, plan, nprocs, "mpirun", cmd, template_dirs,
+                                          identity)
         monitor.start(case_id, manifest.total_steps, attempt.from_step)
         before = history(case, manifest, attempt)
 

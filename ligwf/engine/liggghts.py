@@ -9,18 +9,19 @@ working folder; the drum input writes periodic restarts alternately to two files
 SIGKILL mid-write leaves the other one whole). The step is read from the binary header.
 
 Library: ``libliggghts.so.3`` exports the LAMMPS C API (open, file, command, close), driven
-through ctypes on an mpi4py sub-communicator by the ensemble worker.
+through ctypes on an mpi4py sub-communicator by the ensemble worker. Which library file is
+not a setting of its own: it is the one the named executable links to
+(:meth:`ligwf.engine.site.EngineConfig.identify`).
 """
 
 from __future__ import annotations
 
 import ctypes
-import os
 import re
 import struct
 from pathlib import Path
 
-from ligwf.engine.site import load_site
+from ligwf.engine.site import EngineConfig
 
 # --------------------------------------------------------------------------- restarts
 
@@ -64,9 +65,9 @@ def restart_step(path: Path) -> int | None:
 # --------------------------------------------------------------------------- library
 
 def library_path() -> str:
-    """The LIGGGHTS shared library: $LIGWF_LIBLIGGGHTS, site key ``libliggghts``, or the
-    Debian package's ``libliggghts.so.3`` (found by the dynamic loader)."""
-    return os.environ.get("LIGWF_LIBLIGGGHTS", load_site().get("libliggghts", "libliggghts.so.3"))
+    """The LIGGGHTS shared library of the site's engine: the file the configured ``liggghts``
+    executable links to (EngineNotFound when there is none)."""
+    return EngineConfig.from_site().identify().library
 
 
 class Liggghts:
@@ -83,6 +84,17 @@ class Liggghts:
         self.lib.lammps_close.restype = None
         self.lib.lammps_command.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
         self.lib.lammps_command.restype = ctypes.c_char_p
+
+    @staticmethod
+    def mapped() -> set[str]:
+        """The libliggghts files mapped into this process (``/proc/self/maps``): what the
+        ensemble worker checks against the library it was told to load."""
+        try:
+            lines = Path("/proc/self/maps").read_text().splitlines()
+        except OSError:
+            return set()
+        paths = {line.split(None, 5)[5] for line in lines if len(line.split(None, 5)) == 6}
+        return {p for p in paths if Path(p).name.startswith("libliggghts")}
 
     def warm_up_vtk(self) -> None:
         """Create (never write) one VTK dump in a throw-away engine on MPI_COMM_SELF.

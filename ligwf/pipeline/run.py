@@ -27,7 +27,7 @@ from ligwf.engine.launch import Monitor, run_case, take_over
 from ligwf.engine.plan import (Phase, Schedule, case_load, machine_cores, override_schedule,
                                plan_study)
 from ligwf.engine.resume import SKIP, plan_case
-from ligwf.engine.site import EngineConfig
+from ligwf.engine.site import EngineConfig, EngineIdentity
 from ligwf.errors import LigwfError
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.study.case import CaseFolder
@@ -196,12 +196,14 @@ def _ensemble_phase(study: Study, members: list[CaseFolder], phase: Phase, label
 @dataclass(frozen=True)
 class StudyRun:
     """A written study about to run: its folder, the schedule of the cases still to run
-    (what the CLI prints before the engines start), the engine and the run settings."""
+    (what the CLI prints before the engines start), the engine (as configured and as
+    found: ``identity``) and the run settings."""
 
     study: Study
     schedule: Schedule
     engine: EngineConfig
     settings: RunSettings
+    identity: EngineIdentity
 
     def run(self, monitor: Monitor | None = None, stop: threading.Event | None = None) -> bool:
         """Run every case of the study (:func:`run_study`); whether all of them are done."""
@@ -212,12 +214,21 @@ class StudyRun:
 def start_run(prepared: Prepared, out: Path, settings: RunSettings,
               mesh_cache: Path | None = None) -> StudyRun:
     """Write a prepared study (the pre-flight is behind it) and schedule the cases that
-    are not finished. The site's engine settings are read first: a bad one is refused
-    before anything is written."""
-    engine = EngineConfig.from_site()
+    are not finished. The site's engine is found first (executable, its library, version,
+    the MPI launcher): one that is missing or cannot be loaded is refused before anything
+    is written."""
+    engine, identity = site_engine()
     study = write(prepared, out, mesh_cache)
     schedule = study_schedule(cases_to_run(study.cases, settings.retry_unstable), settings)
-    return StudyRun(study, schedule, engine, settings)
+    return StudyRun(study, schedule, engine, settings, identity)
+
+
+def site_engine() -> tuple[EngineConfig, EngineIdentity]:
+    """The site's engine settings and the engine they name, checked: EngineNotFound (or
+    ConfigError) when the executable, its library or the MPI launcher is not usable."""
+    engine = EngineConfig.from_site()
+    engine.mpirun_path()
+    return engine, engine.identify()
 
 
 def run_case_of(study: Study, case: CaseFolder, nprocs: int | None = None,
@@ -226,7 +237,8 @@ def run_case_of(study: Study, case: CaseFolder, nprocs: int | None = None,
     """Run one case of a written study (what a scheduler's array task does) on ``nprocs``
     ranks, default the allocation's ``SLURM_NTASKS``, else 1. Whether it is done."""
     ranks = nprocs or int(os.environ.get("SLURM_NTASKS", "1"))
-    return run_study(study, [case], EngineConfig.from_site(),
+    engine, _ = site_engine()       # refused before the case is locked or touched
+    return run_study(study, [case], engine,
                      RunSettings(nprocs=ranks, retry_unstable=retry_unstable), monitor, stop)
 
 

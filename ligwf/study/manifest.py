@@ -76,6 +76,8 @@ class Manifest:
     scene_hash: str
     ligwf_version: str
     liggghts_version: str
+    liggghts_executable: str = ""       # the engine that ran: executable (the --np path) ...
+    liggghts_library: str = ""          # ... and the library it links to (the ensemble path)
     status: str = RUNNING
     reason: str = ""
     reason_step: int | None = None
@@ -190,7 +192,7 @@ def case_lock(case_dir: Path) -> Iterator[bool]:
     waiting). Two ``ligwf run`` on one study split its cases this way."""
     path = Path(case_dir) / RUNNER_LOCK
     try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
     except OSError as exc:
         if exc.errno in NOT_WRITABLE:
             raise not_writable(exc, path.parent) from exc

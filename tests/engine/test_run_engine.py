@@ -58,6 +58,8 @@ def test_two_cases_np2_end_to_end_then_skipped(tmp_path):
         assert m.nprocs == 2 and m.core_seconds == pytest.approx(2 * m.wall_seconds)
         assert "-np" in m.command and "2" in m.command
         assert m.liggghts_version.startswith("LIGGGHTS Version LIGGGHTS-PUBLIC 3.8.0")
+        assert m.liggghts_executable == m.command[m.command.index("-in") - 1]
+        assert Path(m.liggghts_library).name.startswith("libliggghts")
         assert m.scene_hash == json.loads((d / "scene.json").read_text())["scene_hash"]
         assert set(m.phases) == {"fill", "settle", "production"}
         assert all(p["wall_seconds"] > 0 and p["core_seconds"] == pytest.approx(
