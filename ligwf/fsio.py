@@ -1,5 +1,11 @@
 """Atomic file writes: a result file is either complete or absent, never half-written.
 
+Files get the user's permissions (``0666`` less the umask, as ``open()`` would give them:
+``0644`` under umask 022), not the ``0600`` of the temporary file, so a colleague, a web
+server or a Slurm job under another account can read a study. Only a regular file (or
+nothing) is ever replaced: a directory, a symbolic link, a FIFO or a device node at the
+target is refused (:class:`NotReplaceable`), never turned into a regular file.
+
 A folder that cannot be written (full disk, read-only mount, no permission) raises
 :class:`FolderNotWritable`, a :class:`ligwf.errors.LigwfError` naming the folder, so the
 command line ends with one line instead of an ``OSError`` traceback.
@@ -10,6 +16,7 @@ from __future__ import annotations
 import errno
 import json
 import os
+import stat
 import tempfile
 from pathlib import Path
 from typing import Any
@@ -26,6 +33,59 @@ class FolderNotWritable(LigwfError):
     """A folder ligwf must write to is full, read-only or not ours."""
 
 
+class NotReplaceable(LigwfError):
+    """The target of a write exists and is not a regular file (a folder, a symbolic
+    link, a FIFO, a device node): ligwf does not replace it."""
+
+
+def umask() -> int:
+    """The process's umask, read without changing it (``/proc/self/status``; else set and
+    restored at once, which other threads could see for an instant)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    old = os.umask(0o022)
+    os.umask(old)
+    return old
+
+
+def file_mode() -> int:
+    """Permissions of a new file: what ``open()`` would give it (0666 less the umask)."""
+    return 0o666 & ~umask()
+
+
+def replaceable(path: Path) -> str | None:
+    """Why ``path`` must not be replaced by a file (None: absent or a regular file)."""
+    try:
+        st = os.lstat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    if stat.S_ISREG(st.st_mode):
+        return None
+    if stat.S_ISLNK(st.st_mode):
+        return f"a symbolic link (to {os.readlink(path)})"
+    if stat.S_ISDIR(st.st_mode):
+        return "a folder"
+    if stat.S_ISFIFO(st.st_mode):
+        return "a FIFO"
+    if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode):
+        return "a device node"
+    if stat.S_ISSOCK(st.st_mode):
+        return "a socket"
+    return "not a regular file"
+
+
+def check_replaceable(path: Path) -> None:
+    """NotReplaceable, naming ``path`` and what it is, unless it is absent or a regular file."""
+    why = replaceable(path)
+    if why is not None:
+        raise NotReplaceable(f"{path} is {why}: ligwf writes only regular files and does not "
+                             "replace it; name another file")
+
+
 def not_writable(exc: OSError, folder: Path) -> FolderNotWritable:
     """The one-line error for an ``OSError`` writing in ``folder`` (or the folder of the
     file the error names)."""
@@ -35,12 +95,16 @@ def not_writable(exc: OSError, folder: Path) -> FolderNotWritable:
 
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` via a temporary file in the same folder and a rename
-    (a per-process unique temporary name: concurrent writers never collide)."""
+    (a per-process unique temporary name: concurrent writers never collide), with the
+    user's permissions (:func:`file_mode`). NotReplaceable when ``path`` is not a regular
+    file; an error names ``path``, never the temporary file."""
     path = Path(path)
+    check_replaceable(path)
     tmp = None
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        os.fchmod(fd, file_mode())
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
@@ -51,6 +115,9 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
             os.unlink(tmp)
         if isinstance(exc, OSError) and exc.errno in NOT_WRITABLE:
             raise not_writable(exc, path.parent) from exc
+        if isinstance(exc, OSError) and exc.errno is not None and exc.filename != str(path):
+            # the same error, naming the file asked for instead of the temporary one
+            raise type(exc)(exc.errno, exc.strerror, str(path)) from exc
         raise
 
 

@@ -20,6 +20,7 @@ from rich.table import Table
 from rich.text import Text
 
 from ligwf.engine.plan import MAX_RANKS, CasePlan, Schedule, particle_steps
+from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import Prepared, prepare_workflow
 
 console = Console(width=None if sys.stdout.isatty() else 160)
@@ -79,7 +80,11 @@ def rank_count(text: str) -> int:
 
 def folder_to_write(text: str) -> Path:
     """argparse type: a folder ligwf may create or write into (refused before any work:
-    an existing file, a path below a file, a read-only or unwritable place)."""
+    an existing file, a path below a file, a read-only or unwritable place, an empty path
+    that would mean the current folder)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{text!r} is an empty path (it would write into the "
+                                         "current folder); name the folder")
     path = Path(text)
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text} is a file, not a folder")
@@ -125,7 +130,13 @@ def add_mesh_cache(p: argparse.ArgumentParser) -> None:
 
 def prepare_from_args(args: argparse.Namespace) -> Prepared:
     """Validate, render and pre-flight the workflow of ``args``; print the warnings.
-    Raises (nothing written) on a bad value or a refused case."""
+    Raises (nothing written) on a bad value or a refused case, or when ``--out`` is the
+    workflow file's own folder (a study would mix its case folders with the workflows)."""
+    out = getattr(args, "out", None)
+    if out is not None and Path(out).resolve() == Path(args.workflow).resolve().parent:
+        raise ConfigError(f"--out {out} is the folder of the workflow file {args.workflow}: "
+                          "a study writes study.json and one folder per case there; name a "
+                          "folder of the study's own")
     prepared = prepare_workflow(args.workflow, args.overrides, args.templates,
                                 args.allow_unstable)
     for line in prepared.warnings:

@@ -18,17 +18,21 @@ import os
 from pathlib import Path
 
 from ligwf.cli.common import console
-from ligwf.fsio import atomic_write_text
+from ligwf.fsio import atomic_write_text, replaceable
 from ligwf.report.dictionary import dictionary_markdown
 from ligwf.scene.reference import reference_markdown, schema_text
 
 
 def file_to_write(text: str) -> Path:
     """argparse type: a file ligwf may (re)write: not a folder, in an existing writable
-    folder (refused before anything is written)."""
+    folder, not a symbolic link, FIFO or device node (refused before anything is written)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{text!r} is an empty path; name the file")
     path = Path(text)
-    if path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text} is a folder, not a file")
+    why = replaceable(path)
+    if why is not None:
+        raise argparse.ArgumentTypeError(f"{text} is {why}: ligwf writes only regular files "
+                                         "and does not replace it")
     parent = path.parent
     if not parent.is_dir():
         raise argparse.ArgumentTypeError(f"{text}: folder {parent} does not exist")

@@ -35,7 +35,8 @@ class Bad:
     overrides: tuple[str, ...] = ()
     command: str = "render"
     options: tuple[str, ...] = ()
-    setup: str = ""     # "out-file", "out-under-file", "cache-file", "study-listed-twice"
+    setup: str = ""     # "out-file", "out-under-file", "cache-file", "study-listed-twice",
+    #                     "out-empty", "out-workflow-folder"
     warns: bool = False                   # a documented warning (check exits 0), not a refusal
     seconds: float = 5.0                  # time allowed before the refusal
     extra: dict = field(default_factory=dict)
@@ -244,6 +245,23 @@ CORPUS: list[Bad] = [
     Bad("site-mpirun-args-mapping", ("site file", "mpirun_args is a dict", "list of arguments"),
         command="run", overrides=("sweep.cg_levels=[3]", "sweep.rules=[bond]"),
         extra={"site": "mpirun_args: {a: 1}\n"}),
+    Bad("render-out-empty", ("--out", "empty path", "current folder"), setup="out-empty"),
+    Bad("run-out-empty", ("--out", "empty path"), command="run", setup="out-empty"),
+    Bad("render-out-workflow-folder", ("--out", "folder of the workflow file"),
+        setup="out-workflow-folder"),
+    Bad("engine-missing", ("LIGGGHTS executable '/nonexistent/liggghts' not found",),
+        command="run", extra={"env": {"LIGWF_LIGGGHTS": "/nonexistent/liggghts"}}),
+    Bad("engine-missing-np", ("LIGGGHTS executable '/nonexistent/liggghts' not found",),
+        command="run", options=("--np", "1"),
+        extra={"env": {"LIGWF_LIGGGHTS": "/nonexistent/liggghts"}}),
+    Bad("engine-without-library", ("/bin/true", "does not link to a libliggghts"),
+        command="run", extra={"env": {"LIGWF_LIGGGHTS": "/bin/true"}}),
+    Bad("mpirun-missing", ("MPI launcher '/nonexistent/mpirun' not found",),
+        command="run", extra={"env": {"LIGWF_MPIRUN": "/nonexistent/mpirun"}}),
+    Bad("library-setting-retired", ("LIGWF_LIBLIGGGHTS", "no longer read", "LIGWF_LIGGGHTS"),
+        command="run", extra={"env": {"LIGWF_LIBLIGGGHTS": "/x/libliggghts.so"}}),
+    Bad("site-library-key-retired", ("site file", "libliggghts", "no longer read"),
+        command="run", extra={"site": "libliggghts: /x/libliggghts.so\n"}),
     Bad("site-unknown-key", ("site file", "mpirun_arg", "typo"),
         command="run", overrides=("sweep.cg_levels=[3]", "sweep.rules=[bond]"),
         extra={"site": "mpirun_arg: --bind-to none\n"}),
@@ -298,6 +316,8 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
     elif bad.setup == "out-under-file":
         (tmp_path / "afile").write_text("a file")
         out = tmp_path / "afile" / "sub"
+    elif bad.setup == "out-workflow-folder":
+        out = workflow.parent
     options = list(bad.options)
     if bad.setup == "cache-file":
         (tmp_path / "cachefile").write_text("x")
@@ -319,7 +339,7 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
     before = sorted(p.name for p in tmp_path.iterdir())
     argv = [*bad.command.split(), str(workflow), *options]
     if bad.command != "check":
-        argv += ["--out", str(out)]
+        argv += ["--out", "" if bad.setup == "out-empty" else str(out)]
     for o in bad.overrides:
         argv += ["--set", o]
     start = time.perf_counter()
