@@ -7,8 +7,10 @@ VENV ?= .venv
 PY := $(VENV)/bin/python
 LIGWF := $(VENV)/bin/ligwf
 APT_PACKAGES := liggghts openmpi-bin libopenmpi-dev python3-venv python3-dev libgl1 libegl1 libxrender1
-# what only the tests need: headless Chromium opens the report page (tests/report/test_page_browser.py)
-TEST_APT_PACKAGES := chromium
+# what only the tests need: headless Chromium opens the report page (tests/report/test_page_browser.py);
+# a real Slurm (tests/slurm/local_cluster.py) and its two-node twin made of network namespaces
+# (tests/slurm/two_node_cluster.py: ip from iproute2, libpmix for srun --mpi=pmix)
+TEST_APT_PACKAGES := chromium slurmctld slurmd munge iproute2 libpmix-dev
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 STAMP := $(VENV)/.ligwf-installed
 DEMO_OUT ?= runs/demo
