@@ -21,7 +21,7 @@ from ligwf.engine.plan import (BOUND_PARTICLES, BOUND_SLAB, MIN_GRID_EFFICIENCY,
                                MIN_MARGINAL_EFFICIENCY, MULTI_RANK_EFFICIENCY, WET_RATE, CaseLoad, CasePlan, case_grid,
                                rank_limits)
 from ligwf.errors import ConfigError
-from ligwf.slurm.site import SLURM_TIME
+from ligwf.slurm.site import slurm_time_problem
 
 
 
@@ -51,9 +51,9 @@ def slurm_time_seconds(text: str | None) -> int | None:
     if text is None:
         return None
     text = text.strip()
-    if not SLURM_TIME.match(text):          # the forms the site settings accept
-        raise ConfigError(f"time = {text!r}: not a Slurm time (minutes, MM:SS, HH:MM:SS, "
-                          "D-HH, D-HH:MM or D-HH:MM:SS)")
+    why = slurm_time_problem(text)          # the forms and ranges the site settings accept
+    if why is not None:
+        raise ConfigError(f"time = {text!r}: {why}")
     days, _, clock = text.rpartition("-")
     parts = [int(p) for p in clock.split(":")]
     if days:                                                # D-H, D-H:M, D-H:M:S

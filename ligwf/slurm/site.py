@@ -42,6 +42,31 @@ _MODULE = re.compile(r"^[A-Za-z0-9_./+-]+$")
 #: Slurm --time: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S (read by ligwf.slurm.budget)
 SLURM_TIME = re.compile(r"^(\d+|\d+:\d{1,2}|\d+:\d{1,2}:\d{1,2}|\d+-\d{1,2}(:\d{1,2}){0,2})$")
 _UNSAFE = re.compile(r"[\n\r\x00]")
+#: longest wall time accepted (a longer one is a typo: Slurm sites cap far below a year)
+MAX_TIME_DAYS = 365
+
+
+def slurm_time_problem(value: str) -> str | None:
+    """Why ``value`` is not a Slurm ``--time`` ligwf accepts (None: it is): the forms of
+    :data:`SLURM_TIME`, seconds and minutes after a colon below 60, hours after a day
+    count below 24, at most :data:`MAX_TIME_DAYS` days in all."""
+    forms = "minutes, MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS"
+    if not SLURM_TIME.match(value):
+        return f"not a Slurm time ({forms})"
+    days, _, clock = value.rpartition("-")
+    parts = [int(p) for p in clock.split(":")]
+    if days:                                    # D-H, D-H:M, D-H:M:S
+        limits = [24, 60, 60][:len(parts)]
+    else:                                       # M, M:S, H:M:S: the first field is open
+        limits = [None, 60, 60][3 - len(parts):] if len(parts) > 1 else [None]
+    for part, limit in zip(parts, limits):
+        if limit is not None and part >= limit:
+            return f"a field is {part}, allowed range [0, {limit - 1}] ({forms})"
+    units = [3600, 60, 1] if days or len(parts) == 3 else [60, 1] if len(parts) == 2 else [60]
+    total = int(days or 0) * 86400 + sum(p * u for p, u in zip(parts, units))
+    if total > MAX_TIME_DAYS * 86400:
+        return f"longer than {MAX_TIME_DAYS} days (allowed up to {MAX_TIME_DAYS}-00:00:00)"
+    return None
 
 ENV_PREFIX = "LIGWF_SLURM_"
 KEYS = ("partition", "account", "time", "ntasks", "max_concurrent", "modules", "setup",
@@ -83,9 +108,9 @@ class SlurmSite:
                                   "are allowed")
         for key in ("time", "analysis_time"):
             value = getattr(self, key)
-            if value is not None and not SLURM_TIME.match(value):
-                raise ConfigError(f"slurm {key} = {value!r}: not a Slurm time (minutes, "
-                                  "MM:SS, HH:MM:SS, D-HH, D-HH:MM or D-HH:MM:SS)")
+            why = slurm_time_problem(value) if value is not None else None
+            if why is not None:
+                raise ConfigError(f"slurm {key} = {value!r}: {why}")
         if self.ntasks < 1:
             raise ConfigError(f"slurm ntasks = {self.ntasks}: allowed range [1, inf)")
         if self.max_concurrent is not None and self.max_concurrent < 1:

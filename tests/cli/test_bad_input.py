@@ -245,6 +245,12 @@ CORPUS: list[Bad] = [
     Bad("site-mpirun-args-mapping", ("site file", "mpirun_args is a dict", "list of arguments"),
         command="run", overrides=("sweep.cg_levels=[3]", "sweep.rules=[bond]"),
         extra={"site": "mpirun_args: {a: 1}\n"}),
+    *(Bad(f"slurm-time-{name}", ("slurm time", repr(value), why), command="slurm submit",
+          options=("--dry-run", "--time", value))
+      for name, value, why in (("seconds-99", "1:99:99", "allowed range [0, 59]"),
+                               ("mm-ss-99", "1:99", "allowed range [0, 59]"),
+                               ("day-hours-99", "1-99", "allowed range [0, 23]"),
+                               ("20-digits", "9" * 20, "longer than 365 days"))),
     Bad("render-out-empty", ("--out", "empty path", "current folder"), setup="out-empty"),
     Bad("run-out-empty", ("--out", "empty path"), command="run", setup="out-empty"),
     Bad("render-out-workflow-folder", ("--out", "folder of the workflow file"),
