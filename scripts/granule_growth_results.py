@@ -121,16 +121,31 @@ def case_table(run_dir: Path, case_ids: list[str]) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def main(run_dir: str, out_dir: str) -> int:
+def measured(case_dir: Path) -> tuple[pd.DataFrame, ...]:
+    """The case's measures, cached beside its run (``growth-*.csv``; a case measured while
+    others still ran is not measured again)."""
+    names = ("growth-rows.pkl", "growth-shares.pkl", "growth-flow.pkl")
+    if all((case_dir / n).exists() for n in names):
+        return tuple(pd.read_pickle(case_dir / n) for n in names)
+    print(f"measuring {case_dir.name} ...", flush=True)
+    tables = measure_case(case_dir)
+    for n, t in zip(names, tables):
+        tmp = case_dir / (n + ".tmp")
+        t.to_pickle(tmp)
+        tmp.replace(case_dir / n)
+    return tables
+
+
+def main(run_dir: str, out_dir: str, processes: int = 2) -> int:
+    from multiprocessing import Pool
+
     run, out = Path(run_dir), Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     case_ids = sorted(p.name for p in run.iterdir() if (p / "scene.json").exists())
-    rows, shares, flows = [], [], []
-    for cid in case_ids:
-        print(f"measuring {cid} ...", flush=True)
-        r, s, f = measure_case(run / cid)
-        rows.append(r), shares.append(s), flows.append(f)
-    rows_df, shares_df, flows_df = (pd.concat(x, ignore_index=True) for x in (rows, shares, flows))
+    with Pool(processes) as pool:
+        results = pool.map(measured, [run / c for c in case_ids])
+    rows_df, shares_df, flows_df = (pd.concat([r[i] for r in results], ignore_index=True)
+                                    for i in range(3))
     seeds = seed_table(rows_df, flows_df)
     ver = verdict(seeds)
     cad = cadence_table(shares_df)
@@ -150,6 +165,6 @@ def main(run_dir: str, out_dir: str) -> int:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 4):
         sys.exit(__doc__)
-    sys.exit(main(sys.argv[1], sys.argv[2]))
+    sys.exit(main(sys.argv[1], sys.argv[2], *(int(a) for a in sys.argv[3:])))
