@@ -137,7 +137,8 @@ def array_script(ctx: ScriptContext, site: SlurmSite, indices: Iterable[int],
              *_launcher_env(site),
              f"cd {_q(study)}",
              'echo "ligwf: case ${SLURM_ARRAY_TASK_ID} of array ${SLURM_ARRAY_JOB_ID}'
-             ' on $(hostname) with ${SLURM_NTASKS:-1} task(s)"',
+             ' on $(hostname) with ${SLURM_NTASKS:-1} task(s) on ${SLURM_JOB_NUM_NODES:-1}'
+             ' node(s): ${SLURM_JOB_NODELIST:-$(hostname)}"',
              f"exec {site.ligwf} run-case {_q(study)} --index \"$SLURM_ARRAY_TASK_ID\""
              ' --np "${SLURM_NTASKS:-1}"',
              ""]

@@ -17,5 +17,5 @@ ulimit -c 0
 export LIGWF_MPIRUN=srun
 export LIGWF_MPIRUN_ARGS=--mpi=pmix
 cd /scratch/alice/drum-study
-echo "ligwf: case ${SLURM_ARRAY_TASK_ID} of array ${SLURM_ARRAY_JOB_ID} on $(hostname) with ${SLURM_NTASKS:-1} task(s)"
+echo "ligwf: case ${SLURM_ARRAY_TASK_ID} of array ${SLURM_ARRAY_JOB_ID} on $(hostname) with ${SLURM_NTASKS:-1} task(s) on ${SLURM_JOB_NUM_NODES:-1} node(s): ${SLURM_JOB_NODELIST:-$(hostname)}"
 exec /opt/ligwf/venv/bin/ligwf run-case /scratch/alice/drum-study --index "$SLURM_ARRAY_TASK_ID" --np "${SLURM_NTASKS:-1}"

@@ -30,8 +30,15 @@ FULL = SlurmSite(partition="compute", account="proj-42", time="1-02:00:00", ntas
                  analysis_time="00:30:00")
 
 
-def _array(site: SlurmSite, indices: list[int]) -> str:
-    return array_script(ScriptContext(STUDY, "ligwf-drum-study", VERSION), site, indices)
+#: a paper-scale case planned on 119 ranks, 64 cores a node: 2 nodes, OpenMPI's mpirun
+TWO_NODES = SlurmSite(partition="compute", time="12:00:00", ntasks=119, cores_per_node=64,
+                      launcher="mpirun", ligwf=LIGWF,
+                      setup=("export OMPI_MCA_btl_tcp_if_include=10.0.0.0/8",))
+
+
+def _array(site: SlurmSite, indices: list[int], nodes: int | None = None) -> str:
+    return array_script(ScriptContext(STUDY, "ligwf-drum-study", VERSION), site, indices,
+                        nodes)
 
 
 def _analysis(site: SlurmSite, steps: list[str]) -> str:
@@ -44,6 +51,7 @@ CASES: dict[str, Callable[[], str]] = {
     "array_full_site.sh": lambda: _array(FULL, list(range(36))),
     "array_resubmit.sh": lambda: _array(SlurmSite(ligwf=LIGWF, max_concurrent=2, time="30"),
                                         [1, 4, 5, 6, 9]),
+    "array_two_nodes.sh": lambda: _array(TWO_NODES, [0], nodes=2),
     "analysis_minimal.sh": lambda: _analysis(MINIMAL, ["analyse"]),
     "analysis_full_site.sh": lambda: _analysis(FULL, ["analyse", "report"]),
 }
