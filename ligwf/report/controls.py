@@ -49,7 +49,7 @@ def controls_markdown(analysis_dir: Path) -> list[str]:
     lines = ["## Granule controls (wet bed / cohesionless twin)", ""]
     if table is None:
         return lines + [NO_CONTROL, ""]
-    for case_id, rows in table.groupby("case_id", sort=False):
+    for (case_id, _), rows in table.groupby(["case_id", "twin_id"], sort=False):
         own = rows.iloc[0]
         lines += [f"**{case_id}** against `{own['twin_id']}`: {own['verdict']}.", "",
                   "| definition | passes | " + " | ".join(h for _, h in COLUMNS) + " |",
@@ -58,7 +58,9 @@ def controls_markdown(analysis_dir: Path) -> list[str]:
             lines.append(f"| {r['definition']} | {'yes' if r['passes'] else 'no'} | "
                          + " | ".join(_cell(r, c) for c, _ in COLUMNS) + " |")
         lines.append("")
-    passing = table[table["passes"].astype(bool)]["definition"].unique()
-    lines.append("Definitions that beat the control here: "
-                 + (", ".join(f"`{d}`" for d in passing) if len(passing) else "none") + ".")
+    every = table.assign(passes=table["passes"].astype(bool)).groupby(
+        "definition", sort=False)["passes"].all()
+    passing = [d for d, ok in every.items() if ok]
+    lines.append("Definitions that beat every control twin here: "
+                 + (", ".join(f"`{d}`" for d in passing) if passing else "none") + ".")
     return lines + [""]

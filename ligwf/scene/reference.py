@@ -47,6 +47,8 @@ UNITS: dict[str, str] = {
     "Particles.density": "kg/m^3", "Particles.youngs_modulus": "Pa",
     "Particles.poisson_ratio": "1", "Particles.restitution": "1", "Particles.friction": "1",
     "Particles.rolling_friction": "1",
+    "FlowMatch.friction": "1",
+    "FlowMatch.rolling_friction": "1",
     "SizeClass.diameter": "m", "SizeClass.diameter_range": "m", "SizeClass.bins": "count",
     "SizeClass.fraction": "1",
     "Liquid.surface_tension": "N/m", "Liquid.contact_angle_deg": "deg",

@@ -36,6 +36,7 @@ from ligwf.yamlio import parse_yaml, read_yaml_mapping
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
 from ligwf.scene.messages import format_validation_error, short_repr
+from ligwf.scene.controls import FlowMatch, control_scene
 from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene
 from ligwf.scene.settings import AnalysisSettings, build_analysis_settings
 
@@ -59,10 +60,15 @@ class Sweep(_Frozen):
     per_cg: dict[float, dict[str, Any]] = Field(
         default_factory=dict, description="scene fields set for one CG level only, e.g. "
         "{2: {process.run_time: 6.0}} (more revolutions where they are cheap)")
-    controls: tuple[Literal["cohesionless"], ...] = Field(
+    controls: tuple[Literal["cohesionless", "flow_matched"], ...] = Field(
         (), description="null controls run beside the cases: cohesionless = a twin of each "
         "case at control_cg_levels with surface tension and viscosity / 1000 (same seeds), "
-        "a bed that should hold no granules")
+        "a bed that should hold no granules; flow_matched = that twin with the particle "
+        "friction and rolling friction of sweep.flow_match (a dry bed that flows like the "
+        "wet one)")
+    flow_match: FlowMatch | None = Field(
+        None, description="particle friction and rolling friction of the flow_matched twin "
+        "(ligwf calibrate-control finds them)")
     control_cg_levels: tuple[float, ...] = Field(
         (1.0,), min_length=1, description="CG levels whose cases get the control twins")
 
@@ -308,6 +314,14 @@ def expand(raw: dict[str, Any]) -> Workflow:
     if sweep.controls and not first.liquid.wet:
         raise ConfigError(f"sweep.controls = {list(sweep.controls)}: the scene is dry (liquid.model "
                           f"{first.liquid.model}): it is its own cohesionless control")
+    if "flow_matched" in sweep.controls and sweep.flow_match is None:
+        raise ConfigError("sweep.controls = [..., flow_matched]: sweep.flow_match is missing "
+                          "({friction: F, rolling_friction: R}; 'ligwf calibrate-control "
+                          "WORKFLOW --out DIR' measures candidates and prints them)")
+    if sweep.flow_match is not None and "flow_matched" not in sweep.controls:
+        raise ConfigError(f"sweep.flow_match = {sweep.flow_match.model_dump()}: set, but "
+                          f"sweep.controls = {list(sweep.controls)} has no flow_matched twin "
+                          "to use it")
     stray = sorted(set(sweep.control_cg_levels) - set(sweep.cg_levels)) if sweep.controls else []
     if stray:
         raise ConfigError(f"sweep.control_cg_levels: CG level {stray[0]:g} is not in "
@@ -343,7 +357,8 @@ def expand(raw: dict[str, Any]) -> Workflow:
                     if cg in sweep.control_cg_levels:
                         for control in sweep.controls:
                             cases.append(Case(len(cases), f"{case_id}_{control}",
-                                              control_scene(scene, control), float(cg), rule,
+                                              control_scene(scene, control, sweep.flow_match),
+                                              float(cg), rule,
                                               rep, values + ((CONTROL_KEY, control),)))
     _unique_case_ids(cases)
     return Workflow(name=name, description=str(raw.get("description", "")), raw=raw,
@@ -352,23 +367,6 @@ def expand(raw: dict[str, Any]) -> Workflow:
 
 #: the ``varied`` entry that marks a control twin (its own comparison group)
 CONTROL_KEY = "control"
-#: factor on surface tension and viscosity of a cohesionless twin
-COHESIONLESS_FACTOR = 1e-3
-
-
-def control_scene(scene: Scene, control: str) -> Scene:
-    """The scene of a control twin: ``cohesionless`` keeps everything (seeds, liquid
-    content, contact dumps) but divides surface tension and viscosity by 1000, so bridges
-    still form and are dumped, but hold nothing: the bed flows like a dry one
-    (LIGGGHTS_NOTES: 32.2 deg against 32.3 dry and 40.2 wet on the demo bed)."""
-    if control != "cohesionless":
-        raise ConfigError(f"sweep.controls: {control!r}: allowed: cohesionless")
-    liquid = scene.liquid.model_copy(update={
-        "surface_tension": scene.liquid.surface_tension * COHESIONLESS_FACTOR,
-        "viscosity": scene.liquid.viscosity * COHESIONLESS_FACTOR})
-    return scene.model_copy(update={"liquid": liquid})
-
-
 def load_workflow(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> Workflow:
     """Read a workflow YAML, apply ``--set`` overrides, validate and expand it."""
     raw = read_yaml_mapping(path, "workflow file")

@@ -1,8 +1,10 @@
-"""The granule controls of a study: every wet case beside its cohesionless twin.
+"""The granule controls of a study: every wet case beside each of its control twins.
 
 A workflow with ``sweep.controls: [cohesionless]`` runs, beside each case at the control
-CG levels, a twin with surface tension and viscosity / 1000 (``ligwf.scene.workflow``).
-:func:`study_controls` pairs each twin with its wet case (same sweep values, CG level,
+CG levels, a twin with surface tension and viscosity / 1000 (``ligwf.scene.workflow``);
+``flow_matched`` adds a twin that also has the friction and rolling friction of
+``sweep.flow_match`` (a dry bed that flows like the wet one). :func:`study_controls` pairs
+each twin with its wet case (same sweep values, CG level,
 rule and replica), measures both with the study's granule definition and the candidate
 definitions (:mod:`ligwf.analysis.granules.control_run`), and judges every definition by the
 pre-registered criteria (:mod:`ligwf.analysis.granules.control_verdict`). The table it returns is
@@ -23,6 +25,8 @@ from ligwf.study.case import CaseFolder
 
 #: the ``varied`` value (under CONTROL_KEY) of a cohesionless twin
 COHESIONLESS = "cohesionless"
+#: ... and of a flow-matched one
+FLOW_MATCHED = "flow_matched"
 
 
 def _varied(case: CaseFolder) -> dict:
@@ -30,7 +34,8 @@ def _varied(case: CaseFolder) -> dict:
 
 
 def control_pairs(cases: list[CaseFolder]) -> list[tuple[CaseFolder, CaseFolder]]:
-    """(wet case, its cohesionless twin) for every twin whose wet case is among ``cases``."""
+    """(wet case, its twin) for every control twin (cohesionless or flow-matched) whose wet
+    case is among ``cases``, in case order."""
     wet = {}
     for c in cases:
         v = _varied(c)
@@ -39,7 +44,7 @@ def control_pairs(cases: list[CaseFolder]) -> list[tuple[CaseFolder, CaseFolder]
     out = []
     for c in cases:
         v = _varied(c)
-        if v.get(CONTROL_KEY) == COHESIONLESS:
+        if v.get(CONTROL_KEY) in (COHESIONLESS, FLOW_MATCHED):
             v.pop(CONTROL_KEY)
             w = wet.get((json.dumps(v, sort_keys=True), c.cg, c.rule, c.replica))
             if w is not None:
