@@ -1,9 +1,12 @@
 """Measure the regime-map runs of scripts/regime_map.sh with every candidate granule definition.
 
 Usage: .venv/bin/python scripts/regime_map.py runs/regime docs/results/regime
+       .venv/bin/python scripts/regime_map.py --verdict-only docs/results/regime
 Writes OUT/controls_rows.csv (one row per run, definition and start frame),
 OUT/controls.csv (means per run and definition, with the run's dimensionless numbers) and
-OUT/regime_map.png.
+OUT/regime_map.png. ``--verdict-only`` re-judges the committed OUT/controls.csv with the
+criteria of today's code (ligwf.analysis.granules.control_verdict) and rewrites
+OUT/controls_verdict.csv and .md (the runs are not needed).
 """
 
 from __future__ import annotations
@@ -84,6 +87,14 @@ def pair_verdicts(summary: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def _mark(passed) -> str:
+    """yes / no, or n/a where the criterion does not apply (ARI of a deterministic
+    definition)."""
+    if passed is None or (isinstance(passed, float) and pd.isna(passed)):
+        return "n/a"
+    return "yes" if bool(passed) else "no"
+
+
 def markdown(v: pd.DataFrame) -> str:
     crit = ["granules exist", "beats the twin", "survives", "moves together", "reproducible",
             "no bed-spanning granule"]
@@ -96,9 +107,17 @@ def markdown(v: pd.DataFrame) -> str:
                      f"{f(r['share_10'])} / {f(r['twin_share_10'])} | "
                      f"{f(r['persist_quarter'])} / {f(r['twin_persist_quarter'])} | "
                      f"{f(r['comove_ratio'])} | {f(r['ari'])} | {f(r['percolating'])} | "
-                     + " | ".join("yes" if r[c] else "no" for c in crit)
+                     + " | ".join(_mark(r.get(c)) for c in crit)
                      + f" | {'**yes**' if r['passes'] else 'no'} |")
     return "\n".join(lines) + "\n"
+
+
+def verdict_only(out: Path) -> int:
+    """Re-judge the committed controls.csv (no runs needed)."""
+    verdicts = pair_verdicts(pd.read_csv(out / "controls.csv"))
+    verdicts.to_csv(out / "controls_verdict.csv", index=False, float_format="%.4g")
+    (out / "controls_verdict.md").write_text(markdown(verdicts))
+    return 0
 
 
 def figure(summary: pd.DataFrame, rows: pd.DataFrame, path: Path,
@@ -152,4 +171,6 @@ def figure(summary: pd.DataFrame, rows: pd.DataFrame, path: Path,
 
 
 if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--verdict-only":
+        sys.exit(verdict_only(Path(sys.argv[2])))
     sys.exit(main(Path(sys.argv[1]), Path(sys.argv[2])))

@@ -53,3 +53,18 @@ def test_sensitivity_varies_only_the_thresholds_in_use_and_states_the_setting():
     src = variants(AnalysisSettings(granules="components", max_velocity_angle=30.0))
     assert [lab for lab, _ in src][1:] == ["angle 24 deg (lab)", "angle 37.5 deg (lab)"]
     assert variants(AnalysisSettings(granules="components"))[1:] == []
+
+
+def test_no_granules_in_either_bed_beats_nothing():
+    """At 0 / 0 the twin is not beaten (the regime map once printed 'beats the twin: yes'
+    for held_1s with no granule in either bed)."""
+    empty = {**GOOD, "share_10": 0.0}
+    names = [c.name for c in criteria(empty, {"share_10": 0.0}) if not c.passed]
+    assert "beats the twin" in names and "granules exist" in names
+
+
+def test_reproducibility_is_judged_only_for_a_stochastic_definition():
+    """A deterministic definition (no optimiser seed) has ARI 1 by construction: the
+    criterion is not counted, neither as a pass nor as a fail."""
+    assert "reproducible" not in [c.name for c in criteria(GOOD, TWIN)]
+    assert "reproducible" in [c.name for c in criteria({**GOOD, "ari_seed": 0.99}, TWIN)]
