@@ -3,8 +3,12 @@
 For each start frame t of the steady window and each definition, :func:`control_rows`
 gives the granules at t and measures them (:mod:`ligwf.analysis.granules.controls`): share of the
 bed in granules of >= 2 and >= 10 particles, granule count, d50, pair persistence after
-``short_dt`` and after a quarter revolution, co-movement over ``comove_tau`` and whether a
-granule percolates; for definitions with an optimiser or an order dependence, the adjusted
+``short_dt`` and after a quarter revolution, co-movement over a quarter revolution and whether a
+granule percolates. Survival and co-movement start when the definition's window ends: a held
+granule at t is selected by bridges present through [t, t + W], so its pairs are together
+until t + W by construction; its persistence compares it with the granules of the window
+that starts at t + W + T/4, and its co-movement is measured over [t + W, t + W + T/4] (W = 0
+for a definition of one frame); for definitions with an optimiser or an order dependence, the adjusted
 Rand index across seeds and across a shuffled contact order. :func:`summarise` averages
 the rows per definition. The same table of a wet bed beside its cohesionless twin says
 whether a definition finds granules or a tiling.
@@ -146,13 +150,12 @@ def growth_rates(labels: np.ndarray, later: np.ndarray | None, dt: float,
 
 
 def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: float = 0.5,
-                 stride: float = 0.1, short_dt: float = 0.05, comove_tau: float = 0.1,
+                 stride: float = 0.1, short_dt: float = 0.05,
                  determinism_frames: int = 2) -> pd.DataFrame:
     """One row per (definition, start frame): the measures of the module docstring."""
     facts = series.facts
     quarter = 0.25 * 2.0 * np.pi / facts.omega if facts.omega else float("nan")
     d_short, d_quarter = series.frames_in(short_dt), series.frames_in(quarter)
-    d_tau = series.frames_in(comove_tau)
     starts = [k for k in range(len(series.frames)) if series.times[k] >= steady_from - 1e-9]
     starts = starts[::series.frames_in(stride)]
     volumes = series.frames[0].particles.volumes
@@ -161,6 +164,8 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
     shared_keys: dict[tuple[int, bool], np.ndarray] = {}
     for name, kind, param in candidates:
         labels_of = labeller(series, kind, param, shared_keys)
+        # frames the definition's own window spans (0 for one-frame definitions)
+        span = series.frames_in(param[0]) if kind == "window" else 0
         cache: dict[int, Identification | None] = {}
 
         def lab(k: int) -> np.ndarray | None:
@@ -183,14 +188,14 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
                    "largest_share": float(np.bincount(labels, weights=volumes).max() / volumes.sum()),
                    "percolating": float(percolating)}
             for tag, dk in (("persist_short", d_short), ("persist_quarter", d_quarter)):
-                later = lab(k + dk)
+                later = lab(k + span + dk)
                 row[tag] = pair_persistence(labels, later) if later is not None else np.nan
                 if tag == "persist_short":
-                    row.update(growth_rates(labels, later, dk * series.interval))
-            if k + d_tau < len(series.frames):
-                cm = comovement(labels, series.frames[k].particles.positions,
-                                series.frames[k + d_tau].particles.positions, series.diameter,
-                                axis, length)
+                    row.update(growth_rates(labels, later, (span + dk) * series.interval))
+            if k + span + d_quarter < len(series.frames):
+                cm = comovement(labels, series.frames[k + span].particles.positions,
+                                series.frames[k + span + d_quarter].particles.positions,
+                                series.diameter, axis, length)
                 row["comove_ratio"] = cm.ratio
             else:
                 row["comove_ratio"] = np.nan

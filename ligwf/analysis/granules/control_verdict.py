@@ -65,7 +65,8 @@ def criteria(wet: dict, twin: dict) -> list[Criterion]:
                          f">= {MIN_PERSISTENCE:g} and >= {MIN_PERSISTENCE_RATIO:g} x twin)"))
     c = _num(wet, "comove_ratio")
     out.append(Criterion("moves together", c <= MAX_COMOVE_RATIO,
-                         f"member / non-member separation over 0.1 s {c:.3g} (needs <= "
+                         f"member / non-member separation over a quarter revolution after "
+                         f"the window {c:.3g} (needs <= "
                          f"{MAX_COMOVE_RATIO:g})"))
     # reproducibility is a criterion only where the definition is stochastic (an optimiser
     # seed, ``ari_seed``): the ARI of a deterministic definition is 1 by construction
