@@ -68,3 +68,8 @@ def test_reproducibility_is_judged_only_for_a_stochastic_definition():
     criterion is not counted, neither as a pass nor as a fail."""
     assert "reproducible" not in [c.name for c in criteria(GOOD, TWIN)]
     assert "reproducible" in [c.name for c in criteria({**GOOD, "ari_seed": 0.99}, TWIN)]
+
+
+def test_the_sentence_names_the_control_it_failed_against():
+    ok, sentence = verdict({**GOOD, "share_10": 0.04}, TWIN, "held_1s", "flow_matched")
+    assert not ok and "do NOT beat the flow_matched control" in sentence

@@ -83,15 +83,17 @@ def criteria(wet: dict, twin: dict) -> list[Criterion]:
     return out
 
 
-def verdict(wet: dict, twin: dict, definition: str) -> tuple[bool, str]:
-    """(passed, one sentence) for ``definition`` on this wet bed and its twin."""
+def verdict(wet: dict, twin: dict, definition: str,
+            control: str = "cohesionless") -> tuple[bool, str]:
+    """(passed, one sentence) for ``definition`` on this wet bed and its twin; ``control``
+    names the twin's kind (cohesionless, flow_matched) in the sentence."""
     checks = criteria(wet, twin)
     failed = [c for c in checks if not c.passed]
     if not failed:
-        return True, (f"granules ({definition}) beat the cohesionless control on every "
+        return True, (f"granules ({definition}) beat the {control} control on every "
                       "pre-registered criterion: sizes and GSD errors below are findings")
     names = "; ".join(f"{c.name}: {c.detail}" for c in failed)
-    return False, (f"granules ({definition}) do NOT beat the cohesionless control ({names}), "
+    return False, (f"granules ({definition}) do NOT beat the {control} control ({names}), "
                    "so they are not shown to be granules (bodies that move together and "
                    "survive, absent without cohesion): no size limit or GSD error below is a "
                    "finding")

@@ -77,8 +77,9 @@ def study_controls(cases: list[CaseFolder], definition: AnalysisSettings,
         t0 = (steady_from or {}).get(wet.case_id, 0.5)
         sw = summarise(control_rows(load_series(wet.path), cands, steady_from=t0))
         st = summarise(control_rows(load_series(twin.path), cands, steady_from=t0))
+        kind = _varied(twin).get(CONTROL_KEY, COHESIONLESS)
         for (_, w), (_, t) in zip(sw.iterrows(), st.iterrows()):
-            ok, sentence = verdict(w.to_dict(), t.to_dict(), w["definition"])
+            ok, sentence = verdict(w.to_dict(), t.to_dict(), w["definition"], kind)
             row = {"case_id": wet.case_id, "twin_id": twin.case_id, "definition": w["definition"],
                    "passes": ok, "verdict": sentence}
             for k in ("share_2", "share_10", "count_10", "d50_mm", "largest_share",
