@@ -1,6 +1,7 @@
 """Measure the granule-growth study and write its committed tables and README.
 
     .venv/bin/python scripts/granule_growth_results.py RUNDIR docs/results/granule_growth
+    .venv/bin/python scripts/granule_growth_results.py --measure-finished RUNDIR
 
 RUNDIR is the folder of ``ligwf run workflows/granule_growth.yaml --out RUNDIR``. Writes
 ``growth_rows.csv`` (every start frame of every run), ``cadence.csv`` (the held share at
@@ -164,7 +165,19 @@ def main(run_dir: str, out_dir: str, processes: int = 2) -> int:
     return 0
 
 
+def measure_finished(run_dir: str) -> int:
+    """Measure (and cache) every case whose run is done, one at a time: the study's cases
+    can be measured while the last ones still run."""
+    for p in sorted(Path(run_dir).iterdir()):
+        m = CaseFolder.open(p).manifest() if (p / "scene.json").exists() else None
+        if m is not None and m.status == "done":
+            measured(p)
+    return 0
+
+
 if __name__ == "__main__":
+    if len(sys.argv) == 3 and sys.argv[1] == "--measure-finished":
+        sys.exit(measure_finished(sys.argv[2]))
     if len(sys.argv) not in (3, 4):
         sys.exit(__doc__)
     sys.exit(main(sys.argv[1], sys.argv[2], *(int(a) for a in sys.argv[3:])))
