@@ -75,6 +75,19 @@ def readme(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame, cases: pd.
             f"{_fmt(r.comove_ratio)} / {_fmt(r.control_comove_ratio)} | "
             f"{_fmt(r.angle_deg)} / {_fmt(r.control_angle_deg)} | "
             f"{_fmt(r.angle_std_deg)} / {_fmt(r.control_angle_std_deg)} |")
+    lines += ["", "## Granules followed in time (wet seeds)", "",
+              "Events between successive start frames (0.1 s apart), summed over the run: a "
+              "granule of >= 10 particles continues, breaks, coalesces, is born or dies; "
+              "particles are accreted by or eroded from continuing granules, or dispersed "
+              "with a dying one.", "",
+              "| seed | granules >= 10 (mean) | d50 first / last rev. [particles] | continued | "
+              "born | died | broke | coalesced | accreted | eroded | dispersed |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in seeds.itertuples():
+        lines.append(f"| {r.seed} | {_fmt(r.count_10)} / {_fmt(r.control_count_10)} | "
+                     f"{_fmt(r.d50_first_rev)} / {_fmt(r.d50_last_rev)} | {r.continued:.0f} | "
+                     f"{r.born:.0f} | {r.died:.0f} | {r.broke:.0f} | {r.coalesced:.0f} | "
+                     f"{r.accreted:.0f} | {r.eroded:.0f} | {r.dispersed:.0f} |")
     lines += ["", "## Held share against the window cadence", "",
               "| case | " + " | ".join(f"{c:g} s" for c in sorted(cad.cadence.unique())) + " |",
               "|---|" + "---|" * cad.cadence.nunique()]
