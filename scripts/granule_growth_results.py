@@ -94,11 +94,11 @@ def readme(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame, cases: pd.
     for case_id, g in cad.groupby("case_id", sort=True):
         vals = g.set_index("cadence")["share_10"]
         lines.append(f"| {case_id} | " + " | ".join(_fmt(vals[c]) for c in sorted(vals.index)) + " |")
-    lines += ["", "## Reading", ""] + reading(seeds, ver)
+    lines += ["", "## Reading", ""] + reading(seeds, ver, cad)
     return "\n".join(lines) + "\n"
 
 
-def reading(seeds: pd.DataFrame, ver: pd.DataFrame) -> list[str]:
+def reading(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame) -> list[str]:
     """The finding in sentences, each number from the tables."""
     v = ver.set_index("criterion")
     out = []
@@ -120,6 +120,17 @@ def reading(seeds: pd.DataFrame, ver: pd.DataFrame) -> list[str]:
                            for r in seeds.itertuples()) + " deg.")
     out.append("- Revolutions of production measured per seed: "
                + ", ".join(f"{r.revolutions:.1f}" for r in seeds.itertuples()) + ".")
+    out.append("- Held share of the bed in granules of >= 10 (wet seeds), first revolution -> "
+               "last: " + ", ".join(f"{_fmt(r.share_10_first_rev)} -> {_fmt(r.share_10_last_rev)}"
+                                    for r in seeds.itertuples()) + ".")
+    if not cad.empty:
+        means = cad.groupby("cadence")["share_10"].mean()
+        out.append("- The held share depends on how densely the window is sampled (mean over "
+                   "the runs, cadence: share): "
+                   + ", ".join(f"{c:g} s: {_fmt(v)}" for c, v in means.items())
+                   + "; the registered definition samples at a fixed 0.05 s, so it does not "
+                   "depend on the dump interval (any interval dividing 0.05 s gives the same "
+                   "granules).")
     return out
 
 
