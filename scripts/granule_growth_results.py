@@ -118,6 +118,10 @@ def reading(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame) -> list[s
                f"{fm.seeds_pass} of {fm.seeds} seeds; angle wet / twin per seed: "
                + ", ".join(f"{_fmt(r.angle_deg)} / {_fmt(r.control_angle_deg)}"
                            for r in seeds.itertuples()) + " deg.")
+    out.append("- The liquid spreads (the engine passes it on when a bridge ruptures): share of "
+               "the wet bed's particles carrying liquid, first frame -> last, per seed: "
+               + ", ".join(f"{_fmt(r.wet_share_start)} -> {_fmt(r.wet_share_end)}"
+                           for r in seeds.itertuples()) + ".")
     out.append("- Revolutions of production measured per seed: "
                + ", ".join(f"{r.revolutions:.1f}" for r in seeds.itertuples()) + ".")
     out.append("- Held share of the bed in granules of >= 10 (wet seeds), first revolution -> "

@@ -25,6 +25,10 @@ from ligwf.analysis.granules.growth import (GrowthSettings, HeldAt, frames_spann
 from ligwf.study.case import CaseFolder
 
 
+#: a particle carrying more liquid than this fraction of its volume counts as wet
+WET = 1e-5
+
+
 @dataclass(frozen=True)
 class Criteria:
     """The pre-registered thresholds (criterion.md); a criterion passes in >= ``seeds_needed``
@@ -67,9 +71,13 @@ def measure_case(case_dir: Path, settings: GrowthSettings = GrowthSettings(),
     geo = DrumGeometry.from_scaled(case.scaled)
     flows = []
     for k in range(0, len(series.frames), frames_spanning(series, flow_every)):
-        f = frame_flow(series.frames[k].particles, geo)
+        particles = series.frames[k].particles
+        f = frame_flow(particles, geo)
+        lc = particles.liquid_content
         flows.append({"case_id": case.case_id, "time": float(series.times[k]),
-                      "angle_of_repose": f.angle_of_repose, "rigid_fraction": f.rigid_fraction})
+                      "angle_of_repose": f.angle_of_repose, "rigid_fraction": f.rigid_fraction,
+                      # the liquid spreads: the engine passes it on when a bridge ruptures
+                      "wet_share": float(np.mean(lc > WET)) if lc is not None else np.nan})
     return rows, pd.DataFrame(shares), pd.DataFrame(flows)
 
 
@@ -116,6 +124,8 @@ def seed_table(rows: pd.DataFrame, flows: pd.DataFrame, control: str = "cohesion
             "broke": w.broke.sum(), "coalesced": w.coalesced.sum(),
             "dispersed": w.dispersed.sum(), "continued": w.continued.sum(),
             "born": w.born.sum(), "died": w.died.sum(),
+            "wet_share_start": _at(flows[flows.case_id == wet], "wet_share", first=True),
+            "wet_share_end": _at(flows[flows.case_id == wet], "wet_share", first=False),
             "angle_deg": fw.angle_of_repose.mean(), "control_angle_deg": fc.angle_of_repose.mean(),
             "angle_std_deg": fw.angle_of_repose.std(),
             "control_angle_std_deg": fc.angle_of_repose.std(),
@@ -124,6 +134,15 @@ def seed_table(rows: pd.DataFrame, flows: pd.DataFrame, control: str = "cohesion
         row.update(judge(row, criteria))
         out.append(row)
     return pd.DataFrame(out)
+
+
+def _at(flow: pd.DataFrame, column: str, first: bool) -> float:
+    """``column`` in the first (or last) frame of a run's flow rows (nan without rows or
+    column)."""
+    if column not in flow or flow.empty:
+        return float("nan")
+    row = flow.loc[flow["time"].idxmin() if first else flow["time"].idxmax()]
+    return float(row[column])
 
 
 def judge(row: dict, criteria: Criteria) -> dict[str, bool]:
