@@ -80,7 +80,7 @@ TABLES: tuple[TableSpec, ...] = (
 TEXT_COLUMNS = frozenset({
     "case_id", "condition", "group", "rule", "status", "reason", "metric", "source",
     "variant", "definition", "control", "twin_id", "twin_case_id", "verdict", "method",
-    "velocity_frame", "pool", "reference", "wet_group",
+    "velocity_frame", "pool", "reference", "comparison", "split",
     # the verdict table (ligwf.report.verdict)
     "criterion", "label", "unit", "state", "condition_state", "budget_source", "note",
     # describe(): the data dictionary's columns

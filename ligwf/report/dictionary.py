@@ -96,6 +96,8 @@ FLOW_METRICS = ("angle_of_repose", "angle_of_repose_std", "angle_error", "profil
 GRANULE_METRICS = ("largest_cluster_fraction", "one_granule_frame_share")
 #: the flow-field errors the report adds (ligwf.analysis.records.field_errors.FIELD_ERRORS)
 FIELD_ERRORS = ("field_error", "field_solid_error")
+#: the field criterion at each reported kernel width (field_errors.KERNEL_COLUMNS)
+FIELD_KERNEL_ERRORS = ("field_error_k1", "field_error_k2", "field_error_k4")
 GSD_REPORT = ("gsd_lower_limit", "gsd_lower_limit_diameter", "gsd_error_below_lower",
               "gsd_error_above_lower", "gsd_error_all")
 COSTS = ("core_seconds", "wall_seconds", "production_core_rate", "production_core_rate_k",
@@ -174,16 +176,18 @@ TABLES: dict[str, Table] = {
     layout.CONDITIONS_REPORT: Table(layout.REPORT_DIR, "condition (sweep group, CG level, "
                                     "rule)", (
         "group", "group_label", "cg", "rule", "replicas", *RUN, *COSTS, *FLOW_METRICS,
-        *GRANULE_METRICS, *GSD_REPORT, *FIELD_ERRORS), CONDITION),
+        *GRANULE_METRICS, *GSD_REPORT, *FIELD_ERRORS, "field_error_kernel",
+        *FIELD_KERNEL_ERRORS), CONDITION),
     layout.VERDICT_TABLE: Table(layout.REPORT_DIR, "sweep group, CG level, rule and "
                                 "criterion of the verdict", (
         "group", "cg", "rule", "condition", "replicas", "condition_state", "speedup_core",
         "speedup_core_lo", "speedup_core_hi", "criterion", "label", "unit", "state", "value",
         "lo", "hi", "budget", "shown_within", "budget_source", "note", "cheapest")),
-    layout.FIELD_NULL_REPORT: Table(layout.REPORT_DIR, "CG1 cohesionless-twin condition: "
-                                    "its field errors against the wet CG1 cases", (
-        "control", "wet_group", "cg", "twins", "wet_cg1", *FIELD_ERRORS),
-        ("_lo", "_hi", "_floor", "_floor_source", "_vs_floor")),
+    layout.FIELD_NULL_REPORT: Table(layout.REPORT_DIR, "null check: per sweep group CG1 "
+                                    "against CG1, per cohesionless-twin condition the twins "
+                                    "against the wet CG1 cases", (
+        "comparison", "control", "group", "cg", "split", "runs", "ref_runs", *FIELD_ERRORS,
+        *FIELD_KERNEL_ERRORS), ("_lo", "_hi", "_floor", "_floor_source", "_vs_floor")),
     layout.NOISE_FLOOR_REPORT: Table(layout.REPORT_DIR, "sweep group and frame metric", (
         "group", "group_label", "metric", "cg1_value", "cg1_scatter", "source")),
 }

@@ -153,17 +153,33 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("gsd_error_all", "1", "GSD err all bins", "error_all of gsd_summary.csv: the whole GSD's "
      "relative L1 error against CG1"),
     # flow fields (ligwf.analysis.records.field_errors)
-    ("field_error", "1", "velocity field err (L2)", "relative L2 error of the in-plane "
-     "velocity field on the drum cross-section against CG1, weighted by the CG1 solid "
-     "fraction, over the nodes where CG1 has material"),
+    ("field_error", "1", "layer velocity err", "the field criterion (what the verdict's "
+     "continuum-fields budget reads): the in-plane velocity in the drum frame, U - omega x "
+     "r, inside the flowing layer (CG1 nodes with solid fraction >= 0.1 moving relative to "
+     "the drum at >= 0.2 omega R), phi_1-weighted RMS of the difference of the mean "
+     "fields over omega R, less the noise of both arms' run scatter (condition table; a "
+     "case's value: its raw distance to its group's CG1 mean); _lo/_hi: bounds that each "
+     "hold with >= 95 %; _floor: the same criterion CG1 against CG1; _se: not given; at "
+     "the kernel width field_error_kernel"),
+    ("field_error_kernel", "1", "verdict field kernel", "the kernel width of field_error "
+     "(analysis.field_kernel), CG1 mean diameters"),
+    ("field_error_k1", "1", "layer velocity err k1", "field_error at a kernel width of 1 CG1 "
+     "mean diameter"),
+    ("field_error_k2", "1", "layer velocity err k2", "field_error at a kernel width of 2 CG1 "
+     "mean diameters"),
+    ("field_error_k4", "1", "layer velocity err k4", "field_error at a kernel width of 4 CG1 "
+     "mean diameters"),
     ("field_solid_error", "1", "solid fraction field err (L1)", "relative L1 error of the "
      "solid-fraction field over the cross-section against CG1: sum |phi_n - phi_1| / sum "
      "phi_1"),
-    ("control", "text", "control", "the sweep group of the cohesionless twins"),
-    ("wet_group", "text", "wet group", "the sweep group of the wet CG1 cases they are "
-     "compared with"),
-    ("twins", "count", "twins", "cohesionless twin cases pooled"),
-    ("wet_cg1", "count", "wet CG1", "wet CG1 cases of the comparison"),
+    ("comparison", "text", "comparison", "CG1 vs CG1 (two halves of the CG1 runs: the "
+     "criterion should find nothing) or cohesionless twin vs wet CG1"),
+    ("control", "text", "compared group", "the sweep group of the compared runs (the "
+     "cohesionless twins', or the CG1 group itself)"),
+    ("split", "text", "split", "how the two arms were formed (seeds against seeds, or the "
+     "first against the second half of every run's window)"),
+    ("runs", "count", "runs", "runs (or half windows) of the compared arm"),
+    ("ref_runs", "count", "reference runs", "runs (or half windows) of the reference arm"),
     # controls (ligwf.analysis.granules.control_run)
     ("twin_id", "text", "twin", "the cohesionless twin of the case (surface tension and "
      "viscosity / 1000, same seeds)"),
@@ -226,6 +242,18 @@ VERDICT = (
     ("shown_within", "unit", "shown within", "the largest |error| its interval allows: the "
      "error this level is shown to stay within"),
     ("budget_source", "text", "budget from", "where the budget came from (the accept: block)"),
+    ("decide_by", "text", "decide by", "undecided only: the cheapest way to decide it "
+     "(extend: more production on the existing runs, continued from their restarts; "
+     "replicas: more runs), from the arms' variance components (ligwf.analysis.records."
+     "sampling)"),
+    ("decide_arm", "text", "decide on", "the arm(s) to extend or add to: CG-n, CG1 or both"),
+    ("decide_amount", "1", "decide amount", "extend: simulated seconds of production more "
+     "per run; replicas: CG-n replicas to add"),
+    ("decide_amount_cg1", "count", "decide CG1 replicas", "replicas: CG1 replicas to add"),
+    ("decide_core_hours", "core-h", "decide cost", "core-hours of that option on one rank "
+     "per run, from the planner's measured rates (ligwf.engine.plan)"),
+    ("decide_half_width", "unit", "predicted half-width", "the half-width of the interval "
+     "predicted after it, the difference and variances as measured (a plan)"),
     ("note", "text", "note", "why a criterion was not assessed, or what decides it"),
     ("cheapest", "flag", "cheapest", "this condition is the cheapest of its group that meets "
      "the whole budget"),

@@ -257,5 +257,5 @@ def build_tables(study: Study, flow: FlowRecord, granules: bool = True
     df = compare_to_cg1(merged, stats, list(flow.error_metrics))
     df, conditions = add_field_errors(df, condition_table(df, stats, metric_columns(flow)),
                                       case_fields(analysis_dir), settings.bootstrap,
-                                      settings.seed)
+                                      settings.seed, settings.field_kernel)
     return df, conditions, skipped, noise_floor_table(df, stats)

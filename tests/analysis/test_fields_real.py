@@ -51,12 +51,14 @@ def test_fields_of_real_wet_dumps(engine, tmp_path_factory, tmp_path):
     assert not stale.exists() and all((analysis / layout.field_image(c)).is_file() for c in fields)
     r0, r1 = fields["cg3-weber-r0"], fields["cg3-weber-r1"]
     assert np.array_equal(r0.moments, r1.moments)
-    assert field_floor([r0, r1], "field_error").value == 0.0
+    assert field_floor([r0, r1], "field_solid_error").value == 0.0
+    assert [w.kernel for w in r0.window_means] == [1.0, 2.0, 4.0]
+    assert r0.omega != 0 and r0.radius > 0
     # no CG1 case in this study: the report's field errors are nan, with their columns
     cases = pd.DataFrame([{"case_id": c, "group": f.group, "cg": f.cg, "rule": f.rule}
                           for c, f in fields.items()])
     conditions = cases.groupby(["group", "cg", "rule"]).size().rename("replicas").reset_index()
-    cases, cond = add_field_errors(cases, conditions, fields, 20, 1)
+    cases, cond = add_field_errors(cases, conditions, fields, 20, 1, 2.0)
     for name in FIELD_ERRORS:
         assert {name, f"{name}_lo", f"{name}_floor", f"{name}_vs_floor"} <= set(cond)
         assert math.isnan(cond[name].iloc[0]) and cond[f"{name}_vs_floor"].iloc[0] == "–"

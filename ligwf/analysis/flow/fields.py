@@ -36,8 +36,11 @@ smoothed towards zero (the usual boundary effect of a kernel; the same at every 
 as the width is), and kernel weight beyond the node square is dropped: on the demo drum
 96-99 % of the bed's volume is on the grid.
 
-The per-frame sums are kept (:class:`~ligwf.analysis.records.fields.CaseFields`): the field
-error's interval resamples them (:mod:`ligwf.analysis.records.field_errors`).
+The per-frame sums are kept (:class:`~ligwf.analysis.records.fields.CaseFields`): the
+solid-fraction error's interval resamples them (:mod:`ligwf.analysis.records.field_errors`).
+Beside them, at each width of ``CRITERION_KERNELS`` CG1 diameters, the window means of the
+in-plane sums (whole window and its two halves) and the drum's omega and radius: the field
+criterion compares runs by these.
 """
 
 from __future__ import annotations
@@ -49,7 +52,8 @@ from scipy import ndimage
 
 from ligwf.analysis.flow.frame import DrumGeometry
 from ligwf.analysis.frames.dumps import ParticleFrame
-from ligwf.analysis.records.fields import CaseFields, FieldGrid
+from ligwf.analysis.records.fields import (CRITERION_KERNELS, IN_PLANE, CaseFields, FieldGrid,
+                                           WindowMeans)
 from ligwf.engine.mesh import axis_frame
 
 #: the Gaussian is cut at this many standard deviations (and renormalised)
@@ -155,18 +159,36 @@ def fluctuation_moment(frame: ParticleFrame, geo: DrumGeometry, grid: FieldGrid,
     return _smooth(grid, sums, kernel_weights(grid))[0]
 
 
+def window_means(frames: list[ParticleFrame], geo: DrumGeometry, kernel: float, cg: float,
+                 length: float) -> WindowMeans:
+    """The window-mean in-plane kernel sums (phi, phi u, phi v) of a case's steady frames
+    at ``kernel`` CG1 diameters: the whole window, its first and its second half (with one
+    frame, the halves are that frame)."""
+    grid = field_grid(geo, kernel_width(geo, cg, kernel), length)
+    flux = np.stack([flux_moments(f, geo, grid)[:IN_PLANE] for f in frames])
+    half = len(frames) // 2 if len(frames) >= 2 else 1
+    second = flux[half:] if len(frames) >= 2 else flux
+    return WindowMeans(kernel=float(kernel), grid=grid,
+                       sums=np.stack([flux.mean(axis=0), flux[:half].mean(axis=0),
+                                      second.mean(axis=0)]))
+
+
 def case_fields(frames: list[ParticleFrame], geo: DrumGeometry, width: float, length: float,
-                head: dict) -> CaseFields:
+                head: dict, kernels: tuple[float, ...] = CRITERION_KERNELS) -> CaseFields:
     """The fields of one case from its steady-window frames (two passes: the mean flux,
-    then the fluctuation about the window's mean velocity). ``head``: the case's
-    identity (case_id, cg, rule, replica, group)."""
+    then the fluctuation about the window's mean velocity), with the window means at each
+    of ``kernels`` CG1 diameters. ``head``: the case's identity (case_id, cg, rule,
+    replica, group)."""
     grid = field_grid(geo, width, length)
     flux = np.stack([flux_moments(f, geo, grid) for f in frames])          # (F, 4, n, n)
     velocity = mean_velocity(flux.mean(axis=0))
     fluct = np.stack([fluctuation_moment(f, geo, grid, velocity) for f in frames])
     moments = np.concatenate([flux, fluct[:, None]], axis=1)
+    means = tuple(window_means(frames, geo, k, head["cg"], length)
+                  for k in sorted(set(kernels)))
     return CaseFields(**head, grid=grid, steps=np.array([f.step for f in frames], np.int64),
-                      moments=moments)
+                      moments=moments, omega=float(geo.omega), radius=float(geo.radius),
+                      window_means=means)
 
 
 def reference_moments(frame: ParticleFrame, geo: DrumGeometry, grid: FieldGrid,

@@ -32,7 +32,8 @@ from ligwf.analysis.frames.checks import check_particles, plan_frames
 from ligwf.analysis.records.flow import CaseFlow, FlowRecord
 from ligwf.analysis.flow.steady import auto_fraction, is_auto
 from ligwf.analysis.flow.fields import case_fields, kernel_width
-from ligwf.analysis.records.fields import CaseFields, fields_bytes, image_text
+from ligwf.analysis.records.fields import (CRITERION_KERNELS, CaseFields, fields_bytes,
+                                           image_text)
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study import layout
@@ -118,7 +119,8 @@ def case_flow(case: CaseFolder, steady_after, field_kernel: float = FIELD_KERNEL
     steady_frames = [frames[k][0] for k in steady]
     fields = case_fields(steady_frames, geo, kernel_width(geo, case.cg, field_kernel),
                          case.scaled.drum_length,
-                         {k: head[k] for k in ("case_id", "cg", "rule", "replica", "group")})
+                         {k: head[k] for k in ("case_id", "cg", "rule", "replica", "group")},
+                         tuple(sorted({*CRITERION_KERNELS, float(field_kernel)})))
     return measured_flow(head, steady_frames, all_flows, all_series, steady, geo,
                          fields), skipped
 

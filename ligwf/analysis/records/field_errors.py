@@ -1,31 +1,41 @@
-"""Field errors of a CG-n condition against CG1, their 95 % interval and their CG1 floor.
+"""Field errors of a CG-n condition against CG1: the field criterion on what CG changes,
+and the solid-fraction error.
 
-Definitions (of window-mean fields, :func:`ligwf.analysis.records.fields.fields_of`; a
-condition's fields are those of the mean over its replicas of their window-mean kernel
-sums):
+* ``field_error`` -- the field criterion: the in-plane velocity in the drum frame, W = U -
+  omega x r (the co-rotating plug has W = 0 at every CG level by construction, so only
+  the flow that CG can change is compared), inside the flowing layer, normalised by the
+  wall speed omega R. The layer is where the CG1 condition has material (phi_1 >=
+  ``MATERIAL_SOLID``) and moves relative to the drum (|W_1| >= ``LAYER_SPEED`` omega R,
+  the rigid-block share's tolerance: slower is co-rotating). Per run (its window mean is
+  the unit of replication) the velocity at those nodes; between the arms' mean fields::
 
-* ``field_error`` -- the velocity field's relative L2 error, weighted by the CG1 solid
-  fraction, over the nodes where CG1 has material (phi_1 >= ``MATERIAL_SOLID``) and the
-  CG-n condition has any (phi_n >= EMPTY_SOLID)::
+      D^2 = sum_x w(x) |mean_n W(x) - mean_1 W(x)|^2 / (omega R)^2,   w = phi_1 / sum phi_1
 
-      sqrt( sum phi_1 |U_n - U_1|^2 / sum phi_1 |U_1|^2 )      U = (u, v), in-plane
+  a weighted RMS of the difference in units of the wall speed (the same as of U: omega x r
+  cancels). Like the velocity profile it is corrected for the noise of both arms: the
+  estimate is sqrt(max(0, D^2 - S)), S = sum w (s_n^2 / R_n + s_1^2 / R_1) / (omega R)^2
+  the noise the run scatter puts into D^2. Bounds: by the triangle inequality the true
+  distance lies within D +- |e|, e the noise; |e| <= t sqrt(S) with t Student's 1 - alpha / 2
+  quantile at the Satterthwaite degrees of freedom of S taken as one component (the
+  most correlated case, the widest), so each bound holds with probability >= 1 - alpha
+  whatever the nodes' correlation (``tests/analysis/test_field_criterion.py`` measures it).
+  Reported at the kernel widths ``CRITERION_KERNELS`` (CG1 diameters); the verdict uses
+  the study's ``analysis.field_kernel``.
 
 * ``field_solid_error`` -- the solid-fraction field's relative L1 error over the whole
   cross-section: sum |phi_n - phi_1| / sum phi_1 (a bed that sits elsewhere or packs
-  otherwise).
+  otherwise), with a frame-and-replica block-bootstrap interval (each replica's frames
+  block-bootstrapped, block length from the autocorrelation of its per-frame mean speed,
+  jointly with the CG1 reference's, replicas drawn with replacement; a resample of frames
+  is a weighting of the recorded per-frame kernel sums, so a draw costs one matrix
+  product) and its CG1 floor: with two or more CG1 replicas, each against the mean of the
+  others (the largest); with one, the split-half error of that run divided by sqrt(2),
+  labelled *indicative*.
 
-Interval: as every error against CG1 (:mod:`ligwf.analysis.records.intervals`): each
-replica's frames are block-bootstrapped (block length from the autocorrelation of its
-per-frame mean speed) jointly with the CG1 reference's, replicas drawn with replacement,
-widened for few replicas, never narrower than the within-run error, none for one CG-n
-replica. A resample of frames is a weighting of the recorded per-frame kernel sums, so a
-draw costs one matrix product, not a re-analysis.
-
-Floor (how far CG1 is from CG1): with two or more CG1 replicas, each against the mean of
-the others (the largest); with one, the split-half error of that run (first half of its
-window against the second) divided by sqrt(2) -- two half windows differ by sqrt(2) more
-than two full windows when the difference is noise -- and labelled *indicative*, as the
-other floors from one run are.
+CG1 against CG1 (:func:`null_split`): the field criterion between two halves of the CG1
+runs -- half of the seeds against the other half when there are four or more, else the
+first half of every run's window against the second half -- should be about 0: the null
+check of the criterion and its noise correction.
 """
 
 from __future__ import annotations
@@ -37,43 +47,31 @@ from typing import Callable
 
 import numpy as np
 
-from ligwf.analysis.records.fields import EMPTY_SOLID, CaseFields
+from scipy import stats
+
+from ligwf.analysis.records.equivalence import ALPHA, NormEstimate, welch_df
+from ligwf.analysis.records.fields import (CRITERION_KERNELS, EMPTY_SOLID, IN_PLANE,
+                                           CaseFields, FieldGrid, WindowMeans)
 from ligwf.analysis.records.intervals import (Interval, block_indices, block_length,
                                               interval_from_draws)
 from ligwf.analysis.records.metrics import POSITIVE
+from ligwf.engine.mesh import axis_frame
 
-#: a node where the CG1 solid fraction reaches this holds material (the velocity error's
+#: a node where the CG1 solid fraction reaches this holds material (the field criterion's
 #: support: the bed and its smoothed edge, not the dilute spray above it)
 MATERIAL_SOLID = 0.1
+#: a CG1 node moving relative to the drum at this share of omega R or more is in the
+#: flowing layer (the rigid-block share's tolerance, ligwf.analysis.flow.frame.frame_flow)
+LAYER_SPEED = 0.2
+#: the field criterion at each width of CRITERION_KERNELS: column name per width
+KERNEL_COLUMNS = {k: f"field_error_k{k:g}" for k in CRITERION_KERNELS}
 #: bootstrap draws evaluated at once (bounds the memory: draws x grid nodes x moments)
 CHUNK = 100
-#: the errors read the first moments only: solid fraction, flux u, flux v
-IN_PLANE = 3
 #: the error columns this module computes, by name
 FIELD_ERRORS = ("field_error", "field_solid_error")
+NO_NORM = NormEstimate(math.nan, math.nan, math.nan, math.nan)
 
 Error = Callable[[np.ndarray, np.ndarray], np.ndarray]
-
-
-def _in_plane(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(phi, u, v) of kernel sums (u, v 0 where phi < EMPTY_SOLID): what the velocity
-    error needs, without the other fields."""
-    phi = sums[..., 0, :, :]
-    ok = phi >= EMPTY_SOLID
-    inv = np.where(ok, 1.0 / np.where(ok, phi, 1.0), 0.0)
-    return phi, sums[..., 1, :, :] * inv, sums[..., 2, :, :] * inv
-
-
-def velocity_error(ref: np.ndarray, sums: np.ndarray) -> np.ndarray:
-    """``field_error`` of kernel sums ``sums`` against ``ref`` (both ``(..., moments, n,
-    n)``, broadcasting over leading draw axes); nan without a common material node."""
-    phi1, u1, v1 = _in_plane(ref)
-    phi, u, v = _in_plane(sums)
-    weight = np.where((phi1 >= MATERIAL_SOLID) & (phi >= EMPTY_SOLID), phi1, 0.0)
-    num = np.sum(weight * ((u - u1) ** 2 + (v - v1) ** 2), axis=(-2, -1))
-    den = np.sum(weight * (u1**2 + v1**2), axis=(-2, -1))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(den > 0, np.sqrt(num / np.where(den > 0, den, 1.0)), np.nan)
 
 
 def solid_error(ref: np.ndarray, sums: np.ndarray) -> np.ndarray:
@@ -85,7 +83,8 @@ def solid_error(ref: np.ndarray, sums: np.ndarray) -> np.ndarray:
                         / np.where(den > 0, den, 1.0), np.nan)
 
 
-ERRORS: dict[str, Error] = {"field_error": velocity_error, "field_solid_error": solid_error}
+#: the errors with a frame-bootstrap interval and a CG1 floor
+ERRORS: dict[str, Error] = {"field_solid_error": solid_error}
 
 
 def same_grid(cases: list[CaseFields]) -> bool:
@@ -137,7 +136,7 @@ def _material_only(cases: list[CaseFields]) -> list[CaseFields]:
 
 
 def field_intervals(cases: list[CaseFields], refs: list[CaseFields], draws: int, seed: int,
-                    names: tuple[str, ...] = FIELD_ERRORS) -> dict[str, Interval]:
+                    names: tuple[str, ...] = tuple(ERRORS)) -> dict[str, Interval]:
     """Each field error ``names`` of a condition's replicas ``cases`` against the CG1
     replicas ``refs``, with its 95 % interval (module docstring; one set of draws for all
     of them); nan without cases, references or a common grid."""
@@ -167,7 +166,7 @@ def field_intervals(cases: list[CaseFields], refs: list[CaseFields], draws: int,
 
 def field_interval(cases: list[CaseFields], refs: list[CaseFields], name: str, draws: int,
                    seed: int) -> Interval:
-    """One field error (``name`` in ``FIELD_ERRORS``) with its interval
+    """One bootstrapped field error (``name`` in ``ERRORS``) with its interval
     (:func:`field_intervals`)."""
     return field_intervals(cases, refs, draws, seed, (name,))[name]
 
@@ -202,3 +201,117 @@ def field_floor(refs: list[CaseFields], name: str) -> FieldFloor:
     first, second = split_half(refs[0])
     return FieldFloor(float(error(first, second)) / math.sqrt(2.0),
                       "indicative: split-half of 1 CG1 run (within-run noise)")
+
+
+# ------------------------------------------------------------------ the field criterion
+def rotation_velocity(grid: FieldGrid, omega: float) -> tuple[np.ndarray, np.ndarray]:
+    """(u, v) components of the rigid rotation omega x r at the grid's nodes ((n, n) each,
+    rows v, columns u), computed in 3-D as the rigid-block share does (the (u, v) plane
+    of axis y is left-handed about +y)."""
+    ia, iu, iv = axis_frame(grid.axis)
+    e = np.eye(3)
+    w = omega * e[ia]
+    du, dv = np.cross(w, e[iu]), np.cross(w, e[iv])    # omega x r is linear in (u, v)
+    c = grid.coordinates()
+    uu, vv = np.meshgrid(c, c)
+    return uu * du[iu] + vv * dv[iu], uu * du[iv] + vv * dv[iv]
+
+
+def _velocity(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(phi, U, V) of in-plane kernel sums (..., 3, n, n); U, V nan where phi < EMPTY_SOLID."""
+    phi = sums[..., 0, :, :]
+    ok = phi >= EMPTY_SOLID
+    safe = np.where(ok, phi, 1.0)
+    return (phi, np.where(ok, sums[..., 1, :, :] / safe, np.nan),
+            np.where(ok, sums[..., 2, :, :] / safe, np.nan))
+
+
+def layer_norm(runs: np.ndarray, reference: np.ndarray, weights: np.ndarray, scale: float,
+               alpha: float = ALPHA) -> NormEstimate:
+    """The noise-corrected weighted RMS distance between two arms' mean vector fields, in
+    units of ``scale`` (module docstring). ``runs`` (R_n, C, K) and ``reference`` (R_1,
+    C, K): per run C components at K nodes; ``weights`` (K,) >= 0. Without two runs in
+    each arm: the raw distance and no bounds."""
+    x, y = np.asarray(runs, float), np.asarray(reference, float)
+    w = np.asarray(weights, float)
+    if (x.ndim != 3 or y.ndim != 3 or x.shape[1:] != y.shape[1:] or not len(x) or not len(y)
+            or w.shape != x.shape[2:] or not np.sum(w) > 0 or not scale > 0):
+        return NO_NORM
+    w = w / np.sum(w)
+    d = x.mean(axis=0) - y.mean(axis=0)                                  # (C, K)
+    d2 = float(np.sum(w * d * d))
+    raw = math.sqrt(d2) / scale
+    if len(x) < 2 or len(y) < 2:
+        return NormEstimate(raw, math.nan, math.nan, raw)
+    a = float(np.sum(w * x.var(axis=0, ddof=1))) / len(x)
+    b = float(np.sum(w * y.var(axis=0, ddof=1))) / len(y)
+    noise = a + b
+    df = welch_df(a * len(x), len(x), b * len(y), len(y))
+    t = float(stats.t.ppf(1.0 - alpha / 2.0, df)) if math.isfinite(df) else float(
+        stats.norm.ppf(1.0 - alpha / 2.0))
+    half = t * math.sqrt(noise)
+    value = math.sqrt(max(0.0, d2 - noise)) / scale
+    return NormEstimate(value, max(0.0, math.sqrt(d2) - half) / scale,
+                        (math.sqrt(d2) + half) / scale, raw)
+
+
+def _means(cases: list[CaseFields], kernel: float) -> list[WindowMeans] | None:
+    means = [c.at_kernel(kernel) for c in cases]
+    return None if any(m is None for m in means) else means
+
+
+def _one_grid(means: list[WindowMeans]) -> bool:
+    return len({(m.grid.origin, m.grid.spacing, m.grid.nodes, m.grid.axis)
+                for m in means}) == 1
+
+
+def layer_error(cases: list[tuple[CaseFields, str]], refs: list[tuple[CaseFields, str]],
+                kernel: float, alpha: float = ALPHA) -> NormEstimate:
+    """The field criterion of the runs ``cases`` against the CG1 runs ``refs`` at
+    ``kernel`` CG1 diameters; each run a (case, part of its window: ``WINDOW_PARTS``).
+    nan when a run lacks the window means (an analysis from before them), the grids
+    differ, the drum's omega R is unknown or there is no flowing layer."""
+    if not cases or not refs:
+        return NO_NORM
+    cm = _means([c for c, _ in cases], kernel)
+    rm = _means([c for c, _ in refs], kernel)
+    if cm is None or rm is None or not _one_grid(cm + rm):
+        return NO_NORM
+    omega, radius = refs[0][0].omega, refs[0][0].radius
+    scale = abs(omega) * radius
+    if not (math.isfinite(scale) and scale > 0):
+        return NO_NORM
+    x = np.stack([m.part(p) for m, (_, p) in zip(cm, cases)])           # (R, 3, n, n)
+    y = np.stack([m.part(p) for m, (_, p) in zip(rm, refs)])
+    grid = rm[0].grid
+    ru, rv = rotation_velocity(grid, omega)
+    phi1, u1, v1 = _velocity(y.mean(axis=0))
+    _, xu, xv = _velocity(x)
+    _, yu, yv = _velocity(y)
+    with np.errstate(invalid="ignore"):
+        moving = np.hypot(u1 - ru, v1 - rv) >= LAYER_SPEED * scale
+    layer = ((phi1 >= MATERIAL_SOLID) & moving & np.isfinite(xu).all(axis=0)
+             & np.isfinite(yu).all(axis=0))
+    if not layer.any():
+        return NO_NORM
+    runs = np.stack([xu[:, layer], xv[:, layer]], axis=1)                 # (R, 2, K)
+    ref = np.stack([yu[:, layer], yv[:, layer]], axis=1)
+    return layer_norm(runs, ref, phi1[layer], scale, alpha)
+
+
+def whole_windows(cases: list[CaseFields]) -> list[tuple[CaseFields, str]]:
+    """Each case as one run: its whole steady window."""
+    return [(c, "window") for c in cases]
+
+
+def null_split(refs: list[CaseFields]) -> tuple[list, list, str]:
+    """Two arms of CG1 runs for the CG1-vs-CG1 null check, and how they were split: half
+    of the seeds against the other half with four or more, else the first half of every
+    run's window against the second half (halves of one run are closer than two seeds,
+    so this null check is lenient)."""
+    if len(refs) >= 4:
+        half = len(refs) // 2
+        return (whole_windows(refs[:half]), whole_windows(refs[half:]),
+                f"CG1 seeds {half} against {len(refs) - half}")
+    return ([(c, "first_half") for c in refs], [(c, "second_half") for c in refs],
+            f"first against second half of the window of {len(refs)} CG1 run(s)")

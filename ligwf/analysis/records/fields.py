@@ -11,6 +11,12 @@ Per case and steady frame, the kernel sums ``MOMENTS`` on the grid nodes (units:
 dimensionless, the fluxes m/s, the fluctuation m^2/s^2, all per unit solid fraction
 times phi); any frame weighting (the window mean, a bootstrap resample) of these sums
 gives the fields of that weighting through :func:`fields_of`.
+
+Per case also, at each kernel width of ``CRITERION_KERNELS`` (CG1 mean diameters), the
+window-mean in-plane kernel sums of the whole window and of its two halves
+(:class:`WindowMeans`), with the drum's angular velocity and radius: what the field
+criterion reads (the drum-frame velocity in the flowing layer, per run,
+:mod:`ligwf.analysis.records.field_errors`).
 """
 
 from __future__ import annotations
@@ -18,6 +24,7 @@ from __future__ import annotations
 import base64
 import io
 import json
+import math
 import struct
 import zipfile
 from dataclasses import dataclass, field
@@ -29,6 +36,13 @@ from ligwf.engine.mesh import axis_frame
 
 #: per-frame kernel sums on the grid, in this order (axis 1 of ``CaseFields.moments``)
 MOMENTS = ("solid_fraction", "flux_u", "flux_v", "flux_axial", "fluctuation")
+#: the kernel widths (CG1 mean diameters) at which every case's window means are kept for
+#: the field criterion (it is reported at each; the verdict uses ``analysis.field_kernel``)
+CRITERION_KERNELS = (1.0, 2.0, 4.0)
+#: the in-plane kernel sums of :class:`WindowMeans`: the first ``IN_PLANE`` of ``MOMENTS``
+IN_PLANE = 3
+#: the parts of the window of :class:`WindowMeans`, in this order
+WINDOW_PARTS = ("window", "first_half", "second_half")
 #: below this solid fraction a node holds no material: no velocity or temperature there
 EMPTY_SOLID = 1e-3
 #: the derived fields, their units (the ImageData arrays and the report's maps)
@@ -57,6 +71,21 @@ class FieldGrid:
 
 
 @dataclass(frozen=True)
+class WindowMeans:
+    """A case's window-mean in-plane kernel sums at one kernel width: the whole steady
+    window and its first and second half (the halves give a CG1-vs-CG1 comparison even
+    from few seeds)."""
+
+    kernel: float      # CG1 mean diameters
+    grid: FieldGrid
+    sums: np.ndarray = field(repr=False, compare=False)   # (len(WINDOW_PARTS), IN_PLANE, n, n)
+
+    def part(self, name: str) -> np.ndarray:
+        """(IN_PLANE, n, n) kernel sums of one part of the window (``WINDOW_PARTS``)."""
+        return self.sums[WINDOW_PARTS.index(name)]
+
+
+@dataclass(frozen=True)
 class CaseFields:
     """The kernel sums of one case's steady frames (see the module docstring)."""
 
@@ -68,6 +97,13 @@ class CaseFields:
     grid: FieldGrid
     steps: np.ndarray = field(repr=False, compare=False)     # (F,) steps of the frames
     moments: np.ndarray = field(repr=False, compare=False)   # (F, len(MOMENTS), n, n)
+    omega: float = math.nan     # rad/s, the drum's rotation about +axis (nan: not recorded)
+    radius: float = math.nan    # m, the drum radius
+    window_means: tuple[WindowMeans, ...] = field(default=(), repr=False, compare=False)
+
+    def at_kernel(self, kernel: float) -> WindowMeans | None:
+        """The window means at ``kernel`` CG1 diameters (None: not recorded)."""
+        return next((w for w in self.window_means if math.isclose(w.kernel, kernel)), None)
 
     @property
     def frames(self) -> int:
@@ -106,10 +142,15 @@ def fields_bytes(cases: list[CaseFields]) -> bytes:
     ``<case>/moments`` arrays."""
     arrays = {"index": np.frombuffer(json.dumps(
         [{"case_id": c.case_id, "cg": c.cg, "rule": c.rule, "replica": c.replica,
-          "group": c.group, "grid": c.grid.to_json()} for c in cases]).encode(), np.uint8)}
+          "group": c.group, "grid": c.grid.to_json(), "omega": c.omega, "radius": c.radius,
+          "window_means": [{"kernel": w.kernel, "grid": w.grid.to_json()}
+                           for w in c.window_means]}
+         for c in cases]).encode(), np.uint8)}
     for k, c in enumerate(cases):
         arrays[f"{k}/steps"] = np.asarray(c.steps, np.int64)
         arrays[f"{k}/moments"] = np.asarray(c.moments, np.float32)
+        for j, w in enumerate(c.window_means):
+            arrays[f"{k}/window_means/{j}"] = np.asarray(w.sums, np.float32)
     buf = io.BytesIO()
     # np.savez stamps each member with the current time: a fixed stamp keeps the bytes
     # (and the digest in the analysis record) the same for the same fields, whatever the
@@ -125,16 +166,22 @@ def fields_bytes(cases: list[CaseFields]) -> bytes:
 
 
 def read_fields(path: Path) -> dict[str, CaseFields]:
-    """The fields of every case in the archive at ``path`` (case_id -> CaseFields);
+    """The fields of every case in the archive at ``path`` (case_id -> CaseFields; an
+    archive from before the window means reads without them: omega and radius nan);
     OSError / ValueError / KeyError when it is missing or not one."""
     with np.load(Path(path), allow_pickle=False) as z:
         index = json.loads(bytes(z["index"]).decode())
         out = {}
         for k, d in enumerate(index):
+            means = tuple(WindowMeans(kernel=float(w["kernel"]), grid=FieldGrid(**w["grid"]),
+                                      sums=z[f"{k}/window_means/{j}"].astype(np.float64))
+                          for j, w in enumerate(d.get("window_means", [])))
             out[d["case_id"]] = CaseFields(
                 case_id=d["case_id"], cg=float(d["cg"]), rule=d["rule"],
                 replica=int(d["replica"]), group=d["group"], grid=FieldGrid(**d["grid"]),
-                steps=z[f"{k}/steps"], moments=z[f"{k}/moments"].astype(np.float64))
+                steps=z[f"{k}/steps"], moments=z[f"{k}/moments"].astype(np.float64),
+                omega=float(d.get("omega", math.nan)), radius=float(d.get("radius", math.nan)),
+                window_means=means)
     return out
 
 
