@@ -10,7 +10,8 @@ import pytest
 
 #: marks a test gets from the fixtures it uses (directly or through other fixtures), so a
 #: test that needs the engine or a Slurm cluster can never run in the fast lane unmarked
-FIXTURE_MARKS = {"engine": ("engine",), "slurm_cluster": ("slurm",), "chromium": ("browser",)}
+FIXTURE_MARKS = {"engine": ("engine",), "slurm_cluster": ("slurm",),
+                 "two_node_slurm": ("slurm", "slow"), "chromium": ("browser",)}
 
 
 def pytest_collection_modifyitems(config, items):

@@ -111,6 +111,34 @@ def slurm_conf(host: str, node: str, root: Path = ROOT, log_dir: Path = LOG_DIR,
     ])
 
 
+def start_munge() -> int | None:
+    """Start munged (key created if missing) unless one runs already; its pid if this call
+    started it (the caller stops it again), None if someone else's munged answers."""
+    key = Path("/etc/munge/munge.key")
+    if not key.is_file():
+        _run(["mungekey", "--create", "--keyfile", str(key)])
+        shutil.chown(key, "munge", "munge")
+        key.chmod(0o400)
+    run = Path("/run/munge")
+    run.mkdir(parents=True, exist_ok=True)
+    shutil.chown(run, "munge", "munge")
+    for d in (Path("/var/lib/munge"), Path("/var/log/munge")):
+        d.mkdir(parents=True, exist_ok=True)
+        shutil.chown(d, "munge", "munge")
+    pidfile = run / "munged.pid"
+    if pidfile.is_file() and pid_alive(int(pidfile.read_text().split()[0])):
+        return None  # someone else's munged: use it, never stop it
+    _run(["runuser", "-u", "munge", "--", "munged", "--force"])
+    pid = None
+    for _ in range(50):
+        if pidfile.is_file():
+            pid = int(pidfile.read_text().split()[0])
+            break
+        time.sleep(0.1)
+    _run(["munge", "-n"])  # proves the daemon answers
+    return pid
+
+
 @dataclass
 class LocalSlurm:
     """Start and stop the one-node cluster; ``jobcomp`` is the finished-jobs record.
@@ -140,27 +168,7 @@ class LocalSlurm:
         return "\n".join(parts)
 
     def _start_munge(self) -> None:
-        key = Path("/etc/munge/munge.key")
-        if not key.is_file():
-            _run(["mungekey", "--create", "--keyfile", str(key)])
-            shutil.chown(key, "munge", "munge")
-            key.chmod(0o400)
-        run = Path("/run/munge")
-        run.mkdir(parents=True, exist_ok=True)
-        shutil.chown(run, "munge", "munge")
-        for d in (Path("/var/lib/munge"), Path("/var/log/munge")):
-            d.mkdir(parents=True, exist_ok=True)
-            shutil.chown(d, "munge", "munge")
-        pidfile = run / "munged.pid"
-        if pidfile.is_file() and pid_alive(int(pidfile.read_text().split()[0])):
-            return  # someone else's munged: use it, never stop it
-        _run(["runuser", "-u", "munge", "--", "munged", "--force"])
-        for _ in range(50):
-            if pidfile.is_file():
-                self.munged_pid = int(pidfile.read_text().split()[0])
-                break
-            time.sleep(0.1)
-        _run(["munge", "-n"])  # proves the daemon answers
+        self.munged_pid = start_munge()
 
     def start(self, timeout: float = 60.0) -> None:
         """Install if needed, configure, start munged, slurmctld and slurmd, wait for idle."""
