@@ -22,6 +22,7 @@ from ligwf.analysis.granules.growth import GrowthSettings
 from ligwf.analysis.granules.growth_study import (CRITERIA, cadence_table, measure_case,
                                                   seed_table, verdict)
 from ligwf.study.case import CaseFolder
+from ligwf.study.layout import is_case_folder
 
 COMMAND = ("ligwf run workflows/granule_growth.yaml --out runs/granule_growth\n"
            ".venv/bin/python scripts/granule_growth_results.py runs/granule_growth "
@@ -170,7 +171,7 @@ def main(run_dir: str, out_dir: str, processes: int = 2) -> int:
 
     run, out = Path(run_dir), Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    case_ids = sorted(p.name for p in run.iterdir() if (p / "scene.json").exists())
+    case_ids = sorted(p.name for p in run.iterdir() if is_case_folder(p))
     with Pool(processes) as pool:
         results = pool.map(measured, [run / c for c in case_ids])
     rows_df, shares_df, flows_df = (pd.concat([r[i] for r in results], ignore_index=True)
@@ -197,7 +198,7 @@ def measure_finished(run_dir: str) -> int:
     """Measure (and cache) every case whose run is done, one at a time: the study's cases
     can be measured while the last ones still run."""
     for p in sorted(Path(run_dir).iterdir()):
-        m = CaseFolder.open(p).manifest() if (p / "scene.json").exists() else None
+        m = CaseFolder.open(p).manifest() if is_case_folder(p) else None
         if m is not None and m.status == "done":
             measured(p)
     return 0

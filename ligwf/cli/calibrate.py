@@ -20,6 +20,7 @@ from ligwf.errors import ConfigError
 from ligwf.pipeline.calibrate import CALIBRATION_TABLE, CalibrationGrid, run_calibration
 from ligwf.pipeline.run import run_settings
 from ligwf.scene.workflow import apply_override, parse_override
+from ligwf.study.layout import SCENE_FILE, is_case_folder
 from ligwf.yamlio import read_yaml_mapping
 
 
@@ -34,8 +35,8 @@ def _values(text: str) -> tuple[float, ...]:
 
 def _finished_case(text: str) -> Path:
     path = Path(text)
-    if not (path / "scene.json").is_file():
-        raise argparse.ArgumentTypeError(f"{text}: not a case folder (no scene.json)")
+    if not is_case_folder(path):
+        raise argparse.ArgumentTypeError(f"{text}: not a case folder (no {SCENE_FILE})")
     return path
 
 
