@@ -1,0 +1,136 @@
+"""Two nodes for real (issue 34), on the two-node Slurm of tests/slurm/two_node_cluster.py.
+
+A case the rank plan puts on 2 ranks (spanning_drum.yaml: 6,085 particles), submitted with
+``cores_per_node: 1``, asks for ``--nodes=2``; Slurm allocates both hosts and OpenMPI's
+mpirun (the site launcher ``mpirun --display-map``, its TCP traffic kept on the cluster
+network by the site's set-up lines) puts one engine rank on each: the launch map in the
+engine's log says so, and each node's namespace holds one engine process that sees that
+node's host name. ``ligwf slurm cancel`` then stops it on both nodes (the case is
+``killed``, no engine process is left on either): the case's fill alone would cost minutes
+on 2 cores, the map is what this test is after.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from ligwf.study.study import Study
+
+from two_node_cluster import NODES, SUBNET, TwoNodeSlurm
+
+HERE = Path(__file__).resolve().parent
+SPANNING = HERE / "spanning_drum.yaml"
+LIGWF = str(Path(sys.executable).parent / "ligwf")
+
+pytestmark = [pytest.mark.slurm, pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
+
+
+def site_file(path: Path, launcher: str) -> Path:
+    """A site file as a cluster user writes it: partition, cores per node, launcher, and
+    OpenMPI's TCP traffic kept on the cluster network (here the veth's subnet)."""
+    setup = [f"export OMPI_MCA_{kind}_tcp_if_include={SUBNET}" for kind in ("btl", "oob")]
+    path.write_text("slurm:\n  partition: debug\n  cores_per_node: 1\n  time: \"00:40:00\"\n"
+                    f"  launcher: {launcher}\n  setup: {json.dumps(setup)}\n")
+    return path
+
+
+def clean_env(**extra: str) -> dict[str, str]:
+    """This environment without site overrides (LIGWF_SLURM_*, LIGWF_MPIRUN*)."""
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("LIGWF_SLURM_", "LIGWF_MPIRUN", "SLURM_"))}
+    return dict(env, **extra)
+
+
+def ligwf(cluster: TwoNodeSlurm, *args: str, env: dict[str, str], expect: int = 0,
+          timeout: float = 900) -> subprocess.CompletedProcess:
+    """``ligwf ARGS`` on node 1 (the cluster's addresses exist only in its namespaces)."""
+    out = cluster.run([LIGWF, *args], env=env, timeout=timeout)
+    assert out.returncode == expect, f"ligwf {' '.join(args)} exited {out.returncode}:\n" \
+                                     f"{out.stdout}\n{out.stderr}"
+    return out
+
+
+def logs(study: Path) -> str:
+    parts = []
+    for log in sorted((study / "slurm" / "logs").glob("*.out")):
+        parts.append(f"--- {log.name} ---\n" + "\n".join(log.read_text().splitlines()[-15:]))
+    return "\n".join(parts)
+
+
+def wait_for_jobs(cluster: TwoNodeSlurm, study: Path, timeout: float) -> None:
+    """Until squeue lists no job (the cluster runs this module's jobs only)."""
+    deadline = time.monotonic() + timeout
+    last = ""
+    while time.monotonic() < deadline:
+        out = cluster.run(["squeue", "-h", "-r", "-o", "%i %T %N"])
+        last = out.stdout.strip()
+        if out.returncode == 0 and not last:
+            return
+        time.sleep(1.0)
+    raise AssertionError(f"jobs still queued after {timeout:.0f} s: {last}\n{logs(study)}\n"
+                         f"{cluster.log_tail()}")
+
+
+def engine_ranks(cluster: TwoNodeSlurm) -> dict[str, list[tuple[int, str]]]:
+    """The running LIGGGHTS processes of each node (its network namespace), with the host
+    name each one sees (its UTS namespace)."""
+    ranks: dict[str, list[tuple[int, str]]] = {}
+    for node in cluster.nodes:
+        pids = subprocess.run(["ip", "netns", "pids", node], capture_output=True,
+                              text=True).stdout.split()
+        for pid in pids:
+            try:
+                name = Path(f"/proc/{pid}/comm").read_text().strip()
+            except OSError:
+                continue
+            if name == "liggghts":
+                host = subprocess.run(["nsenter", "-t", pid, "-u", "hostname"],
+                                      capture_output=True, text=True).stdout.strip()
+                ranks.setdefault(node, []).append((int(pid), host))
+    return ranks
+
+
+def launch_map(screen: str) -> list[tuple[str, str, str]]:
+    """(node, procs, rank) of each node in mpirun's ``--display-map`` in the engine's log."""
+    return re.findall(r"Data for node: (\S+)\s+Num slots: \d+\s+Max slots: \d+\s+"
+                      r"Num procs: (\d+)\s+Process OMPI jobid: \S+ App: 0 Process rank: (\d+)",
+                      screen)
+
+
+ONE_RANK_EACH = [(NODES[0][0], "1", "0"), (NODES[1][0], "1", "1")]
+
+
+def test_a_planned_two_rank_case_asks_two_nodes_and_gets_a_rank_on_each(two_node_slurm,
+                                                                          tmp_path):
+    env = clean_env(LIGWF_MESH_CACHE=str(tmp_path / "meshes"),
+                    LIGWF_SITE=str(site_file(tmp_path / "site.yaml", "mpirun --display-map")))
+    study = tmp_path / "planned"
+    out = ligwf(two_node_slurm, "slurm", "submit", str(SPANNING), "--out", str(study),
+                "--no-analysis", env=env).stdout
+    assert "array-1.sh: 1 case(s), --ntasks=2, --nodes=2" in out, out
+    script = (study / "slurm" / "array-1.sh").read_text()
+    assert "#SBATCH --ntasks=2\n#SBATCH --nodes=2\n" in script
+    case = Study.open(study).case(0)
+    deadline = time.monotonic() + 1800
+    while time.monotonic() < deadline and not launch_map(
+            case.screen.read_text(errors="replace") if case.screen.is_file() else ""):
+        time.sleep(0.5)
+    assert launch_map(case.screen.read_text()) == ONE_RANK_EACH, logs(study)
+    ranks: dict = {}
+    while time.monotonic() < deadline and sum(map(len, ranks.values())) < 2:
+        ranks = engine_ranks(two_node_slurm)
+        time.sleep(0.2)
+    assert {node: [host for _, host in found] for node, found in ranks.items()} == \
+        {node: [node] for node in two_node_slurm.nodes}, ranks   # each rank sees its host
+    ligwf(two_node_slurm, "slurm", "cancel", str(study), env=env)
+    wait_for_jobs(two_node_slurm, study, timeout=900)
+    assert case.manifest().status == "killed", (case.manifest().reason, logs(study))
+    assert not engine_ranks(two_node_slurm)                   # nothing left on either node
