@@ -1,6 +1,6 @@
 """Measure the granule-growth study and write its committed tables and README.
 
-    .venv/bin/python scripts/granule_growth_results.py RUNDIR docs/results/granule_growth
+    .venv/bin/python scripts/granule_growth_results.py RUNDIR docs/results/granule_growth [CALIBRATION_DIR ...]
     .venv/bin/python scripts/granule_growth_results.py --measure-finished RUNDIR
 
 RUNDIR is the folder of ``ligwf run workflows/granule_growth.yaml --out RUNDIR``. Writes
@@ -25,15 +25,53 @@ from ligwf.study.case import CaseFolder
 from ligwf.study.layout import is_case_folder
 
 COMMAND = ("ligwf run workflows/granule_growth.yaml --out runs/granule_growth\n"
+           "ligwf calibrate-control workflows/granule_growth.yaml --out runs/cal1 "
+           "--reference runs/granule_growth/cg1-none-r0 --friction 0.8,1.0 "
+           "--rolling-friction 0.6,1.0 --run-time 3\n"
+           "ligwf calibrate-control workflows/granule_growth.yaml --out runs/cal2 "
+           "--reference runs/granule_growth/cg1-none-r0 --friction 0.65 "
+           "--rolling-friction 0.3,0.6 --run-time 3\n"
            ".venv/bin/python scripts/granule_growth_results.py runs/granule_growth "
-           "docs/results/granule_growth")
+           "docs/results/granule_growth runs/cal1 runs/cal2")
 
 
 def _fmt(x: float, digits: int = 3) -> str:
     return "–" if pd.isna(x) else f"{x:.{digits}g}"
 
 
-def readme(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame, cases: pd.DataFrame) -> str:
+def calibration_lines(cal: pd.DataFrame | None) -> list[str]:
+    """The flow-match calibration section (criterion.md, amendment 2) from calibration.csv."""
+    if cal is None or cal.empty:
+        return []
+    ref = cal[cal["role"] == "wet reference"].iloc[0]
+    cands = cal[cal["role"] == "candidate"]
+    lines = ["", "## Flow-match calibration (criterion.md, amendment 2)", "",
+             "`ligwf calibrate-control` against the wet seed r0 (its production after 30 %): "
+             "cohesionless twins of 3 s production each, one row per candidate "
+             "(`calibration.csv`, both rounds).", "",
+             "| round | friction | rolling friction | angle [deg] | angle std [deg] | "
+             "angle gap [deg] | std gap [deg] |", "|---|---|---|---|---|---|---|",
+             f"| wet r0 | {ref.friction:g} | {ref.rolling_friction:g} | {ref.angle_deg:.2f} | "
+             f"{ref.angle_std_deg:.2f} | – | – |"]
+    for r in cands.itertuples():
+        lines.append(f"| {r.round} | {r.friction:g} | {r.rolling_friction:g} | "
+                     f"{r.angle_deg:.2f} | {r.angle_std_deg:.2f} | {r.angle_gap_deg:+.2f} | "
+                     f"{r.std_gap_deg:+.2f} |")
+    within = cands[cands["angle_gap_deg"].abs() <= 1.0]
+    best = cands.loc[cands["angle_gap_deg"].abs().idxmin()]
+    lines += ["", (f"- {len(within)} of {len(cands)} candidates match the wet angle within 1 deg"
+                   + (f" (closest: friction {best.friction:g}, rolling friction "
+                      f"{best.rolling_friction:g}, {best.angle_gap_deg:+.2f} deg)" ) + "; the "
+                   f"largest angle fluctuation of any candidate is "
+                   f"{cands['angle_std_deg'].max():.2f} deg against the wet bed's "
+                   f"{ref.angle_std_deg:.2f} deg: friction and rolling friction "
+                   + ("match the mean angle but not the slumping." if len(within) else
+                      "match neither the mean angle within 1 deg nor the slumping."))]
+    return lines
+
+
+def readme(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame, cases: pd.DataFrame,
+           calibration: pd.DataFrame | None = None) -> str:
     """The README, every number from the tables beside it."""
     s = GrowthSettings()
     lines = [
@@ -95,6 +133,7 @@ def readme(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame, cases: pd.
     for case_id, g in cad.groupby("case_id", sort=True):
         vals = g.set_index("cadence")["share_10"]
         lines.append(f"| {case_id} | " + " | ".join(_fmt(vals[c]) for c in sorted(vals.index)) + " |")
+    lines += calibration_lines(calibration)
     lines += ["", "## Reading", ""] + reading(seeds, ver, cad)
     return "\n".join(lines) + "\n"
 
@@ -166,7 +205,8 @@ def measured(case_dir: Path) -> tuple[pd.DataFrame, ...]:
     return tables
 
 
-def main(run_dir: str, out_dir: str, processes: int = 2) -> int:
+def main(run_dir: str, out_dir: str, processes: int = 2,
+         calibrations: tuple[str, ...] = ()) -> int:
     from multiprocessing import Pool
 
     run, out = Path(run_dir), Path(out_dir)
@@ -186,10 +226,17 @@ def main(run_dir: str, out_dir: str, processes: int = 2) -> int:
     seeds.to_csv(out / "seeds.csv", index=False, float_format="%.6g")
     ver.to_csv(out / "controls_verdict.csv", index=False)
     cases.to_csv(out / "cases.csv", index=False)
+    if calibrations:
+        cal = pd.concat([pd.read_csv(Path(c) / "calibration.csv").assign(round=k + 1)
+                         for k, c in enumerate(calibrations)], ignore_index=True)
+        ref = cal[cal["role"] == "wet reference"].drop_duplicates("case_id")
+        cal = pd.concat([ref, cal[cal["role"] == "candidate"]], ignore_index=True)
+        cal.to_csv(out / "calibration.csv", index=False, float_format="%.6g")
     # the README reads the tables as written (what its test recomputes from)
     seeds, ver, cad, cases = (pd.read_csv(out / f) for f in
                               ("seeds.csv", "controls_verdict.csv", "cadence.csv", "cases.csv"))
-    (out / "README.md").write_text(readme(seeds, ver, cad, cases))
+    cal = pd.read_csv(out / "calibration.csv") if (out / "calibration.csv").exists() else None
+    (out / "README.md").write_text(readme(seeds, ver, cad, cases, cal))
     print(ver.to_string(index=False))
     return 0
 
@@ -207,6 +254,6 @@ def measure_finished(run_dir: str) -> int:
 if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "--measure-finished":
         sys.exit(measure_finished(sys.argv[2]))
-    if len(sys.argv) not in (3, 4):
+    if len(sys.argv) < 3:
         sys.exit(__doc__)
-    sys.exit(main(sys.argv[1], sys.argv[2], *(int(a) for a in sys.argv[3:])))
+    sys.exit(main(sys.argv[1], sys.argv[2], 2, tuple(sys.argv[3:])))
