@@ -10,7 +10,7 @@ Usage (the cases are ligwf case folders with ``scene.json`` and ``post/`` dumps)
         [--tiles 2 4] [--steady 0.25] [--boot 1000] [--speed-tiles 1 4 16]
 
 The measurement of docs/results/granule_definitions.md (cases of ``ligwf run
-workflows/demo.yaml --out /tmp/gd/lc --np 2 --set "sweep.cg_levels=[1,2]" --set
+workflows/granules.yaml --out /tmp/gd/lc --np 2 --set "sweep.cg_levels=[1,2]" --set
 "sweep.rules=[weber]" --set sweep.replicas=1 --set scene.numerics.dump_interval=0.02 --set
 scene.process.run_time=1.5 --set "sweep.scene.liquid.liquid_content=[0.01,0.02,0.04]"``)::
 

@@ -37,7 +37,7 @@ from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_par
 from ligwf.engine.ghosts import last_run_spread  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 
-WORKFLOW = ROOT / "workflows" / "demo.yaml"
+WORKFLOW = ROOT / "workflows" / "granules.yaml"   # the demo scene until 2026-12-04
 #: the registered case (ranks_criterion.md): demo CG1, no twin, 0.1 s settle, 0.8 s turning
 SETS = ("sweep.cg_levels=[1]", "sweep.controls=[]", "scene.process.settle_time=0.1",
         "scene.process.run_time=0.8", "scene.numerics.dump_interval=0.025")

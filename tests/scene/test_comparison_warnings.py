@@ -10,11 +10,11 @@ import yaml
 from helpers import ROOT
 from ligwf.scene.workflow import comparison_warnings, expand
 
-DEMO = yaml.safe_load((ROOT / "workflows" / "demo.yaml").read_text())
+GRANULES = yaml.safe_load((ROOT / "workflows" / "granules.yaml").read_text())
 
 
 def warnings_for(**sweep) -> list[str]:
-    raw = copy.deepcopy(DEMO)
+    raw = copy.deepcopy(GRANULES)
     raw["sweep"].update(sweep)
     return comparison_warnings(expand(raw))
 
@@ -26,11 +26,11 @@ def test_one_cg1_replica_warns_and_its_twin_does_not_count():
 
 
 def test_two_cg1_replicas_or_cg1_alone_do_not_warn():
-    assert warnings_for() == []          # the demo: 2 CG1 seeds
+    assert warnings_for() == []          # granules.yaml: 2 CG1 seeds
     assert warnings_for(replicas={1: 2, 2: 2}) == []
     assert warnings_for(cg_levels=[1], replicas=1, controls=[]) == []
 
 
 def test_no_cg1_case_says_so_instead():
-    (w,) = warnings_for(cg_levels=[2], controls=[])
+    (w,) = warnings_for(cg_levels=[2], replicas=2, controls=[])
     assert "no CG1 case" in w

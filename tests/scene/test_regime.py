@@ -13,11 +13,11 @@ from ligwf.scene.workflow import CONTROL_KEY, load_workflow
 
 from helpers import ROOT
 
-DEMO = ROOT / "workflows" / "demo.yaml"
+GRANULES = ROOT / "workflows" / "granules.yaml"
 
 
 def _case(overrides=()):
-    return load_workflow(DEMO, list(overrides)).cases
+    return load_workflow(GRANULES, list(overrides)).cases
 
 
 def test_numbers_by_hand_and_under_both_rules():
@@ -44,23 +44,23 @@ def test_check_warns_where_the_map_expects_no_granules(capsys):
     warned: water-like viscosity (St_v ~ 105) and binder-like viscosity with weak cohesion
     (St_v 0.35, Bo_g 1.1) as 'no definition beat the control', the map's closest point
     (St_v 0.35, Bo_g 3.4) as such; a case without contact dumps is not warned."""
-    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.001",
+    assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.001",
                  "--set", "scene.liquid.surface_tension=0.024"]) == 0
     out = capsys.readouterr()
     assert "granule analysis asked for, but St_v = 105, Bo_g = 1.13: no granule definition" in out.err
     row = next(line for line in out.out.splitlines() if line.startswith("│ cg1-none-r0 ")
                and "105" in line)
     assert row.rstrip().endswith("no │")
-    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.3",
+    assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.3",
                  "--set", "scene.liquid.surface_tension=0.024"]) == 0
     assert "St_v = 0.349, Bo_g = 1.13: no granule definition" in capsys.readouterr().err
     assert GRANULATING_BOND <= 3.39 and GRANULATING_ST_V >= 0.349
-    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.3",
+    assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.3",
                  "--set", "scene.liquid.surface_tension=0.072"]) == 0
     out = capsys.readouterr()
     assert "St_v = 0.349, Bo_g = 3.39 is the regime map's closest point" in out.err
     assert "closest (unproven)" in out.out
-    assert main(["check", str(DEMO), "--set", "scene.liquid.viscosity=0.001",
+    assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.001",
                  "--set", "scene.analysis.granules=false"]) == 0
     assert "granule analysis asked for" not in capsys.readouterr().err
 
@@ -75,7 +75,7 @@ def test_cohesionless_twin_keeps_everything_but_the_bridge_forces():
     assert b.viscosity == pytest.approx(a.viscosity / 1000)
     same = ("seeds", "particle_count", "dt", "liquid_content", "granules", "run_steps")
     assert all(getattr(a, k) == getattr(b, k) for k in same)
-    # the demo: 2 CG1 seeds, each with its twin; 2 seeds of each CG2 rule
+    # granules.yaml: 2 CG1 seeds, each with its twin; 2 seeds of each CG2 rule
     assert sum(c.cg == 1 for c in cases) == 4 and sum(c.cg == 2 for c in cases) == 4
     assert sum(CONTROL_KEY in dict(c.varied) for c in cases) == 2
 
@@ -91,7 +91,7 @@ def test_controls_refused_on_a_dry_scene_and_at_a_missing_level():
 
 
 def test_check_warns_when_the_definition_never_beat_the_control(capsys):
-    assert main(["check", str(DEMO), "--set", "analysis.granules=communities"]) == 0
+    assert main(["check", str(GRANULES), "--set", "analysis.granules=communities"]) == 0
     assert "analysis.granules: communities: its granules never beat" in capsys.readouterr().err
-    assert main(["check", str(DEMO)]) == 0                     # the demo: held
+    assert main(["check", str(GRANULES)]) == 0                     # granules.yaml: held
     assert "never beat" not in capsys.readouterr().err

@@ -14,19 +14,19 @@ from ligwf.scene.window import (MIN_USABLE_FRAMES, held_window_warnings, plug_ar
                                 plug_residence)
 from ligwf.scene.workflow import expand
 
-DEMO = yaml.safe_load((ROOT / "workflows" / "demo.yaml").read_text())
+GRANULES = yaml.safe_load((ROOT / "workflows" / "granules.yaml").read_text())
 
 
 def warnings_for(run_time: float, **analysis) -> list[str]:
-    raw = copy.deepcopy(DEMO)
+    raw = copy.deepcopy(GRANULES)
     raw["scene"]["process"]["run_time"] = run_time
     raw["analysis"].update(analysis)
     return held_window_warnings(expand(raw))
 
 
-def test_demo_timing_warns_once_naming_the_fields_and_the_run_time_that_fits():
-    """Demo: 30 rpm (T = 2 s), 1 s hold, dumps every 0.05 s, 2.5 s production: an auto window
-    starting at 1.25 s leaves 1.25 - 1 - 0.5 < 0 s."""
+def test_granules_timing_warns_once_naming_the_fields_and_the_run_time_that_fits():
+    """The granules workflow (the former demo): 30 rpm (T = 2 s), 1 s hold, dumps every
+    0.05 s, 2.5 s production: an auto window starting at 1.25 s leaves 1.25 - 1 - 0.5 < 0 s."""
     (w,) = warnings_for(2.5)
     assert w.startswith("analysis.hold_time = 1 s") and "process.run_time = 2.5 s" in w
     assert "0 of the 10" in w
@@ -43,7 +43,7 @@ def test_fixed_steady_fraction_is_used_instead_of_the_latest_auto_start():
 
 def test_other_definitions_and_dry_scenes_do_not_warn():
     assert warnings_for(2.5, granules="communities") == []
-    raw = copy.deepcopy(DEMO)
+    raw = copy.deepcopy(GRANULES)
     raw["scene"]["liquid"] = {"model": "none"}
     raw["scene"]["analysis"] = {"granules": False}
     raw["sweep"].update(controls=[], rules=["weber"])
@@ -51,11 +51,11 @@ def test_other_definitions_and_dry_scenes_do_not_warn():
 
 
 def test_a_hold_time_shorter_than_this_drums_plug_is_named():
-    """The demo's 0.3 fill covers 143 deg of shell: 0.8 s in the plug at 30 rpm (T = 2 s), so
+    """The granules workflow's 0.3 fill covers 143 deg of shell: 0.8 s in the plug at 30 rpm (T = 2 s), so
     its 1 s window (1.25x) is fine; at 6 rpm (T = 10 s) the plug lasts 3.96 s and a 1 s window
     would count it as granules: the warning gives the plug, the arc and the value to use."""
     assert warnings_for(5.0) == []
-    raw = copy.deepcopy(DEMO)
+    raw = copy.deepcopy(GRANULES)
     raw["scene"]["process"]["run_time"] = 30.0
     raw["scene"]["process"]["rotation"] = {"rpm": 6}
     (w,) = held_window_warnings(expand(raw))
