@@ -67,6 +67,11 @@ def calibration_lines(cal: pd.DataFrame | None) -> list[str]:
                    f"{ref.angle_std_deg:.2f} deg: friction and rolling friction "
                    + ("match the mean angle but not the slumping." if len(within) else
                       "match neither the mean angle within 1 deg nor the slumping."))]
+    lo, hi = cands["angle_gap_deg"].min(), cands["angle_gap_deg"].max()
+    if not len(within) and lo < 0.0 < hi:
+        lines.append(f"- The candidates bracket the wet angle (gaps {lo:+.2f} to {hi:+.2f} deg): "
+                     "a candidate between them would match the mean angle; none reaches half "
+                     "the wet bed's fluctuation.")
     return lines
 
 
