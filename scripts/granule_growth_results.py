@@ -70,8 +70,9 @@ def calibration_lines(cal: pd.DataFrame | None) -> list[str]:
     lo, hi = cands["angle_gap_deg"].min(), cands["angle_gap_deg"].max()
     if not len(within) and lo < 0.0 < hi:
         lines.append(f"- The candidates bracket the wet angle (gaps {lo:+.2f} to {hi:+.2f} deg): "
-                     "a candidate between them would match the mean angle; none reaches half "
-                     "the wet bed's fluctuation.")
+                     "a candidate between them would match the mean angle; the largest "
+                     f"fluctuation any reaches is {cands['angle_std_deg'].max() / ref.angle_std_deg:.2f} "
+                     "of the wet bed's.")
     return lines
 
 
