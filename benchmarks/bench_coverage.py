@@ -16,7 +16,11 @@ run value is its steady-window mean, exactly as the report takes it. For every c
 * ``norm``: the upper bound of the relative L2 profile distance (8 bins, a profile of
   mean 1 per bin, the CG-n arm shifted by 0.3 in the first bin) holds the true distance
   (nominal >= 0.95; the Bonferroni box makes it conservative);
-* ``norm bias``: mean noise-corrected and raw distance of two arms with no difference.
+* ``norm bias``: mean noise-corrected and raw distance of two arms with no difference;
+* ``sequential``: the whole procedure of ``ligwf study --until-decided`` (looks at alpha /
+  looks, the cheapest extension or replicas after each undecided look, new seeds for new
+  replicas) on null studies: the share of final passes when the truth sits on the budget
+  and of final fails when it sits on the budget or at 0 (each must be <= 0.05).
 
 Every coverage cell must lie in [0.92, 0.99]; the summary line says how many do.
 The previous interval (frame bootstrap over replicas, ``intervals.frame_metric_interval``)
@@ -92,6 +96,90 @@ def norm_cell(rng, trials: int, R: int, frames: int, phi: float, offset: float,
             "norm raw": float(np.mean(raw))}
 
 
+class SynthRun:
+    """One synthetic run that can be continued: AR(1) frames of unit sd plus its offset."""
+
+    def __init__(self, rng, frames: int, phi: float, offset: float, shift: float = 0.0):
+        self.rng, self.phi = rng, phi
+        self.offset = offset * rng.standard_normal() + shift
+        self.x = [rng.standard_normal()]
+        self.extend(frames - 1)
+
+    def extend(self, frames: int) -> None:
+        innov = math.sqrt(1.0 - self.phi**2)
+        for _ in range(frames):
+            self.x.append(self.phi * self.x[-1] + innov * self.rng.standard_normal())
+
+    def series(self) -> np.ndarray:
+        return np.asarray(self.x) + self.offset
+
+
+#: the sequential benchmark's prices: a replica = fill and settle (100 frames' worth) plus
+#: its window; one frame of production costs 1; CG1 runs cost 10x CG-n ones
+FILL_FRAMES, CG1_PRICE = 100, 10.0
+
+
+def _synth_arm(runs: list, price: float) -> "sp.Arm":
+    from ligwf.analysis.records import sampling as sp
+    series = [r.series() for r in runs]
+    return sp.arm([s.mean() for s in series], [sp.within_variance(s) for s in series],
+                  [float(len(s)) for s in series], steady_share=1.0,
+                  replica_core_seconds=price * (FILL_FRAMES + len(series[0])) * 3600.0,
+                  production_core_seconds=price * 3600.0)
+
+
+def sequential_study(rng, R: int, frames: int, phi: float, offset: float, delta: float,
+                     budget: float = 1.0, looks: int = 3) -> str:
+    """The whole sequential procedure of ``ligwf study --until-decided`` on one synthetic
+    comparison (true CG-n - CG1 = ``delta``): up to ``looks`` looks, each two one-sided
+    tests at alpha / looks (Bonferroni spending); after an undecided look the cheapest
+    option of :func:`ligwf.analysis.records.sampling.cheapest` that halves the half-width
+    is done (runs continued or replicas added, new seeds). Returns the final state."""
+    from ligwf.analysis.records import sampling as sp
+    alpha = ALPHA / looks
+    arms = [[SynthRun(rng, frames, phi, offset, delta) for _ in range(R)],
+            [SynthRun(rng, frames, phi, offset) for _ in range(R)]]
+    state = "undecided"
+    for look in range(1, looks + 1):
+        x, y = _synth_arm(arms[0], 1.0), _synth_arm(arms[1], CG1_PRICE)
+        state = equivalence(difference_estimate(x.values, y.values, alpha), budget, alpha).state
+        if state != "undecided" or look == looks:
+            return state
+        e = difference_estimate(x.values, y.values, alpha)
+        # the round's rule (ligwf.pipeline.rounds): the cheapest way to halve the half-width
+        best = sp.cheapest(x, y, budget + 0.25 * (e.hi - e.lo), budget, alpha)
+        if best is None:
+            return state
+        if best.kind == sp.EXTEND:
+            n = math.ceil(best.amount)
+            for k, name in enumerate(("CG-n", "CG1")):
+                if name in best.arm.split(" and "):
+                    for r in arms[k]:
+                        r.extend(n)
+        else:
+            for k, count in enumerate((int(best.amount), int(best.amount_cg1))):
+                length = len(arms[k][0].x)
+                arms[k] += [SynthRun(rng, length, phi, offset, delta if k == 0 else 0.0)
+                            for _ in range(count)]
+    return state
+
+
+def sequential_cells(rng, trials: int, looks: int = 3) -> list[dict]:
+    """Wrong final decisions of the sequential procedure on null studies: a pass when the
+    truth sits on the budget (delta = budget), a fail when it sits on the budget or at 0."""
+    out = []
+    for R, frames, phi, offset in itertools.product((2, 3), (20, 100), (0.3, 0.8), (0.0, 1.0)):
+        on = [sequential_study(rng, R, frames, phi, offset, 1.0, 1.0, looks)
+              for _ in range(trials)]
+        zero = [sequential_study(rng, R, frames, phi, offset, 0.0, 1.0, looks)
+                for _ in range(trials)]
+        out.append({"R": R, "frames": frames, "phi": phi, "offset": offset,
+                    "wrong pass": on.count("pass") / trials,
+                    "wrong fail": max(on.count("fail"), zero.count("fail")) / trials,
+                    "decided at 0": 1.0 - zero.count("undecided") / trials})
+    return out
+
+
 def old_cell(rng, trials: int, R: int, frames: int, phi: float, offset: float) -> float:
     from ligwf.analysis.records.intervals import frame_metric_interval
     x = ar1_runs(rng, trials, R, frames, phi, offset)
@@ -107,6 +195,11 @@ def main(argv=None) -> int:
     ap.add_argument("--trials", type=int, default=400)
     ap.add_argument("--seed", type=int, default=20261202)
     ap.add_argument("--old", action="store_true", help="also the previous bootstrap interval")
+    ap.add_argument("--sequential-trials", type=int, default=400,
+                    help="null studies a cell of the sequential procedure")
+    ap.add_argument("--looks", type=int, default=3, help="looks of the sequential procedure")
+    ap.add_argument("--sequential-only", action="store_true",
+                    help="only the sequential procedure (skip the interval cells)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     rows, inside, total = [], 0, 0
@@ -114,8 +207,8 @@ def main(argv=None) -> int:
     head = (f"{'R':>2} {'frames':>6} {'phi':>4} {'offset':>6} | {'value':>6} {'diff':>6} "
             f"{'tost':>6} {'norm':>6} | {'wrong pass':>10} {'norm bias':>9} {'norm raw':>8}")
     print(head)
-    for R, frames, phi, offset in itertools.product((2, 3, 4, 6), (10, 50, 200),
-                                                    (0.3, 0.6, 0.9), (0.0, 1.0, 3.0)):
+    for R, frames, phi, offset in ([] if args.sequential_only else itertools.product(
+            (2, 3, 4, 6), (10, 50, 200), (0.3, 0.6, 0.9), (0.0, 1.0, 3.0))):
         c = cell(rng, args.trials, R, frames, phi, offset)
         c.update(norm_cell(rng, args.trials, R, frames, phi, offset))
         for k in ("value", "diff", "tost", "norm"):
@@ -125,14 +218,25 @@ def main(argv=None) -> int:
         print(f"{R:>2} {frames:>6} {phi:>4} {offset:>6} | {c['value']:6.3f} {c['diff']:6.3f} "
               f"{c['tost']:6.3f} {c['norm']:6.3f} | {c['wrong pass']:10.3f} "
               f"{c['norm bias']:9.3f} {c['norm raw']:8.3f}", flush=True)
-    worst_wrong = max(c["wrong pass"] for *_, c in rows)
-    for k in ("value", "diff", "tost", "norm"):
+    worst_wrong = max((c["wrong pass"] for *_, c in rows), default=math.nan)
+    for k in ("value", "diff", "tost", "norm") if rows else ():
         vals = [c[k] for *_, c in rows]
         n_in = sum(LOW <= v <= HIGH for v in vals)
         print(f"{k}: coverage {min(vals):.3f}-{max(vals):.3f}, {n_in} of {len(vals)} cells "
               f"in [{LOW}, {HIGH}]")
     print(f"wrong pass at delta = budget: at most {worst_wrong:.3f} (nominal 0.05)")
     print(f"summary: {inside} of {total} coverage cells in [{LOW}, {HIGH}]")
+    seq = sequential_cells(rng, args.sequential_trials, args.looks)
+    print(f"sequential (--until-decided): at most {args.looks} looks at alpha "
+          f"{ALPHA}/{args.looks} each, {args.sequential_trials} null studies a cell")
+    print(f"{'R':>2} {'frames':>6} {'phi':>4} {'offset':>6} | {'wrong pass':>10} "
+          f"{'wrong fail':>10} | {'decided at 0':>12}")
+    for c in seq:
+        print(f"{c['R']:>2} {c['frames']:>6} {c['phi']:>4} {c['offset']:>6} | "
+              f"{c['wrong pass']:10.3f} {c['wrong fail']:10.3f} | {c['decided at 0']:12.3f}",
+              flush=True)
+    worst = max(max(c["wrong pass"], c["wrong fail"]) for c in seq)
+    print(f"sequential: final decisions wrong at most {worst:.3f} of the time (must be <= 0.05)")
     if args.old:
         for R, frames, phi, offset in itertools.product((2, 3), (50,), (0.6,), (0.0, 2.0)):
             print(f"old bootstrap interval R={R} frames={frames} phi={phi} offset={offset}: "

@@ -2,7 +2,8 @@
 
 Running a study again must not redo finished work:
 
-* ``done`` with the case's scene hash             -> skip;
+* ``done`` with the case's scene hash             -> skip, unless its production was
+  extended (:mod:`ligwf.study.extension`): then continue from its newest own restart;
 * ``unstable`` with a matching hash               -> skip (the engine is deterministic:
   re-running gives the same blow-up; pass ``retry_unstable`` to force it);
 * ``failed``, no manifest, or a stale hash        -> fresh run (old outputs removed);
@@ -106,6 +107,8 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> Plan:
     if m.scene_hash != case.scene_hash:
         return Plan(FRESH, "scene changed since the last run")
     status = effective_status(m)
+    if status == DONE and m.steps_done < case.scaled.total_steps and case.extension_steps:
+        return _extension_plan(case, m.steps_done)
     if status == DONE:
         return Plan(SKIP, DONE)
     if status == UNSTABLE and not retry_unstable:
@@ -124,6 +127,20 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> Plan:
                     f"{ignored}", restarts[0])
     return Plan(FRESH, f"killed at step {m.steps_done} before any restart file of its own was "
                 f"written{ignored}")
+
+
+def _extension_plan(case: CaseFolder, steps_done: int) -> Plan:
+    """A done case whose production was extended (:mod:`ligwf.study.extension`): continue
+    it from its newest own restart to the new end (never from one past the steps it ran);
+    afresh only when it has none."""
+    target = case.scaled.total_steps
+    restarts, refused = own_restarts(case, steps_done)
+    ignored = f" (ignored {'; '.join(refused)})" if refused else ""
+    if restarts:
+        return Plan(RESUME, f"production extended to step {target} (done at {steps_done}); "
+                    f"continue from {restarts[0].path}{ignored}", restarts[0])
+    return Plan(FRESH, f"production extended to step {target}, but no restart file of its "
+                f"own to continue from{ignored}: run again from step 0")
 
 
 def clean_outputs(case_dir: Path) -> None:

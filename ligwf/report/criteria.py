@@ -19,7 +19,9 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis.records import equivalence as eq
+from ligwf.analysis.records import sampling
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.report import planning
 from ligwf.scene.accept import AcceptSettings
 
 #: the states of a criterion beside the tests' own (pass, fail, undecided)
@@ -52,6 +54,10 @@ CRITERIA = (
 )
 
 
+#: the case-table columns the signed criteria read (their runs' noise costs a decision)
+SIGNED_COLUMNS = tuple(s.column for s in CRITERIA if s.kind in (SIGNED, RELATIVE))
+
+
 @dataclass(frozen=True)
 class Gate:
     """Whether the granules of a sweep group beat their cohesionless control (None: no
@@ -74,6 +80,23 @@ class CriterionResult:
     budget_source: str = ""   # "tolerance"
     note: str = ""            # what would decide it, or why it is not assessed
     bound: float = math.nan   # the largest |error| its interval allows (shown within)
+    #: the cheapest way to decide it (undecided only, :mod:`ligwf.analysis.records.sampling`):
+    #: extend | replicas, on which arm, how much (s of production per run, or runs), at
+    #: what cost (core-hours, the planner's rates) and the half-width it predicts
+    decide_by: str = ""
+    decide_arm: str = ""
+    decide_amount: float = math.nan       # s of production per run, or CG-n replicas
+    decide_amount_cg1: float = math.nan   # CG1 replicas (replicas only)
+    decide_core_hours: float = math.nan
+    decide_half_width: float = math.nan
+    #: what a round of a sequential study does instead (:mod:`ligwf.pipeline.rounds`): the
+    #: cheapest way to HALVE the half-width, which does not depend on the measured
+    #: difference (amounts chosen from the difference bias the later looks' tests)
+    round_by: str = ""
+    round_arm: str = ""
+    round_amount: float = math.nan
+    round_amount_cg1: float = math.nan
+    round_core_hours: float = math.nan
 
     @property
     def assessed(self) -> bool:
@@ -100,22 +123,69 @@ def _per_run(runs: pd.DataFrame, column: str) -> np.ndarray:
         runs is not None and column in runs) else np.array([])
 
 
-def _replica_note(x: np.ndarray, y: np.ndarray, budget: float, alpha: float,
-                  scale: float = 1.0) -> str:
-    """What would decide an undecided signed criterion: replicas of the arm that
-    dominates the width (from the measured variances)."""
-    if len(x) < 2 or len(y) < 2:
-        who = "CG-n" if len(x) < 2 else "CG1"
-        return f"{who} has one run: no variance, no interval (run at least 2 replicas)"
-    need = eq.arm_replicas_to_decide(x * scale, y * scale, budget, alpha)
-    if need is None:
-        return ("the difference sits near the budget for its spread: over 64 replicas of "
-                "either arm would be needed")
-    arm, n = need
-    return f"about {n} {arm} replicas would decide (the {arm} scatter dominates the width)"
+def _arm(runs: pd.DataFrame, column: str, noise: pd.DataFrame | None,
+         scale: float) -> sampling.Arm:
+    """The runs of one arm with their noise and prices (noise table rows by case id)."""
+    values = _per_run(runs, column)
+    ids = list(runs["case_id"]) if runs is not None and "case_id" in runs else []
+    if noise is None or noise.empty or len(ids) != len(values):
+        return sampling.arm(values * scale)
+
+    def col(name: str) -> np.ndarray:
+        if name not in noise:
+            return np.full(len(ids), math.nan)
+        return np.array([float(noise[name].get(i, math.nan)) for i in ids])
+
+    share = col(planning.STEADY_SHARE)
+    share = float(np.nanmean(share)) if np.isfinite(share).any() else 0.75
+    return sampling.arm(values, col(planning.within_column(column)),
+                        col(planning.WINDOW), steady_share=share,
+                        replica_core_seconds=float(np.nanmean(col(planning.REPLICA_COST))),
+                        production_core_seconds=float(np.nanmean(
+                            col(planning.PRODUCTION_COST)))).scaled(scale)
 
 
-def _signed(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
+def _round_fields(o: "sampling.Option | None") -> dict:
+    """A sequential round's option (see :attr:`CriterionResult.round_by`) as fields."""
+    if o is None:
+        return {}
+    return dict(round_by=o.kind, round_arm=o.arm, round_amount=o.amount,
+                round_amount_cg1=o.amount_cg1 if o.kind == sampling.REPLICAS else math.nan,
+                round_core_hours=o.core_hours)
+
+
+def _replica_cost(runs: pd.DataFrame, noise: pd.DataFrame | None) -> float:
+    """Mean core-seconds of a new replica of an arm (nan without a noise table)."""
+    if noise is None or noise.empty or runs is None or planning.REPLICA_COST not in noise:
+        return math.nan
+    costs = [float(noise[planning.REPLICA_COST].get(i, math.nan)) for i in runs["case_id"]]
+    return float(np.nanmean(costs)) if np.isfinite(costs).any() else math.nan
+
+
+def _decide_fields(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
+                   alpha: float, unit: str) -> tuple[dict, str]:
+    """What would decide an undecided signed criterion: the cheapest option's fields and
+    its sentence (the arms' variances and the difference as measured)."""
+    if x.n < 2 or y.n < 2:
+        who = "CG-n" if x.n < 2 else "CG1"
+        return {}, f"{who} has one run: no variance, no interval (run at least 2 replicas)"
+    best = sampling.cheapest(x, y, e.value, budget, alpha)
+    fields = _round_fields(sampling.cheapest(x, y, budget + 0.5 * (e.hi - e.lo) / 2, budget,
+                                             alpha)) if e.has_interval else {}
+    if best is None:
+        return fields, (f"the difference sits near the budget for its spread: neither "
+                        f"{sampling.MOST_REPLICAS} replicas of an arm nor "
+                        f"{sampling.MOST_EXTENSION:g}x longer runs would decide it")
+    fields |= dict(decide_by=best.kind, decide_arm=best.arm, decide_amount=best.amount,
+                  decide_amount_cg1=(best.amount_cg1 if best.kind == sampling.REPLICAS
+                                     else math.nan),
+                  decide_core_hours=best.core_hours,
+                  decide_half_width=best.predicted_half_width)
+    return fields, (f"cheapest to decide: {best.text(unit)}; the {sampling.dominant_arm(x, y)} "
+                    "scatter dominates the width now")
+
+
+def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.Arm,
             alpha: float) -> tuple[CriterionResult, float]:
     """A signed criterion: the difference of run means CG-n - CG1 (relative to the CG1
     mean for RELATIVE), two one-sided tests at alpha. Returns the result and the p-value
@@ -124,47 +194,78 @@ def _signed(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
                 budget_source="tolerance")
     scale = 1.0
     if spec.kind == RELATIVE:
-        ref = float(np.nanmean(y)) if np.isfinite(y).any() else math.nan
+        ref = float(np.nanmean(y.values)) if np.isfinite(y.values).any() else math.nan
         if not ref > 0:
             return CriterionResult(**base, state=NOT_MEASURED, note=(
                 f"not measured: the CG1 {spec.label} is 0: no relative difference")), math.nan
         scale = 1.0 / ref
-    e = eq.scaled(eq.difference_estimate(x, y, alpha), scale)
+    e = eq.scaled(eq.difference_estimate(x.values, y.values, alpha), scale)
     if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED,
                                note=f"not measured: no {spec.column} value"), math.nan
     test = eq.equivalence(e, tolerance, alpha)
-    noise = eq.difference_estimate(x, y, alpha / 2)
+    noise = eq.difference_estimate(x.values, y.values, alpha / 2)
     vs_noise = ("" if not noise.has_interval else
                 "differs from CG1 beyond seed noise" if (noise.lo > 0 or noise.hi < 0)
                 else "indistinguishable from CG1 seed noise at these replicas")
-    note = vs_noise
-    if test.state == UNDECIDED:
-        note = "; ".join(part for part in (_replica_note(x, y, tolerance, alpha, scale),
-                                           vs_noise) if part)
+    note, decide = vs_noise, {}
+    if test.state != PASS:      # a fail may be undone by Holm: keep what would decide it
+        xs, ys = x.scaled(scale), y.scaled(scale)
+        decide, how = _decide_fields(xs, ys, e, tolerance, alpha, spec.unit)
+        if test.state == UNDECIDED:
+            note = "; ".join(part for part in (how, vs_noise) if part)
     bound = max(abs(e.lo), abs(e.hi)) if e.has_interval else math.nan
     return CriterionResult(**base, state=test.state, value=e.value, lo=e.lo, hi=e.hi,
-                           bound=bound, note=note), test.p_fail
+                           bound=bound, note=note, **decide), test.p_fail
+
+
+def _profile_replicas(x: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
+                      costs: tuple[float, float]) -> dict:
+    """The fewest replicas added to each arm (the same number, the profile's noise is both
+    arms') whose predicted bin-wise bounds would decide the profile criterion."""
+    out: dict = {}
+    width = eq.norm_estimate(x, y, alpha)
+    width = width.hi - width.lo
+    hours = lambda k: k * (costs[0] + costs[1]) / 3600.0   # noqa: E731
+    for k in range(1, sampling.MOST_REPLICAS - max(len(x), len(y)) + 1):
+        p = eq.norm_estimate(x, y, alpha, add=(k, k))
+        if not p.has_interval:
+            break
+        if not out.get("round_by") and p.hi - p.lo <= 0.5 * width:
+            out.update(round_by=sampling.REPLICAS, round_arm="CG-n and CG1", round_amount=k,
+                       round_amount_cg1=k, round_core_hours=hours(k))
+        if eq.norm_decision(p, tolerance) != UNDECIDED:
+            out.update(decide_by=sampling.REPLICAS, decide_arm="CG-n and CG1",
+                       decide_amount=k, decide_amount_cg1=k, decide_core_hours=hours(k),
+                       decide_half_width=0.5 * (p.hi - p.lo))
+            break
+    return out
 
 
 def _norm(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
-          alpha: float) -> CriterionResult:
+          alpha: float, costs: tuple[float, float] = (math.nan, math.nan)) -> CriterionResult:
     """The velocity profile: the noise-corrected relative L2 distance between the arms'
-    mean profiles, decided by its bin-wise bounds."""
+    mean profiles, decided by its bin-wise bounds (``costs``: core-seconds of a replica of
+    each arm, for what would decide it)."""
     base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
                 budget_source="tolerance")
     e = eq.norm_estimate(x, y, alpha)
     if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED, note="not measured: no profiles")
     state = eq.norm_decision(e, tolerance)
-    note = (f"raw distance {e.raw:.3g} before the noise of both arms is taken off"
-            if state != UNDECIDED else
-            f"raw distance {e.raw:.3g}; the bin-wise bounds [{e.lo:.3g}, {e.hi:.3g}] straddle "
-            "the budget: more replicas of both arms narrow them")
+    decide = {}
+    note = f"raw distance {e.raw:.3g} before the noise of both arms is taken off"
+    if state == UNDECIDED and e.has_interval:
+        decide = _profile_replicas(x, y, tolerance, alpha, costs)
+        r = CriterionResult(**base, state=state, **decide)
+        how = decide_text(r) or (f"over {sampling.MOST_REPLICAS} replicas of both arms "
+                                 "would be needed")
+        note = (f"raw distance {e.raw:.3g}; the bin-wise bounds [{e.lo:.3g}, {e.hi:.3g}] "
+                f"straddle the budget; {how}")
     if not e.has_interval:
         note = "an arm has one run: no variance, no bounds (run at least 2 replicas)"
     return CriterionResult(**base, state=state, value=e.value, lo=e.lo, hi=e.hi, bound=e.hi,
-                           note=note)
+                           note=note, **decide)
 
 
 def _analysis_interval(spec: CriterionSpec, tolerance: float, row) -> CriterionResult:
@@ -184,8 +285,8 @@ def _analysis_interval(spec: CriterionSpec, tolerance: float, row) -> CriterionR
 
 
 def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs: pd.DataFrame,
-                       profiles: dict, gate: Gate, alpha: float = eq.ALPHA
-                       ) -> tuple[CriterionResult, ...]:
+                       profiles: dict, gate: Gate, alpha: float = eq.ALPHA,
+                       noise: pd.DataFrame | None = None) -> tuple[CriterionResult, ...]:
     """Every criterion of the budget for one CG-n condition (``row`` of the condition table,
     ``runs`` its cases, ``ref_runs`` its group's CG1 cases), with Holm's step-down over the
     level's fail tests: a criterion fails only if its fail test survives Holm."""
@@ -200,8 +301,8 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
                                        note=f"not assessed: {gate.reason}"))
             p_fail.append(math.nan)
         elif spec.kind in (SIGNED, RELATIVE):
-            r, p = _signed(spec, tol, _per_run(runs, spec.column),
-                           _per_run(ref_runs, spec.column), alpha)
+            r, p = _signed(spec, tol, _arm(runs, spec.column, noise, 1.0),
+                           _arm(ref_runs, spec.column, noise, 1.0), alpha)
             out.append(r)
             p_fail.append(p)
         elif spec.kind == PROFILE:
@@ -212,7 +313,8 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
                 ya = np.array([p for p in y if p is not None and len(p)], dtype=float)
             except ValueError:
                 xa = ya = np.array([])
-            out.append(_norm(spec, tol, xa, ya, alpha))
+            costs = (_replica_cost(runs, noise), _replica_cost(ref_runs, noise))
+            out.append(_norm(spec, tol, xa, ya, alpha, costs))
             # a fail by its bounds has no p-value: it enters Holm's family as decided
             # (p = 0), which only makes the signed fails beside it harder to keep
             p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
@@ -225,7 +327,33 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
             p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
     rejected = eq.holm_rejects(p_fail, alpha)
     family = sum(math.isfinite(p) for p in p_fail)
-    return tuple(r if r.state != FAIL or ok else dataclasses.replace(
-        r, state=UNDECIDED, note=(f"outside the budget on its own, not after Holm over the "
-                                  f"level's {family} tested criteria; " + r.note).rstrip("; "))
-                 for r, ok in zip(out, rejected))
+    return tuple(_after_holm(r, ok, family) for r, ok in zip(out, rejected))
+
+
+def decide_text(r: CriterionResult) -> str:
+    """The cheapest way to decide ``r`` in words (empty when none is stored)."""
+    if not r.decide_by:
+        return ""
+    cg1 = r.decide_amount_cg1 if math.isfinite(r.decide_amount_cg1) else 0.0
+    return "cheapest to decide: " + sampling.Option(
+        r.decide_by, r.decide_arm, r.decide_amount, r.decide_core_hours,
+        r.decide_half_width, 0, cg1).text(r.unit)
+
+
+_NO_DECIDE = dict(decide_by="", decide_arm="", decide_amount=math.nan, decide_amount_cg1=math.nan,
+                  decide_core_hours=math.nan, decide_half_width=math.nan, round_by="",
+                  round_arm="", round_amount=math.nan, round_amount_cg1=math.nan,
+                  round_core_hours=math.nan)
+
+
+def _after_holm(r: CriterionResult, rejected: bool, family: int) -> CriterionResult:
+    """A fail that Holm's step-down does not keep becomes undecided (saying what would
+    decide it); a decided criterion carries no decide option."""
+    if r.state == FAIL and not rejected:
+        note = "; ".join(p for p in (f"outside the budget on its own, not after Holm over "
+                                     f"the level's {family} tested criteria", decide_text(r),
+                                     r.note) if p)
+        return dataclasses.replace(r, state=UNDECIDED, note=note)
+    if r.state in (PASS, FAIL):
+        return dataclasses.replace(r, **_NO_DECIDE)
+    return r

@@ -182,7 +182,9 @@ TABLES: dict[str, Table] = {
                                 "criterion of the verdict", (
         "group", "cg", "rule", "condition", "replicas", "condition_state", "speedup_core",
         "speedup_core_lo", "speedup_core_hi", "criterion", "label", "unit", "state", "value",
-        "lo", "hi", "budget", "shown_within", "budget_source", "note", "cheapest")),
+        "lo", "hi", "budget", "shown_within", "budget_source", "decide_by", "decide_arm",
+        "decide_amount", "decide_amount_cg1", "decide_core_hours", "decide_half_width",
+        "note", "cheapest")),
     layout.FIELD_NULL_REPORT: Table(layout.REPORT_DIR, "null check: per sweep group CG1 "
                                     "against CG1, per cohesionless-twin condition the twins "
                                     "against the wet CG1 cases", (

@@ -178,10 +178,13 @@ def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[st
 
 def decide(conditions: pd.DataFrame, accept: AcceptSettings,
            gates: dict[str, Gate] | None = None, cases: pd.DataFrame | None = None,
-           profiles: dict | None = None, alpha: float = eq.ALPHA) -> Verdict:
+           profiles: dict | None = None, alpha: float = eq.ALPHA,
+           noise: pd.DataFrame | None = None) -> Verdict:
     """The verdict of every sweep group of a condition table (control groups left out);
     ``cases`` (one row per run) and ``profiles`` (case id -> mean velocity profile) hold
-    the run values the signed and profile criteria are decided on."""
+    the run values the signed and profile criteria are decided on; ``noise`` (by case id,
+    :func:`ligwf.report.planning.noise_table`) what would decide an undecided one and its
+    cost; ``alpha`` each test's level (a sequential study's per-look level)."""
     gates, profiles = gates or {}, profiles or {}
     groups = []
     if conditions.empty:
@@ -203,7 +206,8 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
         for _, row in sub[sub["cg"] != REFERENCE_CG].sort_values(["cg", "rule"]).iterrows():
             runs = in_group[(in_group["cg"] == row["cg"])
                             & (in_group["rule"].astype(str) == str(row["rule"]))]
-            results = condition_criteria(accept, row, runs, ref_runs, profiles, gate, alpha)
+            results = condition_criteria(accept, row, runs, ref_runs, profiles, gate, alpha,
+                                         noise)
             out.append(ConditionVerdict(group, float(row["cg"]), str(row["rule"]),
                                         int(row["replicas"]), *band(row, "speedup_core"),
                                         results))

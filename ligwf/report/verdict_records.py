@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ligwf.analysis.records.equivalence import ALPHA
 from ligwf.fsio import atomic_write_json, atomic_write_text
 from ligwf.report.controls import read_controls
 from ligwf.report.criteria import CriterionResult
@@ -44,6 +45,11 @@ def verdict_rows(verdict: Verdict) -> pd.DataFrame:
                              "state": r.state, "value": r.value, "lo": r.lo, "hi": r.hi,
                              "budget": r.budget, "shown_within": r.bound,
                              "budget_source": r.budget_source,
+                             "decide_by": r.decide_by, "decide_arm": r.decide_arm,
+                             "decide_amount": r.decide_amount,
+                             "decide_amount_cg1": r.decide_amount_cg1,
+                             "decide_core_hours": r.decide_core_hours,
+                             "decide_half_width": r.decide_half_width,
                              "note": r.note, "cheapest": g.cheapest == c.name})
     return pd.DataFrame(rows)
 
@@ -72,7 +78,12 @@ def read_verdict(out: Path) -> Verdict | None:
             for c in g["conditions"]:
                 crit = tuple(CriterionResult(**{**r, **{k: _nan(r.get(k)) for k in
                                                         ("value", "lo", "hi", "budget",
-                                                         "bound")}})
+                                                         "bound", "decide_amount", "decide_amount_cg1",
+                                                         "round_amount", "round_amount_cg1",
+                                                         "round_core_hours",
+                                                         "decide_core_hours",
+                                                         "decide_half_width")
+                                                        if k in r}})
                              for r in c["criteria"])
                 conds.append(ConditionVerdict(c["group"], float(c["cg"]), c["rule"],
                                               int(c["replicas"]), _nan(c["speedup"]),
@@ -84,10 +95,12 @@ def read_verdict(out: Path) -> Verdict | None:
 
 
 def study_verdict(cases: pd.DataFrame, conditions: pd.DataFrame, accept: AcceptSettings,
-                  analysis_dir: Path, profiles: dict | None = None) -> Verdict:
+                  analysis_dir: Path, profiles: dict | None = None,
+                  noise: pd.DataFrame | None = None, alpha: float = ALPHA) -> Verdict:
     """The verdict of a study's report tables, with its granule control verdicts read from
-    the analysis folder."""
+    the analysis folder (``noise``: the runs' noise and prices, what would decide;
+    ``alpha``: each test's level)."""
     if cases.empty or conditions.empty:
         return Verdict((), accept.model_dump(mode="json"))
     return decide(conditions, accept, granule_gates(cases, read_controls(analysis_dir)),
-                  cases, profiles)
+                  cases, profiles, alpha, noise)

@@ -38,12 +38,16 @@ from ligwf.report.sections import (Figure, Section, figure_section, ordered, ren
 from ligwf.report.table_sections import (markdown_tables, noise_markdown, paraview_markdown,
                                          pooling_markdown, stability_markdown, steady_line)
 from ligwf.report.tables import build_tables
+from ligwf.report.criteria import SIGNED_COLUMNS
+from ligwf.report.planning import noise_table
+from ligwf.report.rounds import rounds_sections
 from ligwf.report.verdict import Verdict
 from ligwf.report.verdict_records import study_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_section
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import MESH_NAME
+from ligwf.study.rounds import read_rounds
 from ligwf.study.study import Study
 
 NO_VERDICT = ("No acceptance budget was evaluated for this study, so there is no pass / fail "
@@ -80,7 +84,9 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
     verdict = study_verdict(cases, conditions, study.accept, study.analysis_dir,
-                            {cid: c.profile_v_mean for cid, c in flow.cases.items()})
+                            {cid: c.profile_v_mean for cid, c in flow.cases.items()},
+                            noise_table(study.usable_cases()[0], flow, SIGNED_COLUMNS),
+                            read_rounds(study.path).alpha_per_look)
     write_verdict(verdict, out)
     figures = report_figures(study, flow, cases, conditions, out, snapshots)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
@@ -105,6 +111,7 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
     tables = (markdown_tables(cases, conditions, flow) if not cases.empty
               else "## Cases\n\nNo usable case.")
     parts = [*verdict_sections(verdict),
+             *rounds_sections(read_rounds(study.path), study.report_dir / fig_dir),
              *split_markdown(tables),
              *split_markdown(noise_markdown(conditions, floors, flow)),
              *split_markdown(pooling_markdown(study.analysis_dir, study.analysis.error_band)),

@@ -15,6 +15,7 @@ edited, copied in from another replica or added afterwards no longer matches it.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import os
 import json
@@ -28,6 +29,7 @@ from ligwf.fsio import atomic_write_json
 from ligwf.scene.model import Scene
 from ligwf.scene.scaling import ScaledScene, scale
 from ligwf.scene.workflow import CONTROL_KEY
+from ligwf.study.extension import extension_steps
 from ligwf.study.layout import (DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME, POST_DIR,
                                 SCENE_FILE, SCREEN_FILE, THERMO_FILE)
 from ligwf.study.manifest import DONE, Manifest, read_manifest, write_manifest
@@ -228,23 +230,40 @@ class CaseFolder:
     scaled: ScaledScene
     scene_hash: str
     explicit_dt: bool          # the scene fixed dt (the pre-flight judges it differently)
+    #: production steps added to the rendered run (:data:`EXTENSION_FILE`): ``scaled``
+    #: includes them, :attr:`rendered_scaled` is the scene as rendered and hashed
+    extension_steps: int = 0
 
     @classmethod
     def open(cls, path: Path | str) -> "CaseFolder":
-        """Parse the case's scene record; ConfigError when it is missing or invalid."""
+        """Parse the case's scene record (and its production extension, if any);
+        ConfigError when it is missing or invalid."""
         path = Path(path)
         try:
             rec = json.loads((path / SCENE_FILE).read_text())
+            scaled = ScaledScene.from_dict(rec["scaled"])
+            added = extension_steps(path, scaled)
+            if added:
+                scaled = dataclasses.replace(scaled, run_steps=scaled.run_steps + added)
             return cls(path=path, case_id=rec["case_id"], index=int(rec["index"]),
                        cg=float(rec["cg"]), rule=str(rec["rule"]),
                        replica=int(rec.get("replica", 0)),
                        group=group_of(rec.get("varied", {})),
-                       scaled=ScaledScene.from_dict(rec["scaled"]), scene_hash=rec["scene_hash"],
+                       scaled=scaled, scene_hash=rec["scene_hash"],
                        explicit_dt=(rec.get("scene", {}).get("numerics", {}) or {})
-                       .get("dt") is not None)
+                       .get("dt") is not None, extension_steps=added)
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise ConfigError(f"{path}: not a readable case folder (scene record missing or "
                               f"invalid: {exc})") from None
+
+    @property
+    def rendered_scaled(self) -> ScaledScene:
+        """The scaled scene as rendered (without a production extension): what the scene
+        record and its content hash describe."""
+        if not self.extension_steps:
+            return self.scaled
+        return dataclasses.replace(self.scaled,
+                                   run_steps=self.scaled.run_steps - self.extension_steps)
 
     # ----------------------------------------------------------------- files of the run
     @property
@@ -328,7 +347,7 @@ class CaseFolder:
             rec = json.loads((self.path / SCENE_FILE).read_text())
         except (OSError, ValueError) as exc:
             return f"{SCENE_FILE} unreadable: {exc}"
-        why = scene_record_problem(self.path, rec, self.scaled)
+        why = scene_record_problem(self.path, rec, self.rendered_scaled)
         return (None if why is None else f"{SCENE_FILE}: {why}; the record no longer describes "
                 "the run (edited after rendering?): render and run the case again")
 

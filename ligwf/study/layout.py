@@ -9,7 +9,9 @@ A study folder (``ligwf render`` / ``run`` / ``study`` write it)::
     STUDY/<case_id>/thermo.csv       thermo table over all attempts
     STUDY/<case_id>/dumps.json       size and SHA-256 of every file in post/ when the run
                                      ended done (written with the done manifest)
+    STUDY/<case_id>/extension.json   production added by a sequential study (optional)
     STUDY/<case_id>/post/, restart/  the engine's dumps and restarts
+    STUDY/rounds.json                the looks of a sequential study (optional)
     STUDY/analysis/                  granule, GSD, kinetics and flow tables, the steady
                                      window, the analysis record, per case a granule series
     STUDY/report/                    tables, summary.md, index.html, figures/, paraview/
@@ -37,6 +39,11 @@ SCREEN_FILE = "run.log"
 THERMO_FILE = "thermo.csv"
 #: Case level: the dumps a finished run left (size and SHA-256 per file of ``post/``).
 DUMP_RECORD = "dumps.json"
+#: Case level: production added to the rendered run (``ligwf study --until-decided``):
+#: the run continues from its restarts; the scene and its hash stay the rendered ones.
+EXTENSION_FILE = "extension.json"
+#: Study level: the looks of a sequential study (``ligwf study --until-decided``).
+ROUNDS_FILE = "rounds.json"
 #: Case level: the engine's dump folder.
 POST_DIR = "post"
 #: Case level: the main LIGGGHTS input (the renderer writes it).

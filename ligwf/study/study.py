@@ -59,6 +59,18 @@ class Study:
         raise ConfigError(f"{path} is not a ligwf study folder (nor a case folder): render "
                           "or submit a workflow first")
 
+    @staticmethod
+    def workflow_of(path: Path | str) -> dict:
+        """The workflow (raw mapping, ``--set`` overrides applied) a study folder was
+        written from; ConfigError when the folder has none."""
+        try:
+            raw = json.loads((Path(path) / STUDY_FILE).read_text())["workflow"]
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise ConfigError(f"{path}: no readable workflow in its study record ({exc})") from None
+        if not isinstance(raw, dict) or not raw:
+            raise ConfigError(f"{path}: its study record holds no workflow")
+        return raw
+
     # ----------------------------------------------------------------- cases
     @property
     def case_dirs(self) -> list[Path]:

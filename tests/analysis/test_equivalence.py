@@ -73,18 +73,6 @@ def test_profile_distance_is_noise_corrected_and_its_bounds_hold_the_truth():
     assert math.isnan(eq.norm_estimate(np.zeros((2, 0)), y).value)
 
 
-def test_replicas_to_decide_names_the_arm_that_dominates():
-    cgn = [41.5, 39.5, 43.5]          # wide
-    cg1 = [40.0, 40.2, 39.8]          # tight
-    arm, n = eq.arm_replicas_to_decide(cgn, cg1, 1.0)
-    assert arm == "CG-n" and n > 3
-    # with n CG-n replicas at the same variances the interval clears the budget
-    vx, vy = np.var(cgn, ddof=1), np.var(cg1, ddof=1)
-    se = math.sqrt(vx / n + vy / 3)
-    assert stats.t.ppf(0.95, eq.welch_df(vx, n, vy, 3)) * se < 0.5
-    assert eq.arm_replicas_to_decide([1.0], cg1, 1.0) is None
-
-
 @pytest.mark.parametrize("R,frames,phi,offset", [(2, 50, 0.9, 3.0), (2, 10, 0.3, 0.0),
                                                  (3, 200, 0.6, 1.0)])
 def test_coverage_on_synthetic_studies(R, frames, phi, offset):

@@ -99,7 +99,8 @@ def test_signed_difference_fails_wholly_outside_and_is_undecided_across_the_budg
     assert crit(v, "cg2-weber")["angle_deg"].state == FAIL
     assert crit(v, "cg2-weber")["angle_deg"].lo > 1.0
     u = crit(v, "cg3-weber")["angle_deg"]
-    assert u.state == UNDECIDED and "CG-n replicas would decide" in u.note
+    assert u.state == UNDECIDED and "more CG-n replicas" in u.note
+    assert u.decide_by == "replicas" and u.decide_amount > max(3, u.decide_amount_cg1)
     # the sign is kept: a CG-n bed 2 deg below CG1 fails too (no folding)
     low = crit(verdict(CG1, runs(2, "weber", [38.0, 38.2, 37.9])), "cg2-weber")["angle_deg"]
     assert low.state == FAIL and low.hi < -1.0 and low.value < 0

@@ -1,0 +1,272 @@
+"""Studies that run until they decide (``ligwf study WORKFLOW --out DIR --until-decided``).
+
+Rounds of run, analyse, verdict: after each look (:func:`plan_look`), the cheapest level
+of each sweep group that can still pass (the fastest condition that does not fail) is
+the round's target; each of its undecided criteria names the cheapest way to HALVE its
+interval's half-width (:mod:`ligwf.analysis.records.sampling`: more production on the runs
+there are, or more replicas of an arm); the round does all of them (per arm the longest
+extension and the most replicas asked for) and looks again, until the target meets the
+budget, every level fails, the planned looks are spent or the next round would pass the
+core-hour cap. A round halves the width rather than doing what item 4's "what would
+decide" names (an amount computed from the measured difference): amounts chosen from the
+difference bias the next look's test (on null synthetic studies, 10 % wrong fails at
+alpha 0.05; halving, which depends on the variances only, stays within 5 %:
+``benchmarks/bench_coverage.py``).
+
+Everything a round adds is first written into the study's rounds record
+(:mod:`ligwf.study.rounds`), then done; so the same command after a kill (of ligwf, an
+engine or mpirun, in any round) reads the record, re-applies what the last look asked for
+(idempotent: an extension names its target step, a new replica its number), resumes the
+runs (:mod:`ligwf.engine.resume`) and looks again: nothing lost, repeated or mixed. A
+continued case keeps its manifest, thermo table and frame series
+(:mod:`ligwf.study.extension`); a new replica is a new case folder with its own seeds.
+
+Repeated looks: every look tests at alpha / max_looks (Bonferroni spending, stated in the
+record and the report).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
+from ligwf.errors import ConfigError
+from ligwf.pipeline.post import postprocess, report_study
+from ligwf.pipeline.prepare import Prepared, prepare, render_case
+from ligwf.pipeline.run import RunSettings, StudyRun, cases_to_run, start_run, study_schedule
+from ligwf.report.planning import run_costs
+from ligwf.report.verdict import FAILS, MEETS, UNDECIDED, Verdict, is_control_group
+from ligwf.report.verdict_records import read_verdict
+from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
+from ligwf.study.case import CaseFolder, group_of
+from ligwf.study.extension import write_extension
+from ligwf.study.rounds import EXTEND, REPLICAS, Look, Rounds, read_rounds, write_rounds
+from ligwf.study.study import Study
+
+
+@dataclass(frozen=True)
+class RoundPlan:
+    """How a sequential study runs: at most ``max_looks`` looks and ``max_core_hours``
+    core-hours of runs in all (None: no cap)."""
+
+    max_looks: int = 3
+    max_core_hours: float | None = None
+
+
+def start_rounds(out: Path, plan: RoundPlan) -> Rounds:
+    """The study's rounds record: created at the first look, and refused when a later call
+    asks for another number of looks (its level was fixed before any data were seen)."""
+    rounds = read_rounds(out)
+    if rounds.looks and rounds.max_looks != plan.max_looks:
+        raise ConfigError(f"--max-looks = {plan.max_looks}: this study was started with "
+                          f"{rounds.max_looks} looks ({len(rounds.looks)} taken); each look "
+                          "tests at alpha / looks, fixed before its first look: keep "
+                          f"--max-looks {rounds.max_looks}")
+    rounds = Rounds(plan.max_looks, rounds.alpha, plan.max_core_hours, rounds.looks)
+    write_rounds(out, rounds)
+    return rounds
+
+
+def prepare_study_folder(path: Path, overrides=(), template_dirs=(),
+                         allow_unstable: bool = False) -> Prepared:
+    """Prepare the workflow a study folder stores (its study record), with ``--set``
+    overrides: ``ligwf study DIR --out DIR --until-decided`` on an existing study."""
+    raw = Study.workflow_of(path)
+    for text in overrides:
+        apply_override(raw, *parse_override(text))
+    return prepare(expand(raw), tuple(template_dirs), allow_unstable)
+
+
+# ---------------------------------------------------------------- what the rounds added
+def added_cases(prepared: Prepared, rounds: Rounds) -> Prepared:
+    """The prepared study with the replicas earlier rounds added (rendered in memory, in
+    the order they were added, indices after the workflow's own cases)."""
+    wanted = [(a["group"], float(a["cg"]), a["rule"], int(r)) for x in rounds.looks
+              for a in x.actions if a["kind"] == REPLICAS for r in a["replicas"]]
+    if not wanted:
+        return prepared
+    raw = copy.deepcopy(prepared.workflow.raw)
+    sweep = raw.setdefault("sweep", {})
+    levels = [float(c) for c in sweep.get("cg_levels", [1])]
+    base = sweep.get("replicas", 1)
+    counts = {c: (base if isinstance(base, int) else int(base.get(c, base.get(int(c), 1)) if
+                                                          isinstance(base, dict) else 1))
+              for c in levels}
+    for _, cg, _, rep in wanted:
+        counts[cg] = max(counts.get(cg, 1), rep + 1)
+    sweep["replicas"] = {(int(c) if c == int(c) else c): n for c, n in counts.items()}
+    by_key = {(group_of(dict(c.varied)), c.cg, c.rule.value, c.replica): c
+              for c in expand(raw).cases if CONTROL_KEY not in dict(c.varied)}
+    have = {rc.case.case_id for rc in prepared.rendered}
+    rendered = list(prepared.rendered)
+    for key in wanted:
+        case = by_key.get(key)
+        if case is None or case.case_id in have:
+            continue
+        case = dataclasses.replace(case, index=len(rendered))
+        rendered.append(render_case(case))
+        have.add(case.case_id)
+    return dataclasses.replace(prepared, rendered=rendered)
+
+
+def apply_extensions(study: Study, rounds: Rounds) -> None:
+    """Write every production extension the looks asked for (a case's newest target
+    step wins; written only where it differs, so a repeat changes nothing)."""
+    target: dict[str, int] = {}
+    new: dict[tuple, int] = {}
+    for x in rounds.looks:
+        for a in x.actions:
+            for cid, steps in a.get("run_steps", {}).items():
+                target[cid] = int(steps)
+            for rep in a.get("replicas", ()):
+                new[(a["group"], float(a["cg"]), a["rule"], int(rep))] = int(a["each_run_steps"])
+    for case in study.cases:
+        steps = target.get(case.case_id, new.get((case.group, case.cg, case.rule,
+                                                  case.replica)))
+        if steps is not None and steps != case.scaled.run_steps:
+            base = case.rendered_scaled.run_steps
+            write_extension(case.path, base, max(steps, base), case.scaled.dt)
+
+
+# ---------------------------------------------------------------- one look
+def spent_core_hours(study: Study) -> float:
+    """Core-hours the study's runs have cost (sum over the manifests' attempts)."""
+    total = 0.0
+    for case in study.cases:
+        m = case.manifest()
+        total += (m.core_seconds if m is not None else 0.0)
+    return total / 3600.0
+
+
+def _criteria_rows(verdict: Verdict) -> tuple[dict, ...]:
+    return tuple({"condition": c.name, "group": g.group, "criterion": r.name, "label": r.label,
+                  "unit": r.unit, "state": r.state, "value": r.value, "lo": r.lo, "hi": r.hi,
+                  "budget": r.budget}
+                 for g in verdict.groups for c in g.conditions for r in c.criteria
+                 if r.assessed)
+
+
+def _arm_cases(study: Study, group: str, cg: float, rule: str) -> list[CaseFolder]:
+    return [c for c in study.cases if c.group == group and c.cg == cg
+            and (cg == REFERENCE_CG or c.rule == rule)]
+
+
+def _actions(study: Study, group: str, cg: float, rule: str, criteria) -> tuple[list[dict], float]:
+    """The round's actions on one condition (and its CG1 arm) from its undecided
+    criteria's cheapest options, merged per arm, and their planned core-hours."""
+    arms = {"CG-n": _arm_cases(study, group, cg, rule),
+            "CG1": _arm_cases(study, group, REFERENCE_CG, "none")}
+    extend = {"CG-n": 0.0, "CG1": 0.0}
+    add = {"CG-n": 0, "CG1": 0}
+    for r in criteria:
+        if r.round_by == EXTEND:
+            for arm in ("CG-n", "CG1"):
+                if arm in r.round_arm.split(" and "):
+                    extend[arm] = max(extend[arm], r.round_amount)
+        elif r.round_by == REPLICAS:
+            if "CG-n" in r.round_arm:
+                add["CG-n"] = max(add["CG-n"], int(r.round_amount))
+            if "CG1" in r.round_arm:
+                cg1 = r.round_amount_cg1 if math.isfinite(r.round_amount_cg1) else 0
+                add["CG1"] = max(add["CG1"], int(cg1))
+    actions, hours = [], 0.0
+    for arm, cases in arms.items():
+        if not cases:
+            continue
+        steps_now = max(c.scaled.run_steps for c in cases)
+        if extend[arm] > 0:
+            more = math.ceil(extend[arm] / cases[0].scaled.dt)
+            run_steps = {c.case_id: steps_now + more for c in cases}
+            actions.append({"kind": EXTEND, "arm": arm, "seconds": extend[arm],
+                            "case_ids": [c.case_id for c in cases], "run_steps": run_steps})
+            hours += sum(run_costs(c.scaled)[1] * extend[arm] for c in cases) / 3600.0
+            steps_now += more
+        if add[arm] > 0:
+            first = max(c.replica for c in cases) + 1
+            reps = list(range(first, first + add[arm]))
+            a_cg, a_rule = (cg, rule) if arm == "CG-n" else (REFERENCE_CG, "none")
+            # new replicas run as long as the arm's runs (extended ones included)
+            actions.append({"kind": REPLICAS, "arm": arm, "group": group, "cg": a_cg,
+                            "rule": a_rule, "replicas": reps, "each_run_steps": steps_now,
+                            "condition": Condition(group, a_cg, a_rule).name})
+            scaled = dataclasses.replace(cases[0].scaled, run_steps=steps_now)
+            hours += add[arm] * run_costs(scaled)[0] / 3600.0
+    return actions, hours
+
+
+def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Look:
+    """The look ``number`` of ``verdict``: what the next round does, or why the study stops."""
+    base = dict(number=number, alpha=rounds.alpha_per_look,
+                core_hours=spent_core_hours(study), criteria=_criteria_rows(verdict))
+    targets, actions, hours, stuck = [], [], 0.0, []
+    for g in verdict.groups:
+        if is_control_group(g.group) or not g.conditions:
+            continue
+        open_ = [c for c in sorted(g.conditions, key=lambda c: -c.speedup
+                                   if math.isfinite(c.speedup) else math.inf)
+                 if c.state != FAILS]
+        if not open_ or open_[0].state == MEETS:
+            continue
+        c = open_[0]
+        undecided = [r for r in c.criteria if r.state == UNDECIDED]
+        if not undecided or any(not r.round_by for r in undecided):
+            stuck += [f"{c.name} {r.label}: {r.note}" for r in undecided if not r.round_by]
+            stuck += [] if undecided else [f"{c.name}: no criterion of the budget assessed"]
+            continue
+        acts, h = _actions(study, g.group, c.cg, c.rule, undecided)
+        targets.append(c.name)
+        actions += acts
+        hours += h
+    if not targets:
+        why = ("decided: " + "; ".join(g.sentence for g in verdict.groups
+                                       if not is_control_group(g.group))) if not stuck else (
+            "no planned way to decide " + "; ".join(stuck))
+        return Look(**base, stop=why)
+    if number >= rounds.max_looks:
+        return Look(**base, target=", ".join(targets), stop=(
+            f"the {rounds.max_looks} planned looks are spent; undecided: the next round "
+            f"would have been {hours:.2g} core-h on {', '.join(targets)}"))
+    cap = rounds.max_core_hours
+    if cap is not None and base["core_hours"] + hours > cap:
+        return Look(**base, target=", ".join(targets), planned_core_hours=hours, stop=(
+            f"the cap of {cap:g} core-h cannot decide it: the next round on "
+            f"{', '.join(targets)} would take ~{hours:.2g} core-h more "
+            f"({base['core_hours']:.2g} spent)"))
+    return Look(**base, target=", ".join(targets), actions=tuple(actions),
+                planned_core_hours=hours)
+
+
+# ---------------------------------------------------------------- the loop
+def until_decided(prepared: Prepared, out: Path, settings: RunSettings, plan: RoundPlan,
+                  run_round: Callable[[StudyRun], bool], show: Callable[[Look, Rounds], None],
+                  mesh_cache: Path | None = None, snapshots: bool = True) -> Rounds:
+    """Run, analyse and judge the study in rounds until it decides (module docstring);
+    ``run_round`` runs a scheduled round (the CLI's progress display), ``show`` prints a
+    look. Returns the rounds record; stops early (no look recorded) when a case did not
+    finish (the same command resumes it)."""
+    rounds = start_rounds(out, plan)
+    while not rounds.stopped:
+        current = added_cases(prepared, rounds)
+        started = start_run(current, out, settings, mesh_cache)
+        apply_extensions(started.study, rounds)
+        study = Study.open(out)       # the extensions read afresh: rescheduled
+        run = dataclasses.replace(started, study=study, schedule=study_schedule(
+            cases_to_run(study.cases, settings.retry_unstable), settings))
+        if not run_round(run):
+            return rounds
+        postprocess(out, snapshots=False)
+        verdict = read_verdict(study.report_dir)
+        if verdict is None:
+            raise ConfigError(f"{study.report_dir}: the report wrote no verdict (no accept: "
+                              "budget?): a sequential study needs one")
+        look = plan_look(verdict, study, rounds, len(rounds.looks) + 1)
+        rounds = rounds.with_look(look)
+        write_rounds(out, rounds)
+        show(look, rounds)
+    report_study(out, snapshots=snapshots)
+    return rounds

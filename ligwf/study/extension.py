@@ -1,0 +1,46 @@
+"""A case's production extension: more production than rendered, continued from restarts.
+
+A sequential study (``ligwf study --until-decided``, :mod:`ligwf.pipeline.rounds`) may
+decide that the cheapest way to narrow an interval is a longer production on the runs
+there are. The scene record and its content hash stay exactly as rendered (an extension is
+not a changed scene: the runner must continue the run, not start it afresh); the case
+folder gets :data:`~ligwf.study.layout.EXTENSION_FILE` naming the rendered production
+steps it extends and the new total. :class:`~ligwf.study.case.CaseFolder` adds the steps
+to its scaled scene, so the runner (which continues a done case whose steps fall short
+from its newest own restart, :func:`ligwf.engine.resume.plan_case`), the health checks,
+the expected dumps and the analysis all see one longer run with one manifest, one thermo
+table and one frame series.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ligwf.errors import ConfigError
+from ligwf.fsio import atomic_write_json
+from ligwf.scene.scaling import ScaledScene
+from ligwf.study.layout import EXTENSION_FILE
+
+
+def extension_steps(path: Path, scaled: ScaledScene) -> int:
+    """Production steps added to the rendered run of the case folder ``path`` (0: none).
+    The record names the rendered production it extends: one written for another scene
+    (re-rendered with another run time since) is stale and ignored."""
+    try:
+        rec = json.loads((Path(path) / EXTENSION_FILE).read_text())
+        base, target = int(rec["base_run_steps"]), int(rec["run_steps"])
+    except FileNotFoundError:
+        return 0
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ConfigError(f"{Path(path) / EXTENSION_FILE}: unreadable production extension "
+                          f"({type(exc).__name__}: {exc})") from None
+    return target - base if base == scaled.run_steps and target > base else 0
+
+
+def write_extension(path: Path, base_run_steps: int, run_steps: int, dt: float) -> None:
+    """Record that the case's production runs to ``run_steps`` instead of the rendered
+    ``base_run_steps`` (atomically; the runner continues it from its restarts)."""
+    atomic_write_json(Path(path) / EXTENSION_FILE, {
+        "base_run_steps": int(base_run_steps), "run_steps": int(run_steps),
+        "added_seconds": (int(run_steps) - int(base_run_steps)) * dt})

@@ -1,0 +1,120 @@
+"""The record of a sequential study (``ligwf study --until-decided``): its plan and its looks.
+
+One JSON file in the study folder (:data:`~ligwf.study.layout.ROUNDS_FILE`), written and
+read only here. It holds the plan fixed at the first look (at most ``max_looks`` looks,
+the family ``alpha``, the core-hour cap) and, per look, the verdict's criteria as they
+stood (value, interval, state), the condition the next round works on, what it adds
+(production extended on named runs to a named step, or new replicas of a condition) and,
+on the last look, why the study stopped.
+
+Repeated looks are paid for by **Bonferroni alpha spending**: every look tests at
+``alpha / max_looks`` (:attr:`Rounds.alpha_per_look`), so the chance that any look of the
+study passes or fails a criterion wrongly is at most ``alpha`` whatever the data do
+between looks (the union bound; conservative, and it needs no assumption about how much
+each round adds). The report of a sequential study decides at that level from its first
+look on.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from ligwf.errors import ConfigError
+from ligwf.fsio import atomic_write_json
+from ligwf.study.layout import ROUNDS_FILE
+
+#: the family error rate of a study's decisions
+FAMILY_ALPHA = 0.05
+#: looks a sequential study takes at most unless told otherwise
+DEFAULT_LOOKS = 3
+#: the kinds of action a round takes
+EXTEND, REPLICAS = "extend", "replicas"
+
+
+@dataclass(frozen=True)
+class Look:
+    """One look: its number (1-based), the level it decided at, the core-hours the study's
+    runs had cost by then (from the manifests), the criteria of every condition
+    (``{condition, criterion, label, unit, state, value, lo, hi, budget}``), the condition
+    the next round works on, its actions and their planned core-hours, and why the study
+    stopped here (empty: it goes on)."""
+
+    number: int
+    alpha: float
+    core_hours: float
+    criteria: tuple[dict, ...] = ()
+    target: str = ""
+    actions: tuple[dict, ...] = ()
+    planned_core_hours: float = 0.0
+    stop: str = ""
+
+
+@dataclass(frozen=True)
+class Rounds:
+    """A sequential study's plan and its looks (the default: one look at ``alpha``)."""
+
+    max_looks: int = 1
+    alpha: float = FAMILY_ALPHA
+    max_core_hours: float | None = None
+    looks: tuple[Look, ...] = field(default_factory=tuple)
+
+    @property
+    def alpha_per_look(self) -> float:
+        """The level every look tests at (Bonferroni spending over ``max_looks``)."""
+        return self.alpha / self.max_looks
+
+    @property
+    def stopped(self) -> bool:
+        return bool(self.looks) and bool(self.looks[-1].stop)
+
+    def with_look(self, look: Look) -> "Rounds":
+        """The record with ``look`` added (or replacing a look of the same number)."""
+        kept = tuple(x for x in self.looks if x.number < look.number)
+        return Rounds(self.max_looks, self.alpha, self.max_core_hours, kept + (look,))
+
+
+def _clean(obj):
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    return obj
+
+
+def read_rounds(study_path: Path) -> Rounds:
+    """The record of the study folder ``study_path`` (the one-look default when it has
+    none); ConfigError when it is unreadable."""
+    path = Path(study_path) / ROUNDS_FILE
+    try:
+        rec = json.loads(path.read_text())
+    except FileNotFoundError:
+        return Rounds()
+    except (OSError, ValueError) as exc:
+        raise ConfigError(f"{path}: unreadable record of the study's rounds ({exc})") from None
+    try:
+        looks = tuple(Look(int(x["number"]), float(x["alpha"]), float(x["core_hours"]),
+                           tuple(x.get("criteria", ())), str(x.get("target", "")),
+                           tuple(x.get("actions", ())),
+                           float(x.get("planned_core_hours") or 0.0), str(x.get("stop", "")))
+                      for x in rec.get("looks", ()))
+        cap = rec.get("max_core_hours")
+        return Rounds(int(rec["max_looks"]), float(rec["alpha"]),
+                      None if cap is None else float(cap), looks)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ConfigError(f"{path}: unreadable record of the study's rounds "
+                          f"({type(exc).__name__}: {exc})") from None
+
+
+def write_rounds(study_path: Path, rounds: Rounds) -> None:
+    """Write the record atomically (a kill leaves the old one or the new one)."""
+    rec = {"max_looks": rounds.max_looks, "alpha": rounds.alpha,
+           "alpha_per_look": rounds.alpha_per_look, "method": "Bonferroni alpha spending "
+           "over max_looks looks (each look at alpha / max_looks)",
+           "max_core_hours": rounds.max_core_hours,
+           "looks": [_clean(asdict(x)) for x in rounds.looks]}
+    atomic_write_json(Path(study_path) / ROUNDS_FILE, rec)

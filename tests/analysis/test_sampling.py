@@ -1,0 +1,93 @@
+"""ligwf.analysis.records.sampling: what would decide an undecided criterion, and its cost.
+
+The options are checked against the arithmetic of Welch's interval they rest on, the arm
+they name against the arm whose scatter dominates, and the half-width they predict for a
+longer production against the one measured after it on synthetic AR(1) runs (the issue's
++-30 %)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from benchmarks.bench_coverage import ar1_runs
+from ligwf.analysis.records import equivalence as eq
+from ligwf.analysis.records import sampling as sp
+
+
+def test_replicas_of_the_wide_arm_decide_and_the_arithmetic_holds():
+    cgn = sp.arm([41.5, 39.5, 43.5], replica_core_seconds=3600.0)       # wide
+    cg1 = sp.arm([40.0, 40.2, 39.8], replica_core_seconds=36000.0)      # tight
+    best = sp.cheapest(cgn, cg1, 1.5, 1.0)
+    assert best.kind == sp.REPLICAS and best.arm == "CG-n"
+    n = 3 + int(best.amount)
+    vx, vy = np.var([41.5, 39.5, 43.5], ddof=1), np.var([40.0, 40.2, 39.8], ddof=1)
+    se = math.sqrt(vx / n + vy / 3)
+    assert stats.t.ppf(0.95, eq.welch_df(vx, n, vy, 3)) * se < 0.5      # decides ...
+    se1 = math.sqrt(vx / (n - 1) + vy / 3)
+    assert stats.t.ppf(0.95, eq.welch_df(vx, n - 1, vy, 3)) * se1 >= 0.5   # ... one fewer not
+    assert best.core_hours == pytest.approx(best.amount)               # 1 core-h a replica
+    assert sp.dominant_arm(cgn, cg1) == "CG-n"
+    assert sp.cheapest(sp.arm([41.0]), cg1, 1.5, 1.0) is None
+
+
+def test_the_issue_demo_angle_names_the_cg2_arm():
+    """The demo's We-CG2 angle (issue 30): CG2 runs 50.4 and 43.5 deg, CG1 45.9 and 47.7:
+    the width is the two CG2 replicas' scatter, not CG1 noise. A CG1 replica costs ~10
+    CG2 ones."""
+    cg2 = sp.arm([50.4, 43.5], replica_core_seconds=360.0)
+    cg1 = sp.arm([45.9, 47.7], replica_core_seconds=3600.0)
+    assert sp.dominant_arm(cg2, cg1) == "CG-n"
+    best = sp.cheapest(cg2, cg1, 50.4 / 2 + 43.5 / 2 - 46.8, 1.0)
+    # about 100 CG2 replicas (the issue's side-aware estimate), not 27 of CG1; CG1's one
+    # degree of freedom takes a few CG1 runs beside them
+    assert best.kind == sp.REPLICAS and best.amount >= 80, best
+    assert best.amount > 5 * best.amount_cg1
+
+
+def test_extension_when_the_frames_dominate_and_not_when_the_seeds_do():
+    # run means scatter by 1.0 (variance); all of it within-run noise of 2 s windows
+    values = [10.0, 11.0, 9.5, 10.5]
+    noisy = sp.arm(values, within=[0.3] * 4, window=[2.0] * 4, steady_share=1.0,
+                   replica_core_seconds=10 * 3600.0, production_core_seconds=3600.0)
+    ref = sp.arm([10.1, 10.0, 9.9, 10.0], within=[0.01] * 4, window=[2.0] * 4,
+                 steady_share=1.0, replica_core_seconds=10 * 3600.0,
+                 production_core_seconds=3600.0)
+    best = sp.cheapest(noisy, ref, 0.3, 1.0)
+    assert best.kind == sp.EXTEND and best.arm == "CG-n"
+    # the prediction: within part x W / (W + S)
+    within, between = sp.components(noisy)
+    assert within == pytest.approx(0.3) and between == pytest.approx(np.var(values, ddof=1) - 0.3)
+    s = best.amount
+    v = between + 0.3 * 2.0 / (2.0 + s)
+    assert sp.run_variance(noisy, s) == pytest.approx(v)
+    assert best.core_hours == pytest.approx(4 * s)        # 4 runs x s seconds x 1 core-h/s
+    # the same scatter from the seeds (no within-run noise): only replicas help
+    seeds = sp.arm(values, within=[0.0] * 4, window=[2.0] * 4, replica_core_seconds=3600.0,
+                   production_core_seconds=3600.0)
+    assert all(o.kind == sp.REPLICAS for o in sp.options(seeds, ref, 0.3, 1.0))
+
+
+def test_predicted_half_width_after_an_extension_matches_the_measured_one():
+    """AR(1) runs of 200 frames (phi 0.8, seed offsets of sd 0.3 frame sd), 3 runs an arm;
+    the half-width predicted for 3x the production from the first 200 frames, against the
+    one measured on the 800 frames: the median ratio within +-30 %, 4 in 5 studies too."""
+    rng = np.random.default_rng(5)
+    ratios = []
+    for _ in range(60):
+        x = ar1_runs(rng, 1, 3, 800, 0.8, 0.3)[0]
+        y = ar1_runs(rng, 1, 3, 800, 0.8, 0.3)[0]
+
+        def side(runs, frames):
+            part = runs[:, :frames]
+            return sp.arm(part.mean(axis=1), [sp.within_variance(r) for r in part],
+                          [float(frames)] * 3, steady_share=1.0)
+        predicted = sp.half_width(side(x, 200), side(y, 200), extend=(600.0, 600.0))
+        measured = sp.half_width(side(x, 800), side(y, 800))
+        ratios.append(predicted / measured)
+    ratios = np.array(ratios)
+    assert 0.7 <= np.median(ratios) <= 1.3, np.median(ratios)
+    assert np.mean((ratios > 0.5) & (ratios < 2.0)) >= 0.8

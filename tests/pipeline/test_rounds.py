@@ -1,0 +1,106 @@
+"""ligwf.pipeline.rounds without the engine: what a look decides to do next on a written
+(not run) study, the stops (decided, looks spent, the cap), the replicas a round adds
+(new case folders with new seeds, indices after the workflow's), the extensions it writes
+(idempotent, the scene hash untouched), and the rounds record."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from ligwf.errors import ConfigError
+from ligwf.pipeline.prepare import prepare_workflow, write
+from ligwf.pipeline.rounds import (RoundPlan, added_cases, apply_extensions, plan_look,
+                                   start_rounds)
+from ligwf.report.criteria import CriterionResult
+from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict
+from ligwf.study.case import CaseFolder
+from ligwf.study.rounds import EXTEND, REPLICAS, Look, Rounds, read_rounds, write_rounds
+from ligwf.study.study import Study
+
+from helpers import ROOT
+
+WORKFLOW = ROOT / "tests" / "workflows" / "rounds_tiny.yaml"
+
+
+@pytest.fixture
+def study(tmp_path):
+    prepared = prepare_workflow(WORKFLOW)
+    return prepared, write(prepared, tmp_path / "study", tmp_path / "meshes")
+
+
+def angle(state: str, **decide) -> CriterionResult:
+    return CriterionResult("angle_deg", "angle of repose", "deg", state, 1.2, 0.4, 2.0, 1.0,
+                           "tolerance", "", 2.0, **decide)
+
+
+def verdict(*criteria: CriterionResult, speedup: float = 9.0) -> Verdict:
+    cond = ConditionVerdict("{}", 1.5, "weber", 2, speedup, math.nan, math.nan, criteria)
+    return Verdict((GroupVerdict("{}", (cond,), "sentence"),), {"angle_deg": 1.0})
+
+
+def test_an_undecided_extension_becomes_the_next_round(study):
+    prepared, s = study
+    rounds = start_rounds(s.path, RoundPlan(3, None))
+    look = plan_look(verdict(angle("undecided", round_by=EXTEND, round_arm="CG-n",
+                                   round_amount=0.05)), s, rounds, 1)
+    assert not look.stop and look.target == "cg1.5-weber" and look.alpha == pytest.approx(0.05 / 3)
+    (act,) = look.actions
+    dt = s.cases[2].scaled.dt
+    assert act["kind"] == EXTEND and act["case_ids"] == ["cg1.5-weber-r0", "cg1.5-weber-r1"]
+    want = s.cases[2].scaled.run_steps + math.ceil(0.05 / dt)
+    assert act["run_steps"] == {"cg1.5-weber-r0": want, "cg1.5-weber-r1": want}
+    assert look.planned_core_hours > 0
+    # applied: the case runs longer, its scene (and hash) is the rendered one
+    rounds = rounds.with_look(look)
+    apply_extensions(s, rounds)
+    apply_extensions(Study.open(s.path), rounds)      # again: nothing changes
+    case = CaseFolder.open(s.path / "cg1.5-weber-r0")
+    assert case.scaled.run_steps == want and case.extension_steps == want - s.cases[2].scaled.run_steps
+    assert case.rendered_scaled == s.cases[2].scaled and case.scene_hash == s.cases[2].scene_hash
+    assert case.record_problem() is None
+    assert CaseFolder.open(s.path / "cg1-none-r0").extension_steps == 0
+
+
+def test_replicas_are_new_cases_with_new_seeds_after_the_workflows(study, tmp_path):
+    prepared, s = study
+    look = plan_look(verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n and CG1",
+                                   round_amount=2, round_amount_cg1=1)), s,
+                     start_rounds(s.path, RoundPlan(3, None)), 1)
+    kinds = {(a["kind"], a["arm"]): a for a in look.actions}
+    assert kinds[(REPLICAS, "CG-n")]["replicas"] == [2, 3]
+    assert kinds[(REPLICAS, "CG1")]["replicas"] == [2]
+    more = added_cases(prepared, Rounds(3, looks=(look,)))
+    new = more.rendered[len(prepared.rendered):]
+    assert [rc.case.case_id for rc in new] == ["cg1.5-weber-r2", "cg1.5-weber-r3", "cg1-none-r2"]
+    assert [rc.case.index for rc in new] == [4, 5, 6]
+    for cg in (1.0, 1.5):                                # every replica its own seeds
+        arm = [rc.scaled.seeds for rc in more.rendered if rc.case.cg == cg]
+        assert len(set(arm)) == len(arm) == (3 if cg == 1.0 else 4)
+    s2 = write(more, s.path, tmp_path / "meshes")
+    assert len(s2.cases) == 7 and s2.cases[6].case_id == "cg1-none-r2"
+
+
+def test_stops_when_decided_when_the_looks_are_spent_and_at_the_cap(study):
+    _, s = study
+    rounds = start_rounds(s.path, RoundPlan(2, 1e-9))
+    assert plan_look(verdict(angle("pass")), s, rounds, 1).stop.startswith("decided")
+    open_ = verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n", round_amount=1))
+    assert "looks are spent" in plan_look(open_, s, rounds, 2).stop
+    assert "cap of 1e-09 core-h cannot decide" in plan_look(open_, s, rounds, 1).stop
+    stuck = verdict(angle("undecided"))
+    assert plan_look(stuck, s, rounds, 1).stop.startswith("no planned way to decide")
+
+
+def test_the_record_round_trips_and_its_looks_are_fixed(study):
+    _, s = study
+    rounds = start_rounds(s.path, RoundPlan(3, 2.5)).with_look(Look(1, 0.05 / 3, 0.1))
+    write_rounds(s.path, rounds)
+    back = read_rounds(s.path)
+    assert back == rounds and back.alpha_per_look == pytest.approx(0.05 / 3)
+    assert json.loads((s.path / "rounds.json").read_text())["method"].startswith("Bonferroni")
+    with pytest.raises(ConfigError, match="--max-looks = 4: this study was started with 3"):
+        start_rounds(s.path, RoundPlan(4, None))
+    assert read_rounds(s.path / "nowhere").alpha_per_look == 0.05     # a study of one look
