@@ -133,7 +133,14 @@ def read_yaml_file(path: str | Path, what: str) -> Any:
     if path.is_dir():
         raise ConfigError(f"{what} {path} is a directory, not a YAML file")
     if not path.is_file():
-        raise ConfigError(f"{what} {path} does not exist")
+        try:
+            path.stat()
+        except OSError as exc:          # a symlink loop, no permission on a folder, ...
+            if not isinstance(exc, FileNotFoundError):
+                raise ConfigError(f"{what} {path}: cannot be opened "
+                                  f"({exc.strerror})") from None
+        raise ConfigError(f"{what} {path} does not exist" if not path.exists()
+                          else f"{what} {path} is not a regular file")
     try:
         size = path.stat().st_size
         if size > MAX_BYTES:

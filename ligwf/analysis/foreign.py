@@ -125,6 +125,23 @@ def find_frames(dump_dir: Path, particles: str, contacts: str) -> list[FrameFile
     return [FrameFiles(s, found["p"][s], found["c"].get(s)) for s in sorted(found["p"])]
 
 
+def check_window(frames: list[FrameFiles], dt: float, settings: AnalysisSettings,
+                 steady_from_step: int) -> None:
+    """Refuse, naming the window, a GSD window after the last frame and a ``held`` hold
+    window longer than the dumps (no frame could be analysed: every one would be skipped)."""
+    first, last = frames[0].step, frames[-1].step
+    if steady_from_step > last:
+        raise ConfigError(f"--steady-from-step = {steady_from_step}: after the last frame "
+                          f"(step {last}); allowed range [0, {last}]")
+    span = (last - first) * dt
+    if settings.granules == "held" and span < settings.hold_time:
+        raise ConfigError(
+            f"analysis.hold_time = {settings.hold_time:g} s: the dumps span {span:.3g} s "
+            f"(steps {first}-{last} at --dt {dt:g} s), so no frame has a whole hold window "
+            f"[t, t + hold_time] for granules: held; --set hold_time=VALUE below {span:.3g} s "
+            "or --set granules=communities")
+
+
 def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
                   settings: AnalysisSettings = AnalysisSettings(), steady_from_step: int = 0,
                   particles: str = "particles_*.vtu", contacts: str = "contacts_*.vtu",
@@ -135,6 +152,7 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
     dump_dir = Path(dump_dir)
     facts = run.facts(dump_dir.resolve().name)
     frames = find_frames(dump_dir, particles, contacts)
+    check_window(frames, run.dt, settings, steady_from_step)
     if run.liquid_content is None and liquids.get(run.liquid).wet:
         try:
             lacks = read_particles(frames[0].particles, frames[0].step).liquid_content is None

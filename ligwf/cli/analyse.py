@@ -19,6 +19,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from ligwf.cli.common import folder_to_write
 from ligwf.errors import ConfigError, LigwfError
 
 
@@ -28,7 +29,7 @@ def register(subparsers) -> None:
         "analyse", help="identify granules, compute GSDs and compare CG levels (MPI-parallel)",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("run_dir", type=Path, help="study folder or one case folder")
-    p.add_argument("--out", type=Path, default=None,
+    p.add_argument("--out", type=folder_to_write, default=None,
                    help="output folder (default: the study's analysis folder)")
     p.add_argument("--reference", action="store_true",
                    help="use the networkx reference implementation (slow) instead of the compiled fast path")

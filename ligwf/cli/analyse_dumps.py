@@ -16,7 +16,7 @@ from pathlib import Path
 
 from ligwf import liquids
 from ligwf.cli.analyse import print_record
-from ligwf.cli.common import number_in
+from ligwf.cli.common import folder_to_write, number_in, step_number
 from ligwf.scene.model import MAX_LIQUID_CONTENT
 
 
@@ -26,11 +26,13 @@ def register(subparsers) -> None:
         "analyse-dumps", help="granules and GSD of LIGGGHTS dumps ligwf did not write",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("dump_dir", type=Path, help="folder with the particle and contact dumps")
-    p.add_argument("--out", type=Path, default=None, help="output folder (default DIR/analysis)")
+    p.add_argument("--out", type=folder_to_write, default=None,
+                   help="output folder (default DIR/analysis)")
     p.add_argument("--liquid", required=True, choices=liquids.names(), help="liquid model")
-    p.add_argument("--surface-tension", type=float, help="N/m as the engine used it "
-                   "(CG-scaled); required for a wet model")
-    p.add_argument("--contact-angle", type=float, help="deg; required for a wet model")
+    p.add_argument("--surface-tension", type=number_in(1e-6, 1e4, "N/m"),
+                   help="N/m as the engine used it (CG-scaled); required for a wet model")
+    p.add_argument("--contact-angle", type=number_in(0.0, 180.0, "deg"),
+                   help="deg; required for a wet model")
     p.add_argument("--angle-convention", required=True, choices=("engine", "scene"),
                    help="engine: the value written into a LIGGGHTS 3.8.0 input (which applied "
                    "0.5 theta^2); scene: the angle the engine applied (fixed engine)")
@@ -44,7 +46,7 @@ def register(subparsers) -> None:
                    help="fraction of particle volume, when the dumps lack f_surfaceLiquidContent")
     p.add_argument("--cg", type=number_in(1.0, 1000.0), default=1.0,
                    help="coarse-graining factor of the run")
-    p.add_argument("--steady-from-step", type=int, default=0,
+    p.add_argument("--steady-from-step", type=step_number, default=0,
                    help="first step of the GSD window (default: every frame)")
     p.add_argument("--particles", default="particles_*.vtu", help="particle file pattern")
     p.add_argument("--contacts", default="contacts_*.vtu", help="contact file pattern")

@@ -68,6 +68,19 @@ def number_in(low: float, high: float, unit: str = ""):
     return parse
 
 
+def step_number(text: str) -> int:
+    """argparse type: a time step of a LIGGGHTS run, a whole number in [0, 2,147,483,647]
+    (the engine counts steps in a 32-bit int within one run)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 2**31 - 1:
+        raise argparse.ArgumentTypeError(f"must be a whole step number, allowed range "
+                                         f"[0, 2,147,483,647], got {text!r}")
+    return value
+
+
 def rank_count(text: str) -> int:
     """argparse type: a number of MPI ranks or cores, a whole number in [1, MAX_RANKS]
     (``--np 1000000000000`` would otherwise be accepted and spin in the rank layout)."""

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ligwf.cli.common import console, err_console
+from ligwf.cli.common import console, err_console, folder_to_write
 from ligwf.pipeline.post import report_study
 from ligwf.study.study import Study
 
@@ -46,7 +46,8 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("report", help="flow metrics, tables, figures and ParaView files "
                               "of a finished study (steady window from its analysis settings)")
     p.add_argument("study", type=Path, help="study folder")
-    p.add_argument("--out", type=Path, default=None, help="report folder (default STUDY/report)")
+    p.add_argument("--out", type=folder_to_write, default=None,
+                   help="report folder (default STUDY/report)")
     p.add_argument("--set", dest="overrides", action="append", default=[],
                    metavar="accept.KEY=VALUE",
                    help="re-decide the verdict under another budget from the stored analysis "

@@ -101,6 +101,17 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
     return manifest, attempt
 
 
+def launcher_failed(attempt: Attempt, exit_code: int, lines: list[str]) -> str:
+    """The reason of an attempt whose launcher failed before LIGGGHTS started (no banner on
+    its screen): "engine exit code 1" would blame an engine that never ran."""
+    launcher = attempt.command[0] if attempt.command else "the launcher"
+    said = next((x.strip() for x in reversed(lines) if x.strip()), "")
+    return (f"launcher {launcher} exited {exit_code} before the engine started (no LIGGGHTS "
+            f"banner in {attempt.screen}; "
+            + (f"its last line: {said[:200]}" if said else "it printed nothing")
+            + "): check LIGWF_MPIRUN / mpirun_args")
+
+
 def credit_restart(s: ScaledScene, manifest: Manifest, restart_step: int) -> None:
     """Count the steps up to ``restart_step`` as run by the attempt that wrote the restart.
 
@@ -227,6 +238,9 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     signal = engine_signal(parser.lines, exit_code)
     status, reason = verdict(issues, exit_code, steps_done, s.total_steps, killed, signal,
                              stop_problem)
+    if status == FAILED and not issues and exit_code not in (0, None) \
+            and engine_version(parser.lines) is None:
+        reason = launcher_failed(attempt, exit_code, parser.lines)
     hole = record_hole(case, rows) if status in (DONE, KILLED) else None
     if hole is not None and status == DONE:
         # never done with a gap or an empty frame: resume from a restart before the hole

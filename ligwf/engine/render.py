@@ -184,6 +184,10 @@ def render_template(name: str, context: dict[str, Any],
         return env.get_template(name).render(**context)
     except jinja2.TemplateError as exc:
         raise RenderError(f"cannot render {name}: {exc}") from exc
+    except UnicodeDecodeError as exc:   # a user's template saved in another encoding
+        raise RenderError(f"template {name} (searched in {', '.join(map(str, template_dirs))} "
+                          f"before ligwf's own) is not UTF-8 text (byte {exc.object[exc.start]:#04x} "
+                          f"at offset {exc.start}); save it as UTF-8") from None
 
 
 def render(scaled: ScaledScene, template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:

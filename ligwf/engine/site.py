@@ -23,6 +23,7 @@ import shlex
 import shutil
 import subprocess
 import sys
+import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -236,9 +237,13 @@ def _check_loadable(library: str, executable: str) -> None:
 
 
 def _version_line(executable: str) -> str:
+    """(``-log none`` and a throw-away working folder: ``liggghts -h`` alone writes a
+    log.liggghts into the current folder)"""
     try:
-        out = subprocess.run([executable, "-h"], capture_output=True, text=True, timeout=60,
-                             stdin=subprocess.DEVNULL, errors="replace")
+        with tempfile.TemporaryDirectory(prefix="ligwf-version-") as scratch:
+            out = subprocess.run([executable, "-log", "none", "-h"], capture_output=True,
+                                 text=True, timeout=60, stdin=subprocess.DEVNULL,
+                                 errors="replace", cwd=scratch)
     except (OSError, subprocess.TimeoutExpired) as exc:
         raise EngineNotFound(f"LIGGGHTS executable {executable} cannot be started: "
                              f"{exc}") from None

@@ -214,6 +214,10 @@ class Liquid(_Frozen):
         if self.placement == "granules" and self.wet_granules is None:
             raise ValueError("placement granules needs wet_granules: {count, radius, "
                              "liquid_content}")
+        if self.placement == "granules" and not liquids.get(self.model).wet:
+            raise ValueError(f"placement granules with liquid.model {self.model!r} (a dry "
+                             "bed): the wet granules would be dropped; choose a wet model "
+                             f"({', '.join(n for n in liquids.names() if liquids.get(n).wet)})")
         if self.placement == "uniform" and self.wet_granules is not None:
             raise ValueError("wet_granules is set but placement is uniform (set placement: "
                              "granules, or drop wet_granules)")

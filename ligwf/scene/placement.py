@@ -48,13 +48,19 @@ def wet_sphere_centres(radius: float, inner_radius: float, length: float, fill: 
     return tuple(out)
 
 
-def wet_sphere_fields(scene) -> dict:
+def wet_sphere_fields(scene, largest_diameter: float, cg: float) -> dict:
     """The :class:`~ligwf.scene.scaling.ScaledScene` fields of placed liquid (none for a
     uniformly wetted bed): the wet spheres (axial, across, vertical, radius) and their
-    liquid content."""
+    liquid content. A sphere smaller than the largest (CG-scaled) particle diameter is
+    refused: it would hold no or a single particle centre, a dry bed in all but name."""
     g = scene.liquid.wet_granules
     if scene.liquid.placement != "granules" or g is None:
         return {}
+    if g.radius < largest_diameter:
+        raise ConfigError(
+            f"scene.liquid.wet_granules.radius = {g.radius:g} m: below the largest particle "
+            f"diameter at CG{cg:g} ({largest_diameter:.3g} m), so a wet sphere holds no "
+            f"particle; allowed range [{largest_diameter:.3g}, 1] m at this CG level")
     drum = scene.drum
     inner = drum.radius - (drum.lifters.height if drum.lifters.count else 0.0)
     centres = wet_sphere_centres(drum.radius, inner, drum.length, scene.process.fill_fraction,

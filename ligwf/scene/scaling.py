@@ -393,6 +393,6 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
         wave_steps=max(thermo_every, _steps(fall_time, dt) // thermo_every * thermo_every),
         seeds=replica_seeds(num.seed, replica, count=len(diameters) + 1 + len(waves)),
         granules=scene.analysis.granules,
-        **wet_sphere_fields(scene),
+        **wet_sphere_fields(scene, max(diameters), cg),
     )
 

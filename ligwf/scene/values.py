@@ -12,6 +12,7 @@ import enum
 import re
 import types
 import typing
+import unicodedata
 from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, ValidationInfo, field_validator
@@ -27,9 +28,11 @@ FORBIDDEN_INPUT_CHARS = ("\n", "\r", "&", "$", "#", "'", '"')
 
 def unsafe_chars(value: str) -> list[str]:
     """The characters of ``value`` that could inject or break a line of a LIGGGHTS input:
-    :data:`FORBIDDEN_INPUT_CHARS` and every other control character (NUL, tab, DEL...)."""
+    :data:`FORBIDDEN_INPUT_CHARS` and every other control character (NUL, tab, DEL, C1...)."""
     bad = [c for c in FORBIDDEN_INPUT_CHARS if c in value]
-    return bad + sorted({c for c in value if (ord(c) < 32 or ord(c) == 127) and c not in bad})
+    # C0, DEL and the C1 controls (U+0080-U+009F: invisible, and bytes 0x80-0x9F in a
+    # Latin-1 terminal)
+    return bad + sorted({c for c in value if unicodedata.category(c) == "Cc" and c not in bad})
 
 
 def check_input_safe(value: str) -> str:

@@ -84,6 +84,32 @@ def test_missing_facts_are_one_line_errors(dumps, tmp_path, capsys, drop, messag
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_a_run_shorter_than_the_hold_window_is_refused_naming_it(dumps, tmp_path, capsys):
+    args = ARGS[:ARGS.index("--set")]                    # granules: held, hold_time 1 s
+    assert main(["analyse-dumps", str(dumps), "--out", str(tmp_path / "o"), *args]) == 2
+    err = " ".join(capsys.readouterr().err.split())
+    assert "analysis.hold_time = 1 s" in err and "hold window" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_gsd_and_hold_windows_are_checked_against_the_frames(tmp_path):
+    from ligwf.analysis.foreign import check_window
+    from ligwf.analysis.frames.dumps import FrameFiles
+    from ligwf.scene.settings import AnalysisSettings
+
+    frames = [FrameFiles(s, tmp_path / f"particles_{s}.vtu", None) for s in (0, 500, 1000)]
+    held = AnalysisSettings(granules="held", hold_time=0.005)
+    check_window(frames, 1e-5, held, 1000)                         # 0.01 s >= 0.005 s
+    with pytest.raises(ConfigError, match=r"after the last frame \(step 1000\); allowed "
+                       r"range \[0, 1000\]"):
+        check_window(frames, 1e-5, held, 10**12)
+    with pytest.raises(ConfigError, match=r"hold_time = 0.02 s: the dumps span 0.01 s"):
+        check_window(frames, 1e-5, AnalysisSettings(granules="held", hold_time=0.02), 0)
+    check_window(frames, 1e-5, AnalysisSettings(granules="communities", hold_time=0.02), 0)
+
+
 def test_required_options_refused_by_the_parser(tmp_path, capsys):
     try:
         code = main(["analyse-dumps", str(tmp_path), "--liquid", "washino"])

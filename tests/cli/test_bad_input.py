@@ -36,7 +36,8 @@ class Bad:
     command: str = "render"
     options: tuple[str, ...] = ()
     setup: str = ""     # "out-file", "out-under-file", "cache-file", "study-listed-twice",
-    #                     "out-empty", "out-workflow-folder"
+    #                     "out-empty", "out-workflow-folder", "workflow-symlink-loop",
+    #                     "template-not-utf8"
     warns: bool = False                   # a documented warning (check exits 0), not a refusal
     seconds: float = 5.0                  # time allowed before the refusal
     extra: dict = field(default_factory=dict)
@@ -119,6 +120,21 @@ CORPUS: list[Bad] = [
     Bad("name-ampersand", ("name", "&"), overrides=("name=a&b",)),
     Bad("name-hash", ("name", "#"), overrides=("name=a#b",)),
     Bad("name-quote", ("name",), overrides=("name=a'b",)),
+    Bad("name-c1-control", ("name", "\\x9b"), overrides=("name=\"a\\x9bb\"",)),
+    Bad("wet-granules-hold-no-particle", ("scene.liquid.wet_granules.radius = 1e-07",
+                                          "largest particle diameter", "allowed range"),
+        overrides=("scene.liquid.placement=granules",
+                   "scene.liquid.wet_granules={count: 2, radius: 1e-7}")),
+    Bad("wet-granules-on-a-dry-bed", ("placement granules", "liquid.model 'none'", "dropped"),
+        overrides=("scene.liquid.model=none", "scene.liquid.placement=granules",
+                   "scene.liquid.wet_granules={count: 2, radius: 0.005}")),
+    Bad("replicas-for-a-level-not-swept", ("sweep.replicas.3 = 5", "not swept", "not used"),
+        overrides=("sweep.cg_levels=[1, 2]", "sweep.replicas={3: 5}"), command="check",
+        warns=True, seconds=60.0),      # legal, surely unintended: a warning
+    Bad("accept-all-null", ("accept: every tolerance is null",), command="check", warns=True,
+        seconds=60.0,           # a warning: check renders and plans every case first
+        overrides=("accept={angle_deg: null, profile_error: null, rigid_share: null, "
+                   "flowing_layer: null, gsd_error: null, field_error: null}",)),
     Bad("rule-sweep-dry", ("rules", "dry"),
         overrides=("scene.liquid.model=none", "scene.analysis.granules=false",
                    "sweep.rules=[weber,bond]")),
@@ -251,6 +267,10 @@ CORPUS: list[Bad] = [
                                ("mm-ss-99", "1:99", "allowed range [0, 59]"),
                                ("day-hours-99", "1-99", "allowed range [0, 23]"),
                                ("20-digits", "9" * 20, "longer than 365 days"))),
+    Bad("workflow-symlink-loop", ("workflow file", "loop.yaml", "symbolic links"),
+        command="check", setup="workflow-symlink-loop"),
+    Bad("template-not-utf8", ("template drum.in.j2", "not UTF-8", "0xff"),
+        setup="template-not-utf8"),
     Bad("render-out-empty", ("--out", "empty path", "current folder"), setup="out-empty"),
     Bad("run-out-empty", ("--out", "empty path"), command="run", setup="out-empty"),
     Bad("render-out-workflow-folder", ("--out", "folder of the workflow file"),
@@ -286,6 +306,19 @@ CORPUS: list[Bad] = [
         command="analyse-dumps", overrides=("seed=[1",), options=FOREIGN),
     Bad("analyse-dumps-dt-denormal", ("--dt", "[1e-10, 1] s", "5e-324"),
         command="analyse-dumps", options=(*FOREIGN[:-1], "5e-324")),
+    Bad("analyse-dumps-surface-tension-inf", ("--surface-tension", "[1e-06, 10000] N/m", "inf"),
+        command="analyse-dumps", options=(*FOREIGN[:2], "--surface-tension", "inf",
+                                          *FOREIGN[4:])),
+    Bad("analyse-dumps-surface-tension-1e300", ("--surface-tension", "[1e-06, 10000] N/m"),
+        command="analyse-dumps", options=(*FOREIGN[:2], "--surface-tension", "1e300",
+                                          *FOREIGN[4:])),
+    Bad("analyse-dumps-contact-angle-200", ("--contact-angle", "[0, 180] deg"),
+        command="analyse-dumps", options=(*FOREIGN[:4], "--contact-angle", "200",
+                                          *FOREIGN[6:])),
+    Bad("analyse-dumps-steady-step-huge", ("--steady-from-step", "[0, 2,147,483,647]"),
+        command="analyse-dumps", options=(*FOREIGN, "--steady-from-step", str(10**12))),
+    Bad("report-out-a-file", ("--out", "is a file, not a folder"), command="report",
+        setup="out-file"),
     Bad("analyse-dumps-cg-zero", ("--cg", "[1, 1000]", "'0'"),
         command="analyse-dumps", options=(*FOREIGN, "--cg", "0")),
     Bad("analyse-dumps-liquid-content-whole", ("--liquid-content", "[1e-05, 0.2]"),
@@ -324,10 +357,17 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
         out = tmp_path / "afile" / "sub"
     elif bad.setup == "out-workflow-folder":
         out = workflow.parent
+    elif bad.setup == "workflow-symlink-loop":
+        workflow = tmp_path / "loop.yaml"
+        workflow.symlink_to(workflow)
     options = list(bad.options)
     if bad.setup == "cache-file":
         (tmp_path / "cachefile").write_text("x")
         options += ["--mesh-cache", str(tmp_path / "cachefile")]
+    if bad.setup == "template-not-utf8":
+        (tmp_path / "templates").mkdir()
+        (tmp_path / "templates" / "drum.in.j2").write_bytes(b"\xff\xfe latin-1 \xe9")
+        options += ["--templates", str(tmp_path / "templates")]
     for name, value in bad.extra.get("env", {}).items():
         monkeypatch.setenv(name, value)
     if "site" in bad.extra:

@@ -46,8 +46,11 @@ def _library_copy(folder: Path, engine: EngineConfig, whole: bool = True) -> Pat
 def test_identify_finds_the_library_the_executable_loads(engine, tmp_path, monkeypatch):
     copy = _library_copy(tmp_path / "lib", engine)
     monkeypatch.setenv("LD_LIBRARY_PATH", str(copy.parent))
+    (tmp_path / "cwd").mkdir()
+    monkeypatch.chdir(tmp_path / "cwd")
     found = engine.identify()
     assert found.library == str(copy)
+    assert list((tmp_path / "cwd").iterdir()) == []      # `liggghts -h` alone leaves a log
     assert found.version.startswith("LIGGGHTS (Version LIGGGHTS-PUBLIC")
 
 
@@ -79,3 +82,17 @@ def test_the_ensemble_path_loads_the_named_engines_library(engine, tmp_path):
         assert m["launcher"] == "ensemble" and m["status"] == "done", m["reason"]
         assert m["liggghts_library"] == str(copy)
         assert m["liggghts_version"].startswith("LIGGGHTS Version LIGGGHTS-PUBLIC")
+
+
+@pytest.mark.slow
+def test_a_launcher_that_fails_before_the_engine_is_named(engine, tmp_path):
+    """LIGWF_MPIRUN=/bin/false used to read "engine exit code 1": an engine that never ran."""
+    out = tmp_path / "study"
+    r = subprocess.run([sys.executable, "-m", "ligwf.cli.main", "run", str(WORKFLOW), "--out",
+                        str(out), "--np", "1", "--set", "sweep.rules=[bond]"],
+                       capture_output=True, text=True, timeout=300,
+                       env={**os.environ, "LIGWF_MPIRUN": shutil.which("false") or "/bin/false"})
+    assert r.returncode == 1, r.stdout + r.stderr
+    m = json.loads(next(out.glob("*/manifest.json")).read_text())
+    assert m["status"] == "failed"
+    assert m["reason"].startswith("launcher ") and "before the engine started" in m["reason"]
