@@ -20,8 +20,8 @@ import argparse
 from pathlib import Path
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, console,
-                              folder_to_write, plan_table, prepare_from_args, rank_count,
-                              stop_on_signals)
+                              err_console, folder_to_write, plan_table, prepare_from_args,
+                              rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.pipeline.run import StudyRun, run_case_of, run_settings, start_run
 from ligwf.study.study import Study
@@ -40,6 +40,8 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     console.print(run.identity.describe(), highlight=False, soft_wrap=True)
     for line in elsewhere(run.study.cases, settings.retry_unstable):
         console.print(line, highlight=False, soft_wrap=True)
+    for line in unreadable_restarts(run.study.cases, settings.retry_unstable):
+        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
     return run
 
 
@@ -52,6 +54,28 @@ def elsewhere(cases, retry_unstable: bool) -> list[str]:
         plan = plan_case(c, retry_unstable)
         if plan.action == SKIP and plan.reason.startswith("running in process"):
             out.append(f"{c.path.name}: {plan.reason}: left to that runner")
+    return out
+
+
+def unreadable_restarts(cases, retry_unstable: bool) -> list[str]:
+    """The restart files a case to be resumed cannot use (a truncated header: killed while
+    writing, or a full disk), with what the runner does instead: said, not skipped silently."""
+    from ligwf.engine.liggghts import FORCED_RESTART_RE, PERIODIC_RESTARTS, restart_step
+    from ligwf.engine.resume import SKIP, plan_case
+
+    out = []
+    for c in cases:
+        plan = plan_case(c, retry_unstable)
+        if plan.action == SKIP:
+            continue
+        names = [p.name for p in c.path.iterdir() if FORCED_RESTART_RE.match(p.name)]
+        names += [rel for rel in PERIODIC_RESTARTS if (c.path / rel).is_file()]
+        bad = sorted(n for n in names if restart_step(c.path / n) is None)
+        if bad:
+            instead = (f"resumes from {plan.restart.path} at step {plan.restart.step}"
+                       if plan.restart is not None else "runs from step 0")
+            out.append(f"{c.path.name}: restart file(s) {', '.join(bad)} unreadable "
+                       f"(truncated?), not used: the case {instead}")
     return out
 
 
