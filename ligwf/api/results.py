@@ -21,6 +21,8 @@ from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec,
                               typed)
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.report import dictionary
+from ligwf.report.digests import damaged_report_files
+from ligwf.report.problems import Problems, study_problems
 from ligwf.report.verdict import Verdict
 from ligwf.report.write import checked_analysis
 from ligwf.report.verdict_records import read_verdict
@@ -38,6 +40,9 @@ _BY_NAME = {t.attribute: t for t in TABLES}
 def open_study(path: str | Path) -> "StudyResults":
     """A study folder's results (:class:`StudyResults`); ConfigError (one line) when
     ``path`` is no study folder. Nothing is read until a table is asked for."""
+    if not isinstance(path, (str, Path)) or not str(path).strip():
+        raise ConfigError(f"open_study: path = {path!r}: a study folder (a str or "
+                          "pathlib.Path naming it)")
     study = Study.open(Path(path))
     if study.single_case:
         raise ConfigError(f"{path}: a case folder, not a study: open the study folder above "
@@ -287,18 +292,21 @@ class StudyResults:
         return typed(frame.astype({"cg": float, "replica": int, "depth": float,
                                    "v_mean": float, "v_std": float}))
 
-    def check(self) -> None:
-        """Refuse (one line, a LigwfError) what ``ligwf report`` would refuse: analysis
-        outputs missing or no longer matching the study (re-run or re-rendered cases,
-        changed settings, an edited table, dumps changed since: this hashes the dumps),
-        and a report older than the analysis it was built from. The tables are read
-        without this check; call it when the study may have changed since."""
+    def check(self) -> Problems:
+        """Refuse (one line) what ``ligwf report`` would: analysis missing or stale (re-run
+        cases, settings, edited tables or dumps), a report older than it or whose tables
+        changed (SHA-256). Returns what the report lists as not used (skipped or unlisted
+        cases, frames, outputs: ``study_problems``). Tables are read without this check."""
         checked_analysis(self.study)
         record = self.analysis_dir / layout.ANALYSIS_RECORD
         report = self.report_dir / layout.CONDITIONS_REPORT
         if report.is_file() and report.stat().st_mtime < record.stat().st_mtime:
             raise MissingOutput(f"{self.report_dir}: older than the analysis in "
                                 f"{self.analysis_dir}: run `{REPORT} {self.path}` again")
+        if self.report_dir.is_dir() and (damaged := damaged_report_files(self.report_dir)):
+            more = f" (and {len(damaged) - 1} more)" if len(damaged) > 1 else ""
+            raise MissingOutput(f"{damaged[0]}{more}: run `{REPORT} {self.path}` again")
+        return study_problems(self.study)
 
     # ------------------------------------------------------------- plots
     def plot_pareto(self, ax: Axes | None = None, metric: str = "angle_error") -> Axes:
@@ -383,7 +391,8 @@ class StudyResults:
             record = json.loads((self.analysis_dir / layout.ANALYSIS_RECORD).read_text())
         except (OSError, ValueError):
             return None
-        absent = [a for a in record.get("granules_absent", []) if isinstance(a, dict)]
+        raw = record.get("granules_absent") if isinstance(record, dict) else None  # damaged
+        absent = [a for a in raw if isinstance(a, dict)] if isinstance(raw, list) else []
         if not absent:
             return None
         reasons = sorted({str(a.get("reason", "")) for a in absent})

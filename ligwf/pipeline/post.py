@@ -43,13 +43,16 @@ def report_study(path: Path, out: Path | None = None, snapshots: bool = True,
     """Flow metrics (the study's steady window) and the report folder; returns it.
     ``accept_overrides`` (``accept.angle_deg=2``, ...) re-decide the verdict under another
     budget from the stored analysis (validated before anything is written)."""
+    from ligwf.report.digests import record_digests
     from ligwf.report.write import write_report
 
     study = Study.open(path)
     if accept_overrides:
         study = dataclasses.replace(study, accept=overridden_accept(study.accept,
                                                                     accept_overrides))
-    return write_report(study, out, snapshots=snapshots)
+    folder = write_report(study, out, snapshots=snapshots)
+    record_digests(folder)      # what the API's check() holds the tables against
+    return folder
 
 
 def overridden_accept(accept: AcceptSettings, overrides: tuple[str, ...]) -> AcceptSettings:

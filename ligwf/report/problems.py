@@ -80,6 +80,12 @@ def _read_json(path: Path, what: str, outputs: list[str]) -> dict:
     return {}
 
 
+def _items(record: dict, key: str) -> list:
+    """``record[key]`` when it is a list (a damaged record may hold anything there)."""
+    value = record.get(key)
+    return value if isinstance(value, list) else []
+
+
 def collect(study_skipped: list[dict], analysis_dir: Path) -> Problems:
     """The problems of a study: its own skipped cases, the analysis record's and the flow
     stage's (read from ``analysis_dir``), and missing analysis outputs."""
@@ -90,17 +96,18 @@ def collect(study_skipped: list[dict], analysis_dir: Path) -> Problems:
         outputs += [f"{name} missing: rerun `ligwf analyse` (granule and GSD columns are empty)"
                     for name in ANALYSIS_OUTPUTS if not (analysis_dir / name).is_file()]
     absent = tuple((str(a.get("case_id", "?")), str(a.get("reason", "")))
-                   for a in record.get("granules_absent", []) if isinstance(a, dict))
+                   for a in _items(record, "granules_absent") if isinstance(a, dict))
     flow = _read_json(analysis_dir / layout.FLOW_PROFILES, "flow metrics missing", [])
     cases: dict[str, str] = {}
-    for s in [*study_skipped, *record.get("skipped_cases", []), *flow.get("skipped_cases", [])]:
+    for s in [*study_skipped, *_items(record, "skipped_cases"), *_items(flow, "skipped_cases")]:
         if isinstance(s, dict):
             cases.setdefault(str(s.get("case_id", "?")), str(s.get("reason", "")))
     frames = {(str(f.get("case_id")), str(f.get("step")), str(f.get("kind", "skipped")),
-               str(f.get("reason"))) for f in record.get("skipped_frames", []) if isinstance(f, dict)}
+               str(f.get("reason"))) for f in _items(record, "skipped_frames")
+              if isinstance(f, dict)}
     notes = flow.get("skipped_frames", {})
     for cid, reasons in (notes.items() if isinstance(notes, dict) else []):
-        for why in reasons:
+        for why in reasons if isinstance(reasons, list) else []:
             if not any(why == r for c, _, _, r in frames if c == cid):
                 frames.add((str(cid), "-", "flow", str(why)))
     return Problems(tuple(sorted(cases.items())),
@@ -108,7 +115,21 @@ def collect(study_skipped: list[dict], analysis_dir: Path) -> Problems:
                     tuple(outputs), absent)
 
 
+def unlisted_cases(study) -> list[dict]:
+    """Case folders (a scene record inside) below a study that its ``study.json`` does not
+    list: no stage reads them, so they are named instead of dropped without a word (a
+    record edited or merged by hand, a replica rendered into the folder by another
+    workflow)."""
+    if getattr(study, "single_case", False) or not Path(study.path).is_dir():
+        return []
+    listed = set(study.case_ids)
+    return [{"case_id": p.name, "reason": f"a case folder not listed in {layout.STUDY_FILE}: "
+             "not used (render the study again to include it)"}
+            for p in sorted(Path(study.path).iterdir())
+            if p.name not in listed and (p / layout.SCENE_FILE).is_file()]
+
+
 def study_problems(study) -> Problems:
-    """:func:`collect` for a :class:`~ligwf.study.study.Study` (its skipped cases and its
-    analysis folder)."""
-    return collect(study.usable_cases()[1], study.analysis_dir)
+    """:func:`collect` for a :class:`~ligwf.study.study.Study` (its skipped cases, the
+    case folders its record does not list, and its analysis folder)."""
+    return collect([*study.usable_cases()[1], *unlisted_cases(study)], study.analysis_dir)
