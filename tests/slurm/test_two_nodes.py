@@ -8,6 +8,11 @@ engine's log says so, and each node's namespace holds one engine process that se
 node's host name. ``ligwf slurm cancel`` then stops it on both nodes (the case is
 ``killed``, no engine process is left on either): the case's fill alone would cost minutes
 on 2 cores, the map is what this test is after.
+
+The analysis across nodes: a tiny study run and analysed locally (two ~200-particle CG3
+cases, as in test_analysis_array.py) is analysed again by ``ligwf analyse DIR --slurm 2``:
+its two array tasks run one on each node, and the merged tables are the local ones, byte
+for byte.
 """
 
 from __future__ import annotations
@@ -22,12 +27,17 @@ from pathlib import Path
 
 import pytest
 
+from ligwf.slurm.jobs import read_record
 from ligwf.study.study import Study
 
 from two_node_cluster import NODES, SUBNET, TwoNodeSlurm
 
 HERE = Path(__file__).resolve().parent
 SPANNING = HERE / "spanning_drum.yaml"
+TINY = HERE / "tiny_drum.yaml"
+TABLES = ("granules.parquet", "frames.csv", "gsd.csv", "gsd_summary.csv", "gsd_pooling.csv",
+          "kinetics.csv", "kinetics_summary.csv", "sensitivity.csv", "flow.csv",
+          "flow_profiles.json")
 LIGWF = str(Path(sys.executable).parent / "ligwf")
 
 pytestmark = [pytest.mark.slurm, pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
@@ -56,6 +66,28 @@ def ligwf(cluster: TwoNodeSlurm, *args: str, env: dict[str, str], expect: int = 
     assert out.returncode == expect, f"ligwf {' '.join(args)} exited {out.returncode}:\n" \
                                      f"{out.stdout}\n{out.stderr}"
     return out
+
+
+def local_ligwf(*args: str, env: dict[str, str]) -> None:
+    """``ligwf ARGS`` on this machine outside the cluster; must exit 0."""
+    out = subprocess.run([LIGWF, *args], capture_output=True, text=True, env=env,
+                         timeout=1800, stdin=subprocess.DEVNULL)
+    assert out.returncode == 0, f"ligwf {' '.join(args)} exited {out.returncode}:\n" \
+                                f"{out.stdout}\n{out.stderr}"
+
+
+def jobcomp_nodes(cluster: TwoNodeSlurm, job_id: str) -> dict[int, str]:
+    """Array task id -> NodeList of the finished tasks of ``job_id`` (the jobcomp file)."""
+    nodes = {}
+    for line in cluster.jobcomp.read_text().splitlines():
+        fields = dict(f.split("=", 1) for f in line.split() if "=" in f)
+        if fields.get("ArrayJobId") == job_id and fields.get("ArrayTaskId", "").isdigit():
+            nodes[int(fields["ArrayTaskId"])] = fields.get("NodeList", "")
+    return nodes
+
+
+def tables(folder: Path) -> dict[str, bytes]:
+    return {name: (folder / name).read_bytes() for name in TABLES if (folder / name).is_file()}
 
 
 def logs(study: Path) -> str:
@@ -134,3 +166,24 @@ def test_a_planned_two_rank_case_asks_two_nodes_and_gets_a_rank_on_each(two_node
     wait_for_jobs(two_node_slurm, study, timeout=900)
     assert case.manifest().status == "killed", (case.manifest().reason, logs(study))
     assert not engine_ranks(two_node_slurm)                   # nothing left on either node
+
+
+def test_the_analysis_split_over_both_nodes_gives_the_local_tables(two_node_slurm, tmp_path):
+    study = tmp_path / "study"
+    local_ligwf("study", str(TINY), "--out", str(study), "--no-snapshots",
+                "--set", "sweep.replicas=2", "--set", "analysis.bootstrap=50",
+                env=clean_env(LIGWF_MESH_CACHE=str(tmp_path / "meshes"),
+                              LIGWF_SITE=str(tmp_path / "none.yaml")))
+    local = tables(study / "analysis")
+    assert {"granules.parquet", "frames.csv", "gsd.csv", "flow.csv"} <= set(local)
+    (study / "analysis" / "frames.csv").unlink()            # the merge must write it again
+    env = clean_env(LIGWF_SITE=str(site_file(tmp_path / "site.yaml", "mpirun")))
+    out = ligwf(two_node_slurm, "analyse", str(study), "--slurm", "2", env=env).stdout
+    token = re.search(r"token (\w+)", out).group(1)
+    subs = [s for s in read_record(study) if token in s["script"]]
+    assert [s["kind"] for s in subs] == ["analysis-array", "analysis-merge"]
+    wait_for_jobs(two_node_slurm, study, timeout=1800)
+    placed = jobcomp_nodes(two_node_slurm, subs[0]["job_id"])
+    assert sorted(placed) == [0, 1] and sorted(placed.values()) == \
+        sorted(two_node_slurm.nodes), placed                    # one task on each node
+    assert tables(study / "analysis") == local, logs(study)
