@@ -39,8 +39,8 @@ import sys
 
 import numpy as np
 
-from ligwf.analysis.records.equivalence import (ALPHA, PASS, difference_estimate, equivalence,
-                                                mean_estimate, norm_estimate)
+from ligwf.analysis.records.equivalence import (ALPHA, HSU, PASS, difference_estimate,
+                                                equivalence, mean_estimate, norm_estimate)
 
 LOW, HIGH = 0.92, 0.99
 
@@ -142,12 +142,12 @@ def sequential_study(rng, R: int, frames: int, phi: float, offset: float, delta:
     state = "undecided"
     for look in range(1, looks + 1):
         x, y = _synth_arm(arms[0], 1.0), _synth_arm(arms[1], CG1_PRICE)
-        state = equivalence(difference_estimate(x.values, y.values, alpha), budget, alpha).state
+        e = difference_estimate(x.values, y.values, alpha, HSU)
+        state = equivalence(e, budget, alpha).state
         if state != "undecided" or look == looks:
             return state
-        e = difference_estimate(x.values, y.values, alpha)
         # the round's rule (ligwf.pipeline.rounds): the cheapest way to halve the half-width
-        best = sp.cheapest(x, y, budget + 0.25 * (e.hi - e.lo), budget, alpha)
+        best = sp.cheapest(x, y, budget + 0.25 * (e.hi - e.lo), budget, alpha, HSU)
         if best is None:
             return state
         if best.kind == sp.EXTEND:

@@ -163,15 +163,15 @@ def _replica_cost(runs: pd.DataFrame, noise: pd.DataFrame | None) -> float:
 
 
 def _decide_fields(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
-                   alpha: float, unit: str) -> tuple[dict, str]:
+                   alpha: float, unit: str, df_rule: str = eq.WELCH) -> tuple[dict, str]:
     """What would decide an undecided signed criterion: the cheapest option's fields and
     its sentence (the arms' variances and the difference as measured)."""
     if x.n < 2 or y.n < 2:
         who = "CG-n" if x.n < 2 else "CG1"
         return {}, f"{who} has one run: no variance, no interval (run at least 2 replicas)"
-    best = sampling.cheapest(x, y, e.value, budget, alpha)
+    best = sampling.cheapest(x, y, e.value, budget, alpha, df_rule)
     fields = _round_fields(sampling.cheapest(x, y, budget + 0.5 * (e.hi - e.lo) / 2, budget,
-                                             alpha)) if e.has_interval else {}
+                                             alpha, df_rule)) if e.has_interval else {}
     if best is None:
         return fields, (f"the difference sits near the budget for its spread: neither "
                         f"{sampling.MOST_REPLICAS} replicas of an arm nor "
@@ -186,7 +186,7 @@ def _decide_fields(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: flo
 
 
 def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.Arm,
-            alpha: float) -> tuple[CriterionResult, float]:
+            alpha: float, df_rule: str = eq.WELCH) -> tuple[CriterionResult, float]:
     """A signed criterion: the difference of run means CG-n - CG1 (relative to the CG1
     mean for RELATIVE), two one-sided tests at alpha. Returns the result and the p-value
     of its fail test (for Holm over the level)."""
@@ -199,19 +199,19 @@ def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.
             return CriterionResult(**base, state=NOT_MEASURED, note=(
                 f"not measured: the CG1 {spec.label} is 0: no relative difference")), math.nan
         scale = 1.0 / ref
-    e = eq.scaled(eq.difference_estimate(x.values, y.values, alpha), scale)
+    e = eq.scaled(eq.difference_estimate(x.values, y.values, alpha, df_rule), scale)
     if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED,
                                note=f"not measured: no {spec.column} value"), math.nan
     test = eq.equivalence(e, tolerance, alpha)
-    noise = eq.difference_estimate(x.values, y.values, alpha / 2)
+    noise = eq.difference_estimate(x.values, y.values, alpha / 2, df_rule)
     vs_noise = ("" if not noise.has_interval else
                 "differs from CG1 beyond seed noise" if (noise.lo > 0 or noise.hi < 0)
                 else "indistinguishable from CG1 seed noise at these replicas")
     note, decide = vs_noise, {}
     if test.state != PASS:      # a fail may be undone by Holm: keep what would decide it
         xs, ys = x.scaled(scale), y.scaled(scale)
-        decide, how = _decide_fields(xs, ys, e, tolerance, alpha, spec.unit)
+        decide, how = _decide_fields(xs, ys, e, tolerance, alpha, spec.unit, df_rule)
         if test.state == UNDECIDED:
             note = "; ".join(part for part in (how, vs_noise) if part)
     bound = max(abs(e.lo), abs(e.hi)) if e.has_interval else math.nan
@@ -286,7 +286,8 @@ def _analysis_interval(spec: CriterionSpec, tolerance: float, row) -> CriterionR
 
 def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs: pd.DataFrame,
                        profiles: dict, gate: Gate, alpha: float = eq.ALPHA,
-                       noise: pd.DataFrame | None = None) -> tuple[CriterionResult, ...]:
+                       noise: pd.DataFrame | None = None, df_rule: str = eq.WELCH
+                       ) -> tuple[CriterionResult, ...]:
     """Every criterion of the budget for one CG-n condition (``row`` of the condition table,
     ``runs`` its cases, ``ref_runs`` its group's CG1 cases), with Holm's step-down over the
     level's fail tests: a criterion fails only if its fail test survives Holm."""
@@ -302,7 +303,7 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
             p_fail.append(math.nan)
         elif spec.kind in (SIGNED, RELATIVE):
             r, p = _signed(spec, tol, _arm(runs, spec.column, noise, 1.0),
-                           _arm(ref_runs, spec.column, noise, 1.0), alpha)
+                           _arm(ref_runs, spec.column, noise, 1.0), alpha, df_rule)
             out.append(r)
             p_fail.append(p)
         elif spec.kind == PROFILE:

@@ -47,8 +47,9 @@ def rounds_markdown(rounds: Rounds, figures: list[Figure], figures_dir: str) -> 
     """The section's body: the method, the looks, and the criteria's half-widths per look."""
     lines = [f"A sequential study: at most {rounds.max_looks} looks, each testing at alpha "
              f"{rounds.alpha_per_look:.3g} (Bonferroni spending of {rounds.alpha:g} over the "
-             "looks, so the study's decisions are wrong at most 5 % of the time however many "
-             "looks it takes); cap "
+             "looks) with Hsu's conservative degrees of freedom (min(R1, R2) - 1), so the "
+             "study's decisions stay wrong about 5 % of the time or less however many looks "
+             "it takes (benchmarks/bench_coverage.py); cap "
              + (f"{rounds.max_core_hours:g} core-h." if rounds.max_core_hours else "none."), ""]
     lines += [f"- {look_line(x)}" for x in rounds.looks]
     keys = list(dict.fromkeys((c["condition"], c["label"]) for x in rounds.looks

@@ -179,12 +179,13 @@ def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[st
 def decide(conditions: pd.DataFrame, accept: AcceptSettings,
            gates: dict[str, Gate] | None = None, cases: pd.DataFrame | None = None,
            profiles: dict | None = None, alpha: float = eq.ALPHA,
-           noise: pd.DataFrame | None = None) -> Verdict:
+           noise: pd.DataFrame | None = None, df_rule: str = eq.WELCH) -> Verdict:
     """The verdict of every sweep group of a condition table (control groups left out);
     ``cases`` (one row per run) and ``profiles`` (case id -> mean velocity profile) hold
     the run values the signed and profile criteria are decided on; ``noise`` (by case id,
     :func:`ligwf.report.planning.noise_table`) what would decide an undecided one and its
-    cost; ``alpha`` each test's level (a sequential study's per-look level)."""
+    cost; ``alpha`` each test's level and ``df_rule`` its degrees of freedom (a sequential
+    study's per-look level, Hsu's conservative df)."""
     gates, profiles = gates or {}, profiles or {}
     groups = []
     if conditions.empty:
@@ -207,7 +208,7 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
             runs = in_group[(in_group["cg"] == row["cg"])
                             & (in_group["rule"].astype(str) == str(row["rule"]))]
             results = condition_criteria(accept, row, runs, ref_runs, profiles, gate, alpha,
-                                         noise)
+                                         noise, df_rule)
             out.append(ConditionVerdict(group, float(row["cg"]), str(row["rule"]),
                                         int(row["replicas"]), *band(row, "speedup_core"),
                                         results))

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.records.equivalence import ALPHA
+from ligwf.analysis.records.equivalence import ALPHA, WELCH
 from ligwf.fsio import atomic_write_json, atomic_write_text
 from ligwf.report.controls import read_controls
 from ligwf.report.criteria import CriterionResult
@@ -96,11 +96,12 @@ def read_verdict(out: Path) -> Verdict | None:
 
 def study_verdict(cases: pd.DataFrame, conditions: pd.DataFrame, accept: AcceptSettings,
                   analysis_dir: Path, profiles: dict | None = None,
-                  noise: pd.DataFrame | None = None, alpha: float = ALPHA) -> Verdict:
+                  noise: pd.DataFrame | None = None, alpha: float = ALPHA,
+                  df_rule: str = WELCH) -> Verdict:
     """The verdict of a study's report tables, with its granule control verdicts read from
     the analysis folder (``noise``: the runs' noise and prices, what would decide;
     ``alpha``: each test's level)."""
     if cases.empty or conditions.empty:
         return Verdict((), accept.model_dump(mode="json"))
     return decide(conditions, accept, granule_gates(cases, read_controls(analysis_dir)),
-                  cases, profiles, alpha, noise)
+                  cases, profiles, alpha, noise, df_rule)

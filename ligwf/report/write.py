@@ -19,6 +19,7 @@ import pandas as pd
 
 from ligwf import __version__
 from ligwf.analysis.records.conditions import REFERENCE_CG
+from ligwf.analysis.records.equivalence import HSU, WELCH
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import LOWER_LIMIT
 from ligwf.analysis.records.provenance import (StaleAnalysis, changed_dumps, damaged_outputs,
@@ -86,7 +87,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     verdict = study_verdict(cases, conditions, study.accept, study.analysis_dir,
                             {cid: c.profile_v_mean for cid, c in flow.cases.items()},
                             noise_table(study.usable_cases()[0], flow, SIGNED_COLUMNS),
-                            read_rounds(study.path).alpha_per_look)
+                            *sequential_level(read_rounds(study.path)))
     write_verdict(verdict, out)
     figures = report_figures(study, flow, cases, conditions, out, snapshots)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
@@ -132,6 +133,12 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
              *split_markdown(stability_markdown(study.usable_cases()[0])),
              *split_markdown(paraview_markdown(figures.paraview))]
     return ordered(parts)
+
+
+def sequential_level(rounds) -> tuple[float, str]:
+    """(alpha, df rule) of each test: a sequential study's looks test at alpha / looks with
+    Hsu's conservative degrees of freedom (:mod:`ligwf.study.rounds`)."""
+    return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH)
 
 
 def verdict_sections(verdict: Verdict | None) -> list[Section]:

@@ -91,3 +91,17 @@ def test_predicted_half_width_after_an_extension_matches_the_measured_one():
     ratios = np.array(ratios)
     assert 0.7 <= np.median(ratios) <= 1.3, np.median(ratios)
     assert np.mean((ratios > 0.5) & (ratios < 2.0)) >= 0.8
+
+
+def test_hsu_degrees_of_freedom_are_the_smaller_arm_less_one():
+    """A sequential study's looks (ligwf.study.rounds) use Hsu's min(R1, R2) - 1: never
+    more than Welch's, so their intervals are never narrower."""
+    x, y = [41.5, 39.5, 43.5, 40.0], [40.0, 40.2]
+    welch = eq.difference_estimate(x, y, 0.05 / 3)
+    hsu = eq.difference_estimate(x, y, 0.05 / 3, eq.HSU)
+    assert hsu.df == 1.0 and welch.df > 1.0 and hsu.value == welch.value
+    assert hsu.hi - hsu.lo > welch.hi - welch.lo
+    assert hsu.hi - hsu.lo == pytest.approx(2 * stats.t.ppf(1 - 0.05 / 3, 1) * welch.se)
+    a, b = sp.arm(x), sp.arm(y)
+    assert sp.half_width(a, b, 0.05 / 3, df_rule=eq.HSU) == pytest.approx(
+        0.5 * (hsu.hi - hsu.lo), rel=1e-3)

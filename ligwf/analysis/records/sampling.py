@@ -32,7 +32,8 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ligwf.analysis.records.equivalence import ALPHA, finite_values, t_quantile, welch_df
+from ligwf.analysis.records.equivalence import (ALPHA, WELCH, finite_values, t_quantile,
+                                                welch_df)
 from ligwf.analysis.records.intervals import autocorrelation_time
 
 #: the kinds of option
@@ -114,7 +115,7 @@ def run_variance(a: Arm, extend_seconds: float = 0.0) -> float:
 
 
 def half_width(x: Arm, y: Arm, alpha: float = ALPHA, add: tuple[int, int] = (0, 0),
-               extend: tuple[float, float] = (0.0, 0.0)) -> float:
+               extend: tuple[float, float] = (0.0, 0.0), df_rule: str = WELCH) -> float:
     """Half-width of the (1 - 2 alpha) Welch interval of mean(x) - mean(y) after ``add``
     replicas and ``extend`` seconds of production on every run (of x, of y)."""
     if x.n < 2 or y.n < 2:
@@ -126,7 +127,7 @@ def half_width(x: Arm, y: Arm, alpha: float = ALPHA, add: tuple[int, int] = (0, 
         return 0.0
     # the variances are still estimated from the runs there are: their degrees of freedom
     # grow with added replicas, not with a longer window
-    df = welch_df(vx, nx, vy, ny)
+    df = welch_df(vx, nx, vy, ny) if df_rule == WELCH else float(min(nx, ny) - 1)
     return _t_planned(float(f"{df:.3g}") if math.isfinite(df) else df, alpha) * se
 
 
@@ -165,7 +166,8 @@ class Option:
         return f"{what} ({cost}; predicted half-width {self.predicted_half_width:.3g}{u})"
 
 
-def _replicas(x: Arm, y: Arm, gap: float, alpha: float) -> Option | None:
+def _replicas(x: Arm, y: Arm, gap: float, alpha: float, df_rule: str = WELCH
+              ) -> Option | None:
     """The cheapest (kx, ky) replicas to add (unknown costs: the fewest in all): for each
     kx the fewest ky by bisection (the half-width falls with ky)."""
     cx = x.replica_core_seconds if math.isfinite(x.replica_core_seconds) else 1.0
@@ -175,12 +177,12 @@ def _replicas(x: Arm, y: Arm, gap: float, alpha: float) -> Option | None:
         if best is not None and kx * cx >= best[0]:
             break                  # CG-n replicas alone already cost more than the best
         most = MOST_REPLICAS - y.n
-        if not half_width(x, y, alpha, add=(kx, most)) < gap:
+        if not half_width(x, y, alpha, add=(kx, most), df_rule=df_rule) < gap:
             continue
         lo, hi = -1, most          # h(lo) >= gap (or lo = -1), h(hi) < gap
         while hi - lo > 1:
             mid = (lo + hi) // 2
-            if mid >= 0 and half_width(x, y, alpha, add=(kx, mid)) < gap:
+            if mid >= 0 and half_width(x, y, alpha, add=(kx, mid), df_rule=df_rule) < gap:
                 hi = mid
             else:
                 lo = mid
@@ -198,11 +200,11 @@ def _replicas(x: Arm, y: Arm, gap: float, alpha: float) -> Option | None:
     hours = ((kx * x.replica_core_seconds if kx else 0.0)
              + (ky * y.replica_core_seconds if ky else 0.0)) / 3600.0
     return Option(REPLICAS, arm, kx, hours if known else math.nan,
-                  half_width(x, y, alpha, add=(kx, ky)), 0, ky)
+                  half_width(x, y, alpha, add=(kx, ky), df_rule=df_rule), 0, ky)
 
 
-def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool]
-               ) -> Option | None:
+def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool],
+               df_rule: str = WELCH) -> Option | None:
     arms = [a for a, on in zip((x, y), which) if on]
     if any(not np.isfinite(a.window).all() or a.n < 2 for a in arms):
         return None
@@ -210,7 +212,8 @@ def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool
         a.steady_share for a in arms)
 
     def h(s: float) -> float:
-        return half_width(x, y, alpha, extend=(s if which[0] else 0.0, s if which[1] else 0.0))
+        return half_width(x, y, alpha, extend=(s if which[0] else 0.0, s if which[1] else 0.0),
+                          df_rule=df_rule)
 
     if not h(longest) < gap:
         return None
@@ -225,8 +228,8 @@ def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool
     return Option(EXTEND, name, s, cost, h(s), sum(a.n for a in arms))
 
 
-def options(x: Arm, y: Arm, difference: float, budget: float, alpha: float = ALPHA
-            ) -> list[Option]:
+def options(x: Arm, y: Arm, difference: float, budget: float, alpha: float = ALPHA,
+            df_rule: str = WELCH) -> list[Option]:
     """Every way that would decide the two one-sided tests of ``difference`` (CG-n - CG1,
     in the unit of the arms) against +-``budget``, with the variances as measured: more
     replicas of either arm, a longer production of either or both arms' runs. Sorted by
@@ -234,18 +237,18 @@ def options(x: Arm, y: Arm, difference: float, budget: float, alpha: float = ALP
     gap = abs(abs(difference) - budget)
     if x.n < 2 or y.n < 2 or not gap > 0:
         return []
-    found = [_replicas(x, y, gap, alpha),
-             _extension(x, y, gap, alpha, (True, False)),
-             _extension(x, y, gap, alpha, (False, True)),
-             _extension(x, y, gap, alpha, (True, True))]
+    found = [_replicas(x, y, gap, alpha, df_rule),
+             _extension(x, y, gap, alpha, (True, False), df_rule),
+             _extension(x, y, gap, alpha, (False, True), df_rule),
+             _extension(x, y, gap, alpha, (True, True), df_rule)]
     return sorted((o for o in found if o is not None),
                   key=lambda o: (not math.isfinite(o.core_hours), o.core_hours, o.amount))
 
 
 def cheapest(x: Arm, y: Arm, difference: float, budget: float,
-             alpha: float = ALPHA) -> Option | None:
+             alpha: float = ALPHA, df_rule: str = WELCH) -> Option | None:
     """The cheapest of :func:`options` (None: nothing within the planned limits decides)."""
-    found = options(x, y, difference, budget, alpha)
+    found = options(x, y, difference, budget, alpha, df_rule)
     return found[0] if found else None
 
 
