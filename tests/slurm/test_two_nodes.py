@@ -120,10 +120,10 @@ def engine_ranks(cluster: TwoNodeSlurm) -> dict[str, list[tuple[int, str]]]:
                               text=True).stdout.split()
         for pid in pids:
             try:
-                name = Path(f"/proc/{pid}/comm").read_text().strip()
+                argv = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
             except OSError:
                 continue
-            if name == "liggghts":
+            if Path(argv[0].decode()).name == "liggghts" and b"-in" in argv:  # not a probe
                 host = subprocess.run(["nsenter", "-t", pid, "-u", "hostname"],
                                       capture_output=True, text=True).stdout.strip()
                 ranks.setdefault(node, []).append((int(pid), host))
