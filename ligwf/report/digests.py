@@ -11,9 +11,10 @@ import json
 from pathlib import Path
 
 from ligwf.fsio import atomic_write_json
+from ligwf.study.layout import REPORT_FILES_RECORD
 
 #: the record, in the report folder (never listed in itself)
-DIGEST_RECORD = "report_files.json"
+DIGEST_RECORD = REPORT_FILES_RECORD
 
 
 def file_digest(path: Path) -> dict:

@@ -128,6 +128,8 @@ VERDICT_RECORD = "verdict.json"
 FIELD_NULL_REPORT = "fields_null_check.csv"
 SUMMARY_REPORT = "summary.md"
 HTML_REPORT = "index.html"
+#: size and SHA-256 of every top-level report file, as the report wrote it (report.digests)
+REPORT_FILES_RECORD = "report_files.json"
 FIGURES_DIR = "figures"
 #: ParaView collections: ``PARAVIEW_DIR/<case_id>.pvd`` + ``PARAVIEW_DIR/<case_id>/drum_<step>.vtu``
 PARAVIEW_DIR = "paraview"
