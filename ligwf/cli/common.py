@@ -152,9 +152,45 @@ def prepare_from_args(args: argparse.Namespace) -> Prepared:
                           "folder of the study's own")
     prepared = prepare_workflow(args.workflow, args.overrides, args.templates,
                                 args.allow_unstable)
-    for line in prepared.warnings:
+    case_ids = [rc.case.case_id for rc in prepared.rendered]
+    for line in grouped_warnings(prepared.warnings, case_ids):
         err_console.print(f"[yellow]ligwf: warning:[/] {escape(line)}", highlight=False)
     return prepared
+
+
+#: stands for the case a warning names while warnings are grouped (never in a warning)
+_CASE = "\x00case\x00"
+
+
+def grouped_warnings(lines: list[str], case_ids: list[str]) -> list[str]:
+    """One line per warning that differs only in the case it names: the cases are listed
+    once (a sweep of 30 cases would otherwise print the same warning 30 times). Order of
+    first appearance is kept (pure)."""
+    import re
+
+    if not case_ids:
+        return list(lines)
+    rx = re.compile("|".join(re.escape(c) for c in sorted(case_ids, key=len, reverse=True)))
+    order: list[str] = []
+    named: dict[str, list[str]] = {}
+    for line in lines:
+        found = rx.findall(line)
+        key = rx.sub(lambda _: _CASE, line) if len(set(found)) == 1 else line
+        if key not in named:
+            order.append(key)
+            named[key] = []
+        if len(set(found)) == 1 and found[0] not in named[key]:
+            named[key].append(found[0])
+    out = []
+    for key in order:
+        cases = named[key]
+        if len(cases) <= 1:
+            out.append(key.replace(_CASE, cases[0]) if cases else key)
+        else:
+            shown = ", ".join(cases[:4]) + (f", ... ({len(cases)} cases)" if len(cases) > 4
+                                            else "")
+            out.append(key.replace(_CASE, shown))
+    return out
 
 
 def case_table(prepared: Prepared, title: str) -> Table:
