@@ -9,6 +9,12 @@ node's host name. ``ligwf slurm cancel`` then stops it on both nodes (the case i
 ``killed``, no engine process is left on either): the case's fill alone would cost minutes
 on 2 cores, the map is what this test is after.
 
+The tiny study's case cut short (~3,500 steps) on ``--ntasks 2``: one core a node, so one
+rank on each host (the launch map again, and jobcomp's NodeList); it ends ``done`` with every
+particle, and its thermo rows (less the engine's wall-clock column) and dumps are those of
+the same case on 2 ranks of one machine (``ligwf run --np 2``, the same processor grid),
+byte for byte.
+
 The analysis across nodes: a tiny study run and analysed locally (two ~200-particle CG3
 cases, as in test_analysis_array.py) is analysed again by ``ligwf analyse DIR --slurm 2``:
 its two array tasks run one on each node, and the merged tables are the local ones, byte
@@ -23,6 +29,7 @@ import re
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -35,6 +42,16 @@ from two_node_cluster import NODES, SUBNET, TwoNodeSlurm
 HERE = Path(__file__).resolve().parent
 SPANNING = HERE / "spanning_drum.yaml"
 TINY = HERE / "tiny_drum.yaml"
+#: the tiny study cut to one cheap case: ~3,500 steps of 222 CG3 particles (soft, long dt)
+CHEAP = ["--set", "sweep.replicas=1", "--set", "scene.particles.youngs_modulus=5.0e+5",
+         "--set", "scene.numerics.dt_rayleigh_fraction=0.18",
+         "--set", "scene.numerics.dump_interval=0.01",
+         "--set", "scene.numerics.restart_interval=0.01"]
+
+SHORT = ["--set", "scene.process.settle_time=0.02", "--set", "scene.process.run_time=0.04"]
+
+PARTICLES = 222             # the tiny case's particles
+
 TABLES = ("granules.parquet", "frames.csv", "gsd.csv", "gsd_summary.csv", "gsd_pooling.csv",
           "kinetics.csv", "kinetics_summary.csv", "sensitivity.csv", "flow.csv",
           "flow_profiles.json")
@@ -187,3 +204,74 @@ def test_the_analysis_split_over_both_nodes_gives_the_local_tables(two_node_slur
     assert sorted(placed) == [0, 1] and sorted(placed.values()) == \
         sorted(two_node_slurm.nodes), placed                    # one task on each node
     assert tables(study / "analysis") == local, logs(study)
+
+
+def dumps(case_dir: Path) -> dict[str, bytes]:
+    return {p.name: p.read_bytes() for p in sorted((case_dir / "post").glob("*.vtu"))}
+
+
+def dump_step(name: str) -> int:
+    return int(re.search(r"_(\d+)\.vtu$", name).group(1))
+
+
+def thermo_rows(case_dir: Path) -> list[str]:
+    """The case's thermo rows (header first) without the engine's ``cpu`` column (the wall
+    seconds of the run, the one column that may differ between identical runs)."""
+    lines = [line.split(",") for line in (case_dir / "thermo.csv").read_text().splitlines()]
+    cpu = lines[0].index("cpu")
+    return [",".join(cells[:cpu] + cells[cpu + 1:]) for cells in lines]
+
+
+def row_step(row: str) -> int:
+    return int(row.split(",")[0])
+
+
+@dataclass(frozen=True)
+class Spanned:
+    """The tiny case on 2 ranks over the two nodes (mpirun) and on 2 ranks of this machine."""
+
+    study: Path
+    local: Path
+    env: dict[str, str]
+    seconds: float
+
+
+@pytest.fixture(scope="module")
+def spanned(two_node_slurm, tmp_path_factory) -> Spanned:
+    root = tmp_path_factory.mktemp("two-nodes")
+    env = clean_env(LIGWF_MESH_CACHE=str(root / "meshes"),
+                    LIGWF_SITE=str(site_file(root / "site.yaml", "mpirun --display-map")))
+    study, local = root / "two-nodes", root / "one-node"
+    t0 = time.monotonic()
+    ligwf(two_node_slurm, "slurm", "submit", str(TINY), "--out", str(study), "--ntasks", "2",
+          "--no-analysis", *CHEAP, *SHORT, env=env)
+    wait_for_jobs(two_node_slurm, study, timeout=2400)
+    # the same case on 2 ranks of this machine (no Slurm, no site file)
+    local_ligwf("run", str(TINY), "--out", str(local), "--np", "2", *CHEAP, *SHORT,
+                env=clean_env(LIGWF_MESH_CACHE=str(root / "meshes"),
+                              LIGWF_SITE=str(root / "none.yaml")))
+    return Spanned(study, local, env, time.monotonic() - t0)
+
+
+def test_a_case_on_both_nodes_matches_two_ranks_of_one(two_node_slurm, spanned):
+    study = spanned.study
+    job = read_record(study)[0]["job_id"]
+    assert jobcomp_nodes(two_node_slurm, job) == {0: "ligwf-n[1-2]"}
+    case = Study.open(study).case(0)
+    manifest = case.manifest()
+    assert manifest.status == "done", (manifest.reason, logs(study))
+    assert manifest.nprocs == 2 and manifest.atoms_end == PARTICLES, manifest
+    assert launch_map(case.screen.read_text()) == ONE_RANK_EACH      # one rank on each host
+    task_log = "".join(p.read_text() for p in (study / "slurm" / "logs").glob("*_0.out"))
+    assert "on ligwf-n1 with 2 task(s) on 2 node(s): ligwf-n[1-2]" in task_log, task_log
+    reference = Study.open(spanned.local).case(0)
+    assert reference.manifest().status == "done" and reference.manifest().nprocs == 2
+    grids = {re.search(r"\d+ by \d+ by \d+ MPI processor grid",
+                       (folder.path / "log.liggghts").read_text()).group(0)
+             for folder in (case, reference)}
+    assert len(grids) == 1, grids                                # the same processor grid
+    assert thermo_rows(case.path) == thermo_rows(reference.path)
+    ours, theirs = dumps(case.path), dumps(reference.path)
+    assert len(ours) >= 4 and ours.keys() == theirs.keys()
+    assert [name for name in ours if ours[name] != theirs[name]] == []
+    print(f"\ntwo nodes: the case on the cluster and on 2 local ranks in {spanned.seconds:.0f} s")
