@@ -13,7 +13,11 @@ The tiny study's case cut short (~3,500 steps) on ``--ntasks 2``: one core a nod
 rank on each host (the launch map again, and jobcomp's NodeList); it ends ``done`` with every
 particle, and its thermo rows (less the engine's wall-clock column) and dumps are those of
 the same case on 2 ranks of one machine (``ligwf run --np 2``, the same processor grid),
-byte for byte.
+byte for byte. Under ``srun --mpi=pmix --kill-on-bad-exit=1`` the same case's remote rank
+(the engine process inside node 2) is SIGKILLed in its production phase: the case ends
+``failed`` with the engine's exit code as the reason (``ligwf slurm status``: FAILED), and
+``ligwf slurm resubmit`` runs it again (a failed case starts over; only killed cases resume
+from a restart) to ``done``, every thermo step and dump once.
 
 The analysis across nodes: a tiny study run and analysed locally (two ~200-particle CG3
 cases, as in test_analysis_array.py) is analysed again by ``ligwf analyse DIR --slurm 2``:
@@ -26,6 +30,7 @@ from __future__ import annotations
 import json
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -50,6 +55,10 @@ CHEAP = ["--set", "sweep.replicas=1", "--set", "scene.particles.youngs_modulus=5
 
 SHORT = ["--set", "scene.process.settle_time=0.02", "--set", "scene.process.run_time=0.04"]
 
+#: the killed case settles and turns longer: the engine's screen (what the runner reads) is
+#: block-buffered and a SIGKILL loses its tail, so the kill waits until the screen shows the
+#: production phase, and the run must go on well past that
+LONG = ["--set", "scene.process.settle_time=0.1", "--set", "scene.process.run_time=0.6"]
 PARTICLES = 222             # the tiny case's particles
 
 TABLES = ("granules.parquet", "frames.csv", "gsd.csv", "gsd_summary.csv", "gsd_pooling.csv",
@@ -275,3 +284,65 @@ def test_a_case_on_both_nodes_matches_two_ranks_of_one(two_node_slurm, spanned):
     assert len(ours) >= 4 and ours.keys() == theirs.keys()
     assert [name for name in ours if ours[name] != theirs[name]] == []
     print(f"\ntwo nodes: the case on the cluster and on 2 local ranks in {spanned.seconds:.0f} s")
+
+
+def test_a_killed_remote_rank_fails_the_case_and_resubmit_finishes_it(two_node_slurm,
+                                                                        tmp_path):
+    t0 = time.monotonic()
+    env = clean_env(LIGWF_MESH_CACHE=str(tmp_path / "meshes"),
+                    LIGWF_SITE=str(site_file(tmp_path / "site.yaml",
+                                             "srun --mpi=pmix --kill-on-bad-exit=1")))
+    study = tmp_path / "killed"
+    ligwf(two_node_slurm, "slurm", "submit", str(TINY), "--out", str(study), "--ntasks", "2",
+          "--no-analysis", *CHEAP, *LONG, env=env)
+    assert "export LIGWF_MPIRUN=srun\n" in (study / "slurm" / "array-1.sh").read_text()
+    case = Study.open(study).case(0)
+    restarts = case.path / "restart"
+    deadline = time.monotonic() + 2400
+    ranks: dict = {}
+    while time.monotonic() < deadline and sum(map(len, ranks.values())) < 2:
+        ranks = engine_ranks(two_node_slurm)
+        time.sleep(0.2)
+    assert {node: [host for _, host in found] for node, found in ranks.items()} == \
+        {node: [node] for node in two_node_slurm.nodes}, ranks        # one rank per host
+    remote = ranks[NODES[1][0]][0][0]
+    while time.monotonic() < deadline and not (
+            any(restarts.glob("restart_*.liggghts")) and "ligwf-phase production" in
+            (case.screen.read_text(errors="replace") if case.screen.is_file() else "")):
+        time.sleep(0.05)                  # restarts on disk, and the screen past them
+    os.kill(remote, signal.SIGKILL)
+    wait_for_jobs(two_node_slurm, study, timeout=900)
+
+    manifest = case.manifest()
+    assert manifest.status == "failed", (manifest.status, manifest.reason, logs(study))
+    assert manifest.reason, manifest
+    status = json.loads(ligwf(two_node_slurm, "slurm", "status", str(study), "--json",
+                              env=env).stdout)
+    (row,) = status["cases"]
+    assert row["manifest"] == "failed" and row["slurm_state"] == "FAILED", row
+    killed_at = manifest.steps_done
+    assert 0 < killed_at < manifest.total_steps, manifest
+
+    out = ligwf(two_node_slurm, "slurm", "resubmit", str(study), "--no-analysis", env=env)
+    assert "resubmitting 1 case(s): 0 cg3-weber-r0 (failed)" in out.stdout, out.stdout
+    record = read_record(study)
+    assert [r["kind"] for r in record] == ["array", "array"] and record[1]["indices"] == [0]
+    wait_for_jobs(two_node_slurm, study, timeout=2400)
+
+    manifest = case.manifest()
+    assert manifest.status == "done", (manifest.reason, logs(study))
+    assert manifest.atoms_end == PARTICLES
+    # a failed case is run again from its start (ligwf.engine.resume: only killed cases
+    # resume from a restart), its earlier rows and dumps replaced, not mixed with the new
+    assert len(manifest.attempts) == 2 and manifest.attempts[0].status == "failed"
+    assert manifest.attempts[1].from_step == 0 and manifest.attempts[1].status == "done"
+    # nothing lost, nothing twice: every row and dump step once, up to the last step
+    steps = [row_step(r) for r in thermo_rows(case.path)[1:]]
+    assert steps == sorted(set(steps)) and steps[-1] == manifest.total_steps
+    ours = dumps(case.path)
+    particle_steps = sorted(dump_step(n) for n in ours if n.startswith("particles_"))
+    assert particle_steps == case.expected_dump_steps(manifest.total_steps)
+    assert all(f'NumberOfPoints="{PARTICLES}"'.encode() in data
+               for name, data in ours.items() if name.startswith("particles_"))
+    print(f"\ntwo nodes: kill of the remote rank at step {killed_at}, run again, done in "
+          f"{time.monotonic() - t0:.0f} s")
