@@ -10,11 +10,11 @@ import math
 from pathlib import Path
 
 from ligwf.report.sections import Figure, Section, figure_markdown
+from ligwf.study import layout
 from ligwf.study.rounds import EXTEND, Look, Rounds
 
 TITLE = "Rounds (sequential study)"
 ANCHOR = "rounds"
-FIGURE = "rounds.png"
 
 
 def action_text(action: dict) -> str:
@@ -114,5 +114,5 @@ def rounds_sections(rounds: Rounds, figures_dir: Path) -> list[Section]:
     """The report's rounds section (none for a study without looks)."""
     if not rounds.looks:
         return []
-    fig = Figure("Intervals per look", draw_rounds(rounds, figures_dir / FIGURE))
+    fig = Figure("Intervals per look", draw_rounds(rounds, figures_dir / layout.FIGURE_ROUNDS))
     return [Section(TITLE, ANCHOR, rounds_markdown(rounds, [fig], figures_dir.name))]

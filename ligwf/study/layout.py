@@ -138,6 +138,8 @@ FIGURE_VELOCITY_PROFILES = "velocity_profiles.png"
 FIGURE_GSD_OVERLAY = "gsd_overlay.png"
 FIGURE_KINETICS = "granule_kinetics.png"
 FIGURE_SENSITIVITY = "granule_sensitivity.png"
+#: a sequential study's looks: every criterion's interval against its budget (report.rounds)
+FIGURE_ROUNDS = "rounds.png"
 
 
 def field_figure(name: str, kind: str) -> str:
