@@ -209,14 +209,29 @@ def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.
                 "differs from CG1 beyond seed noise" if (noise.lo > 0 or noise.hi < 0)
                 else "indistinguishable from CG1 seed noise at these replicas")
     note, decide = vs_noise, {}
-    if test.state != PASS:      # a fail may be undone by Holm: keep what would decide it
-        xs, ys = x.scaled(scale), y.scaled(scale)
-        decide, how = _decide_fields(xs, ys, e, tolerance, alpha, spec.unit, df_rule)
-        if test.state == UNDECIDED:
-            note = "; ".join(part for part in (how, vs_noise) if part)
+    if test.state == UNDECIDED:
+        decide, how = _decide_fields(x.scaled(scale), y.scaled(scale), e, tolerance, alpha,
+                                     spec.unit, df_rule)
+        note = "; ".join(part for part in (how, vs_noise) if part)
     bound = max(abs(e.lo), abs(e.hi)) if e.has_interval else math.nan
     return CriterionResult(**base, state=test.state, value=e.value, lo=e.lo, hi=e.hi,
                            bound=bound, note=note, **decide), test.p_fail
+
+
+def _holm_replan(r: CriterionResult, x: sampling.Arm, y: sampling.Arm, alpha: float,
+                 df_rule: str) -> CriterionResult:
+    """What would decide a signed fail that Holm's step-down did not keep: the fail test
+    must pass at ``alpha`` (the level's alpha over its family size, which Holm's first step
+    asks and which is enough at every later step), so the cheapest option is planned at
+    that level, not at the per-test alpha where the fail already holds."""
+    scale = 1.0
+    if any(c.name == r.name and c.kind == RELATIVE for c in CRITERIA):
+        ref = float(np.nanmean(y.values))
+        scale = 1.0 / ref if ref > 0 else math.nan
+    e = eq.scaled(eq.difference_estimate(x.values, y.values, alpha, df_rule), scale)
+    fields, _ = _decide_fields(x.scaled(scale), y.scaled(scale), e, r.budget, alpha, r.unit,
+                               df_rule)
+    return dataclasses.replace(r, **(_NO_DECIDE | fields))
 
 
 def _profile_replicas(x: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
@@ -292,6 +307,7 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
     ``runs`` its cases, ``ref_runs`` its group's CG1 cases), with Holm's step-down over the
     level's fail tests: a criterion fails only if its fail test survives Holm."""
     out, p_fail = [], []
+    arms: dict[int, tuple[sampling.Arm, sampling.Arm]] = {}   # signed criteria: their arms
     for spec in CRITERIA:
         tol = getattr(accept, spec.name)
         if tol is None:
@@ -302,10 +318,11 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
                                        note=f"not assessed: {gate.reason}"))
             p_fail.append(math.nan)
         elif spec.kind in (SIGNED, RELATIVE):
-            r, p = _signed(spec, tol, _arm(runs, spec.column, noise, 1.0),
-                           _arm(ref_runs, spec.column, noise, 1.0), alpha, df_rule)
+            x, y = _arm(runs, spec.column, noise, 1.0), _arm(ref_runs, spec.column, noise, 1.0)
+            r, p = _signed(spec, tol, x, y, alpha, df_rule)
             out.append(r)
             p_fail.append(p)
+            arms[len(out) - 1] = (x, y)
         elif spec.kind == PROFILE:
             x = [profiles.get(c) for c in runs["case_id"]] if runs is not None else []
             y = [profiles.get(c) for c in ref_runs["case_id"]] if ref_runs is not None else []
@@ -328,6 +345,9 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
             p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
     rejected = eq.holm_rejects(p_fail, alpha)
     family = sum(math.isfinite(p) for p in p_fail)
+    out = [_holm_replan(r, *arms[i], alpha / family, df_rule)
+           if r.state == FAIL and not ok and i in arms else r
+           for i, (r, ok) in enumerate(zip(out, rejected))]
     return tuple(_after_holm(r, ok, family) for r, ok in zip(out, rejected))
 
 

@@ -134,6 +134,11 @@ def test_rigid_block_share_of_bond_fails_and_holm_keeps_a_lone_marginal_fail_und
     marginal = runs(2, "weber", [41.45, 41.70, 41.20])   # lo just above 1 deg
     m = crit(verdict(CG1, marginal), "cg2-weber")["angle_deg"]
     assert m.lo > 1.0 and m.state == UNDECIDED and "not after Holm" in m.note
+    # what would decide it is planned at Holm's alpha / m, where the fail does not hold yet:
+    # a real amount (the demo once printed '3.4e-16 s more production'), whose predicted
+    # half-width (at alpha / m) is narrower than the difference's distance from the budget
+    assert m.decide_by and m.decide_amount >= 1, (m.decide_by, m.decide_amount)
+    assert 0 < m.decide_half_width < m.value - 1.0
 
 
 def test_profile_distance_is_noise_corrected_and_bounded():

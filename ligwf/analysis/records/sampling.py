@@ -215,8 +215,8 @@ def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool
         return half_width(x, y, alpha, extend=(s if which[0] else 0.0, s if which[1] else 0.0),
                           df_rule=df_rule)
 
-    if not h(longest) < gap:
-        return None
+    if not h(longest) < gap or h(0.0) < gap:
+        return None                 # nothing decides it, or it is decided at this alpha
     lo, hi = 0.0, longest
     for _ in range(60):
         mid = 0.5 * (lo + hi)
