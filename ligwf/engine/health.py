@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Iterable, Sequence
 
 from ligwf.study.manifest import DONE, FAILED, KILLED, UNSTABLE
-from ligwf.study.thermo_table import ThermoRow
+from ligwf.study.thermo_table import ThermoRow, atom_fall
 
 #: Issue kinds that make a case ``failed`` (the engine stopped on an error) rather than
 #: ``unstable`` (it ran, but the physics went wrong).
@@ -80,22 +80,15 @@ def non_finite(rows: Sequence[ThermoRow]) -> list[HealthIssue]:
 
 
 def atom_loss(rows: Sequence[ThermoRow], target: int | None = None) -> list[HealthIssue]:
-    """First drop of the atom count (atoms are only ever added, by insertion).
-
-    ``target``: the particle count asked for. The top-up insertion wave deliberately places
-    a few particles too many and deletes them one step later (see drum.in.j2), so with a
-    target only a fall below min(running maximum, target) is a loss.
-    """
-    top = -1.0
-    for row in rows:
-        atoms = row.get("atoms")
-        if not math.isfinite(atoms):
-            continue
-        if atoms < top:
-            return [HealthIssue("atom_loss", row.step, f"atom count fell from {top:.0f} to "
-                                f"{atoms:.0f} at step {row.step}")]
-        top = max(top, atoms) if target is None else min(max(top, atoms), float(target))
-    return []
+    """First drop of the atom count (atoms are only ever added, by insertion):
+    :func:`ligwf.study.thermo_table.atom_fall` (``target``: the particle count asked for),
+    the rule the folder model also holds a finished case's table to."""
+    fall = atom_fall(list(rows), target)
+    if fall is None:
+        return []
+    step, top, atoms = fall
+    return [HealthIssue("atom_loss", step, f"atom count fell from {top:.0f} to "
+                        f"{atoms:.0f} at step {step}")]
 
 
 def kinetic_energy_blowup(rows: Sequence[ThermoRow], ceiling: float | None = None,
@@ -238,16 +231,31 @@ def assess(rows: Sequence[ThermoRow], lines: Iterable[str],
 STOP_SIGNALS = frozenset({1, 2, 9, 15, 24})
 #: mpirun's notice when a rank dies by a signal (OpenMPI 4.1), e.g. "... exited on signal 9"
 _RANK_SIGNAL_RE = re.compile(r"exited on signal (\d+)")
+#: srun's notice when a task dies by a signal: "srun: error: node2: task 1: Killed"
+#: (the signal's strsignal text)
+_SRUN_SIGNAL_RE = re.compile(r"srun: error: \S+: tasks? [0-9,\-\[\]]+: (.+?)\s*$")
+_SIGNAL_NAMES = {"Hangup": 1, "Interrupt": 2, "Killed": 9, "Terminated": 15,
+                 "CPU time limit exceeded": 24}
 
 
 def engine_signal(lines: Sequence[str], exit_code: int | None) -> int | None:
-    """Signal that ended the engine: mpirun's notice about a rank, or the launcher's own
-    (a negative exit code from ``subprocess``). None when it exited by itself."""
+    """Signal that ended the engine: the launcher's notice about a rank (mpirun's, or
+    srun's for a task on any node of the allocation), the launcher's own (a negative exit
+    code from ``subprocess``), or a launcher exit code of 128 + a stop signal (how srun and
+    mpirun report a task killed from outside: 137 for SIGKILL). None when it exited by
+    itself."""
     for line in reversed(lines[-100:]):
         m = _RANK_SIGNAL_RE.search(line)
         if m:
             return int(m.group(1))
-    return -exit_code if exit_code is not None and exit_code < 0 else None
+        m = _SRUN_SIGNAL_RE.search(line)
+        if m and m.group(1) in _SIGNAL_NAMES:
+            return _SIGNAL_NAMES[m.group(1)]
+    if exit_code is not None and exit_code < 0:
+        return -exit_code
+    if exit_code is not None and exit_code > 128 and exit_code - 128 in STOP_SIGNALS:
+        return exit_code - 128
+    return None
 
 
 def verdict(issues: Sequence[HealthIssue], exit_code: int | None, steps_done: int,

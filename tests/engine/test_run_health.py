@@ -7,7 +7,7 @@ import math
 
 import pytest
 
-from ligwf.engine.health import (Expectation, assess, atom_loss, insertion_shortfall,
+from ligwf.engine.health import (Expectation, assess, engine_signal, atom_loss, insertion_shortfall,
                           kinetic_energy_blowup, kinetic_energy_ceiling, log_errors,
                           log_warnings, non_finite, verdict)
 from ligwf.study.manifest import Manifest, read_manifest, write_manifest
@@ -98,6 +98,21 @@ def test_verdict_order():
     assert verdict([], 0, 500, 1000, killed=True)[0] == "killed"
     assert verdict([], 1, 500, 1000)[0] == "failed"
     assert verdict([], 0, 500, 1000)[0] == "failed"  # exit 0 but short: not success
+
+
+def test_a_task_killed_from_outside_is_a_stop_and_a_crash_is_not():
+    """mpirun's and srun's notices and the launchers' 128 + signal exit codes: a rank killed
+    by SIGKILL/SIGTERM (the OOM killer, a user, a lost node's slurmstepd) makes the case
+    ``killed`` (resumable from its own restart); a segfault stays a crash (``failed``)."""
+    mpirun = ["mpirun noticed that process rank 1 with PID 0 on node n1 exited on signal 9 (Killed)."]
+    srun = ["srun: error: ligwf-n2: task 1: Killed", "srun: Terminating StepId=12.0"]
+    assert engine_signal(mpirun, 137) == 9 and engine_signal(srun, 137) == 9
+    assert engine_signal(["srun: error: n3: tasks 0-1: Terminated"], 143) == 15
+    assert engine_signal([], 137) == 9 and engine_signal([], -15) == 15
+    assert engine_signal(["srun: error: n2: task 0: Segmentation fault"], 139) is None
+    assert engine_signal([], 1) is None and engine_signal([], 0) is None
+    assert verdict([], 137, 500, 1000, signal=engine_signal(srun, 137))[0] == "killed"
+    assert verdict([], 139, 500, 1000, signal=engine_signal([], 139))[0] == "failed"
 
 
 def test_manifest_write_is_atomic(tmp_path):
