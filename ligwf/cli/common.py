@@ -154,8 +154,36 @@ def prepare_from_args(args: argparse.Namespace) -> Prepared:
                                 args.allow_unstable)
     case_ids = [rc.case.case_id for rc in prepared.rendered]
     for line in grouped_warnings(prepared.warnings, case_ids):
-        err_console.print(f"[yellow]ligwf: warning:[/] {escape(line)}", highlight=False)
+        print_warning(line)
     return prepared
+
+
+WARNING_PREFIX = "ligwf: warning: "
+
+
+def wrapped_warning(line: str, width: int | None) -> list[str]:
+    """One warning as the lines a terminal of ``width`` columns shows: the prefix on the
+    first, the rest indented by two spaces, broken at spaces (a long path or case list is
+    never cut mid-word). ``width`` None: one line, as in a log or a pipe (whole for grep).
+    Pure."""
+    import textwrap
+
+    if width is None:
+        return [WARNING_PREFIX + line]
+    return textwrap.wrap(line, width=max(width, 40), initial_indent=WARNING_PREFIX,
+                         subsequent_indent="  ", break_long_words=False,
+                         break_on_hyphens=False) or [WARNING_PREFIX]
+
+
+def print_warning(line: str, console: Console | None = None) -> None:
+    """A warning on stderr, wrapped to the terminal's width (a terminal cuts or breaks a
+    long line mid-word otherwise); unwrapped when stderr is no terminal."""
+    out = console or err_console
+    lines = wrapped_warning(line, out.width if out.is_terminal else None)
+    head = lines[0][len(WARNING_PREFIX):]
+    out.print(f"[yellow]{WARNING_PREFIX.rstrip()}[/] {escape(head)}", highlight=False)
+    for rest in lines[1:]:
+        out.print(escape(rest), highlight=False)
 
 
 #: stands for the case a warning names while warnings are grouped (never in a warning)

@@ -20,8 +20,8 @@ import argparse
 from pathlib import Path
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, console,
-                              err_console, folder_to_write, plan_table, prepare_from_args,
-                              rank_count, stop_on_signals)
+                              folder_to_write, plan_table, prepare_from_args,
+                              print_warning, rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.pipeline.run import StudyRun, run_case_of, run_settings, start_run
 from ligwf.study.study import Study
@@ -41,7 +41,7 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     for line in elsewhere(run.study.cases, settings.retry_unstable):
         console.print(line, highlight=False, soft_wrap=True)
     for line in unreadable_restarts(run.study.cases, settings.retry_unstable):
-        err_console.print(f"[yellow]ligwf: warning:[/] {line}", highlight=False)
+        print_warning(line)
     return run
 
 

@@ -42,7 +42,7 @@ from rich.text import Text
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_table,
                               console, duration, err_console, folder_to_write, positive_int,
-                              prepare_from_args, rank_count)
+                              prepare_from_args, print_warning, rank_count)
 from ligwf.engine.plan import CasePlan
 from ligwf.engine.progress import shown_reason
 from ligwf.engine.site import EngineConfig
@@ -93,7 +93,7 @@ def _site_from_record(values: dict[str, Any]) -> SlurmSite:
 
 def _warn(lines: list[str]) -> None:
     for line in lines:
-        err_console.print(f"[yellow]ligwf: warning:[/] {escape(line)}", highlight=False)
+        print_warning(line)
 
 
 def _print_submitted(entries: list[dict]) -> None:

@@ -20,10 +20,8 @@ from functools import partial
 
 from rich.table import Table
 
-from rich.markup import escape
-
-from ligwf.cli.common import (add_workflow_args, console, err_console, number_in, positive_int,
-                              prepare_from_args, stop_on_signals)
+from ligwf.cli.common import (add_workflow_args, console, grouped_warnings, number_in,
+                              positive_int, prepare_from_args, print_warning, stop_on_signals)
 from ligwf.cli.report import add_snapshots, print_report
 from ligwf.cli.run import add_run_args, run_with_progress, start_from_args
 from ligwf.engine.progress import RichMonitor, summary_table
@@ -75,8 +73,9 @@ def cmd_until_decided(args: argparse.Namespace) -> int:
     if is_study_folder(args.workflow):
         prepared = prepare_study_folder(args.workflow, args.overrides, args.templates,
                                         args.allow_unstable)
-        for line in prepared.warnings:
-            err_console.print(f"[yellow]ligwf: warning:[/] {escape(line)}", highlight=False)
+        for line in grouped_warnings(prepared.warnings,
+                                     [rc.case.case_id for rc in prepared.rendered]):
+            print_warning(line)
     else:
         prepared = prepare_from_args(args)
     settings = run_settings(args.np, args.ensemble, args.cores, args.retry_unstable,
