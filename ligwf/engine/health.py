@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Iterable, Sequence
 
 from ligwf.study.manifest import DONE, FAILED, KILLED, UNSTABLE
-from ligwf.study.thermo_table import ThermoRow, atom_fall
+from ligwf.study.thermo_table import ThermoRow
 
 #: Issue kinds that make a case ``failed`` (the engine stopped on an error) rather than
 #: ``unstable`` (it ran, but the physics went wrong).
