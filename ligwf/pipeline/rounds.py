@@ -45,7 +45,8 @@ from ligwf.report.verdict_records import read_verdict
 from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
 from ligwf.study.case import CaseFolder, group_of
 from ligwf.study.extension import write_extension
-from ligwf.study.rounds import EXTEND, REPLICAS, Look, Rounds, read_rounds, write_rounds
+from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Look,
+                                Rounds, read_rounds, write_rounds)
 from ligwf.study.study import Study
 
 
@@ -67,7 +68,15 @@ def start_rounds(out: Path, plan: RoundPlan) -> Rounds:
                           f"{rounds.max_looks} looks ({len(rounds.looks)} taken); each look "
                           "tests at alpha / looks, fixed before its first look: keep "
                           f"--max-looks {rounds.max_looks}")
-    rounds = Rounds(plan.max_looks, rounds.alpha, plan.max_core_hours, rounds.looks)
+    looks = rounds.looks
+    last = looks[-1] if looks else None
+    if (last is not None and last.stop_kind == CAPPED and (
+            plan.max_core_hours is None
+            or last.core_hours + last.planned_core_hours <= plan.max_core_hours)):
+        # the cap was raised past the round it stopped: that look is taken again (same
+        # number, same data, same level) and plans the round it could not afford
+        looks = looks[:-1]
+    rounds = Rounds(plan.max_looks, rounds.alpha, plan.max_core_hours, looks)
     write_rounds(out, rounds)
     return rounds
 
@@ -226,17 +235,19 @@ def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Lo
         why = ("decided: " + "; ".join(g.sentence for g in verdict.groups
                                        if not is_control_group(g.group))) if not stuck else (
             "no planned way to decide " + "; ".join(stuck))
-        return Look(**base, stop=why)
+        return Look(**base, stop=why, stop_kind=STUCK if stuck else DECIDED)
     if number >= rounds.max_looks:
-        return Look(**base, target=", ".join(targets), stop=(
+        return Look(**base, target=", ".join(targets), stop_kind=LOOKS_SPENT, stop=(
             f"the {rounds.max_looks} planned looks are spent; undecided: the next round "
             f"would have been {hours:.2g} core-h on {', '.join(targets)}"))
     cap = rounds.max_core_hours
     if cap is not None and base["core_hours"] + hours > cap:
-        return Look(**base, target=", ".join(targets), planned_core_hours=hours, stop=(
+        return Look(**base, target=", ".join(targets), planned_core_hours=hours,
+                    stop_kind=CAPPED, stop=(
             f"the cap of {cap:g} core-h cannot decide it: the next round on "
             f"{', '.join(targets)} would take ~{hours:.2g} core-h more "
-            f"({base['core_hours']:.2g} spent)"))
+            f"({base['core_hours']:.2g} spent; the same command with a cap of at least "
+            f"{base['core_hours'] + hours:.2g} core-h continues)"))
     return Look(**base, target=", ".join(targets), actions=tuple(actions),
                 planned_core_hours=hours)
 

@@ -34,6 +34,10 @@ FAMILY_ALPHA = 0.05
 DEFAULT_LOOKS = 3
 #: the kinds of action a round takes
 EXTEND, REPLICAS = "extend", "replicas"
+#: why a study stopped (a look's ``stop_kind``): it decided, no planned way decides it, its
+#: looks are spent, or the next round would pass the core-hour cap (the one a later call
+#: with a higher cap continues from)
+DECIDED, STUCK, LOOKS_SPENT, CAPPED = "decided", "stuck", "looks spent", "capped"
 
 
 @dataclass(frozen=True)
@@ -52,6 +56,7 @@ class Look:
     actions: tuple[dict, ...] = ()
     planned_core_hours: float = 0.0
     stop: str = ""
+    stop_kind: str = ""
 
 
 @dataclass(frozen=True)
@@ -102,7 +107,8 @@ def read_rounds(study_path: Path) -> Rounds:
         looks = tuple(Look(int(x["number"]), float(x["alpha"]), float(x["core_hours"]),
                            tuple(x.get("criteria", ())), str(x.get("target", "")),
                            tuple(x.get("actions", ())),
-                           float(x.get("planned_core_hours") or 0.0), str(x.get("stop", "")))
+                           float(x.get("planned_core_hours") or 0.0), str(x.get("stop", "")),
+                           str(x.get("stop_kind", "")))
                       for x in rec.get("looks", ()))
         cap = rec.get("max_core_hours")
         return Rounds(int(rec["max_looks"]), float(rec["alpha"]),

@@ -17,7 +17,8 @@ from ligwf.pipeline.rounds import (RoundPlan, added_cases, apply_extensions, pla
 from ligwf.report.criteria import CriterionResult
 from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict
 from ligwf.study.case import CaseFolder
-from ligwf.study.rounds import EXTEND, REPLICAS, Look, Rounds, read_rounds, write_rounds
+from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Look,
+                                Rounds, read_rounds, write_rounds)
 from ligwf.study.study import Study
 
 from helpers import ROOT
@@ -92,6 +93,29 @@ def test_stops_when_decided_when_the_looks_are_spent_and_at_the_cap(study):
     assert "cap of 1e-09 core-h cannot decide" in plan_look(open_, s, rounds, 1).stop
     stuck = verdict(angle("undecided"))
     assert plan_look(stuck, s, rounds, 1).stop.startswith("no planned way to decide")
+    kinds = [plan_look(v, s, rounds, n).stop_kind for v, n in
+             ((verdict(angle("pass")), 1), (open_, 2), (open_, 1), (stuck, 1))]
+    assert kinds == [DECIDED, LOOKS_SPENT, CAPPED, STUCK]
+
+
+def test_a_raised_cap_continues_a_study_the_cap_stopped_and_a_lower_one_does_not(study):
+    """The look the cap stopped is taken again with the new cap (same number: no extra look
+    is spent, its data and level are unchanged); a cap still too low, or a study stopped
+    for another reason, keeps its record."""
+    _, s = study
+    open_ = verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n", round_amount=1))
+    rounds = start_rounds(s.path, RoundPlan(3, 1e-9))
+    capped = plan_look(open_, s, rounds, 1)
+    assert capped.stop_kind == CAPPED and "continues" in capped.stop
+    write_rounds(s.path, rounds.with_look(capped))
+    need = capped.core_hours + capped.planned_core_hours
+    assert start_rounds(s.path, RoundPlan(3, 0.5 * need)).looks == (capped,)   # still short
+    raised = start_rounds(s.path, RoundPlan(3, 2 * need))
+    assert raised.looks == () and raised.max_core_hours == 2 * need
+    again = plan_look(open_, s, raised, 1)
+    assert again.number == 1 and not again.stop and again.actions
+    write_rounds(s.path, raised.with_look(plan_look(verdict(angle("pass")), s, raised, 1)))
+    assert len(start_rounds(s.path, RoundPlan(3, None)).looks) == 1        # decided: kept
 
 
 def test_the_record_round_trips_and_its_looks_are_fixed(study):
