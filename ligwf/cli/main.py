@@ -119,6 +119,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     for module in COMMAND_MODULES:
         module.register(sub)
+    parser.set_defaults(root_parser=parser)     # `ligwf schema --cli` documents this parser
     return parser
 
 

@@ -2,13 +2,14 @@
 
 Without options it prints the JSON Schema of a workflow file (for a YAML editor:
 ``# yaml-language-server: $schema=docs/workflow.schema.json``); ``--out`` writes it,
-``--reference`` writes the markdown workflow reference and ``--dictionary`` the data
-dictionary of every table ligwf writes. The text comes from
-:mod:`ligwf.scene.reference` and :mod:`ligwf.report.dictionary`; the committed copies in
+``--reference`` writes the markdown workflow reference, ``--dictionary`` the data
+dictionary of every table ligwf writes and ``--cli`` the command-line reference. The text
+comes from :mod:`ligwf.scene.reference`, :mod:`ligwf.report.dictionary` and
+:mod:`ligwf.cli.reference` (on the parser ``ligwf`` runs with); the committed copies in
 ``docs/`` are regenerated with::
 
     ligwf schema --out docs/workflow.schema.json --reference docs/workflow_reference.md \\
-        --dictionary docs/data_dictionary.md
+        --dictionary docs/data_dictionary.md --cli docs/cli.md
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import os
 from pathlib import Path
 
 from ligwf.cli.common import console
+from ligwf.cli.reference import cli_markdown
 from ligwf.fsio import atomic_write_text, replaceable
 from ligwf.report.dictionary import dictionary_markdown
 from ligwf.scene.reference import reference_markdown, schema_text
@@ -43,7 +45,8 @@ def file_to_write(text: str) -> Path:
 
 def cmd_schema(args: argparse.Namespace) -> int:
     outputs = [(args.out, schema_text), (args.reference, reference_markdown),
-               (args.dictionary, dictionary_markdown)]
+               (args.dictionary, dictionary_markdown),
+               (args.cli, lambda: cli_markdown(args.root_parser))]
     texts = [(path, make()) for path, make in outputs if path is not None]
     if not texts:
         print(schema_text(), end="")
@@ -58,11 +61,13 @@ def register(subparsers) -> None:
     """Add ``schema``."""
     p = subparsers.add_parser(
         "schema", help="print the workflow's JSON Schema (for YAML editors); write it, the "
-        "workflow reference and the data dictionary of every table")
+        "workflow reference, the data dictionary of every table and the command-line reference")
     p.add_argument("--out", type=file_to_write, default=None, metavar="FILE",
                    help="write the JSON Schema here (e.g. docs/workflow.schema.json)")
     p.add_argument("--reference", type=file_to_write, default=None, metavar="FILE",
                    help="write the markdown workflow reference here (docs/workflow_reference.md)")
     p.add_argument("--dictionary", type=file_to_write, default=None, metavar="FILE",
                    help="write the data dictionary of every table here (docs/data_dictionary.md)")
+    p.add_argument("--cli", type=file_to_write, default=None, metavar="FILE",
+                   help="write the command-line reference of every command here (docs/cli.md)")
     p.set_defaults(func=cmd_schema)
