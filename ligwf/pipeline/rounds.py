@@ -37,8 +37,9 @@ from typing import Callable
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess, report_study
-from ligwf.pipeline.prepare import Prepared, prepare, render_case
-from ligwf.pipeline.run import RunSettings, StudyRun, cases_to_run, start_run, study_schedule
+from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
+from ligwf.pipeline.run import (RunSettings, StudyRun, cases_to_run, site_engine,
+                                study_schedule)
 from ligwf.report.planning import run_costs
 from ligwf.report.verdict import FAILS, MEETS, UNDECIDED, Verdict, is_control_group
 from ligwf.report.verdict_records import read_verdict
@@ -262,22 +263,42 @@ def until_decided(prepared: Prepared, out: Path, settings: RunSettings, plan: Ro
     finish (the same command resumes it)."""
     rounds = start_rounds(out, plan)
     while not rounds.stopped:
-        current = added_cases(prepared, rounds)
-        started = start_run(current, out, settings, mesh_cache)
-        apply_extensions(started.study, rounds)
-        study = Study.open(out)       # the extensions read afresh: rescheduled
-        run = dataclasses.replace(started, study=study, schedule=study_schedule(
-            cases_to_run(study.cases, settings.retry_unstable), settings))
+        engine, identity = site_engine()        # refused before anything is written
+        study = write_round(prepared, out, rounds, mesh_cache)
+        run = StudyRun(study, study_schedule(cases_to_run(study.cases, settings.retry_unstable),
+                                             settings), engine, settings, identity)
         if not run_round(run):
             return rounds
-        postprocess(out, snapshots=False)
-        verdict = read_verdict(study.report_dir)
-        if verdict is None:
-            raise ConfigError(f"{study.report_dir}: the report wrote no verdict (no accept: "
-                              "budget?): a sequential study needs one")
-        look = plan_look(verdict, study, rounds, len(rounds.looks) + 1)
-        rounds = rounds.with_look(look)
-        write_rounds(out, rounds)
-        show(look, rounds)
+        rounds = take_look(out, rounds)
+        show(rounds.looks[-1], rounds)
     report_study(out, snapshots=snapshots)
+    return rounds
+
+
+# ---------------------------------------------------------------- the steps of a round
+def write_round(prepared: Prepared, out: Path, rounds: Rounds,
+                mesh_cache: Path | None = None) -> Study:
+    """Write the study as its looks left it: the workflow's cases and the replicas the
+    rounds added (:func:`added_cases`), then the production extensions
+    (:func:`apply_extensions`). Idempotent (an unchanged case is rewritten byte for byte,
+    an extension only where it differs); the study read afresh (its cases rescheduled).
+    The local loop and a scheduler's follow-up job (:mod:`ligwf.pipeline.submit_rounds`)
+    both write a round this way."""
+    study = write(added_cases(prepared, rounds), out, mesh_cache)
+    apply_extensions(study, rounds)
+    return Study.open(out)
+
+
+def take_look(out: Path, rounds: Rounds) -> Rounds:
+    """Analyse and report the study (no snapshots), plan the next look from the report's
+    verdict (:func:`plan_look`) and write it into the rounds record before anything acts
+    on it; the record with that look."""
+    postprocess(out, snapshots=False)
+    study = Study.open(out)
+    verdict = read_verdict(study.report_dir)
+    if verdict is None:
+        raise ConfigError(f"{study.report_dir}: the report wrote no verdict (no accept: "
+                          "budget?): a sequential study needs one")
+    rounds = rounds.with_look(plan_look(verdict, study, rounds, len(rounds.looks) + 1))
+    write_rounds(out, rounds)
     return rounds
