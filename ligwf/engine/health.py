@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Iterable, Sequence
 
 from ligwf.study.manifest import DONE, FAILED, KILLED, UNSTABLE
-from ligwf.study.thermo_table import ThermoRow
+from ligwf.study.thermo_table import ThermoRow, atom_fall
 
 #: Issue kinds that make a case ``failed`` (the engine stopped on an error) rather than
 #: ``unstable`` (it ran, but the physics went wrong).
@@ -80,22 +80,15 @@ def non_finite(rows: Sequence[ThermoRow]) -> list[HealthIssue]:
 
 
 def atom_loss(rows: Sequence[ThermoRow], target: int | None = None) -> list[HealthIssue]:
-    """First drop of the atom count (atoms are only ever added, by insertion).
-
-    ``target``: the particle count asked for. The top-up insertion wave deliberately places
-    a few particles too many and deletes them one step later (see drum.in.j2), so with a
-    target only a fall below min(running maximum, target) is a loss.
-    """
-    top = -1.0
-    for row in rows:
-        atoms = row.get("atoms")
-        if not math.isfinite(atoms):
-            continue
-        if atoms < top:
-            return [HealthIssue("atom_loss", row.step, f"atom count fell from {top:.0f} to "
-                                f"{atoms:.0f} at step {row.step}")]
-        top = max(top, atoms) if target is None else min(max(top, atoms), float(target))
-    return []
+    """First drop of the atom count (atoms are only ever added, by insertion):
+    :func:`ligwf.study.thermo_table.atom_fall` (``target``: the particle count asked for),
+    the rule the folder model also holds a finished case's table to."""
+    fall = atom_fall(list(rows), target)
+    if fall is None:
+        return []
+    step, top, atoms = fall
+    return [HealthIssue("atom_loss", step, f"atom count fell from {top:.0f} to "
+                        f"{atoms:.0f} at step {step}")]
 
 
 def kinetic_energy_blowup(rows: Sequence[ThermoRow], ceiling: float | None = None,

@@ -87,7 +87,10 @@ class DumpRecord:
         entry = self.files.get(path.name)
         if entry is None:
             return f"{path}: not among the dumps the run left (dump record {DUMP_RECORD})"
-        size = path.stat().st_size
+        try:
+            size = path.stat().st_size
+        except OSError as exc:
+            return f"{path}: the run left it, it cannot be read now ({exc.strerror}: deleted?)"
         if size != entry[0]:
             return f"{path}: {size} bytes, the run left {entry[0]} (truncated or replaced)"
         if file_digest(path) != entry[1]:
@@ -137,12 +140,18 @@ def _changed_fields(rec: dict, scaled: ScaledScene) -> list[str]:
 
 def scene_record_problem(path: Path, rec: dict, scaled: ScaledScene) -> str | None:
     """Why a case folder's scene record is not the one rendering wrote (None: its stored
-    content hash is recomputed and matches, and its CG level and rule are the scaled
-    scene's), naming the changed fields where they can be told."""
+    content hash is recomputed and matches, its CG level and rule are the scaled scene's,
+    and its original scene block, scaled again, gives exactly its scaled values), naming
+    the changed fields where they can be told. The content hash covers the scaled values,
+    the input and the mesh, not the original block: an original edited after rendering
+    (a surface tension multiplied by 10) is caught by scaling it again."""
     if str(rec["rule"]) != scaled.rule or float(rec["cg"]) != scaled.cg:
         return "changed: " + "; ".join(_changed_fields(rec, scaled))
     digest = recomputed_hash(path, scaled)
     if digest is None or digest == rec["scene_hash"]:
+        if fields := _changed_fields(rec, scaled):
+            return ("its original scene block no longer gives its scaled values (changed: "
+                    + "; ".join(fields) + ")")
         return None
     fields = _changed_fields(rec, scaled)
     what = ("changed: " + "; ".join(fields)) if fields else (
@@ -329,7 +338,8 @@ class CaseFolder:
         except (OSError, ValueError, KeyError, TypeError) as exc:
             return f"{self.thermo.name} is unreadable (truncated or corrupt?): {exc}"
         last = rows[-1].step if rows else None
-        if (why := table_problem(rows, self.scaled.thermo_every)) is not None:
+        if (why := table_problem(rows, self.scaled.thermo_every,
+                                 self.scaled.particle_count)) is not None:
             return f"{self.thermo.name}: {why}"
         if last != manifest.steps_done:
             return (f"{self.thermo.name} ends at step {last}, the manifest says "

@@ -51,18 +51,39 @@ def rows_from_csv(text: str) -> list[ThermoRow]:
     return rows
 
 
+def atom_fall(rows: list[ThermoRow], target: int | None = None
+              ) -> tuple[int, float, float] | None:
+    """The first drop of the atom count, as (step, count before, count then); None when it
+    never falls. Atoms are only ever added, by insertion; ``target``: the particle count
+    asked for (the top-up insertion wave places a few too many and deletes them one step
+    later, see drum.in.j2, so with a target only a fall below min(running maximum, target)
+    counts). The engine's health check (a running case) and the folder model (a finished
+    case's table read back) share this rule."""
+    top = -1.0
+    for row in rows:
+        atoms = row.get("atoms")
+        if not math.isfinite(atoms):
+            continue
+        if atoms < top:
+            return row.step, top, atoms
+        top = max(top, atoms) if target is None else min(max(top, atoms), float(target))
+    return None
+
+
 #: Columns every thermo row of a finished run must hold as finite numbers.
 REQUIRED_FINITE = ("time", "atoms", "ke")
 
 
-def table_problem(rows: list[ThermoRow], thermo_every: int) -> str | None:
+def table_problem(rows: list[ThermoRow], thermo_every: int,
+                  particle_count: int | None = None) -> str | None:
     """Why a finished run's thermo rows cannot be its own (None: they are plausible).
 
     The runner writes one row every ``thermo_every`` steps (and at the end of each
     ``run`` command), steps rising strictly from the first row on; a done run never
-    printed nan (its health check would have stopped it). So a nan or missing number, a
-    step repeated or going back, or a gap wider than ``thermo_every`` means the table was
-    edited, merged wrongly or lost rows.
+    printed nan and never lost an atom (its health check would have stopped it). So a nan
+    or missing number, a step repeated or going back, a gap wider than ``thermo_every``,
+    or an atom count that falls (:func:`atom_fall`, ``particle_count``: the scene's) means
+    the table was edited, merged wrongly or lost rows.
     """
     prev = None
     for k, row in enumerate(rows):
@@ -77,4 +98,8 @@ def table_problem(rows: list[ThermoRow], thermo_every: int) -> str | None:
                 return (f"rows missing between steps {prev} and {row.step} (the run writes "
                         f"one every {thermo_every} steps)")
         prev = row.step
+    if (fall := atom_fall(rows, particle_count)) is not None:
+        step, before, atoms = fall
+        return (f"the atom count falls from {before:.0f} to {atoms:.0f} at step {step} (a "
+                "finished run keeps every particle: atoms lost, or the table edited)")
     return None

@@ -18,10 +18,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import ligwf
 from helpers import ROOT
 from ligwf.analysis.frames.dumps import read_particles
 from ligwf.analysis.flow.frame import DrumGeometry, cross_section, rising_side
 from ligwf.analysis.flow.surface import SurfaceFit, fit_surface
+from ligwf.analysis.records.provenance import StaleAnalysis
 from ligwf.cli.main import main
 from ligwf.study.case import CaseFolder
 
@@ -158,6 +160,9 @@ def test_truncated_analysis_table_is_refused(copy, capsys, table):
     (lambda r: r["scaled"].update(contact_angle_deg=40.0), "scaled.contact_angle_deg"),
     (lambda r: r["scaled"].update(dt=r["scaled"]["dt"] * 0.5), "scaled.dt"),
     (lambda r: r.update(cg=2.0), "cg = 2.0"),
+    # the original block (not under the content hash) no longer gives the scaled one
+    (lambda r: r["scene"]["liquid"].update(surface_tension=0.24),
+     "scaled.surface_tension = 0.216 (its scene gives 2.16)"),
 ])
 def test_edited_scene_record_is_refused_naming_the_field(copy, capsys, edit, field):
     path = copy / R0 / "scene.json"
@@ -170,6 +175,7 @@ def test_edited_scene_record_is_refused_naming_the_field(copy, capsys, edit, fie
     assert code == 0 and "the report lists 1 skipped case" in err
     summary = (copy / "report" / "summary.md").read_text()
     assert field in summary[summary.index("## Skipped cases"):summary.index("## Skipped or")]
+    assert field in dict(ligwf.open_study(copy).check().cases)[R0]     # the API alike
 
 
 def _thermo_rows(path: Path) -> list[str]:
@@ -183,6 +189,9 @@ def _thermo_rows(path: Path) -> list[str]:
      "no finite"),
     (lambda rows: rows[:20] + [rows[20]] + rows[20:], "duplicated or out of order"),
     (lambda rows: rows[:20] + rows[25:], "rows missing between steps"),
+    # the atom count falls near the end (56 -> 40): a done run never loses a particle
+    (lambda rows: rows[:-3] + [_with_atoms(r, 40) for r in rows[-3:]],
+     "the atom count falls from 56 to 40"),
 ])
 def test_damaged_thermo_table_is_a_skipped_case(copy, capsys, damage, words):
     path = copy / R0 / "thermo.csv"
@@ -192,6 +201,52 @@ def test_damaged_thermo_table_is_a_skipped_case(copy, capsys, damage, words):
     code, _, err = run(capsys, "report", str(copy), "--no-snapshots")
     assert code == 0
     assert words in (copy / "report" / "summary.md").read_text()
+    assert words in dict(ligwf.open_study(copy).check().cases)[R0]     # the API alike
+
+
+def _with_atoms(row: str, atoms: int) -> str:
+    cells = row.split(",")
+    cells[2] = f"{atoms}.0"                       # step,time,atoms,...
+    return ",".join(cells)
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_a_same_size_edit_of_a_contact_dump_is_refused_by_report_and_check(copy, capsys):
+    """Every dump kind the analysis read is hashed again (a contact dump was not)."""
+    dump = sorted((copy / R0 / "post").glob("contacts_*.vtu"))[-1]
+    data = bytearray(dump.read_bytes())
+    i = len(data) // 2
+    data[i] = ord("1") if data[i] != ord("1") else ord("2")
+    dump.write_bytes(bytes(data))
+    code, _, err = run(capsys, "report", str(copy), "--no-snapshots")
+    line = one_line(err)
+    assert code == 2 and dump.name in line and "content differs" in line, line
+    with pytest.raises(StaleAnalysis, match=f"{dump.name}: content differs"):
+        ligwf.open_study(copy).check()
+
+
+@pytest.mark.engine
+@pytest.mark.mpi
+def test_a_frame_copied_over_the_next_is_a_skipped_frame(copy, capsys):
+    """Without a dump record (a case run by hand), a frame that is byte for byte the one
+    before it is refused by the analysis and listed by the report, not used twice."""
+    (copy / R0 / "dumps.json").unlink()
+    post = copy / R0 / "post"
+    steps = sorted(int(p.stem.split("_")[1]) for p in post.glob("particles_*.vtu"))
+    a, b = steps[-3], steps[-2]
+    for kind in ("particles", "contacts"):
+        shutil.copyfile(post / f"{kind}_{a}.vtu", post / f"{kind}_{b}.vtu")
+    code, _, err = run(capsys, "analyse", str(copy), "--no-vtu")
+    assert code == 0, err
+    frames = list(csv.DictReader(io.StringIO((copy / "analysis" / "frames.csv").read_text())))
+    (row,) = [f for f in frames if f["case_id"] == R0 and int(f["step"]) == b]
+    assert row["status"] == "duplicate" and f"particle dump of step {a}" in row["reason"]
+    code, _, err = run(capsys, "report", str(copy), "--no-snapshots")
+    assert code == 0, err
+    summary = (copy / "report" / "summary.md").read_text()
+    frames_section = summary[summary.index("## Skipped or"):summary.index("## Analysis outputs")]
+    assert f"| {R0} | {b} | duplicate |" in frames_section
 
 
 # ---------------------------------------------------------------- swapped, listed twice

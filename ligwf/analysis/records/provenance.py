@@ -13,6 +13,7 @@ import hashlib
 import json
 from pathlib import Path
 
+from ligwf.analysis.frames.dumps import dump_files
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.study.case import file_digest, folder_fingerprint
 
@@ -76,10 +77,13 @@ def damaged_outputs(out_dir: Path, record: dict) -> list[str]:
 
 
 def changed_dumps(study, flow) -> str | None:
-    """Why a dump the flow stage read (``flow``: the
-    :class:`~ligwf.analysis.records.flow.FlowRecord`) is no longer the one the run left
-    (size or SHA-256 against the case's dump record: post/ folders swapped, a dump edited),
-    in words; None when every one still is (cases without a dump record are not checked)."""
+    """Why a dump the analysis read (``flow``: the
+    :class:`~ligwf.analysis.records.flow.FlowRecord`; its read frames passed the record check
+    for both their particle and their contact dump) is no longer the one the run left (size
+    or SHA-256 against the case's dump record: post/ folders swapped, a dump edited, even
+    at the same size), in words; None when every one still is (cases without a dump record
+    are not checked). Every dump kind the analysis reads is re-hashed: particles and
+    contacts."""
     for case in study.usable_cases()[0]:
         c = flow.cases.get(case.case_id)
         if c is None:
@@ -91,7 +95,12 @@ def changed_dumps(study, flow) -> str | None:
         if record is None:
             continue
         files = dict(c.frames)
+        contacts = dump_files(case.path)[1]
         for step in c.read_steps:
-            if (why := record.mismatch(case.path / files[step])) is not None:
-                return why
+            read = [case.path / files[step]]
+            if step in contacts:
+                read.append(contacts[step])
+            for path in read:
+                if (why := record.mismatch(path)) is not None:
+                    return why
     return None
