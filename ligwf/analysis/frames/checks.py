@@ -40,8 +40,8 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files,
-                                         read_particles)
+from ligwf.analysis.frames.dumps import ContactFrame, FrameFiles, ParticleFrame, dump_files, read_particles
+from ligwf.analysis.granules.bonds import AXES
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study.case import CaseFolder, DumpRecord, file_digest
 
