@@ -40,7 +40,7 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     console.print(run.identity.describe(), highlight=False, soft_wrap=True)
     for line in elsewhere(run.study.cases, settings.retry_unstable):
         console.print(line, highlight=False, soft_wrap=True)
-    for line in unreadable_restarts(run.study.cases, settings.retry_unstable):
+    for line in skipped_restarts(run.study.cases, settings.retry_unstable):
         print_warning(line)
     return run
 
@@ -57,25 +57,18 @@ def elsewhere(cases, retry_unstable: bool) -> list[str]:
     return out
 
 
-def unreadable_restarts(cases, retry_unstable: bool) -> list[str]:
-    """The restart files a case to be resumed cannot use (a truncated header: killed while
-    writing, or a full disk), with what the runner does instead: said, not skipped silently."""
-    from ligwf.engine.liggghts import FORCED_RESTART_RE, PERIODIC_RESTARTS, restart_step
+def skipped_restarts(cases, retry_unstable: bool) -> list[str]:
+    """The restart files a case to be resumed or extended does not use (unreadable: killed
+    while writing or a full disk; or not its own: another case's, edited, past its
+    recorded progress), each with what the case does instead: said here, one line each,
+    and recorded in its manifest's issues by the runner (:class:`ligwf.engine.resume.Plan`)."""
     from ligwf.engine.resume import SKIP, plan_case
 
     out = []
     for c in cases:
         plan = plan_case(c, retry_unstable)
-        if plan.action == SKIP:
-            continue
-        names = [p.name for p in c.path.iterdir() if FORCED_RESTART_RE.match(p.name)]
-        names += [rel for rel in PERIODIC_RESTARTS if (c.path / rel).is_file()]
-        bad = sorted(n for n in names if restart_step(c.path / n) is None)
-        if bad:
-            instead = (f"resumes from {plan.restart.path} at step {plan.restart.step}"
-                       if plan.restart is not None else "runs from step 0")
-            out.append(f"{c.path.name}: restart file(s) {', '.join(bad)} unreadable "
-                       f"(truncated?), not used: the case {instead}")
+        if plan.action != SKIP:
+            out += [f"{c.path.name}: {line}" for line in plan.skipped]
     return out
 
 

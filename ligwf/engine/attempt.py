@@ -18,8 +18,9 @@ from ligwf.engine.health import (Expectation, assess, engine_signal, kinetic_ene
                                  verdict)
 from ligwf.engine.restart_id import CaseIdentity, stamp
 from ligwf.engine.site import EngineIdentity
-from ligwf.engine.resume import (FRESH, RESUME, Plan, clean_outputs, input_for,
-                                 phase_steps_between, render_resume, rotate_screen)
+from ligwf.engine.resume import (FRESH, RESTART_SKIPPED, RESUME, Plan, clean_outputs,
+                                 input_for, own_restarts, phase_steps_between, render_resume,
+                                 rotate_screen)
 from ligwf.engine.thermo import parse_screen, phase_group
 from ligwf.scene.scaling import ScaledScene
 from ligwf.study.case import NO_DIGESTS, CaseFolder, KnownDigests
@@ -83,6 +84,11 @@ def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
         credit_restart(case.scaled, manifest, from_step)
     else:
         raise ValueError(f"begin_attempt: nothing to run for plan {plan}")
+    # restarts the plan did not use are said in the record too (not only on the screen)
+    said = [i for i in (previous.issues if previous is not None else [])
+            if isinstance(i, dict) and i.get("kind") == RESTART_SKIPPED]
+    manifest.issues = said + [{"kind": RESTART_SKIPPED, "step": from_step, "message": line}
+                              for line in plan.skipped]
     manifest.status, manifest.reason, manifest.reason_step = RUNNING, plan.reason, None
     manifest.host, manifest.pid = os.uname().nodename, os.getpid()
     manifest.pid_start, manifest.engine = start_time(os.getpid()), []
@@ -174,6 +180,17 @@ def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | No
     return min(holes) if holes else None
 
 
+def resume_before(case: CaseFolder, step: int) -> str:
+    """What a case whose record is whole only up to ``step`` does next, in words: resume
+    from its newest own restart at or before it, or run again from step 0 (none is; the
+    periodic restarts may all lie past a hole a full disk left)."""
+    restarts, _ = own_restarts(case, step)
+    if restarts:
+        return (f"resumes from {restarts[0].path} at step {restarts[0].step} (the newest "
+                f"restart of its own at or before step {step})")
+    return f"no restart of its own at or before step {step}: runs again from step 0"
+
+
 def merge_rows(previous: list[ThermoRow], new: list[ThermoRow], from_step: int,
                dt: float) -> list[ThermoRow]:
     """Thermo of earlier attempts up to the restart step, then this attempt's rows.
@@ -244,8 +261,7 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     hole = record_hole(case, rows) if status in (DONE, KILLED) else None
     if hole is not None and status == DONE:
         # never done with a gap or an empty frame: resume from a restart before the hole
-        status, reason = KILLED, (f"incomplete record ({hole[1]}): resumes from a restart "
-                                  f"at or before step {hole[0]}")
+        status, reason = KILLED, f"incomplete record ({hole[1]}): {resume_before(case, hole[0])}"
     left = space_left(case.path)
     if status in (FAILED, KILLED) and left < LOW_SPACE_BYTES:
         # a full disk makes LIGGGHTS segfault: the case resumes once there is room
@@ -261,7 +277,8 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
                       for ph in walls.keys() | steps.keys()}
     manifest.status, manifest.reason = status, reason
     manifest.reason_step = _cause_step(issues, status)
-    manifest.issues = [i.to_dict() for i in issues]
+    manifest.issues = ([i for i in manifest.issues if isinstance(i, dict)
+                        and i.get("kind") == RESTART_SKIPPED] + [i.to_dict() for i in issues])
     manifest.liggghts_version = (engine_version(parser.lines) or engine_version_line
                                  or manifest.liggghts_version)
     manifest.ended = attempt.ended

@@ -23,6 +23,7 @@ re-issues every fix with the same ID and runs the remaining phases with ``run N 
 
 from __future__ import annotations
 
+import dataclasses
 import re
 import shutil
 from dataclasses import dataclass
@@ -52,11 +53,24 @@ class RestartFile:
 
 @dataclass(frozen=True)
 class Plan:
-    """What the runner does with one case, and why."""
+    """What the runner does with one case, and why; ``skipped``: one line per restart file
+    of the case it does not use (unreadable, or not its own) and what it does instead, for
+    the run output and the manifest's issues (:data:`RESTART_SKIPPED`)."""
 
     action: str                         # skip | fresh | resume
     reason: str
     restart: RestartFile | None = None
+    skipped: tuple[str, ...] = ()
+
+    def instead(self) -> str:
+        """What the case does instead of the restarts it skips, in words."""
+        if self.restart is not None:
+            return f"resumes from {self.restart.path} at step {self.restart.step}"
+        return "runs again from step 0"
+
+
+#: the manifest issue kind of a restart file a resume did not use
+RESTART_SKIPPED = "restart_skipped"
 
 
 def restart_files(case_dir: Path) -> list[RestartFile]:
@@ -77,11 +91,22 @@ def restart_files(case_dir: Path) -> list[RestartFile]:
     return sorted(found, key=lambda r: r.step, reverse=True)
 
 
+def unreadable_restarts(case_dir: Path) -> list[str]:
+    """Restart files of a case whose header cannot be read (empty or truncated: killed
+    while writing, or a full disk), as ``"<path>: <reason>"``, by path."""
+    case_dir = Path(case_dir)
+    names = [p.name for p in case_dir.iterdir() if FORCED_RESTART_RE.match(p.name)]
+    names += [rel for rel in PERIODIC_RESTARTS if (case_dir / rel).is_file()]
+    return [f"{n}: header unreadable (empty or truncated)"
+            for n in sorted(names) if restart_step(case_dir / n) is None]
+
+
 def own_restarts(case: CaseFolder, max_step: int | None) -> tuple[list[RestartFile], list[str]]:
     """The case's own restarts, newest step first, and why each other one is refused
-    (``"<path>: <reason>"``); ``max_step``: the progress the manifest records."""
+    (``"<path>: <reason>"``, unreadable ones first); ``max_step``: the progress the manifest
+    records."""
     identity = CaseIdentity.of(case)
-    mine, refused = [], []
+    mine, refused = [], unreadable_restarts(case.path)
     for r in restart_files(case.path):
         why = why_not_own(case.path / r.path, identity, max_step)
         if why is None:
@@ -123,10 +148,19 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> Plan:
     restarts, refused = own_restarts(case, limit)
     ignored = f" (ignored {'; '.join(refused)})" if refused else ""
     if restarts:
-        return Plan(RESUME, f"killed at step {m.steps_done}; resume from {restarts[0].path}"
-                    f"{ignored}", restarts[0])
-    return Plan(FRESH, f"killed at step {m.steps_done} before any restart file of its own was "
-                f"written{ignored}")
+        return _with_skipped(Plan(RESUME, f"killed at step {m.steps_done}; resume from "
+                                  f"{restarts[0].path}{ignored}", restarts[0]), refused)
+    none = (f"no restart file of its own at or before step {limit} (its record is whole up "
+            "to there)" if m.complete_upto is not None and m.complete_upto < m.steps_done
+            else "before any restart file of its own was written")
+    return _with_skipped(Plan(FRESH, f"killed at step {m.steps_done} {none}{ignored}: runs "
+                              "again from step 0"), refused)
+
+
+def _with_skipped(plan: Plan, refused: list[str]) -> Plan:
+    """``plan`` with one line per refused restart and what the case does instead."""
+    return dataclasses.replace(plan, skipped=tuple(
+        f"restart file {why}, not used: the case {plan.instead()}" for why in refused))
 
 
 def _extension_plan(case: CaseFolder, steps_done: int) -> Plan:
@@ -137,10 +171,12 @@ def _extension_plan(case: CaseFolder, steps_done: int) -> Plan:
     restarts, refused = own_restarts(case, steps_done)
     ignored = f" (ignored {'; '.join(refused)})" if refused else ""
     if restarts:
-        return Plan(RESUME, f"production extended to step {target} (done at {steps_done}); "
-                    f"continue from {restarts[0].path}{ignored}", restarts[0])
-    return Plan(FRESH, f"production extended to step {target}, but no restart file of its "
-                f"own to continue from{ignored}: run again from step 0")
+        return _with_skipped(Plan(RESUME, f"production extended to step {target} (done at "
+                                  f"{steps_done}); continue from {restarts[0].path}{ignored}",
+                                  restarts[0]), refused)
+    return _with_skipped(Plan(FRESH, f"production extended to step {target}, but no restart "
+                              f"file of its own to continue from{ignored}: run again from "
+                              "step 0"), refused)
 
 
 def clean_outputs(case_dir: Path) -> None:

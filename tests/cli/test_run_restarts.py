@@ -1,4 +1,6 @@
-"""A restart the runner cannot use is said, not skipped silently (issue 32, item 4)."""
+"""A restart the runner does not use is said, not skipped silently (issue 32, item 4): one
+line in the run output and one ``restart_skipped`` issue in the case's manifest, each
+naming the file, why, and what the case does instead."""
 
 from __future__ import annotations
 
@@ -6,7 +8,10 @@ import struct
 
 from helpers import ROOT
 from ligwf.cli.main import main
-from ligwf.cli.run import unreadable_restarts
+from ligwf.cli.run import skipped_restarts
+from ligwf.engine.attempt import begin_attempt, finish_attempt, resume_before
+from ligwf.engine.restart_id import CaseIdentity, stamp
+from ligwf.engine.resume import FRESH, RESTART_SKIPPED, RESUME, plan_case
 from ligwf.study.manifest import Manifest
 from ligwf.study.study import Study
 
@@ -21,21 +26,71 @@ def restart_header(step: int) -> bytes:
             + struct.pack("<ii", 4, 2) + b"si" + struct.pack("<iq", 5, step) + bytes(64))
 
 
-def test_a_truncated_restart_is_named_with_what_the_case_does_instead(tmp_path):
+def killed_case(tmp_path, steps_done: int = 3000, complete_upto: int | None = None):
     out = tmp_path / "study"
     assert main(["render", str(TINY), "--out", str(out), "--set", "sweep.rules=[bond]"]) == 0
     case = Study.open(out).cases[0]
     case.write_manifest(Manifest(case_id=case.case_id, index=case.index,
                                  scene_hash=case.scene_hash, ligwf_version="",
-                                 liggghts_version="", status="killed", steps_done=3000,
+                                 liggghts_version="", status="killed", steps_done=steps_done,
+                                 complete_upto=complete_upto,
                                  total_steps=case.scaled.total_steps))
     (case.path / "restart").mkdir(exist_ok=True)
+    return out, case
+
+
+def test_a_truncated_or_foreign_restart_is_named_with_what_the_case_does_instead(tmp_path):
+    out, case = killed_case(tmp_path)
     (case.path / "restart" / "restart_a.liggghts").write_bytes(b"")
     (case.path / "restart" / "restart_b.liggghts").write_bytes(restart_header(3000)[:12])
-    (line,) = unreadable_restarts(Study.open(out).cases, False)
-    assert line.startswith(f"{case.case_id}: restart file(s) restart/restart_a.liggghts, "
-                           "restart/restart_b.liggghts unreadable")
-    assert line.endswith("runs from step 0")
+    lines = skipped_restarts(Study.open(out).cases, False)
+    assert lines == [f"{case.case_id}: restart file restart/{n}: header unreadable (empty or "
+                     "truncated), not used: the case runs again from step 0"
+                     for n in ("restart_a.liggghts", "restart_b.liggghts")]
+    # a whole restart the case did not write (no identity record) is not used either
     (case.path / "restart" / "restart_b.liggghts").write_bytes(restart_header(3000))
     (case.path / "restart" / "restart_a.liggghts").unlink()
-    assert unreadable_restarts(Study.open(out).cases, False) == []
+    (line,) = skipped_restarts(Study.open(out).cases, False)
+    assert "restart/restart_b.liggghts: no identity record" in line
+    assert line.endswith("not used: the case runs again from step 0")
+
+
+def test_a_skipped_restart_lands_in_the_manifest_issues_and_stays(tmp_path):
+    _, case = killed_case(tmp_path)
+    (case.path / "restart" / "restart_a.liggghts").write_bytes(restart_header(3000)[:12])
+    plan = plan_case(case)
+    assert plan.action == FRESH and len(plan.skipped) == 1
+    manifest, attempt = begin_attempt(case, plan, 1, "mpirun")
+    (issue,) = case.manifest().issues
+    assert issue["kind"] == RESTART_SKIPPED and issue["message"] == plan.skipped[0]
+    # the attempt's own verdict keeps it beside the health issues
+    finish_attempt(case, manifest, attempt, exit_code=1, wall_seconds=0.0)
+    assert [i["message"] for i in case.manifest().issues
+            if i["kind"] == RESTART_SKIPPED] == list(plan.skipped)
+
+
+def test_a_hole_left_by_a_full_disk_says_where_the_case_resumes_or_that_it_starts_over(
+        tmp_path):
+    """'resumes from a restart at or before step N' was promised and the case re-ran from
+    step 0 when every restart lay past the hole: now the message says which it is."""
+    _, case = killed_case(tmp_path, steps_done=3000, complete_upto=1500)
+    restart = case.path / "restart" / "restart_a.liggghts"
+    restart.write_bytes(restart_header(2000))
+    assert stamp(case.path, CaseIdentity.of(case), 1, 0.0) == ["restart/restart_a.liggghts"]
+    assert resume_before(case, 2500) == ("resumes from restart/restart_a.liggghts at step 2000 "
+                                         "(the newest restart of its own at or before step 2500)")
+    assert resume_before(case, 1500) == ("no restart of its own at or before step 1500: runs "
+                                         "again from step 0")
+    plan = plan_case(case)
+    assert plan.action == FRESH
+    assert "no restart file of its own at or before step 1500" in plan.reason
+    assert plan.skipped == ("restart file restart/restart_a.liggghts: step 2000 is past the "
+                            "case's recorded progress (step 1500), not used: the case runs "
+                            "again from step 0",)
+    # with the hole after the restart the case resumes from it, nothing skipped
+    case.write_manifest(Manifest(case_id=case.case_id, index=case.index,
+                                 scene_hash=case.scene_hash, ligwf_version="",
+                                 liggghts_version="", status="killed", steps_done=3000,
+                                 complete_upto=2500, total_steps=case.scaled.total_steps))
+    plan = plan_case(case)
+    assert plan.action == RESUME and plan.restart.step == 2000 and plan.skipped == ()
