@@ -48,8 +48,9 @@ class CaseView(Protocol):
 
 
 class StudyStatus(Protocol):
-    """Every case's status, the recorded jobs (with their state) and, in tolerant mode,
-    why the scheduler's view is missing."""
+    """Every case's status, the recorded jobs (with their ``state``; a job after the
+    arrays also with ``active``: still queued or running) and, in tolerant mode, why the
+    scheduler's view is missing."""
 
     cases: list
     jobs: list[dict]
@@ -97,12 +98,15 @@ class Scheduler(Protocol):
     def plan_jobs(self, study_dir: Path, study_name: str, indices: Iterable[int],
                   ranks: Mapping[int, int] | None, post_steps: Sequence[str], round_no: int,
                   plan_cores: int | None = None, analysis_tasks: int = 1,
-                  token: str | None = None) -> Sequence[BatchJob]:
+                  token: str | None = None, study_round: int | None = None
+                  ) -> Sequence[BatchJob]:
         """The scripts of one submission round (pure): one array per rank count of
         ``ranks`` (case index -> MPI ranks; None: the site's fixed task count) and, with
         ``post_steps``, the follow-up job running ``ligwf <step> STUDY`` for each
         (``analysis_tasks`` > 1: ``analyse`` as an array of that many tasks staged under
-        ``token``, then a merge job running the other steps)."""
+        ``token``, then a merge job running the other steps). No ``indices``: the
+        follow-up job alone. The submission records the follow-up's steps and
+        ``study_round``, the round of a sequential study the jobs run."""
 
     def dry_run_text(self, jobs: Sequence[BatchJob]) -> str:
         """Every script and the command that would submit it."""

@@ -43,6 +43,9 @@ from rich.text import Text
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_table,
                               console, duration, err_console, folder_to_write, positive_int,
                               prepare_from_args, print_warning, rank_count)
+from ligwf.cli.slurm_rounds import (add_next_round_parser, add_until_decided_args,
+                                    dry_run_note, follow_up_of, next_round, print_submitted,
+                                    resubmit_rounds, submit_until_decided)
 from ligwf.engine.plan import CasePlan
 from ligwf.engine.progress import shown_reason
 from ligwf.engine.site import EngineConfig
@@ -51,7 +54,8 @@ from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_
 from ligwf.slurm.assumptions import site_assumptions
 from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
                                 plan_rows, slab_note, slurm_time_seconds)
-from ligwf.slurm.jobs import PlannedJob, recorded_site, study_status
+from ligwf.pipeline.submit_rounds import is_sequential
+from ligwf.slurm.jobs import PlannedJob, read_record, recorded_site, study_status
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
 
@@ -94,12 +98,6 @@ def _site_from_record(values: dict[str, Any]) -> SlurmSite:
 def _warn(lines: list[str]) -> None:
     for line in lines:
         print_warning(line)
-
-
-def _print_submitted(entries: list[dict]) -> None:
-    for e in entries:
-        dep = f" (after {e['after']})" if e.get("after") else ""
-        console.print(f"submitted {e['kind']} job {e['job_id']}{dep}: {e['script']}")
 
 
 def plan_caption(plans: tuple[CasePlan, ...], jobs: list[PlannedJob], rows: tuple[PlanRow, ...],
@@ -158,9 +156,11 @@ def cmd_submit(args: argparse.Namespace) -> int:
     site = site_from_args(args, load_slurm_site())
     scheduler = SlurmScheduler(site)
     fixed = args.ntasks is not None or ntasks_configured()   # every case on site.ntasks ranks
+    rounds = follow_up_of(args, not fixed, args.cores)      # None: no --until-decided
     submission = plan_submission(prepared, args.out.resolve(), scheduler, args.cores,
                                  site.ntasks if fixed else None, not args.no_analysis,
-                                 args.analysis_tasks)
+                                 args.analysis_tasks, rounds.steps if rounds else None,
+                                 1 if rounds else None)
     plans, jobs = submission.schedule.cases, list(submission.jobs)
     title = ("rank plan" + (f" (at most {args.cores} per case)" if args.cores else "")
              if submission.planned else "ranks as asked (--ntasks / site ntasks)")
@@ -177,12 +177,16 @@ def cmd_submit(args: argparse.Namespace) -> int:
         print("\n".join(site_assumptions(site, jobs, shlex.join([engine.mpirun,
                                                                   *engine.mpirun_args]))))
         print(scheduler.dry_run_text(jobs))
+        if rounds:
+            print(dry_run_note(args, submission.out))
         return 0
     write_for_submit(prepared, submission, scheduler, args.mesh_cache)
     console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) -> {submission.out}"))
     console.print(plan_view)
     _warn(over_time)
-    _print_submitted(submission.submit(scheduler))
+    if rounds:      # the rounds record first, then round 1 (or what an earlier study asks)
+        return submit_until_decided(args, prepared, submission.out, scheduler, rounds)
+    print_submitted(submission.submit(scheduler))
     return 0
 
 
@@ -225,6 +229,10 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
     scheduler = SlurmScheduler(site_from_args(args, base))
     # a planned submission is planned again (same core limit unless --cores says otherwise)
     plan = scheduler.recorded_plan(study_dir) if args.ntasks is None else None
+    if is_sequential(read_record(study_dir)):
+        return resubmit_rounds(study_dir, scheduler, read_record(study_dir), plan is not None,
+                               args.cores if args.cores is not None else (plan or {}).get(
+                                   "cores"), args.include_unstable, args.dry_run)
     again = plan_resubmission(study_dir, scheduler, args.include_unstable, args.cores,
                               planned=plan is not None, recorded_cores=(plan or {}).get("cores"),
                               analysis=not args.no_analysis,
@@ -241,8 +249,16 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
     if args.dry_run:
         print(scheduler.dry_run_text(list(again.jobs)))
         return 0
-    _print_submitted(again.submit(scheduler))
+    print_submitted(again.submit(scheduler))
     return 0
+
+
+def cmd_next_round(args: argparse.Namespace) -> int:
+    study_dir: Path = args.study_dir.resolve()
+    recorded = recorded_site(study_dir)
+    scheduler = SlurmScheduler(_site_from_record(recorded) if recorded else load_slurm_site())
+    plan = scheduler.recorded_plan(study_dir)
+    return next_round(args, study_dir, scheduler, plan is not None, (plan or {}).get("cores"))
 
 
 def cmd_cancel(args: argparse.Namespace) -> int:
@@ -270,6 +286,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=folder_to_write, required=True, help="study folder to write")
     add_mesh_cache(p)
     add_site_args(p)
+    add_until_decided_args(p)
     p.set_defaults(func=cmd_submit)
 
     p = sub.add_parser("status", help="cases with their manifest and Slurm state")
@@ -289,3 +306,5 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                                       "cases resume on 'ligwf slurm resubmit')")
     p.add_argument("study_dir", type=Path, help="study folder")
     p.set_defaults(func=cmd_cancel)
+
+    add_next_round_parser(sub, add_mesh_cache).set_defaults(func=cmd_next_round)

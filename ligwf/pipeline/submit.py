@@ -53,18 +53,22 @@ class Submission:
 
 def plan_submission(prepared: Prepared, out: Path, scheduler: Scheduler, cores: int | None,
                     ntasks: int | None, analysis: bool = True,
-                    analysis_tasks: int = 1) -> Submission:
+                    analysis_tasks: int = 1, post_steps: Sequence[str] | None = None,
+                    study_round: int | None = None) -> Submission:
     """The schedule and scripts of a first submission of ``prepared`` into ``out`` (pure
     apart from reading an earlier submission record to number the scripts and drawing a
-    staging token when the analysis is split over ``analysis_tasks`` array tasks)."""
+    staging token when the analysis is split over ``analysis_tasks`` array tasks).
+    ``post_steps``: the follow-up job's commands instead of :data:`POSTPROCESS_COMMANDS`
+    (a sequential study's next round, :mod:`ligwf.pipeline.submit_rounds`)."""
     schedule = submission_schedule(prepared_loads(prepared), cores, ntasks)
     ranks = None if not schedule.planned else {
         rc.case.index: schedule.ranks_of(rc.case.case_id) for rc in prepared.rendered}
-    steps = list(POSTPROCESS_COMMANDS) if analysis else []
+    steps = (list(post_steps) if post_steps is not None
+             else list(POSTPROCESS_COMMANDS) if analysis else [])
     jobs = scheduler.plan_jobs(out, prepared.workflow.name,
                                [rc.case.index for rc in prepared.rendered], ranks, steps,
                                scheduler.next_round(out), cores, analysis_tasks,
-                               _token(analysis_tasks))
+                               _token(analysis_tasks), study_round)
     return Submission(out, schedule, tuple(jobs))
 
 
@@ -120,15 +124,25 @@ def plan_resubmission(study_dir: Path, scheduler: Scheduler, include_unstable: b
     jobs: Sequence[BatchJob] = ()
     plan_cores = cores if cores is not None else recorded_cores
     if indices:
-        again = [c for c in study.cases if c.index in indices]
-        ranks = None
-        if planned:
-            schedule = submission_schedule([case_load(c.path.name, c.scaled) for c in again],
-                                           plan_cores, None)
-            ranks = {c.index: schedule.ranks_of(c.path.name) for c in again}
         steps = list(POSTPROCESS_COMMANDS) if analysis else []
-        jobs = scheduler.plan_jobs(study_dir, study.name, indices, ranks, steps,
-                                   scheduler.next_round(study_dir), plan_cores, analysis_tasks,
-                                   _token(analysis_tasks))
+        jobs = rerun_jobs(study, scheduler, indices, plan_cores, planned, steps,
+                          analysis_tasks)
     return Resubmission(Path(study_dir), tuple(st.cases), tuple(indices), tuple(busy),
                         tuple(jobs))
+
+
+def rerun_jobs(study: Study, scheduler: Scheduler, indices: Sequence[int], cores: int | None,
+               planned: bool, steps: Sequence[str], analysis_tasks: int = 1,
+               study_round: int | None = None) -> Sequence[BatchJob]:
+    """The scripts that run the cases ``indices`` of a written study (none: the follow-up
+    job alone) and then ``steps``: ``planned``, their ranks from the rank plan on at most
+    ``cores``; otherwise every case on the site's fixed task count."""
+    again = [c for c in study.cases if c.index in set(indices)]
+    ranks = None
+    if planned and again:
+        schedule = submission_schedule([case_load(c.path.name, c.scaled) for c in again],
+                                       cores, None)
+        ranks = {c.index: schedule.ranks_of(c.path.name) for c in again}
+    return scheduler.plan_jobs(study.path, study.name, indices, ranks, list(steps),
+                               scheduler.next_round(study.path), cores, analysis_tasks,
+                               _token(analysis_tasks), study_round)

@@ -100,7 +100,10 @@ class PlannedJob:
     ``site``: the settings this script was built with (an array of a planned study has
     its own ``ntasks``); ``planned``: its ranks came from the rank plan (a resubmit plans
     again, on ``plan_cores``), not from ``--ntasks`` / the site setting; ``nodes``: the
-    ``--nodes`` each array task asks for (None: not asked, Slurm places the ranks)."""
+    ``--nodes`` each array task asks for (None: not asked, Slurm places the ranks);
+    ``steps``: the ligwf commands a follow-up job runs; ``study_round``: the round of a
+    sequential study the job belongs to (:mod:`ligwf.pipeline.submit_rounds`). Both are
+    recorded with the submission."""
 
     kind: str  # "array", "analysis", "analysis-array" or "analysis-merge"
     script_path: Path
@@ -111,14 +114,18 @@ class PlannedJob:
     planned: bool = False
     plan_cores: int | None = None
     nodes: int | None = None
+    steps: tuple[str, ...] = ()
+    study_round: int | None = None
 
 
 def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterable[int],
               analysis_steps: Sequence[str], round_no: int,
               ranks: Mapping[int, int] | None = None,
               plan_cores: int | None = None, analysis_tasks: int = 1,
-              token: str | None = None) -> list[PlannedJob]:
+              token: str | None = None, study_round: int | None = None) -> list[PlannedJob]:
     """The array job over ``indices`` and (if steps are given) its analysis job (pure).
+    No ``indices``: the follow-up job alone, depending on nothing. ``study_round`` is
+    recorded with every job (the round of a sequential study they run).
 
     ``analysis_tasks`` > 1 (a big study): the ``analyse`` step is split over an array of
     that many analysis tasks, after the case arrays, and the merge job after them runs the
@@ -134,7 +141,9 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
     study = PurePosixPath(Path(study_dir).resolve())
     idx = tuple(sorted(set(indices)))
     array_ctx = ScriptContext(study, job_name(study_name, "array"), __version__)
-    if ranks is None:
+    if not idx:
+        classes: dict[int, Sequence[int]] = {}
+    elif ranks is None:
         classes = {site.ntasks: idx}
     else:
         missing = [i for i in idx if i not in ranks]
@@ -153,18 +162,20 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
                                array_script(array_ctx, job_site, members, nodes), members,
                                site=job_site, planned=ranks is not None,
                                plan_cores=plan_cores if ranks is not None else None,
-                               nodes=nodes))
+                               nodes=nodes, study_round=study_round))
     if analysis_steps and analysis_tasks > 1 and "analyse" in analysis_steps:
         if token is None:
             raise ConfigError("a split analysis needs a staging token")
         rest = [step for step in analysis_steps if step != "analyse"]
         split = plan_analysis_array(study_dir, study_name, site, analysis_tasks, token, rest)
-        jobs += [replace(split[0], after_array=True), split[1]]   # the array after the runs
+        jobs += [replace(split[0], after_array=bool(idx), study_round=study_round),
+                 replace(split[1], steps=tuple(rest), study_round=study_round)]
     elif analysis_steps:
         ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
         jobs.append(PlannedJob("analysis", Path(study) / SLURM_DIR / f"analysis-{round_no}.sh",
                                analysis_script(ctx, site, analysis_steps), idx,
-                               after_array=True))
+                               after_array=bool(idx), steps=tuple(analysis_steps),
+                               study_round=study_round))
     return jobs
 
 
@@ -232,6 +243,10 @@ def submit_jobs(study_dir: Path, jobs: Sequence[PlannedJob], site: SlurmSite,
                  "submitted": datetime.now(timezone.utc).isoformat(timespec="seconds")}
         if job.planned:
             entry["planned"] = {"cores": job.plan_cores}
+        if job.steps:
+            entry["steps"] = list(job.steps)
+        if job.study_round is not None:
+            entry["study_round"] = job.study_round
         append_record(study_dir, entry)
         entries.append(entry)
     return entries
@@ -346,6 +361,8 @@ def study_status(study_dir: Path, run: Runner = run_command, user: str | None = 
     for sub in record:
         entry = dict(sub)
         if sub.get("kind") != "array":
-            entry["state"] = states.get((str(sub["job_id"]), None))
+            state = states.get((str(sub["job_id"]), None))
+            entry["state"] = state
+            entry["active"] = state is not None and state.split()[0] not in FINISHED_STATES
         jobs.append(entry)
     return StudyStatus(cases, jobs, scheduler_error)

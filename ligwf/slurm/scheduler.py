@@ -34,9 +34,10 @@ class SlurmScheduler:
     def plan_jobs(self, study_dir: Path, study_name: str, indices: Iterable[int],
                   ranks: Mapping[int, int] | None, post_steps: Sequence[str], round_no: int,
                   plan_cores: int | None = None, analysis_tasks: int = 1,
-                  token: str | None = None) -> list[PlannedJob]:
+                  token: str | None = None, study_round: int | None = None
+                  ) -> list[PlannedJob]:
         return plan_jobs(study_dir, study_name, self.site, indices, post_steps, round_no, ranks,
-                         plan_cores, analysis_tasks, token)
+                         plan_cores, analysis_tasks, token, study_round)
 
     def dry_run_text(self, jobs: Sequence[PlannedJob]) -> str:
         return dry_run_text(jobs)

@@ -44,6 +44,9 @@ DUMP_RECORD = "dumps.json"
 EXTENSION_FILE = "extension.json"
 #: Study level: the looks of a sequential study (``ligwf study --until-decided``).
 ROUNDS_FILE = "rounds.json"
+#: Study level: held while one process takes a look or submits a round of a sequential
+#: study on a scheduler (``ligwf slurm next-round``), so two never do it at once.
+ROUNDS_LOCK = ".rounds.lock"
 #: Case level: the engine's dump folder.
 POST_DIR = "post"
 #: Case level: the main LIGGGHTS input (the renderer writes it).

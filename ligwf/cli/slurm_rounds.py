@@ -1,0 +1,148 @@
+"""``ligwf slurm submit --until-decided`` and ``ligwf slurm next-round``: a sequential
+study (``ligwf study --until-decided``) as Slurm arrays, one dependent round at a time.
+
+``submit --until-decided`` writes the study and its rounds record and submits round 1
+with a follow-up job running ``ligwf slurm next-round STUDY`` instead of the plain
+analysis job; that job analyses, reports and takes the look, then writes and submits the
+next round with another follow-up job of its kind, until the study stops (final report).
+``resubmit`` on such a study submits what keeps it going (the cases of the round that did
+not finish, with a follow-up; or the follow-up job alone when a look is due and no job
+will take it). The chain is :mod:`ligwf.pipeline.submit_rounds`; this module parses and
+prints.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import os
+from functools import partial
+from pathlib import Path
+
+from ligwf.cli.common import (console, grouped_warnings, number_in, positive_int,
+                              print_warning)
+from ligwf.cli.report import add_snapshots, print_report
+from ligwf.cli.study import show_look
+from ligwf.errors import ConfigError
+from ligwf.pipeline.prepare import Prepared
+from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, start_rounds
+from ligwf.pipeline.submit_rounds import (INCOMPLETE, NEXT_ROUND, STOPPED, FollowUp, Moved,
+                                          keep_going, progress, recorded_steps)
+from ligwf.scheduler import Scheduler
+from ligwf.study.rounds import DEFAULT_LOOKS
+
+#: how long a follow-up job waits for case tasks Slurm still shows (a task that has just
+#: ended may still be completing), seconds
+SETTLE_SECONDS = 60.0
+
+
+def add_until_decided_args(p: argparse.ArgumentParser) -> None:
+    """``--until-decided``, ``--max-looks``, ``--max-core-hours``, ``--no-snapshots``."""
+    p.add_argument("--until-decided", action="store_true",
+                   help="a sequential study (as 'ligwf study --until-decided'): each round a "
+                   "dependent array whose follow-up job ('ligwf slurm next-round') takes the "
+                   "look and submits the next round")
+    p.add_argument("--max-looks", type=partial(positive_int, unit="looks"),
+                   default=DEFAULT_LOOKS, help="with --until-decided: looks at most (each "
+                   f"tests at 0.05 / looks; default {DEFAULT_LOOKS})")
+    p.add_argument("--max-core-hours", type=number_in(1e-6, 1e9, "core-h"), default=None,
+                   metavar="H", help="with --until-decided: stop before a round would take "
+                   "the study's runs past H core-hours")
+    add_snapshots(p)
+
+
+def add_next_round_parser(sub, add_mesh_cache) -> argparse.ArgumentParser:
+    p = sub.add_parser(NEXT_ROUND, help="the follow-up job of a study submitted "
+                       "--until-decided: analyse, report and take the look, then submit the "
+                       "next round (or write the final report); safe to run again")
+    p.add_argument("study_dir", type=Path, help="study folder")
+    p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR",
+                   help="user template folder the study was written with (repeatable)")
+    p.add_argument("--allow-unstable", action="store_true",
+                   help="as given to the first submission (renders added replicas)")
+    add_mesh_cache(p)
+    add_snapshots(p)
+    return p
+
+
+def follow_up_of(args: argparse.Namespace, planned: bool, cores: int | None) -> FollowUp | None:
+    """The follow-up settings of ``submit --until-decided`` (None without it); refuses the
+    options a sequential study cannot keep."""
+    if not args.until_decided:
+        return None
+    if args.no_analysis:
+        raise ConfigError("--no-analysis: a study --until-decided takes its looks in the "
+                          "follow-up job after each round; drop one of the two")
+    if args.analysis_tasks != 1:
+        raise ConfigError(f"--analysis-tasks = {args.analysis_tasks}: with --until-decided "
+                          "the follow-up job analyses the study itself (allowed: 1)")
+    return FollowUp("slurm", planned, cores, not args.no_snapshots,
+                    tuple(Path(t).resolve() for t in args.templates), args.allow_unstable,
+                    mesh_cache=args.mesh_cache)
+
+
+def dry_run_note(args: argparse.Namespace, out: Path) -> str:
+    return (f"--until-decided: this is round 1; its follow-up job ('ligwf slurm {NEXT_ROUND} "
+            f"{out}') analyses, reports and takes look 1, then plans and submits each later "
+            f"round itself (at most {args.max_looks} looks"
+            + (f", {args.max_core_hours:g} core-h" if args.max_core_hours else "") + ")")
+
+
+def print_submitted(entries) -> None:
+    for e in entries:
+        dep = f" (after {e['after']})" if e.get("after") else ""
+        console.print(f"submitted {e['kind']} job {e['job_id']}{dep}: {e['script']}")
+
+
+def print_moved(moved: Moved) -> None:
+    for look in moved.looks:
+        console.print(f"look {look.number} taken", highlight=False)
+    console.print(moved.note, highlight=False, soft_wrap=True)
+    print_submitted(moved.submitted)
+
+
+def submit_until_decided(args: argparse.Namespace, prepared: Prepared, out: Path,
+                         scheduler: Scheduler, how: FollowUp) -> int:
+    """After the study is written: its rounds record, then what its state asks for (round
+    1 on a new study)."""
+    start_rounds(out, RoundPlan(args.max_looks, args.max_core_hours))
+    print_moved(keep_going(out, scheduler, how, prepared=lambda: prepared))
+    return 0
+
+
+def next_round(args: argparse.Namespace, study_dir: Path, scheduler: Scheduler,
+               planned: bool, cores: int | None) -> int:
+    """``ligwf slurm next-round``: 1 when the round did not finish (no look taken)."""
+    how = FollowUp("slurm", planned, cores, not args.no_snapshots,
+                   tuple(Path(t).resolve() for t in args.templates), args.allow_unstable,
+                   mesh_cache=args.mesh_cache)
+
+    def prepared() -> Prepared:
+        ready = prepare_study_folder(study_dir, (), how.template_dirs, how.allow_unstable)
+        for line in grouped_warnings(ready.warnings, [rc.case.case_id for rc in ready.rendered]):
+            print_warning(line)
+        return ready
+
+    own = os.environ.get("SLURM_JOB_ID")
+    moved = keep_going(study_dir, scheduler, how, prepared, take_looks=True, show=show_look,
+                       wait_seconds=SETTLE_SECONDS if own else 0.0, own_job=own)
+    print_moved(moved)
+    if moved.progress.state == STOPPED:
+        print_report(study_dir, study_dir / "report")
+    return 1 if moved.progress.state == INCOMPLETE else 0
+
+
+def resubmit_rounds(study_dir: Path, scheduler: Scheduler, jobs: list[dict], planned: bool,
+                    cores: int | None, include_unstable: bool, dry_run: bool) -> int:
+    """``ligwf slurm resubmit`` on a sequential study: what keeps it going."""
+    steps = recorded_steps(jobs)
+    how = dataclasses.replace(FollowUp.from_steps(steps, planned, cores),
+                              retry_unstable=include_unstable)
+    if dry_run:
+        p = progress(study_dir, scheduler, include_unstable)
+        console.print(f"sequential study: {p.looks} look(s) taken, round {p.round} "
+                      f"{p.state}" + (f"; would submit case(s) {list(p.unfinished)}"
+                                      if p.unfinished else ""), highlight=False)
+        return 0
+    print_moved(keep_going(study_dir, scheduler, how))
+    return 0
