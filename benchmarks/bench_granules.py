@@ -49,9 +49,9 @@ from ligwf.analysis import granules_numba
 from ligwf.analysis.gsd import bins as gsd
 from ligwf.analysis.frames.dumps import (ContactFrame, ParticleFrame, discover_frames, read_contacts,
                          read_particles)
-from ligwf.analysis.granules.bonds import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
-                            granule_table, identify, label_reference, unwrap_reference)
-from ligwf.analysis.granules.bridge_law import relative_energy
+from ligwf.analysis.granules.bonds import (BondCriterion, bonded_contacts, bonded_contacts_reference,
+                                          granule_table, identify, label_reference, unwrap_reference)
+from ligwf.analysis.granules.bridge_law import Liquid, relative_energy
 from ligwf.analysis.granules.communities import cpm_labels
 from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
 from ligwf.scene.settings import AnalysisSettings

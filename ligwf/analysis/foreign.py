@@ -26,10 +26,10 @@ from pathlib import Path
 
 from ligwf import liquids
 from ligwf.analysis.granules.case import GranuleAnalysis, RunFacts
-from ligwf.analysis.frames.dumps import FrameFiles, read_particles
+from ligwf.analysis.frames.dumps import AXES, FrameFiles, read_particles
 from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
                                           nothing_analysed, stage_granules)
-from ligwf.analysis.granules.bonds import AXES, Liquid
+from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError

@@ -12,7 +12,7 @@ import pytest
 
 from ligwf.analysis.granules.case import RunFacts
 from ligwf.analysis.frames.dumps import read_contacts, read_particles
-from ligwf.analysis.granules.bonds import Liquid
+from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.cli.main import main
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study import layout

@@ -17,9 +17,11 @@ from ligwf.liquids import washino
 from ligwf.liquids.capillary import rupture_distance
 from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
 from ligwf.errors import DumpReadError
-from ligwf.analysis.granules.bonds import (BondCriterion, Liquid, bonded_contacts, bonded_contacts_reference,
-                            comoving, force_law_positive, granule_table, identify_fast,
-                            identify_reference, label_fast, label_reference, louvain_labels)
+from ligwf.analysis.granules.bonds import (BondCriterion, bonded_contacts, bonded_contacts_reference,
+                                          comoving, granule_table, identify_fast,
+                                          identify_reference, label_fast, label_reference)
+from ligwf.analysis.granules.bridge_law import Liquid, force_law_positive
+from ligwf.analysis.granules.communities import louvain_labels
 from wetdump import wet_case_frames
 
 

@@ -9,7 +9,8 @@ import pytest
 from pathlib import Path
 
 from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
-from ligwf.analysis.granules.bonds import BondCriterion, Liquid, identify_fast, identify_reference
+from ligwf.analysis.granules.bonds import BondCriterion, identify_fast, identify_reference
+from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.engine.render import render
 from ligwf.errors import ConfigError
 from ligwf.scene.scaling import Rule

@@ -9,8 +9,7 @@ frames and report the same reasons:
   steps of its scene up to the step the manifest says it reached
   (:meth:`~ligwf.study.case.CaseFolder.expected_dump_steps`). A missing particle or
   contact dump, a dump at a step the run never writes (beyond the run, or off the dump
-  interval) is a problem of that frame: listed with its reason, never analysed, and so is a
-  particle dump that holds the same bytes as the frame before it (a copy). When the
+  interval) is a problem of that frame: listed with its reason, never analysed. When the
   run left a dump record (:meth:`~ligwf.study.case.CaseFolder.dump_record`),
   :meth:`FramePlan.check_record` refuses a file whose size or SHA-256 differs from what
   the run left (done by whoever reads the frame, so MPI ranks share the hashing).
@@ -40,10 +39,10 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ligwf.analysis.frames.dumps import ContactFrame, FrameFiles, ParticleFrame, dump_files, read_particles
-from ligwf.analysis.granules.bonds import AXES
+from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files,
+                                         read_particles)
 from ligwf.errors import ConfigError, DumpReadError
-from ligwf.study.case import CaseFolder, DumpRecord, file_digest
+from ligwf.study.case import CaseFolder, DumpRecord
 
 #: Relative slack of the geometric checks (float32 positions, mesh facets vs circle).
 GEOMETRY_SLACK = 0.05
@@ -161,32 +160,9 @@ def plan_frames(case: CaseFolder) -> FramePlan:
         elif s.granules and contact is None:
             refuse(step, f"missing frame: no contact dump for step {step} "
                    f"(its particle dump {part.name} is left)")
-        elif (copy := _copy_of(frames[-1] if frames else None, part, record)) is not None:
-            refuse(step, f"{part}: byte for byte the particle dump of step {copy} (a copy of "
-                   "it: the bed moves between two dumps of a turning drum)", "duplicate")
         else:
             frames.append(FrameFiles(step, part, contact))
     return FramePlan(case.case_id, tuple(frames), tuple(problems), len(expected), record)
-
-
-def _copy_of(prev: FrameFiles | None, part: Path, record: DumpRecord | None) -> int | None:
-    """The step of ``prev`` when ``part`` holds the same bytes as its particle dump (a frame
-    copied over its neighbour), else None. Files of different sizes differ; with a dump
-    record the run's own digests are compared (a copy made after the run fails the
-    record check anyway), without one the two files are hashed."""
-    if prev is None:
-        return None
-    try:
-        if os.stat(prev.particles).st_size != os.stat(part).st_size:
-            return None
-    except OSError:
-        return None
-    if record is not None:
-        a, b = record.files.get(prev.particles.name), record.files.get(part.name)
-        same = a is not None and b is not None and a[1] == b[1]
-    else:
-        same = file_digest(prev.particles) == file_digest(part)
-    return prev.step if same else None
 
 
 def _fail(p: ParticleFrame | ContactFrame, what: str) -> None:

@@ -37,6 +37,9 @@ from ligwf.errors import DumpReadError
 PARTICLE_ARRAYS = ("id", "type", "v", "radius")
 CONTACT_ARRAYS = ("id1", "id2", "delta")
 _CONTACT_WANTED = frozenset(CONTACT_ARRAYS)     # contact geometry (Points) is not used
+#: the axis letters in the order of a position's columns (``AXES.index("y") == 1``)
+AXES = "xyz"
+
 _PARTICLE_RE = re.compile(r"^particles_(\d+)\.vtu$")
 _CONTACT_RE = re.compile(r"^contacts_(\d+)\.vtu$")
 

@@ -40,13 +40,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-# Liquid and louvain_labels live in their own modules; callers import them from here too
-from ligwf.analysis.granules.bridge_law import (Liquid, bridge_forces, content_of,  # noqa: F401
-                                       force_law_positive, pair_forces)
-from ligwf.analysis.granules.communities import louvain_labels  # noqa: F401
+from ligwf.analysis.granules.bridge_law import Liquid, content_of, force_law_positive, pair_forces
 from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
 
-AXES = "xyz"
 
 
 @dataclass(frozen=True)

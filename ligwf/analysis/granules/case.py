@@ -19,12 +19,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.frames.dumps import (ContactFrame, FrameFiles, ParticleFrame, read_contacts,
-                                  read_particles)
+from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame,
+                                         read_contacts, read_particles)
 from ligwf.analysis.granules.persistent import Frame, bridge_keys, persistent_labels, presence_run
 from ligwf.analysis.frames.checks import FramePlan, check_contacts, check_particles, plan_frames
 from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
-from ligwf.analysis.granules.bonds import AXES, Liquid, bonded_contacts, granule_table, louvain_labels
+from ligwf.analysis.granules.bonds import bonded_contacts, granule_table
+from ligwf.analysis.granules.bridge_law import Liquid
+from ligwf.analysis.granules.communities import louvain_labels
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.fsio import atomic_write_bytes
 from ligwf.scene.settings import AnalysisSettings

@@ -27,7 +27,8 @@ import numpy as np
 
 from ligwf.analysis.granules.definitions import Motion, drum_frame_velocities
 from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
-from ligwf.analysis.granules.bonds import BondCriterion, Identification, Liquid, bonded_contacts, components
+from ligwf.analysis.granules.bonds import BondCriterion, Identification, bonded_contacts, components
+from ligwf.analysis.granules.bridge_law import Liquid
 
 #: every bridge the engine still holds counts (no force or velocity-angle filter)
 ALL_BRIDGES = BondCriterion(0.0, 180.0)
