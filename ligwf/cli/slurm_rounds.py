@@ -48,7 +48,8 @@ def add_until_decided_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--max-core-hours", type=number_in(1e-6, 1e9, "core-h"), default=None,
                    metavar="H", help="with --until-decided: stop before a round would take "
                    "the study's runs past H core-hours")
-    add_snapshots(p)
+    p.add_argument("--no-snapshots", action="store_true", help="with --until-decided: the "
+                   "final report without the pyvista snapshots (the slowest figures)")
 
 
 def add_next_round_parser(sub, add_mesh_cache) -> argparse.ArgumentParser:
