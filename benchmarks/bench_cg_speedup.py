@@ -34,7 +34,8 @@ sys.path.insert(0, str(ROOT))
 from benchmarks.quiet import check_quiet  # noqa: E402
 from ligwf.study.manifest import DONE  # noqa: E402
 from ligwf.engine.launch import run_case  # noqa: E402
-from ligwf.engine.plan import case_load, machine_cores, plan_ranks  # noqa: E402
+from ligwf.engine.cores import machine_cores  # noqa: E402
+from ligwf.engine.plan import case_load, plan_ranks  # noqa: E402
 from ligwf.engine.site import EngineConfig  # noqa: E402
 from ligwf.scene.workflow import load_workflow  # noqa: E402
 from ligwf.pipeline.prepare import render_workflow, write_study  # noqa: E402

@@ -27,7 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 from benchmarks.quiet import check_quiet  # noqa: E402
 from ligwf.study.manifest import DONE  # noqa: E402
-from ligwf.engine.plan import machine_cores  # noqa: E402
+from ligwf.engine.cores import machine_cores  # noqa: E402
 from ligwf.study.study import Study  # noqa: E402
 
 TARGET = 1.10

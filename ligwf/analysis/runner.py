@@ -79,9 +79,9 @@ from ligwf.study import layout
 from ligwf.study.case import CaseFolder, folder_fingerprint, granules_absent
 from ligwf.study.study import Study
 
-__all__ = ["AnalysisOptions", "AnalysisPlan", "analyse", "analyse_part", "merge_parts"]
+__all__ = ["AnalysisOptions", "AnalysisPlan", "analyse", "analyse_part", "merge_parts", "mpi_comm"]
 
-def _mpi_comm():
+def mpi_comm():
     """MPI.COMM_WORLD when started under mpirun with more than one rank, else None."""
     if not any(k in os.environ for k in ("OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK")):
         return None
@@ -217,7 +217,7 @@ def analyse(run_dir: Path, out_dir: Path | None = None, options: AnalysisOptions
     (outputs untouched) when no frame could be analysed."""
     plan = plan_analysis(run_dir, options)
     out_dir = Path(out_dir) if out_dir is not None else plan.study.analysis_dir
-    comm = _mpi_comm() if comm is None else comm
+    comm = mpi_comm() if comm is None else comm
     rank, size = (comm.Get_rank(), comm.Get_size()) if comm is not None else (0, 1)
     token = new_token() if comm is None else comm.bcast(new_token() if rank == 0 else None)
     outputs = OutputSet(out_dir, token)

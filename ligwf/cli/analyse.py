@@ -54,7 +54,7 @@ def register(subparsers) -> None:
 
 
 def cmd_analyse(args: argparse.Namespace) -> int:
-    from ligwf.analysis.runner import AnalysisOptions, _mpi_comm
+    from ligwf.analysis.runner import AnalysisOptions, mpi_comm
     from ligwf.pipeline.post import analyse_study
     from ligwf.study.study import Study
 
@@ -65,7 +65,7 @@ def cmd_analyse(args: argparse.Namespace) -> int:
         return cmd_split(args, options)
     if args.token is not None or args.dry_run:
         raise ConfigError("--token and --dry-run belong to --slurm / --part / --merge")
-    comm = _mpi_comm()
+    comm = mpi_comm()
     try:
         record = analyse_study(args.run_dir, args.out, options, comm)
     except LigwfError as exc:          # a refusal: one line (every rank got here or is done)

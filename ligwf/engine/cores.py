@@ -12,7 +12,7 @@ from typing import Mapping
 from ligwf.errors import ConfigError
 
 
-def _at_least(field: str, value: object, lowest: int) -> int:
+def at_least(field: str, value: object, lowest: int) -> int:
     """``value`` as a whole number >= ``lowest``; ConfigError naming the field otherwise
     (also the rank planner's check of its counts)."""
     if isinstance(value, bool) or not isinstance(value, int) or value < lowest:
@@ -27,7 +27,7 @@ def available_cores(explicit: int | None, environ: Mapping[str, str],
     option), else the tasks of the Slurm allocation this runs in (``SLURM_NTASKS``: the
     ranks ``mpirun`` may start there), else the CPUs this process may run on."""
     if explicit is not None:
-        return _at_least("--cores", explicit, 1), "--cores"
+        return at_least("--cores", explicit, 1), "--cores"
     if environ.get("SLURM_JOB_ID") and environ.get("SLURM_NTASKS"):
         text = environ["SLURM_NTASKS"]
         try:
@@ -38,7 +38,7 @@ def available_cores(explicit: int | None, environ: Mapping[str, str],
             raise ConfigError(f"SLURM_NTASKS = {text!r}: must be a whole number (allowed "
                               "range [1, inf))")
         return value, "SLURM_NTASKS"
-    return _at_least("CPU affinity", affinity, 1), "CPUs this process may use"
+    return at_least("CPU affinity", affinity, 1), "CPUs this process may use"
 
 
 def machine_cores(explicit: int | None = None) -> tuple[int, str]:

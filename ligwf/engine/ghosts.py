@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from ligwf.engine.thermo import _LOOP_RE
+from ligwf.engine.thermo import LOOP_RE
 
 _TIME_RE = re.compile(r"^(Pair|Neigh|Comm|Outpt|Other)\s+time \(%\) = ([0-9.eE+-]+)")
 _COUNT_RE = re.compile(r"^(Nlocal|Nghost):\s+([0-9.eE+-]+) ave ([0-9.eE+-]+) max "
@@ -55,7 +55,7 @@ def run_spreads(log_text: str) -> list[RankSpread]:
     cur: dict | None = None
     for raw in log_text.splitlines():
         line = raw.strip()
-        if m := _LOOP_RE.match(line):
+        if m := LOOP_RE.match(line):
             cur = {"loop_seconds": float(m.group(1)), "procs": int(m.group(2)),
                    "steps": int(m.group(3)), "atoms": int(m.group(4)), "seconds": {}}
         elif cur is not None and (m := _TIME_RE.match(line)):

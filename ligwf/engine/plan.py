@@ -47,7 +47,7 @@ from typing import Mapping, Sequence
 
 from ligwf.engine.decomposition import (Bed, GridCost, axial_slab_limit, best_grid,
                                         scene_bed)
-from ligwf.engine.cores import _at_least, available_cores, machine_cores  # noqa: F401
+from ligwf.engine.cores import at_least
 from ligwf.errors import ConfigError
 from ligwf.scene.scaling import ScaledScene
 
@@ -106,8 +106,8 @@ class CaseLoad:
         where = f"case {self.name!r}: " if self.name else ""
         if not self.name:
             raise ConfigError("case name = '': must not be empty")
-        _at_least(f"{where}particles", self.particles, 1)
-        _at_least(f"{where}steps", self.steps, 1)
+        at_least(f"{where}particles", self.particles, 1)
+        at_least(f"{where}steps", self.steps, 1)
         for field in ("drum_length", "d_max"):
             value = getattr(self, field)
             if not isinstance(value, (int, float)) or not value > 0 or value == float("inf"):
@@ -133,7 +133,7 @@ def case_load(name: str, scaled: ScaledScene) -> CaseLoad:
 def case_grid(load: CaseLoad, ranks: int) -> GridCost:
     """The processor grid ``load`` runs on at ``ranks`` ranks and its modelled cost (the
     runner's grid: :func:`ligwf.engine.render.processor_grid`)."""
-    return best_grid(_at_least("ranks", ranks, 1), load.drum_length, load.d_max,
+    return best_grid(at_least("ranks", ranks, 1), load.drum_length, load.d_max,
                      load.periodic, load.bed)
 
 
@@ -142,7 +142,7 @@ def efficiency(load: CaseLoad, ranks: int) -> float:
     the decomposition model's for the case's grid (calibrated on the one measurement, 0.88
     on 2 axial ranks); :data:`MULTI_RANK_EFFICIENCY` where no grid fits or its cost is
     unknown (a cut across a drum whose bed is not given, e.g. ``--np`` beyond the slabs)."""
-    if _at_least("ranks", ranks, 1) == 1:
+    if at_least("ranks", ranks, 1) == 1:
         return 1.0
     try:
         value = case_grid(load, ranks).efficiency
@@ -188,11 +188,11 @@ def rank_limits(load: CaseLoad, cores: int | None,
                 min_particles_per_rank: int = MIN_PARTICLES_PER_RANK) -> dict[str, int]:
     """Each rule's largest rank count for ``load``: particles per rank, the axial slab
     rule and (when given) the cores."""
-    _at_least("min_particles_per_rank", min_particles_per_rank, 1)
+    at_least("min_particles_per_rank", min_particles_per_rank, 1)
     limits = {BOUND_SLAB: axial_slab_limit(load.drum_length, load.d_max),
               BOUND_PARTICLES: max(1, load.particles // min_particles_per_rank)}
     if cores is not None:
-        limits[BOUND_CORES] = _at_least("cores", cores, 1)
+        limits[BOUND_CORES] = at_least("cores", cores, 1)
     return limits
 
 
@@ -290,7 +290,7 @@ class Schedule:
 def list_schedule_seconds(durations: Sequence[float], groups: int) -> float:
     """When the last of ``durations`` ends if ``groups`` workers each take the next one
     in order as soon as they are free (what the ensemble's claims do)."""
-    _at_least("groups", groups, 1)
+    at_least("groups", groups, 1)
     free = [0.0] * groups
     for d in durations:
         heapq.heappush(free, heapq.heappop(free) + d)
@@ -309,7 +309,7 @@ def plan_study(loads: Sequence[CaseLoad], cores: int,
     """Ranks per case and the phases that pack them onto ``cores`` cores (see the module
     docstring): one phase per rank count, widest first; in a phase as many groups as
     fit the cores (never more than its cases), longest case first."""
-    _at_least("cores", cores, 1)
+    at_least("cores", cores, 1)
     _unique_names(loads)
     plans = tuple(plan_ranks(l, cores, min_particles_per_rank) for l in loads)
     phases = []
@@ -345,7 +345,7 @@ def allocation_schedule(loads: Sequence[CaseLoad], cores_per_case: int | None = 
 
 def fixed_ranks(loads: Sequence[CaseLoad], ranks: int, bound: str) -> tuple[CasePlan, ...]:
     """Every case on ``ranks`` ranks because option ``bound`` says so (no planning)."""
-    _at_least(bound, ranks, 1)
+    at_least(bound, ranks, 1)
     return tuple(case_plan(l, ranks, bound) for l in loads)
 
 
@@ -354,8 +354,8 @@ def override_schedule(loads: Sequence[CaseLoad], nprocs: int, ensemble: int = 0,
     """What ``--np K`` (every case on K ranks, one after the other) or ``--ensemble P``
     (all cases, in study order, in one mpirun of P ranks, groups of K) do: no planning,
     no core limit (the user asked for it); ``cores`` only for the fill estimate."""
-    _at_least("--np", nprocs, 1)
-    _at_least("--ensemble", ensemble, 0)
+    at_least("--np", nprocs, 1)
+    at_least("--ensemble", ensemble, 0)
     for field, value in (("--np", nprocs), ("--ensemble", ensemble)):
         if value > MAX_RANKS:
             raise ConfigError(f"{field} = {value}: allowed range [1, {MAX_RANKS}] MPI ranks")
@@ -369,4 +369,4 @@ def override_schedule(loads: Sequence[CaseLoad], nprocs: int, ensemble: int = 0,
                      list_schedule_seconds([p.estimated_seconds for p in plans], groups)),)
               if plans else ())
     used = cores if cores is not None else (ensemble or nprocs)
-    return Schedule(_at_least("cores", used, 1), plans, phases, planned=False)
+    return Schedule(at_least("cores", used, 1), plans, phases, planned=False)

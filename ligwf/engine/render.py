@@ -23,7 +23,7 @@ import jinja2
 from ligwf import __version__
 from ligwf.errors import RenderError
 from ligwf.liquids.contact_angle import input_angle
-from ligwf.engine.decomposition import MIN_AXIAL_SLAB, axial_slab_limit, runner_grid  # noqa: F401
+from ligwf.engine.decomposition import runner_grid
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.model import GRAVITY, unsafe_chars

@@ -34,7 +34,8 @@ COLUMN_NAMES = {
 #: Prefix of the phase markers printed by the rendered input.
 PHASE_MARKER = "ligwf-phase"
 
-_LOOP_RE = re.compile(r"^Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
+#: The engine's line after each run command: wall seconds, ranks, steps, atoms.
+LOOP_RE = re.compile(r"^Loop time of ([0-9.eE+-]+) on (\d+) procs for (\d+) steps with (\d+) atoms")
 
 
 def phase_group(marker: str) -> str:
@@ -96,7 +97,7 @@ class ThermoParser:
             self._header = [COLUMN_NAMES.get(t, t) for t in tokens]
             self.runs.append(RunBlock(phase=self.phase))
             return None
-        loop = _LOOP_RE.match(stripped)
+        loop = LOOP_RE.match(stripped)
         if loop:
             if self.runs:
                 run = self.runs[-1]

@@ -24,8 +24,8 @@ from typing import Callable, Iterable, Sequence
 
 from ligwf.engine.ensemble import run_ensemble
 from ligwf.engine.launch import Monitor, run_case, take_over
-from ligwf.engine.plan import (Phase, Schedule, case_load, machine_cores, override_schedule,
-                               plan_study)
+from ligwf.engine.cores import machine_cores
+from ligwf.engine.plan import Phase, Schedule, case_load, override_schedule, plan_study
 from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig, EngineIdentity
 from ligwf.errors import LigwfError
@@ -66,7 +66,7 @@ class RunSettings:
     retry_unstable: bool = False
     template_dirs: tuple[Path, ...] = ()
     cores: int = 1                  # cores a planned run fills
-    cores_source: str = "given"     # where ``cores`` came from (engine.plan.available_cores)
+    cores_source: str = "given"     # where ``cores`` came from (engine.cores.available_cores)
 
     @property
     def planned(self) -> bool:
@@ -77,7 +77,7 @@ def run_settings(nprocs: int | None = None, ensemble: int = 0, cores: int | None
                  retry_unstable: bool = False,
                  template_dirs: Iterable[Path] = ()) -> RunSettings:
     """How ``ligwf run`` / ``study`` run: planned on the cores of this machine or
-    allocation (``cores`` to say otherwise, :func:`ligwf.engine.plan.machine_cores`) unless
+    allocation (``cores`` to say otherwise, :func:`ligwf.engine.cores.machine_cores`) unless
     ``nprocs`` or ``ensemble`` is given (``ensemble`` alone keeps groups of one rank)."""
     count, source = machine_cores(cores)
     if nprocs is None and ensemble:

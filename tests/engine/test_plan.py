@@ -8,12 +8,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ligwf.engine.plan import (MIN_PARTICLES_PER_RANK, CaseLoad, allocation_schedule,
-                               available_cores, case_load,
+from ligwf.engine.cores import available_cores
+from ligwf.engine.decomposition import MIN_AXIAL_SLAB
+from ligwf.engine.plan import (MIN_PARTICLES_PER_RANK, CaseLoad, allocation_schedule, case_load,
                                estimated_seconds, fixed_ranks, list_schedule_seconds,
                                override_schedule, particle_steps, plan_ranks, plan_study,
                                rank_limits)
-from ligwf.engine.render import MIN_AXIAL_SLAB
 from ligwf.errors import ConfigError
 from ligwf.scene.workflow import load_workflow
 

@@ -154,7 +154,8 @@ def test_processor_grid_never_cuts_along_gravity(axis, grid):
 
 
 def test_processor_grid_puts_ranks_along_the_axis_first():
-    from ligwf.engine.render import MIN_AXIAL_SLAB, grid_vars, processor_grid
+    from ligwf.engine.decomposition import MIN_AXIAL_SLAB
+    from ligwf.engine.render import grid_vars, processor_grid
 
     wf = load_workflow(DRUM, ["sweep.cg_levels=[1, 3]", "sweep.rules=[weber]"])
     cg1, cg3 = (c.scaled() for c in wf.cases)
