@@ -105,11 +105,26 @@ def _one_line(exc: yaml.YAMLError) -> str:
     return f"not valid YAML{where}: {what}"
 
 
+#: characters YAML folds into a line break or a space without a word (C1 controls such as
+#: NEL U+0085, line and paragraph separators): ``--set name=a<NEL>b`` became "a b"
+_SILENT_BREAKS = re.compile("[\u0080-\u009f\u2028\u2029]")
+
+
 def parse_yaml(text: str, source: str) -> Any:
     """Parse YAML text (``source`` names it in errors); ConfigError on anything refused."""
     if "\0" in text:
         raise ConfigError(f"{source}: holds a NUL character")
-    loader = _StrictLoader(text)
+    if m := _SILENT_BREAKS.search(text):
+        line = text.count("\n", 0, m.start()) + 1
+        column = m.start() - (text.rfind("\n", 0, m.start()) + 1) + 1
+        raise ConfigError(f"{source}: holds U+{ord(m.group()):04X}, a control or line-separator "
+                          f"character, at "
+                          f"line {line}, column {column} (YAML would read it as a line break "
+                          "or a space); remove it, or write it as an escape in double quotes")
+    try:
+        loader = _StrictLoader(text)     # its reader refuses other control characters
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{source}: {_one_line(exc)}") from None
     try:
         node = loader.get_single_node()
         if node is None:

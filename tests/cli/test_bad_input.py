@@ -121,6 +121,13 @@ CORPUS: list[Bad] = [
     Bad("name-hash", ("name", "#"), overrides=("name=a#b",)),
     Bad("name-quote", ("name",), overrides=("name=a'b",)),
     Bad("name-c1-control", ("name", "\\x9b"), overrides=("name=\"a\\x9bb\"",)),
+    # raw control characters on the command line: YAML folded NEL / U+2028 into a space
+    # ("a b", accepted without a word) and an ESC was a ReaderError traceback (issue 32)
+    Bad("set-raw-nel", ("--set name", "U+0085", "line 1, column 2"), overrides=("name=a\x85b",)),
+    Bad("set-raw-line-separator", ("--set name", "U+2028"), overrides=("name=a\u2028b",)),
+    Bad("set-raw-escape", ("--set name", "#x001b"), overrides=("name=a\x1bb",)),
+    Bad("file-raw-nel", ("workflow", "U+0085", "line 2"),
+        text=BASE.replace("name: drum-slice", "name: a\x85b")),
     Bad("wet-granules-hold-no-particle", ("scene.liquid.wet_granules.radius = 1e-07",
                                           "largest particle diameter", "allowed range"),
         overrides=("scene.liquid.placement=granules",
