@@ -17,7 +17,7 @@ from pathlib import Path
 from ligwf import liquids
 from ligwf.cli.analyse import print_record
 from ligwf.cli.common import folder_to_write, number_in, step_number
-from ligwf.scene.model import MAX_LIQUID_CONTENT
+from ligwf.scene.values import MAX_LIQUID_CONTENT
 
 
 def register(subparsers) -> None:

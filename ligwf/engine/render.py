@@ -26,7 +26,8 @@ from ligwf.liquids.contact_angle import input_angle
 from ligwf.engine.decomposition import runner_grid
 from ligwf.engine.mesh import axis_frame
 from ligwf.scene.scaling import ScaledScene
-from ligwf.scene.model import GRAVITY, unsafe_chars
+from ligwf.scene.model import GRAVITY
+from ligwf.scene.values import unsafe_chars
 from ligwf.study.layout import INPUT_NAME, MESH_NAME
 
 #: Sub-folders the input writes into (the case writer creates them).

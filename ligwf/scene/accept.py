@@ -35,10 +35,10 @@ from pydantic import Field, ValidationError
 
 from ligwf.errors import ConfigError
 from ligwf.scene.messages import format_validation_error
-from ligwf.scene.values import _Frozen
+from ligwf.scene.values import Frozen
 
 
-class AcceptSettings(_Frozen):
+class AcceptSettings(Frozen):
     """The error budget a CG level must meet (tolerances in each metric's unit; None: the
     criterion is not part of the budget)."""
 

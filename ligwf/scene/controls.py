@@ -14,13 +14,14 @@ from typing import Any
 from pydantic import Field
 
 from ligwf.errors import ConfigError
-from ligwf.scene.model import Scene, _Frozen
+from ligwf.scene.model import Scene
+from ligwf.scene.values import Frozen
 
 #: factor on surface tension and viscosity of a cohesionless twin
 COHESIONLESS_FACTOR = 1e-3
 
 
-class FlowMatch(_Frozen):
+class FlowMatch(Frozen):
     """The non-cohesive knobs of a flow-matched control twin (``sweep.controls:
     [flow_matched]``): the cohesionless twin with these particle properties, chosen so that
     the dry bed flows like the wet one (``ligwf calibrate-control`` measures candidates)."""

@@ -18,18 +18,15 @@ from pydantic import AfterValidator, Field, ValidationError, model_validator
 from ligwf import liquids
 from ligwf.errors import ConfigError
 from ligwf.scene.messages import format_validation_error
-# re-exported: the names other modules import from the scene model
-from ligwf.scene.values import (FORBIDDEN_INPUT_CHARS, MAX_LIQUID_CONTENT,  # noqa: F401
-                                MIN_LENGTH, MIN_RESTITUTION, MIN_TIME, PENDULAR_REASON,
-                                SafeStr, _Frozen, check_input_safe, unsafe_chars,
-                                zero_or_at_least)
+from ligwf.scene.values import (MAX_LIQUID_CONTENT, MIN_LENGTH, MIN_RESTITUTION, MIN_TIME,
+                                PENDULAR_REASON, Frozen, SafeStr, zero_or_at_least)
 
 
 # ---------------------------------------------------------------------------------------
 # Drum
 # ---------------------------------------------------------------------------------------
 
-class Lifters(_Frozen):
+class Lifters(Frozen):
     """Rectangular lifter bars cut radially into the drum shell, evenly spaced."""
 
     count: int = Field(0, ge=0, le=360, description="number of lifters")
@@ -47,7 +44,7 @@ class Lifters(_Frozen):
         return self
 
 
-class Drum(_Frozen):
+class Drum(Frozen):
     """The rotating drum: a cylinder shell (with lifters), axis through the origin."""
 
     diameter: float = Field(ge=1e-3, le=10.0, description="inner shell diameter, m")
@@ -84,7 +81,7 @@ class Drum(_Frozen):
 # Particles
 # ---------------------------------------------------------------------------------------
 
-class SizeClass(_Frozen):
+class SizeClass(Frozen):
     """One class of the size distribution: a diameter, or a diameter range split into bins.
 
     ``fraction`` is a NUMBER fraction (share of particles), not a mass fraction.
@@ -118,7 +115,7 @@ class SizeClass(_Frozen):
         return [(lo + (k + 0.5) * width, self.fraction / self.bins) for k in range(self.bins)]
 
 
-class Particles(_Frozen):
+class Particles(Frozen):
     """Material and size distribution of the primary (CG1) particles."""
 
     density: float = Field(ge=10.0, le=1e5, description="kg/m^3")
@@ -160,7 +157,7 @@ def check_liquid_model(name: str) -> str:
     return name
 
 
-class WetGranules(_Frozen):
+class WetGranules(Frozen):
     """Pre-formed wet granules in a dry bed (``liquid.placement: granules``): after the
     fill, every particle is dried and those whose centres lie in one of ``count`` spheres
     of ``radius`` get ``liquid_content``; the spheres sit in the settled bed (half-way
@@ -176,7 +173,7 @@ class WetGranules(_Frozen):
         "inside the spheres", json_schema_extra={"bound_reason": PENDULAR_REASON})
 
 
-class Liquid(_Frozen):
+class Liquid(Frozen):
     """The binder liquid and its bridge model (a name of :mod:`ligwf.liquids`' registry).
 
     ``liquid_content`` is the liquid volume as a FRACTION of each particle's solid volume
@@ -238,7 +235,7 @@ class Liquid(_Frozen):
 GRAVITY = 9.81  # m/s^2, the value written to the LIGGGHTS input
 
 
-class Rotation(_Frozen):
+class Rotation(Frozen):
     """Drum speed, as rpm or as Froude number Fr = omega^2 R / g (give exactly one)."""
 
     rpm: float | None = Field(None, ge=0.01, le=1e4, description="revolutions per minute")
@@ -258,7 +255,7 @@ class Rotation(_Frozen):
         return math.sqrt(self.froude * GRAVITY / drum_radius)  # type: ignore[operator]
 
 
-class Process(_Frozen):
+class Process(Frozen):
     """How the drum is filled and turned."""
 
     rotation: Rotation
@@ -271,7 +268,7 @@ class Process(_Frozen):
     run_time: float = Field(ge=MIN_TIME, le=1e4, description="s, drum rotating")
 
 
-class Numerics(_Frozen):
+class Numerics(Frozen):
     """Integration and output settings."""
 
     dt_rayleigh_fraction: float = Field(0.15, ge=1e-3, le=2.0,
@@ -301,7 +298,7 @@ class Numerics(_Frozen):
                       description="base random seed (ligwf derives primes > 10000 from it)")
 
 
-class Analysis(_Frozen):
+class Analysis(Frozen):
     """Which analyses the run must prepare output for."""
 
     granules: bool = Field(False, description="write contact dumps for granule analysis")
@@ -312,7 +309,7 @@ MAX_DUMPS = 20_000
 MAX_THERMO_LINES = 2_000_000
 
 
-class Scene(_Frozen):
+class Scene(Frozen):
     """One original-size (CG1) drum simulation."""
 
     name: SafeStr = Field("scene", min_length=1, max_length=80, description="scene name "

@@ -27,7 +27,8 @@ from pydantic import BaseModel
 
 from ligwf import liquids
 from ligwf.scene.accept import AcceptSettings
-from ligwf.scene.model import MAX_DUMPS, MAX_LIQUID_CONTENT, Scene
+from ligwf.scene.model import MAX_DUMPS, Scene
+from ligwf.scene.values import MAX_LIQUID_CONTENT
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.scene.stability import CLOSED_MIN, SLICE_MIN, SLICE_WARN
 from ligwf.scene.workflow import MAX_CASES, MAX_REPLICAS, Sweep

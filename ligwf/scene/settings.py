@@ -18,14 +18,14 @@ from pydantic import Field, ValidationError, field_validator
 
 from ligwf.errors import ConfigError
 from ligwf.scene.messages import format_validation_error
-from ligwf.scene.model import _Frozen
+from ligwf.scene.values import Frozen
 
 
 #: largest seed: numpy's legacy generator (the compiled CPM optimiser's) takes 32 bits
 MAX_SEED = 2**32 - 1
 
 
-class AnalysisSettings(_Frozen):
+class AnalysisSettings(Frozen):
     """What the analysis of a study uses.
 
     The granule definition (``granules`` and the fields after it) defaults to ``held``:

@@ -1,9 +1,9 @@
 """What a scene value may be: safe strings, numbers that are numbers, physical floors.
 
-The base of every parameter object (:class:`_Frozen`: immutable, unknown keys refused,
+The base of every parameter object (:class:`Frozen`: immutable, unknown keys refused,
 finite numbers that are never text or a yes/no value, also inside lists and mappings) and
-the checks the scene model's fields share. Split from :mod:`ligwf.scene.model`, which
-re-exports these names.
+the checks the scene model's fields share (:mod:`ligwf.scene.model` and the other parameter
+modules import them from here).
 """
 
 from __future__ import annotations
@@ -152,7 +152,7 @@ def _scalar_problem(value: Any, annotation: Any,
     return None
 
 
-class _Frozen(BaseModel):
+class Frozen(BaseModel):
     """Base of all parameter objects: immutable, unknown keys are errors (typos), numbers
     are finite, never a YAML ``true``/``false`` (pydantic would read true as 1.0) and never
     text (pydantic would read "2500" as 2500)."""

@@ -37,7 +37,8 @@ from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
 from ligwf.scene.messages import format_validation_error, short_repr
 from ligwf.scene.controls import FlowMatch, control_scene
-from ligwf.scene.model import Scene, SafeStr, _Frozen, build_scene
+from ligwf.scene.model import Scene, build_scene
+from ligwf.scene.values import Frozen, SafeStr
 from ligwf.scene.settings import AnalysisSettings, build_analysis_settings
 
 _TOP_KEYS = {"name", "description", "scene", "sweep", "analysis", "accept"}
@@ -47,7 +48,7 @@ MAX_REPLICAS = 1000
 MAX_CASES = 5000
 
 
-class Sweep(_Frozen):
+class Sweep(Frozen):
     """What varies between the cases of a workflow (scene-field lists are kept apart)."""
 
     cg_levels: tuple[float, ...] = Field((1.0,), min_length=1, description="coarse-graining "
