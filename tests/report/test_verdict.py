@@ -6,7 +6,7 @@ cheapest-level sentence, the GSD gated by the granule controls, control twins le
 the ``accept:`` block (validation, ``--set``) and the written records.
 
 The runs are chosen so the expected state follows from the arithmetic of Welch's interval
-(checked against scipy's own Welch test in tests/analysis/test_equivalence.py).
+(checked against scipy's own Welch test in tests/analysis/records/test_equivalence.py).
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ and the solid-fraction error.
   distance lies within D +- |e|, e the noise; |e| <= t sqrt(S) with t Student's 1 - alpha / 2
   quantile at the Satterthwaite degrees of freedom of S taken as one component (the
   most correlated case, the widest), so each bound holds with probability >= 1 - alpha
-  whatever the nodes' correlation (``tests/analysis/test_field_criterion.py`` measures it).
+  whatever the nodes' correlation (``tests/analysis/records/test_field_criterion.py`` measures it).
   Reported at the kernel widths ``CRITERION_KERNELS`` (CG1 diameters); the verdict uses
   the study's ``analysis.field_kernel``.
 
