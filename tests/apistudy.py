@@ -1,4 +1,4 @@
-"""A tiny real study for the Python API tests (tests/test_api.py, tests/test_notebook.py),
+"""A tiny real study for the Python API tests (tests/api/test_api.py, tests/test_notebook.py),
 made once per test session through ``ligwf study`` (run + analyse + report).
 
 tests/workflows/tiny_study.yaml with the Weber rule only: CG1 (and its cohesionless twin,
