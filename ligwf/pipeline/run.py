@@ -28,7 +28,7 @@ from ligwf.engine.cores import machine_cores
 from ligwf.engine.plan import Phase, Schedule, case_load, override_schedule, plan_study
 from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig, EngineIdentity
-from ligwf.errors import LigwfError
+from ligwf.errors import ConfigError, LigwfError
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import DONE, case_busy, case_lock
@@ -235,7 +235,11 @@ def run_case_of(study: Study, case: CaseFolder, nprocs: int | None = None,
                 retry_unstable: bool = False, monitor: Monitor | None = None,
                 stop: threading.Event | None = None) -> bool:
     """Run one case of a written study (what a scheduler's array task does) on ``nprocs``
-    ranks, default the allocation's ``SLURM_NTASKS``, else 1. Whether it is done."""
+    ranks, default the allocation's ``SLURM_NTASKS``, else 1. Whether it is done.
+    ConfigError (one line, nothing touched) when the case's scene record is not the one
+    rendering wrote (edited since: its run would be analysed as a skipped case)."""
+    if (why := case.record_problem()) is not None:
+        raise ConfigError(f"{case.path}: not run: {why}")
     ranks = nprocs or int(os.environ.get("SLURM_NTASKS", "1"))
     engine, _ = site_engine()       # refused before the case is locked or touched
     return run_study(study, [case], engine,
