@@ -146,6 +146,9 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
         # the liquid block comes from the case's model (ligwf.liquids): its cohesion
         # keyword, its lines (the contact angle as LIGGGHTS 3.8.0 needs it) and dump columns
         "cohesion": s.liquid.cohesion,
+        # its on/off switches (washino's modifyLbVolume, limitLiquidContent), after all
+        # the models of the pair style; none at the defaults
+        "cohesion_settings": s.liquid.cohesion_settings(s),
         "liquid_lines": s.liquid.liggghts_lines(
             s, input_angle(s.contact_angle_deg, s.contact_angle_compensation)),
         "liquid_dump_columns": s.liquid.dump_columns,

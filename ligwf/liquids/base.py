@@ -27,7 +27,7 @@ import numpy as np
 
 
 class LiquidBlock(Protocol):
-    """The scene's liquid block (``ligwf.scene.model.Liquid``) as a model validates it."""
+    """The scene's liquid block (``ligwf.scene.liquid.Liquid``) as a model validates it."""
 
     surface_tension: float      # N/m
     contact_angle_deg: float
@@ -35,6 +35,8 @@ class LiquidBlock(Protocol):
     liquid_content: float       # liquid volume / solid volume
     min_separation_ratio: float
     max_separation_ratio: float
+    bridge_volume_fraction: float | None    # share of both partners' liquid (None: default)
+    max_liquid_content: float | None        # cap of a particle's liquid content (None: none)
 
 
 class ScaledLiquid(Protocol):
@@ -46,6 +48,8 @@ class ScaledLiquid(Protocol):
     liquid_content: float
     min_separation_ratio: float
     max_separation_ratio: float
+    bridge_volume_fraction: float | None    # None: the model's default (unchanged by CG)
+    max_liquid_content: float | None        # None: no cap (unchanged by CG)
 
 
 @dataclass(frozen=True)
@@ -107,6 +111,16 @@ class LiquidModel(ABC):
     cohesion: str | None = None
     #: every ``fix property/global`` name the cohesion model reads (all must be written)
     properties: tuple[str, ...] = ()
+    #: properties the cohesion model reads only when one of its switches is on (each
+    #: written at most once, together with its switch: :meth:`cohesion_settings`)
+    optional_properties: tuple[str, ...] = ()
+    #: the share of both partners' surface liquid a bridge takes when the scene leaves
+    #: ``liquid.bridge_volume_fraction`` unset; None: the model has no such share (its
+    #: bridge volume is computed otherwise, e.g. easo's caps), so the setting is refused
+    default_bridge_volume_fraction: float | None = None
+    #: True when the engine model can cap each particle's liquid content
+    #: (``liquid.max_liquid_content``); False: the setting is refused
+    limits_liquid_content: bool = False
     #: True when the engine forms a bridge only once the pair has touched
     bridge_needs_contact: bool = False
     #: per-atom columns the cohesion model creates, dumped with the particles
@@ -115,8 +129,40 @@ class LiquidModel(ABC):
     kernels: Kernels
 
     def validate(self, liquid: LiquidBlock) -> list[str]:
-        """Model-specific problems of the scene's liquid block (one message each)."""
-        return []
+        """Model-specific problems of the scene's liquid block (one message each): here,
+        settings the model does not have."""
+        problems = []
+        fraction = getattr(liquid, "bridge_volume_fraction", None)
+        if fraction is not None and self.default_bridge_volume_fraction is None:
+            problems.append(f"bridge_volume_fraction = {fraction:g}: liquid model "
+                            f"{self.name!r} has no bridge volume fraction (only "
+                            "washino's bridge takes a share of both partners' liquid); "
+                            "leave it unset")
+        cap = getattr(liquid, "max_liquid_content", None)
+        if cap is not None and not self.limits_liquid_content:
+            problems.append(f"max_liquid_content = {cap:g}: liquid model {self.name!r} "
+                            "cannot cap the liquid content (only washino can); leave it unset")
+        return problems
+
+    def configured(self, bridge_volume_fraction: float | None) -> "LiquidModel":
+        """This model applying ``bridge_volume_fraction`` (None or the model's default: the
+        registered instance itself, so every default output stays as it was)."""
+        if bridge_volume_fraction is None or (
+                bridge_volume_fraction == self.default_bridge_volume_fraction):
+            return self
+        raise ValueError(f"liquid model {self.name!r} has no bridge volume fraction "
+                         f"(bridge_volume_fraction = {bridge_volume_fraction:g})")
+
+    def capped_separation_ratio(self, r_min: float, r_max: float, max_liquid_content: float,
+                                theta_rad: float) -> float:
+        """The ``maxSeparationDistanceRatio`` the engine applies when it caps the liquid
+        content at ``max_liquid_content`` (radii in m, the applied angle in rad)."""
+        raise ValueError(f"liquid model {self.name!r} cannot cap the liquid content")
+
+    def cohesion_settings(self, s: ScaledLiquid) -> tuple[str, ...]:
+        """Words the ``pair_style gran`` line appends after all its models (the cohesion
+        model's on/off switches); () at every default."""
+        return ()
 
     def liggghts_lines(self, s: ScaledLiquid, angle: InputAngle) -> tuple[Line, ...]:
         """The liquid's lines of the input (before ``pair_style``), property names checked."""
@@ -125,18 +171,21 @@ class LiquidModel(ABC):
     def property_line(self, fix_id: str, name: str, style: str, *values: float) -> Line:
         """``fix <id> all property/global <name> <style> <values>``, refusing a name the
         cohesion model does not read (LIGGGHTS would accept it silently)."""
-        if name not in self.properties:
+        if name not in self.properties + self.optional_properties:
             raise ValueError(f"liquid model {self.name!r}: LIGGGHTS property {name!r} is not "
                              f"one the {self.cohesion} cohesion model reads "
-                             f"({', '.join(self.properties)})")
+                             f"({', '.join(self.properties + self.optional_properties)})")
         return command("fix", fix_id, "all", "property/global", name, style, *values)
 
     def checked_lines(self, lines: tuple[Line, ...]) -> tuple[Line, ...]:
-        """``lines`` if they set every property the cohesion model reads exactly once (a
-        missing one is an engine error at run time, a repeated one overrides silently)."""
+        """``lines`` if they set every property the cohesion model reads exactly once and
+        each optional one at most once (a missing one is an engine error at run time, a
+        repeated one overrides silently)."""
         written = [ln.words[4] for ln in lines if ln.words[:1] == ("fix",)
                    and len(ln.words) > 4 and ln.words[3] == "property/global"]
-        if sorted(written) != sorted(self.properties):
+        optional = [w for w in written if w in self.optional_properties]
+        required = [w for w in written if w not in self.optional_properties]
+        if sorted(required) != sorted(self.properties) or len(set(optional)) != len(optional):
             raise ValueError(f"liquid model {self.name!r} writes properties {written}; the "
                              f"{self.cohesion} cohesion model needs each of "
                              f"{list(self.properties)} once")

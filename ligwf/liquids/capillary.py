@@ -60,10 +60,11 @@ class CapillaryModel(LiquidModel):
     dump_columns = ("f_surfaceLiquidContent",)
 
     def validate(self, liquid: LiquidBlock) -> list[str]:
+        problems = super().validate(liquid)
         if liquid.max_separation_ratio < liquid.min_separation_ratio:
-            return [f"max_separation_ratio = {liquid.max_separation_ratio:g} must be >= "
-                    f"min_separation_ratio = {liquid.min_separation_ratio:g}"]
-        return []
+            problems.append(f"max_separation_ratio = {liquid.max_separation_ratio:g} must "
+                            f"be >= min_separation_ratio = {liquid.min_separation_ratio:g}")
+        return problems
 
     def liggghts_lines(self, s: ScaledLiquid, angle: InputAngle) -> tuple[Line, ...]:
         # LIGGGHTS reads surfaceLiquidContentInitial as a FRACTION of the particle volume

@@ -4,6 +4,19 @@ Mirrors ``cohesion_model_washino_capillary_viscous.h``: the bridge takes a fixed
 both particles' surface liquid, and the force follows Rabinovich et al., Langmuir 21
 (2005) as coded in LIGGGHTS (see :meth:`Washino.capillary_force`). Verified against the
 engine's pair force to 1e-9 (``tests/engine/test_engine_bridge.py``).
+
+Two switches of the engine model (3.8.0 source lines 89-92, 128-129, 153-163, 206-222,
+254-260; docs/liquid_bridges.md) are scene settings:
+
+* ``liquid.bridge_volume_fraction`` (the engine's ``lbVolumeFraction``, read only with the
+  pair_style keyword ``modifyLbVolume on``; default 0.05): the share of both particles'
+  liquid a bridge takes. :meth:`Washino.configured` gives the law at another share, its
+  numba volume kernel compiled with that share (:func:`volume_kernel`).
+* ``liquid.max_liquid_content`` (``maxLiquidContent``, per atom type, read only with
+  ``limitLiquidContent on``): the engine clips a particle's content to it whenever one of
+  its pairs is evaluated, and REPLACES ``maxSeparationDistanceRatio`` by the ratio at
+  which two of the largest particles holding the cap break their bridge
+  (:func:`engine_max_separation_ratio`).
 """
 
 from __future__ import annotations
@@ -12,9 +25,11 @@ import math
 
 import numpy as np
 
-from ligwf.liquids.base import Kernels, sphere_volume
+from functools import lru_cache
+
+from ligwf.liquids.base import InputAngle, Kernels, Line, ScaledLiquid, sphere_volume
 from ligwf.liquids.capillary import CapillaryModel, within_rupture
-from ligwf.numba_cache import cached_jit
+from ligwf.numba_cache import cached_jit, specialised
 
 #: LIGGGHTS' default fraction of the two particles' liquid that forms a washino bridge
 #: (``lbVolumeFraction``, used unless ``modifyLbVolume`` is switched on).
@@ -30,6 +45,33 @@ def bridge_volume(r_i, r_j, content_i, content_j, fraction: float = BRIDGE_VOLUM
 def _volume(ri, rj, lvi, lvj):
     """:func:`bridge_volume` from each partner's liquid volume (m^3), m^3."""
     return BRIDGE_VOLUME_FRACTION * (lvi + lvj)
+
+
+@lru_cache(maxsize=None)
+def volume_kernel(fraction: float):
+    """The numba volume kernel of a bridge taking ``fraction`` of both partners' liquid:
+    ``_volume`` itself at the default share, else a copy with the module constant bound
+    to ``fraction`` (:func:`ligwf.numba_cache.specialised`). Its name carries the share, so
+    the granule kernels it is inlined into are cached under a name of their own."""
+    if fraction == BRIDGE_VOLUME_FRACTION:
+        return _volume
+    tag = "f" + float(fraction).hex().replace(".", "_").replace("+", "p").replace("-", "m")
+    return specialised(_volume.py_func, tag, {"inline": "always", "error_model": "numpy"},
+                       BRIDGE_VOLUME_FRACTION=float(fraction))
+
+
+def engine_max_separation_ratio(r_min: float, r_max: float, max_liquid_content: float,
+                                theta_rad: float,
+                                fraction: float = BRIDGE_VOLUME_FRACTION) -> float:
+    """The ``maxSeparationDistanceRatio`` the engine sets when ``limitLiquidContent`` is on
+    (3.8.0 source lines 206-222): 1 + d / (2 r_min), with d = (1 + theta/2) V^(1/3) the
+    rupture gap of a bridge between two particles of the largest radius ``r_max`` (m)
+    holding ``max_liquid_content``; ``r_min`` (m) the smallest radius. ``theta_rad``: the
+    angle the engine applies (3.8.0 computes it as 0.5 theta_in^2 here too, as in its force
+    law: :func:`ligwf.liquids.contact_angle.applied_contact_angle_rad`). Scale-free: the
+    same at every CG level."""
+    vol = fraction * 2.0 * float(sphere_volume(r_max)) * max_liquid_content
+    return 1.0 + 0.5 * (1.0 + 0.5 * theta_rad) * float(np.cbrt(vol)) / r_min
 
 
 @cached_jit(inline="always", error_model="numpy")
@@ -52,12 +94,52 @@ def _force(ri, rj, gap, gamma, theta, cos_theta, sin_theta, vol):
 
 
 class Washino(CapillaryModel):
+    """The law at one bridge volume fraction (the registered instance: the default 0.05;
+    others from :meth:`configured`)."""
+
     name = "washino"
     cohesion = "washino/capillary/viscous"
-    kernels = Kernels(volume=_volume, within_rupture=within_rupture, force=_force)
+    optional_properties = ("lbVolumeFraction", "maxLiquidContent")
+    default_bridge_volume_fraction = BRIDGE_VOLUME_FRACTION
+    limits_liquid_content = True
+
+    def __init__(self, bridge_volume_fraction: float = BRIDGE_VOLUME_FRACTION) -> None:
+        self.bridge_volume_fraction = float(bridge_volume_fraction)
+        self.kernels = Kernels(volume=volume_kernel(self.bridge_volume_fraction),
+                               within_rupture=within_rupture, force=_force)
+
+    def configured(self, bridge_volume_fraction: float | None) -> "Washino":
+        fraction = (BRIDGE_VOLUME_FRACTION if bridge_volume_fraction is None
+                    else float(bridge_volume_fraction))
+        return WASHINO if fraction == BRIDGE_VOLUME_FRACTION else _washino(fraction)
+
+    def capped_separation_ratio(self, r_min: float, r_max: float, max_liquid_content: float,
+                                theta_rad: float) -> float:
+        return engine_max_separation_ratio(r_min, r_max, max_liquid_content, theta_rad,
+                                           self.bridge_volume_fraction)
+
+    def cohesion_settings(self, s: ScaledLiquid) -> tuple[str, ...]:
+        words: tuple[str, ...] = ()
+        if s.bridge_volume_fraction is not None and (
+                s.bridge_volume_fraction != BRIDGE_VOLUME_FRACTION):
+            words += ("modifyLbVolume", "on")
+        if s.max_liquid_content is not None:
+            words += ("limitLiquidContent", "on")
+        return words
+
+    def liggghts_lines(self, s: ScaledLiquid, angle: InputAngle) -> tuple[Line, ...]:
+        lines = super().liggghts_lines(s, angle)
+        if "modifyLbVolume" in self.cohesion_settings(s):
+            lines += (self.property_line("lq_lbvol", "lbVolumeFraction", "scalar",
+                                         s.bridge_volume_fraction),)
+        if s.max_liquid_content is not None:
+            # per atom type (particles, wall); the wall's never binds (walls hold no liquid)
+            lines += (self.property_line("lq_maxlc", "maxLiquidContent", "peratomtype",
+                                         s.max_liquid_content, s.max_liquid_content),)
+        return self.checked_lines(lines)
 
     def bridge_volume(self, r_i, r_j, content_i, content_j):
-        return bridge_volume(r_i, r_j, content_i, content_j)
+        return bridge_volume(r_i, r_j, content_i, content_j, self.bridge_volume_fraction)
 
     def capillary_force(self, r_i, r_j, gap, surface_tension, theta_rad, content_i,
                         content_j=None):
@@ -73,7 +155,7 @@ class Washino(CapillaryModel):
         content_j = content_i if content_j is None else content_j
         r_i, r_j, gap = (np.asarray(a, float) for a in (r_i, r_j, gap))
         r_eff = r_i * r_j / (r_i + r_j)
-        vol = bridge_volume(r_i, r_j, content_i, content_j)
+        vol = self.bridge_volume(r_i, r_j, content_i, content_j)
         with np.errstate(divide="ignore", invalid="ignore"):
             touching = 2 * np.pi * r_eff * surface_tension * np.cos(theta_rad) * (
                 1.0 - gap * np.sqrt(np.pi * r_eff / (2.0 * vol)))
@@ -91,7 +173,7 @@ class Washino(CapillaryModel):
                                     theta_rad: float, content: float) -> tuple[float, float]:
         """F_0 = 2 pi R* gamma cos(theta), k_b = F_0 sqrt(pi R* / (2 V)) (the slope of
         Rabinovich's eq. A11 as coded in LIGGGHTS), R* = r / 2."""
-        vol = float(bridge_volume(radius, radius, content, content))
+        vol = float(self.bridge_volume(radius, radius, content, content))
         r_eff = 0.5 * radius
         f0 = 2.0 * math.pi * r_eff * surface_tension * math.cos(theta_rad)
         return f0, f0 * math.sqrt(math.pi * r_eff / (2.0 * vol))
@@ -108,9 +190,15 @@ class Washino(CapillaryModel):
             return False
         if not content_min >= 1e-12:          # a dry partner: the law is 0 * inf at contact
             return False
-        v_max = BRIDGE_VOLUME_FRACTION * 2.0 * float(sphere_volume(r_max)) * content_max
+        v_max = self.bridge_volume_fraction * 2.0 * float(sphere_volume(r_max)) * content_max
         r_eff = 0.5 * r_min
         return math.sqrt(2.0 * v_max / (math.pi * r_eff)) / r_eff <= (0.5 * math.pi) ** 2
 
 
 WASHINO = Washino()
+
+
+@lru_cache(maxsize=None)
+def _washino(fraction: float) -> Washino:
+    """One law object per non-default fraction (its kernels compile once per process)."""
+    return Washino(fraction)

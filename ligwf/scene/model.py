@@ -1,6 +1,6 @@
 """Scene model: typed, validated, frozen parameters of one drum simulation, in SI units.
 
-A :class:`Scene` describes the *original* (CG1) system: the drum, the particles, the liquid,
+A :class:`Scene` describes the *original* (CG1) system: the drum, the particles, the liquid (:mod:`ligwf.scene.liquid`),
 the process and the numerics. Coarse graining is a separate, pure stage (``scaling``) that
 turns a Scene plus a CG level and a rule into the parameters LIGGGHTS will see.
 
@@ -11,15 +11,15 @@ the value and the allowed range before any file is written or any engine launche
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any, Literal
+from typing import Any, Literal
 
-from pydantic import AfterValidator, Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
 from ligwf import liquids
 from ligwf.errors import ConfigError
+from ligwf.scene.liquid import Liquid
 from ligwf.scene.messages import format_validation_error
-from ligwf.scene.values import (MAX_LIQUID_CONTENT, MIN_LENGTH, MIN_RESTITUTION, MIN_TIME,
-                                PENDULAR_REASON, Frozen, SafeStr, zero_or_at_least)
+from ligwf.scene.values import MIN_LENGTH, MIN_RESTITUTION, MIN_TIME, Frozen, SafeStr
 
 
 # ---------------------------------------------------------------------------------------
@@ -145,87 +145,6 @@ class Particles(Frozen):
         for c in self.size_distribution:
             out.extend(c.discrete())
         return sorted(out, key=lambda t: -t[0])
-
-
-# ---------------------------------------------------------------------------------------
-# Liquid
-# ---------------------------------------------------------------------------------------
-
-def check_liquid_model(name: str) -> str:
-    """Refuse a name no liquid model is registered under (the error lists the allowed)."""
-    liquids.get(name)
-    return name
-
-
-class WetGranules(Frozen):
-    """Pre-formed wet granules in a dry bed (``liquid.placement: granules``): after the
-    fill, every particle is dried and those whose centres lie in one of ``count`` spheres
-    of ``radius`` get ``liquid_content``; the spheres sit in the settled bed (half-way
-    between its free surface and the shell, spread across it, in the middle of the slice).
-    The granule size is physical (m), the same at every CG level. The engine moves liquid
-    to dry partners when a bridge ruptures, so the granules also wet the bed around them
-    (accretion) -- measured in docs/results/granule_definitions.md."""
-
-    count: int = Field(3, ge=1, le=100, description="wet spheres")
-    radius: float = Field(gt=0.0, le=1.0, description="m, radius of each wet sphere")
-    liquid_content: float = Field(
-        0.05, ge=1e-5, le=MAX_LIQUID_CONTENT, description="liquid volume / solid volume "
-        "inside the spheres", json_schema_extra={"bound_reason": PENDULAR_REASON})
-
-
-class Liquid(Frozen):
-    """The binder liquid and its bridge model (a name of :mod:`ligwf.liquids`' registry).
-
-    ``liquid_content`` is the liquid volume as a FRACTION of each particle's solid volume
-    (LIGGGHTS' ``surfaceLiquidContentInitial``; the engine source uses a fraction although
-    its docs say %). Model-specific limits are the model's own (``validate``).
-    """
-
-    model: Annotated[str, AfterValidator(check_liquid_model)] = Field(
-        "none", description="liquid-bridge model (ligwf.liquids: none is a dry bed)")
-    surface_tension: Annotated[float, zero_or_at_least(1e-6, 1e4, "N/m")] = Field(
-        0.072, ge=0.0, le=1e4, description="N/m (0: no cohesion)")
-    contact_angle_deg: float = Field(30.0, ge=0.0, le=180.0, description="degrees")
-    viscosity: Annotated[float, zero_or_at_least(1e-9, 1e6, "Pa s")] = Field(
-        1e-3, ge=0.0, le=1e6, description="Pa s (0: no viscous force)")
-    liquid_content: float = Field(
-        0.02, ge=1e-5, le=MAX_LIQUID_CONTENT, description="liquid volume / solid volume",
-        json_schema_extra={"bound_reason": PENDULAR_REASON})
-    min_separation_ratio: float = Field(1.01, ge=1.0, le=10.0,
-                                        description="minSeparationDistanceRatio (distance "
-                                        "over the sum of radii: >= 1, outside contact)")
-    max_separation_ratio: float = Field(1.1, ge=1.0, le=10.0,
-                                        description="maxSeparationDistanceRatio")
-    placement: Literal["uniform", "granules"] = Field(
-        "uniform", description="uniform: every particle starts with liquid_content; "
-        "granules: a dry bed with pre-formed wet granules (wet_granules)")
-    wet_granules: WetGranules | None = Field(None, description="the wet granules of "
-                                             "placement: granules")
-
-    @property
-    def wet(self) -> bool:
-        return liquids.get(self.model).wet
-
-    @model_validator(mode="after")
-    def _placement(self) -> "Liquid":
-        if self.placement == "granules" and self.wet_granules is None:
-            raise ValueError("placement granules needs wet_granules: {count, radius, "
-                             "liquid_content}")
-        if self.placement == "granules" and not liquids.get(self.model).wet:
-            raise ValueError(f"placement granules with liquid.model {self.model!r} (a dry "
-                             "bed): the wet granules would be dropped; choose a wet model "
-                             f"({', '.join(n for n in liquids.names() if liquids.get(n).wet)})")
-        if self.placement == "uniform" and self.wet_granules is not None:
-            raise ValueError("wet_granules is set but placement is uniform (set placement: "
-                             "granules, or drop wet_granules)")
-        return self
-
-    @model_validator(mode="after")
-    def _model_limits(self) -> "Liquid":
-        problems = liquids.get(self.model).validate(self)
-        if problems:
-            raise ValueError("; ".join(problems))
-        return self
 
 
 # ---------------------------------------------------------------------------------------

@@ -55,6 +55,7 @@ UNITS: dict[str, str] = {
     "Liquid.surface_tension": "N/m", "Liquid.contact_angle_deg": "deg",
     "Liquid.viscosity": "Pa s", "Liquid.liquid_content": "1",
     "Liquid.min_separation_ratio": "1", "Liquid.max_separation_ratio": "1",
+    "Liquid.bridge_volume_fraction": "1", "Liquid.max_liquid_content": "1",
     "WetGranules.count": "count", "WetGranules.radius": "m",
     "WetGranules.liquid_content": "1",
     "Rotation.rpm": "1/min", "Rotation.froude": "1",

@@ -23,6 +23,16 @@ is a fraction of solid volume, so V_bridge/R^3 is unchanged, as are the separati
 and the contact angle; at the same dimensionless gap and the same velocity the forces
 therefore grow like n * gamma' and n * mu'. Forces x n^k need gamma' = n^(k-1) gamma.
 
+The washino law's two optional settings are fractions and pass through both rules
+unchanged: ``bridge_volume_fraction`` (the share of both particles' liquid a bridge takes:
+V_bridge/R^3 stays as it is) and ``max_liquid_content`` (a cap on the liquid content, itself
+a fraction of solid volume). With the cap set, the engine replaces
+``maxSeparationDistanceRatio`` by the rupture gap of two of the largest particles at the
+cap over twice the smallest radius (:func:`ligwf.liquids.washino.engine_max_separation_ratio`),
+a ratio of lengths that also stays unchanged; the scaled scene carries that ratio (the
+model's ``capped_separation_ratio``), so
+rendering, pre-flight and analysis use the cut the engine applies.
+
 Particle sizes follow Same Statistic Weight (SSW): every class of the size distribution is
 multiplied by n and keeps its number fraction, so the distribution keeps its shape and the
 particle count drops by n^3. The time step is a fixed fraction of the Rayleigh time of the
@@ -40,8 +50,10 @@ from ligwf import liquids
 from ligwf.errors import ConfigError
 from ligwf.scene.placement import wet_sphere_fields
 from ligwf.liquids.base import LiquidModel
+from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.scene.model import GRAVITY, Scene
 from ligwf.scene.neighbour import fill_skin, turning_skin
+from ligwf.scene.seeds import replica_seeds
 
 
 class Rule(str, Enum):
@@ -114,8 +126,6 @@ def drum_free_volume(scene: Scene) -> float:
 
 #: the largest solid volume / drum free volume a bed can have (fill 0.7 x packing 0.74)
 MAX_SOLID_SHARE = 0.7 * 0.74
-#: LIGGGHTS reads seeds as 32-bit ints
-INT_MAX = 2**31 - 1
 
 
 def mean_particle_volume(classes: list[tuple[float, float]]) -> float:
@@ -137,41 +147,6 @@ def original_particle_count(scene: Scene) -> int:
         return n
     solid = scene.process.fill_fraction * scene.numerics.packing_fraction * drum_free_volume(scene)
     return max(1, round(solid / mean_particle_volume(scene.particles.size_classes())))
-
-
-def is_prime(n: int) -> bool:
-    if n < 2:
-        return False
-    if n % 2 == 0:
-        return n == 2
-    k = 3
-    while k * k <= n:
-        if n % k == 0:
-            return False
-        k += 2
-    return True
-
-
-def next_prime(n: int) -> int:
-    """Smallest prime >= n."""
-    while not is_prime(n):
-        n += 1
-    return n
-
-
-def replica_seeds(base: int, replica: int, count: int = 3) -> tuple[int, ...]:
-    """Distinct primes > 10000 (LIGGGHTS requires them) for one replica's random streams;
-    each must fit the engine's 32-bit int, else ConfigError naming the base seed."""
-    seeds: list[int] = []
-    p = max(base, 10007) + 10007 * replica
-    for _ in range(count):
-        p = next_prime(p + 1 if seeds else p)
-        seeds.append(p)
-    if seeds and seeds[-1] > INT_MAX:
-        raise ConfigError(f"scene.numerics.seed = {base}: replica {replica}'s random streams "
-                          f"reach {seeds[-1]} > {INT_MAX} (the engine's largest int); allowed "
-                          f"range [10000, {INT_MAX - 10007 * (replica + 1)}] for this study")
-    return tuple(seeds)
 
 
 #: Solid fraction one insertion wave may reach in the insertion region. Random sequential
@@ -279,6 +254,10 @@ class ScaledScene:
     # placed liquid (ligwf.scene.placement): wet spheres (axial, across, vertical, r), m
     wet_spheres: tuple[tuple[float, float, float, float], ...] = ()
     wet_sphere_content: float = 0.0
+    # washino's optional settings (None: the engine default, nothing rendered), fractions
+    # unchanged by CG; with max_liquid_content, max_separation_ratio is the engine's own
+    bridge_volume_fraction: float | None = None
+    max_liquid_content: float | None = None
 
     @property
     def wet(self) -> bool:
@@ -286,8 +265,9 @@ class ScaledScene:
 
     @property
     def liquid(self) -> LiquidModel:
-        """The liquid model of this case (from :mod:`ligwf.liquids`' registry)."""
-        return liquids.get(self.liquid_model)
+        """The liquid model of this case (from :mod:`ligwf.liquids`' registry), applying
+        the case's bridge volume fraction."""
+        return liquids.get(self.liquid_model).configured(self.bridge_volume_fraction)
 
     @property
     def insertion_steps(self) -> int:
@@ -329,6 +309,9 @@ class ScaledScene:
         out["insertion_waves"] = list(self.insertion_waves)
         if not self.wet_spheres:                 # records of uniform beds stay as they were
             del out["wet_spheres"], out["wet_sphere_content"]
+        for key in ("bridge_volume_fraction", "max_liquid_content"):
+            if out[key] is None:                 # so do records at the engine's defaults
+                del out[key]
         return out
 
 
@@ -358,6 +341,15 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
     thermo_every = _every(num.thermo_interval, dt)
     r_ins, waves = insertion_waves(scene, diameters, fractions, count)
     fall_time = math.sqrt(2.0 * drum.diameter / GRAVITY)
+    law = liquids.get(liq.model)
+    fraction = liq.bridge_volume_fraction
+    if fraction == law.default_bridge_volume_fraction:
+        fraction = None                  # the default written out: the same case as unset
+    max_separation_ratio = liq.max_separation_ratio
+    if liq.max_liquid_content is not None:
+        max_separation_ratio = law.configured(fraction).capped_separation_ratio(
+            0.5 * min(diameters), 0.5 * max(diameters), liq.max_liquid_content,
+            applied_contact_angle_rad(liq.contact_angle_deg, num.contact_angle_compensation))
 
     return ScaledScene(
         name=scene.name, cg=float(cg), rule=rule.value, replica=replica,
@@ -377,7 +369,7 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
         surface_tension=liq.surface_tension * factor, viscosity=liq.viscosity * factor,
         contact_angle_deg=liq.contact_angle_deg, liquid_content=liq.liquid_content,
         min_separation_ratio=liq.min_separation_ratio,
-        max_separation_ratio=liq.max_separation_ratio,
+        max_separation_ratio=max_separation_ratio,
         contact_angle_compensation=num.contact_angle_compensation,
         rayleigh_time=t_r, dt=dt,
         dt_rayleigh_fraction=num.dt_rayleigh_fraction if num.dt is None else dt / t_r,
@@ -394,5 +386,6 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
         seeds=replica_seeds(num.seed, replica, count=len(diameters) + 1 + len(waves)),
         granules=scene.analysis.granules,
         **wet_sphere_fields(scene, max(diameters), cg),
+        bridge_volume_fraction=fraction, max_liquid_content=liq.max_liquid_content,
     )
 

@@ -29,6 +29,11 @@ ANGLE_GAP_RATIO = 0.3
 
 
 def measure(engine, tmp_path, scaled, name: str, gap_ratio: float = GAP_RATIO) -> float:
+    return probe(engine, tmp_path, scaled, name, gap_ratio)[0]
+
+
+def probe(engine, tmp_path, scaled, name: str, gap_ratio: float) -> tuple[float, str]:
+    """(the engine's bridge force on particle 2 at ``gap_ratio``, N; the engine's output)."""
     case = tmp_path / name
     case.mkdir()
     files = render_bridge_probe(scaled, gap_ratio, model_approach=scaled.liquid.bridge_needs_contact)
@@ -41,7 +46,7 @@ def measure(engine, tmp_path, scaled, name: str, gap_ratio: float = GAP_RATIO) -
     r = 0.5 * scaled.d_min
     assert float(gap) == pytest.approx(gap_ratio * 0.5 * r, rel=1e-6)
     assert abs(float(fy)) < 1e-12 * abs(float(fx))
-    return -float(fx)  # attraction pulls particle 2 (at +x) towards -x
+    return -float(fx), out.stdout  # attraction pulls particle 2 (at +x) towards -x
 
 
 @pytest.fixture(scope="module")
@@ -97,3 +102,34 @@ def test_uncompensated_engine_applies_the_product_angle(engine, tmp_path):
         r, r, ANGLE_GAP_RATIO * 0.5 * r, s.surface_tension,
         engine_effective_angle_rad(s.contact_angle_deg), s.liquid_content, s.liquid_content)
     assert measured == pytest.approx(expected, rel=1e-4)
+
+
+def test_engine_applies_the_bridge_volume_fraction_and_the_cap(engine, tmp_path):
+    """liquid.bridge_volume_fraction 0.2 (lbVolumeFraction with modifyLbVolume on) and
+    max_liquid_content 0.1 (maxLiquidContent with limitLiquidContent on): the engine's
+    pair force equals ligwf's law at that fraction to 1e-9 (thermo prints 13 digits), is
+    far from the default law's, and the maxSeparationDistanceRatio the engine sets in place
+    of the written one is the one ligwf computed and wrote."""
+    base = ["scene.liquid.model=washino", "scene.liquid.bridge_volume_fraction=0.2"]
+    for name, extra in (("fraction", []), ("fraction-cap", ["scene.liquid.max_liquid_content=0.1"])):
+        s = scale(load_workflow(DRUM, base + extra).cases[0].scene, 1, "none")
+        measured, log = probe(engine, tmp_path, s, name, ANGLE_GAP_RATIO)
+        r = 0.5 * s.d_min
+        theta = math.radians(s.contact_angle_deg)
+        gap = ANGLE_GAP_RATIO * 0.5 * r
+        assert s.liquid.bridge_volume_fraction == 0.2
+        expected = s.liquid.capillary_force(r, r, gap, s.surface_tension, theta, s.liquid_content)
+        assert measured == pytest.approx(expected, rel=1e-9)
+        default = liquids.get("washino").capillary_force(r, r, gap, s.surface_tension, theta,
+                                                         s.liquid_content)
+        assert measured > 1.5 * default           # the test tells the fractions apart
+        overwritten = re.findall(r"maxSeparationDistanceRatio being overwritten by (\S+) "
+                                 r"\(was (\S+)\)", log)
+        if extra:
+            assert overwritten, log[-3000:]
+            engine_ratio, written = (float(x) for x in overwritten[-1])
+            assert engine_ratio == pytest.approx(s.max_separation_ratio, rel=1e-6)
+            assert written == pytest.approx(s.max_separation_ratio, rel=1e-6)
+            assert s.max_separation_ratio > 1.3   # the law's rupture gap, not the default 1.1
+        else:
+            assert not overwritten

@@ -8,8 +8,8 @@ import math
 
 import pytest
 
-from ligwf.scene.scaling import (bond_number, rayleigh_time, replica_seeds, is_prime, scale,
-                                 weber_number)
+from ligwf.scene.scaling import bond_number, rayleigh_time, scale, weber_number
+from ligwf.scene.seeds import is_prime, replica_seeds
 from ligwf.scene.workflow import load_workflow
 
 from helpers import DRUM, WET_POLY
