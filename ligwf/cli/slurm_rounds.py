@@ -29,7 +29,7 @@ from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, start_rounds
 from ligwf.pipeline.submit_rounds import (INCOMPLETE, NEXT_ROUND, STOPPED, FollowUp, Moved,
                                           keep_going, progress, recorded_steps)
 from ligwf.scheduler import Scheduler
-from ligwf.study.rounds import DEFAULT_LOOKS
+from ligwf.study.rounds import DEFAULT_LOOKS, read_rounds
 
 #: how long a follow-up job waits for case tasks Slurm still shows (a task that has just
 #: ended may still be completing), seconds
@@ -83,6 +83,11 @@ def follow_up_of(args: argparse.Namespace, planned: bool, cores: int | None) -> 
 
 
 def dry_run_note(args: argparse.Namespace, out: Path) -> str:
+    taken = len(read_rounds(out).looks)
+    if taken:
+        return (f"--until-decided: {out} has {taken} look(s) already: without --dry-run the "
+                "command goes on from its records (the next round, or what keeps it going), "
+                "not from round 1 as shown")
     return (f"--until-decided: this is round 1; its follow-up job ('ligwf slurm {NEXT_ROUND} "
             f"{out}') analyses, reports and takes look 1, then plans and submits each later "
             f"round itself (at most {args.max_looks} looks"
