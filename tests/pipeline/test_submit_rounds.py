@@ -17,6 +17,7 @@ from ligwf.pipeline.submit_rounds import (INCOMPLETE, ROUND_DUE, RUNNING, Follow
 from ligwf.slurm.jobs import append_record, read_record
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite
+from ligwf.study.rounds import Look, Rounds, read_rounds, write_rounds
 
 from helpers import ROOT
 
@@ -106,3 +107,27 @@ def test_a_login_node_call_resubmits_an_incomplete_round_once(tmp_path, monkeypa
     again = keep_going(out, SlurmScheduler(SITE, slurm), how)
     assert again.submitted == () and again.progress.state == RUNNING
     assert len(slurm.sbatch) == 2
+
+
+def test_a_look_whose_round_was_never_submitted_gets_a_follow_up_job_once(tmp_path,
+                                                                       monkeypatch):
+    """The follow-up job killed after it wrote look 1 and before it submitted round 2:
+    round 2 is due; a resubmit (no workflow at hand) submits the follow-up job alone, no
+    look, no array; again while that job is queued: nothing."""
+    out = _round_one(tmp_path, monkeypatch)
+    write_rounds(out, Rounds(2, looks=(Look(1, 0.025, 0.01, target="cg1.5-weber", actions=(
+        {"kind": "replicas", "group": "", "cg": 1.5, "rule": "weber", "replicas": [2],
+         "each_run_steps": 100, "condition": "cg1.5-weber"},)),)))
+    slurm = Slurm("")
+    p = progress(out, SlurmScheduler(SITE, slurm))
+    assert (p.state, p.round, p.looks) == (ROUND_DUE, 2, 1)
+    how = FollowUp.from_steps([STEP], planned=False, cores=None)
+    moved = keep_going(out, SlurmScheduler(SITE, slurm), how)
+    assert "round 2 is due: its follow-up job submitted" in moved.note
+    new = read_record(out)[2:]
+    assert [(s["kind"], s.get("study_round"), s["after"], s["steps"]) for s in new] == [
+        ("analysis", None, None, [STEP])]
+    slurm.squeue = f"{new[0]['job_id']}|{new[0]['job_id']}|N/A|PENDING|None\n"
+    again = keep_going(out, SlurmScheduler(SITE, slurm), how)
+    assert again.submitted == () and "is still queued" in again.note
+    assert len(slurm.sbatch) == 1 and len(read_rounds(out).looks) == 1
