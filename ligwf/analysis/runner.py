@@ -39,7 +39,7 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
 * granule table (parquet): one row per granule per frame (case_id, cg, rule, replica,
   frame, step, time, granule, members, volume, primary_volume, com_x/y/z, first_id,
   percolating: the granule closes a cycle around the periodic axis);
-* frame table: per frame: status (ok, missing, unexpected, skipped) and reason,
+* frame table: per frame: status (ok, missing, unexpected, duplicate, skipped) and reason,
   particles, contacts, bonds, granules, largest granule share and whether the largest
   granule percolates (wraps around the periodic axis);
 * GSD and GSD summary tables: see :mod:`ligwf.analysis.gsd.tables`;
