@@ -140,10 +140,6 @@ class EngineConfig:
         return self.mpirun_prefix(nprocs) + [self.liggghts_path(), "-in", input_name,
                                              "-log", log_name, *extra]
 
-    def version_line(self) -> str:
-        """First output line of ``liggghts -h`` (which exits 1 by design)."""
-        return _version_line(self.liggghts_path())
-
     def identify(self) -> "EngineIdentity":
         """The engine every launch path runs: executable, the library it links to (the
         ensembles load that one) and its version line. EngineNotFound, naming the setting,

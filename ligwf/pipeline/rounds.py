@@ -35,13 +35,14 @@ from pathlib import Path
 from typing import Callable
 
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
+from ligwf.analysis.records.equivalence import UNDECIDED
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
 from ligwf.pipeline.run import (RunSettings, StudyRun, cases_to_run, site_engine,
                                 study_schedule)
 from ligwf.report.planning import run_costs
-from ligwf.report.verdict import FAILS, MEETS, UNDECIDED, Verdict, is_control_group
+from ligwf.report.verdict import FAILS, MEETS, Verdict, is_control_group
 from ligwf.report.verdict_records import read_verdict
 from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
 from ligwf.study.case import CaseFolder, group_of

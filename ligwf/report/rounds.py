@@ -38,11 +38,6 @@ def look_line(look: Look) -> str:
             f"(planned ~{look.planned_core_hours:.2g} core-h)")
 
 
-def _half(c: dict) -> float:
-    lo, hi = c.get("lo"), c.get("hi")
-    return 0.5 * (hi - lo) if lo is not None and hi is not None else math.nan
-
-
 def rounds_markdown(rounds: Rounds, figures: list[Figure], figures_dir: str) -> str:
     """The section's body: the method, the looks, and the criteria's half-widths per look."""
     lines = [f"A sequential study: at most {rounds.max_looks} looks, each testing at alpha "

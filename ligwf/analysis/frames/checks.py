@@ -39,8 +39,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files,
-                                         read_particles)
+from ligwf.analysis.frames.dumps import AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study.case import CaseFolder, DumpRecord
 
@@ -221,20 +220,3 @@ def check_contacts(p: ParticleFrame, c: ContactFrame, periodic_axis: int | None,
         _fail(c, f"pair {c.id1[k]}-{c.id2[k]}: overlap {c.delta[k]:.3g} m does not match the "
               f"particle dump of step {p.step} ({int(np.sum(off > OVERLAP_TOLERANCE))} pair(s) "
               "off: ids permuted, or the dumps are of different frames or runs)")
-
-
-
-def last_usable_frame(case: CaseFolder) -> FrameFiles | None:
-    """The last frame of the case that passes every check (for a snapshot), or None."""
-    try:
-        plan = plan_frames(case)
-    except ConfigError:
-        return None
-    for ff in reversed(plan.frames):
-        try:
-            plan.check_record(ff)
-            check_particles(case, read_particles(ff.particles, ff.step, case.scaled.dt))
-        except DumpReadError:
-            continue
-        return ff
-    return None

@@ -52,11 +52,6 @@ def control_pairs(cases: list[CaseFolder]) -> list[tuple[CaseFolder, CaseFolder]
     return out
 
 
-def is_control(case: CaseFolder) -> bool:
-    """True for a control twin (it is never a CG1 reference of a comparison)."""
-    return CONTROL_KEY in _varied(case)
-
-
 def candidates_for(definition: AnalysisSettings):
     """The study's own definition first, then the candidates of the regime map."""
     name = "study definition (" + definition.granules + ")"

@@ -17,10 +17,10 @@ import pytest
 
 from helpers import tiled
 from ligwf.analysis.cpm_numba import _stable_key_order
-from ligwf.analysis.granules.bonds import bonded_contacts
+from ligwf.analysis.granules.bonds import BondCriterion, bonded_contacts
 from ligwf.analysis.granules.bridge_law import relative_energy
 from ligwf.analysis.granules.communities import cpm_labels, cpm_labels_reference
-from ligwf.analysis.granules.definitions import BondCriterion, cpm_weights
+from ligwf.analysis.granules.definitions import cpm_weights
 from ligwf.analysis.granules.persistent import Frame, bridge_keys, held_through, presence_run
 from wetdump import wet_case_frames
 
