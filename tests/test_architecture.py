@@ -3,6 +3,8 @@
 * the packages form layers that point one way (:data:`LAYERS`, bottom first): a module
   imports only modules of its own layer or of layers below it, counting imports inside
   functions and under ``TYPE_CHECKING`` too; every module belongs to exactly one layer;
+* inside the analysis stage the sub-packages form layers too (:data:`ANALYSIS_LAYERS`:
+  kernels, frames, records, flow, granules, GSD, the granule stage, the runners);
 * no import cycle between ligwf modules, counting imports inside functions too, and no
   dynamic import (``importlib.import_module`` / ``__import__``) hiding one;
 * every module under 400 lines (split by topic before that);
@@ -123,6 +125,42 @@ def test_layers_point_one_way():
     edges = up_edges(import_graph())
     assert not edges, ("imports from a lower layer into a higher one (move the code to the "
                        "layer it belongs to):\n" + "\n".join(edges))
+
+
+#: The analysis stage's own layers, bottom first: compiled kernels and the output set; frames
+#: (dumps read and checked); records (what the stage hands on); flow metrics; granules; GSD
+#: and split outputs; the granule stage; the runners (a study, foreign dumps).
+ANALYSIS_LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("kernels", ("ligwf.analysis.dumps_numba", "ligwf.analysis.cpm_numba",
+                 "ligwf.analysis.pair_table_numba", "ligwf.analysis.granules_numba",
+                 "ligwf.analysis.outputs")),
+    ("frames", ("ligwf.analysis.frames",)),
+    ("records", ("ligwf.analysis.records",)),
+    ("flow", ("ligwf.analysis.flow",)),
+    ("granules", ("ligwf.analysis.granules",)),
+    ("gsd", ("ligwf.analysis.gsd", "ligwf.analysis.parts")),
+    ("granule stage", ("ligwf.analysis.granule_stage",)),
+    ("runners", ("ligwf.analysis.runner", "ligwf.analysis.foreign")),
+)
+
+
+def _analysis_graph() -> nx.DiGraph:
+    return import_graph().subgraph(m for m in MODULES if m.startswith("ligwf.analysis."))
+
+
+def test_every_analysis_module_has_a_sub_layer():
+    homeless = [m for m in _analysis_graph() if layer_of(m, ANALYSIS_LAYERS) is None]
+    assert not homeless, f"analysis modules in no sub-layer (add them to ANALYSIS_LAYERS): {homeless}"
+
+
+def test_analysis_sub_packages_point_one_way():
+    # the checker sees the import this rule removed (frames/checks took AXES from granules)
+    was = nx.DiGraph([("ligwf.analysis.frames.checks", "ligwf.analysis.granules.bonds")])
+    assert up_edges(was, ANALYSIS_LAYERS) == ["ligwf.analysis.frames.checks -> "
+                                              "ligwf.analysis.granules.bonds (frames imports granules)"]
+    edges = up_edges(_analysis_graph(), ANALYSIS_LAYERS)
+    assert not edges, ("inside the analysis stage, imports from a lower sub-layer into a higher "
+                       "one (move the shared code down):\n" + "\n".join(edges))
 
 
 def test_the_layer_check_sees_an_up_edge_inside_a_function(tmp_path):
