@@ -46,8 +46,9 @@ Outputs (``OUT`` defaults to the study's analysis folder; names in
 * GSD pooling table and its summary per condition and pool size: the size limits and
   errors of CG-n replica pools of K = 1, 2, 4, 8 against CG1, and CG1 against itself;
 * kinetics (per case and frame, per condition with bands and CG-n/CG1 ratios) and
-  sensitivity tables: :mod:`ligwf.analysis.gsd.kinetics`; controls: :mod:`.study_controls`;
-* flow table and flow record (steady window, metrics, series): :mod:`.flow_run`;
+  sensitivity tables: :mod:`ligwf.analysis.gsd.kinetics`; controls:
+  :mod:`ligwf.analysis.granules.study_controls`;
+* flow table and flow record (steady window, metrics, series): :mod:`ligwf.analysis.flow.stage`;
 * per case a granule series: particles with a ``granule`` array per frame;
 * the analysis record (JSON): settings, analysed and skipped cases with their steady
   window, skipped frames with reasons, cases without granule data, its provenance
