@@ -70,6 +70,8 @@ class ForeignRun:
     dt: float                        # s per step
     liquid_content: float | None = None   # fraction of particle volume, if dumps lack it
     cg: float = 1.0
+    #: washino's lbVolumeFraction of the run (None: the engine default; only washino has it)
+    bridge_volume_fraction: float | None = None
 
     def facts(self, name: str) -> RunFacts:
         """The run facts; ConfigError naming the missing or invalid piece."""
@@ -98,8 +100,16 @@ class ForeignRun:
             raise ConfigError(f"--box-length: a periodic axis ({axis}) needs its length, m (> 0)")
         if not (self.dt > 0 and math.isfinite(self.dt)):
             raise ConfigError(f"--dt {self.dt!r}: the time step must be > 0 s")
+        fraction = self.bridge_volume_fraction
+        if fraction is not None and law.default_bridge_volume_fraction is None:
+            raise ConfigError(f"--bridge-volume-fraction {fraction:g}: liquid model "
+                              f"{self.liquid!r} has no bridge volume fraction (washino only)")
+        if fraction is not None and not 0.0 < fraction <= 1.0:
+            raise ConfigError(f"--bridge-volume-fraction {fraction!r}: allowed range (0, 1]")
         content = math.nan if self.liquid_content is None else float(self.liquid_content)
-        return RunFacts(name, float(self.cg), Liquid(self.liquid, gamma, theta, content),
+        return RunFacts(name, float(self.cg),
+                        Liquid(self.liquid, gamma, theta, content,
+                               None if fraction is None else float(fraction)),
                         None if axis is None else AXES.index(axis),
                         float(self.box_length or 0.0), float(self.dt))
 
@@ -174,7 +184,10 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
                        {facts.case_id: float(steady_from_step)}, settings, "fast", write_vtu,
                        controls=False,
                        frames_of={facts.case_id: frames})
-        record = {"dump_dir": str(dump_dir), "run": asdict(run),
+        run_record = asdict(run)
+        if run.bridge_volume_fraction is None:     # records at the default stay as they were
+            del run_record["bridge_volume_fraction"]
+        record = {"dump_dir": str(dump_dir), "run": run_record,
                   "settings": settings.model_dump(mode="json"),
                   "steady_from_step": steady_from_step,
                   "checked_against_scene": False,

@@ -44,6 +44,10 @@ def register(subparsers) -> None:
     p.add_argument("--liquid-content", type=number_in(1e-5, MAX_LIQUID_CONTENT),
                    default=None,
                    help="fraction of particle volume, when the dumps lack f_surfaceLiquidContent")
+    p.add_argument("--bridge-volume-fraction", type=number_in(1e-6, 1.0), default=None,
+                   help="washino only: the run's lbVolumeFraction (share of both particles' "
+                   "liquid in a bridge), when its input set modifyLbVolume on; default: the "
+                   "engine's 0.05")
     p.add_argument("--cg", type=number_in(1.0, 1000.0), default=1.0,
                    help="coarse-graining factor of the run")
     p.add_argument("--steady-from-step", type=step_number, default=0,
@@ -73,7 +77,7 @@ def cmd_analyse_dumps(args: argparse.Namespace) -> int:
     settings = build_analysis_settings(values, "analysis")
     run = ForeignRun(args.liquid, args.surface_tension, args.contact_angle,
                      args.angle_convention, args.periodic_axis, args.box_length, args.dt,
-                     args.liquid_content, args.cg)
+                     args.liquid_content, args.cg, args.bridge_volume_fraction)
     out = args.out or args.dump_dir / "analysis"
     record = analyse_dumps(args.dump_dir, run, out, settings, args.steady_from_step,
                            args.particles, args.contacts, not args.no_vtu)

@@ -141,3 +141,19 @@ def test_analysis_applies_the_cases_fraction_and_cap():
     assert content_of(frame, liquid).tolist() == [0.02, 0.1, 0.1]
     assert content_of(frame, Liquid.from_scaled(scale(scene(), 1, "none"))).tolist() == [
         0.02, 0.15, 0.1]
+
+
+def test_foreign_runs_are_analysed_at_their_fraction():
+    """``ligwf analyse-dumps --bridge-volume-fraction``: dumps of a run with another
+    lbVolumeFraction are analysed with it; refused for a model without one."""
+    from ligwf.analysis.foreign import ForeignRun
+
+    def run(liquid, fraction):
+        return ForeignRun(liquid, 0.02, 30.0, "scene", "y", 0.01, 1e-5, None, 1.0, fraction)
+
+    assert run("washino", 0.2).facts("r").liquid.law is liquids.get("washino").configured(0.2)
+    assert run("washino", None).facts("r").liquid.law is liquids.get("washino")
+    with pytest.raises(ConfigError, match=r"--bridge-volume-fraction 0.2: liquid model 'easo'"):
+        run("easo", 0.2).facts("r")
+    with pytest.raises(ConfigError, match=r"allowed range \(0, 1\]"):
+        run("washino", 1.5).facts("r")
