@@ -27,11 +27,17 @@ class Liquid:
     surface_tension: float      # N/m, already CG-scaled
     contact_angle_rad: float    # the angle the engine APPLIED (see ligwf.liquids.contact_angle)
     liquid_content: float       # fraction of particle volume, used if a dump lacks it
+    #: washino's share of both partners' liquid in a bridge (None: the engine default)
+    bridge_volume_fraction: float | None = None
+    #: the engine's cap of a particle's liquid content (None: none); it clips a content
+    #: above the cap before every pair it evaluates, so the analysis clips too
+    max_liquid_content: float | None = None
 
     @property
     def law(self) -> LiquidModel:
-        """The liquid model (its force law, bridge volume and rupture distance)."""
-        return liquids.get(self.model)
+        """The liquid model (its force law, bridge volume and rupture distance) at the run's
+        bridge volume fraction."""
+        return liquids.get(self.model).configured(self.bridge_volume_fraction)
 
     @classmethod
     def from_scaled(cls, scaled: ScaledScene, engine_product_bug: bool = True) -> "Liquid":
@@ -41,15 +47,20 @@ class Liquid:
         theta = applied_contact_angle_rad(scaled.contact_angle_deg,
                                           scaled.contact_angle_compensation, engine_product_bug)
         return cls(scaled.liquid_model, float(scaled.surface_tension), theta,
-                   float(scaled.liquid_content))
+                   float(scaled.liquid_content), scaled.bridge_volume_fraction,
+                   scaled.max_liquid_content)
 
 
 def content_of(particles: ParticleFrame, liquid: Liquid) -> np.ndarray:
-    """Liquid content per particle: the dump's, or the scene's when the dump lacks it."""
+    """Liquid content per particle: the dump's, or the scene's when the dump lacks it;
+    clipped to the run's cap (``max_liquid_content``) as the engine clips it."""
     content = particles.liquid_content
     if content is None:
         content = np.full(len(particles), liquid.liquid_content)
-    return np.asarray(content, dtype=np.float64)
+    content = np.asarray(content, dtype=np.float64)
+    if liquid.max_liquid_content is not None:
+        content = np.minimum(content, liquid.max_liquid_content)
+    return content
 
 
 def pair_forces(particles: ParticleFrame, i: np.ndarray, j: np.ndarray, gap: np.ndarray,
