@@ -87,10 +87,9 @@ class DumpRecord:
         entry = self.files.get(path.name)
         if entry is None:
             return f"{path}: not among the dumps the run left (dump record {DUMP_RECORD})"
-        try:
-            size = path.stat().st_size
-        except OSError as exc:
-            return f"{path}: the run left it, it cannot be read now ({exc.strerror}: deleted?)"
+        if not path.is_file():
+            return f"{path}: the run left it, it is gone now (deleted or moved?)"
+        size = path.stat().st_size
         if size != entry[0]:
             return f"{path}: {size} bytes, the run left {entry[0]} (truncated or replaced)"
         if file_digest(path) != entry[1]:
@@ -139,12 +138,10 @@ def _changed_fields(rec: dict, scaled: ScaledScene) -> list[str]:
 
 
 def scene_record_problem(path: Path, rec: dict, scaled: ScaledScene) -> str | None:
-    """Why a case folder's scene record is not the one rendering wrote (None: its stored
-    content hash is recomputed and matches, its CG level and rule are the scaled scene's,
-    and its original scene block, scaled again, gives exactly its scaled values), naming
-    the changed fields where they can be told. The content hash covers the scaled values,
-    the input and the mesh, not the original block: an original edited after rendering
-    (a surface tension multiplied by 10) is caught by scaling it again."""
+    """Why a case folder's scene record is not the one rendering wrote (None: its content
+    hash recomputes, its CG level and rule are the scaled scene's, and its original block
+    scaled again gives its scaled values: the hash does not cover the original), naming
+    the changed fields where they can be told."""
     if str(rec["rule"]) != scaled.rule or float(rec["cg"]) != scaled.cg:
         return "changed: " + "; ".join(_changed_fields(rec, scaled))
     digest = recomputed_hash(path, scaled)
