@@ -17,7 +17,10 @@ import pytest
 from helpers import ROOT
 from ligwf.analysis.flow.frame import DrumGeometry, frame_flow
 from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
+from ligwf.analysis.granules.case import RunFacts
+from ligwf.analysis.granules.definitions import identify_granules
 from ligwf.cli.main import main
+from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 
@@ -105,3 +108,26 @@ def test_ligwf_analyse_on_real_engine_output(run, tmp_path):
     # the slice is 3 beads long: in the last frame 4 granules wrap around it
     assert granules.loc[granules["step"] == STEPS[-1], "percolating"].sum() == 4
     assert per_frame["granules"].tolist() == [86, 85, 90]
+
+
+@pytest.mark.parametrize("definition", [
+    AnalysisSettings(granules="components", max_velocity_angle=30.0),        # the source study
+    AnalysisSettings(granules="components", velocity_frame="drum", max_velocity_angle=10.0),
+    AnalysisSettings(granules="communities"),
+], ids=["components-lab-30", "components-drum-10", "communities"])
+def test_compiled_granules_equal_the_reference_on_real_frames(run, definition):
+    """The compiled kernels against their plain reference (networkx components, the
+    Python Louvain) on real engine frames, in the fast lane: the same granules, the same
+    wrap flags and unwrapped positions."""
+    case, frames = run
+    facts = RunFacts.of_case(case)
+    sizes = []
+    for p, c in frames:
+        fast = identify_granules(p, c, facts.liquid, definition, case.cg, facts.motion)
+        ref = identify_granules(p, c, facts.liquid, definition, case.cg, facts.motion,
+                                "reference")
+        np.testing.assert_array_equal(fast.labels, ref.labels)
+        np.testing.assert_array_equal(fast.percolating, ref.percolating)
+        np.testing.assert_allclose(fast.unwrapped_axis, ref.unwrapped_axis, atol=1e-15)
+        sizes.append(np.bincount(fast.labels).max())
+    assert max(sizes) >= 2                      # real bonds: not every particle alone
