@@ -31,7 +31,7 @@ class Lifters(Frozen):
 
     count: int = Field(0, ge=0, le=360, description="number of lifters")
     height: float = Field(0.0, ge=0.0, description="radial height, m (> 0 with lifters; "
-                          "at least MIN_LENGTH)")
+                          f"at least {MIN_LENGTH:g} m)")
     width_deg: float = Field(3.0, ge=0.1, lt=180.0, description="angular width, degrees")
 
     @model_validator(mode="after")
