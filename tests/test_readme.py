@@ -91,3 +91,13 @@ def test_the_demo_numbers_are_the_committed_report():
     for line in quoted:       # a quote may end in "..." (the rest of the report's line elided)
         assert line.removesuffix(" ...") in summary, \
             f"README quotes what the demo report does not say: {line}"
+    # the README's reading of it: We-CG2's speedup, angle error and its bound, rounded
+    verdict = pd.read_csv(DEMO / "verdict.csv")
+    angle = verdict[(verdict["condition"] == "cg2-weber") & (verdict["criterion"] == "angle_deg")]
+    row = angle.iloc[0]
+    assert (f"We-CG2 is about {row['speedup_core']:.0f}x cheaper, but its angle of repose is "
+            f"{row['value']:.1f} deg steeper than CG1's (shown within {row['shown_within']:.1f} "
+            "deg)") in text and row["state"] == "fail"
+    profile = verdict[(verdict["condition"] == "cg2-weber")
+                      & (verdict["criterion"] == "profile_error")].iloc[0]
+    assert "its velocity profile fails too" in text and profile["state"] == "fail"
