@@ -157,3 +157,19 @@ def test_foreign_runs_are_analysed_at_their_fraction():
         run("easo", 0.2).facts("r")
     with pytest.raises(ConfigError, match=r"allowed range \(0, 1\]"):
         run("washino", 1.5).facts("r")
+
+
+def test_a_cap_at_the_content_cuts_bridges_at_the_laws_own_rupture_gap():
+    """With max_liquid_content = liquid_content the engine's cut (the ratio it computes) is
+    the law's own rupture gap of the pair: the pre-flight's bridge_cut ratio is 1; a short
+    written ratio warns and names the cap as the other way out."""
+    from ligwf.scene.stability import preflight
+
+    def bridge_cut(*overrides):
+        s = scale(scene(*overrides), 1, "none")
+        return next(f for f in preflight(s).findings if f.check == "bridge_cut")
+
+    capped = bridge_cut("scene.liquid.max_liquid_content=0.02")
+    assert capped.value == pytest.approx(1.0, rel=1e-12) and capped.verdict == "ok"
+    short = bridge_cut("scene.liquid.max_separation_ratio=1.02")
+    assert short.verdict != "ok" and "or set max_liquid_content" in short.message
