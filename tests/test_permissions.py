@@ -100,3 +100,13 @@ def test_schema_out_refuses_what_it_must_not_replace(tmp_path, capsys, target):
     assert sorted(p.name for p in tmp_path.iterdir()) == before
     assert stat.S_ISFIFO(os.lstat(tmp_path / "fifo").st_mode)
     assert (tmp_path / "link").is_symlink()
+
+
+def test_schema_out_where_no_file_can_be_made_is_one_line_naming_the_option(tmp_path, capsys):
+    """/proc takes no new file: one line naming --out and the path, not a bare
+    FileNotFoundError (issue 32 item 5)."""
+    assert main(["schema", "--out", "/proc/ligwf-x.json"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("ligwf: ConfigError: --out /proc/ligwf-x.json: cannot write a file "
+                          "there (No such file or directory)"), err
+    assert len(err.strip().splitlines()) == 1

@@ -20,6 +20,7 @@ from pathlib import Path
 
 from ligwf.cli.common import console
 from ligwf.cli.reference import cli_markdown
+from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_text, replaceable
 from ligwf.report.dictionary import dictionary_markdown
 from ligwf.scene.reference import reference_markdown, schema_text
@@ -44,15 +45,20 @@ def file_to_write(text: str) -> Path:
 
 
 def cmd_schema(args: argparse.Namespace) -> int:
-    outputs = [(args.out, schema_text), (args.reference, reference_markdown),
-               (args.dictionary, dictionary_markdown),
-               (args.cli, lambda: cli_markdown(args.root_parser))]
-    texts = [(path, make()) for path, make in outputs if path is not None]
+    outputs = [("--out", args.out, schema_text), ("--reference", args.reference,
+                                                  reference_markdown),
+               ("--dictionary", args.dictionary, dictionary_markdown),
+               ("--cli", args.cli, lambda: cli_markdown(args.root_parser))]
+    texts = [(option, path, make()) for option, path, make in outputs if path is not None]
     if not texts:
         print(schema_text(), end="")
         return 0
-    for path, text in texts:     # every text built before the first file is written
-        atomic_write_text(path, text)
+    for option, path, text in texts:     # every text built before the first file is written
+        try:
+            atomic_write_text(path, text)
+        except OSError as exc:       # e.g. /proc/x.json: a folder that holds no new files
+            raise ConfigError(f"{option} {path}: cannot write a file there "
+                              f"({exc.strerror or exc})") from None
         console.print(f"wrote {path}", highlight=False)
     return 0
 
