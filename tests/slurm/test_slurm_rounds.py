@@ -6,7 +6,8 @@ The tiny rounds workflow (tests/workflows/rounds_tiny.yaml: a CG1 bed of ~490 pa
 its We-CG1.5 twin, two seeds each) with two looks: after the jobs end the rounds record has
 its looks, each round's array ran exactly what its look added (new replicas, extended
 cases), every continued case has one manifest and a thermo table without gap, the report
-draws the rounds, and the follow-up command run again (or ``resubmit``), by hand while
+draws the rounds. Round 1's follow-up job is killed while it works and ``resubmit``
+keeps the study going; the follow-up command run again (or ``resubmit``), by hand while
 round 2 runs or after the stop, changes nothing.
 """
 
@@ -53,9 +54,10 @@ def _logs(study: Path) -> str:
     return "\n".join(parts)
 
 
-def wait_until_stopped(study: Path, timeout: float) -> None:
-    """Poll until the rounds record says stopped and no job of the study is queued; fail
-    early when nothing is queued for 60 s and the study has not stopped (a stall)."""
+def wait_until_stopped(study: Path, timeout: float, on_stall=None) -> None:
+    """Poll until the rounds record says stopped and no job of the study is queued. When
+    nothing is queued for 20 s and the study has not stopped (a stall), ``on_stall`` is
+    called once (a resubmit: what a user does then); a second stall fails."""
     deadline = time.monotonic() + timeout
     idle_since = None
     while time.monotonic() < deadline:
@@ -64,10 +66,26 @@ def wait_until_stopped(study: Path, timeout: float) -> None:
         if not busy and read_rounds(study).stopped:
             return
         idle_since = None if busy else (idle_since or time.monotonic())
-        assert idle_since is None or time.monotonic() - idle_since < 60, \
-            f"{study}: nothing queued and the study has not stopped:\n{_logs(study)}"
+        if idle_since is not None and time.monotonic() - idle_since > 20:
+            assert on_stall is not None, \
+                f"{study}: nothing queued and the study has not stopped:\n{_logs(study)}"
+            on_stall()
+            on_stall, idle_since = None, None
         time.sleep(2.0)
     raise AssertionError(f"{study}: not stopped after {timeout:.0f} s:\n{_logs(study)}")
+
+
+def job_state(study: Path, job_id: str) -> tuple[str | None, bool]:
+    """Slurm's state of the study's follow-up job ``job_id`` and whether it is active."""
+    job = [j for j in study_status(study).jobs if str(j["job_id"]) == job_id][0]
+    return job.get("state"), bool(job.get("active"))
+
+
+def wait_for(what, timeout: float, study: Path) -> None:
+    deadline = time.monotonic() + timeout
+    while not what():
+        assert time.monotonic() < deadline, _logs(study)
+        time.sleep(0.5)
 
 
 def one_continuous_record(case_dir: Path) -> None:
@@ -105,6 +123,16 @@ def test_until_decided_runs_each_round_as_a_dependent_array(slurm_cluster, tmp_p
     assert f"{LIGWF} slurm next-round --no-snapshots" in (study / first[1]["script"]).read_text()
     assert read_rounds(study).max_looks == 2 and not read_rounds(study).looks
 
+    # round 1's follow-up job killed while it works (scancel: SIGTERM, at whatever point
+    # of analysis, look or submission it is), then a resubmit: the study goes on from its
+    # records (the look taken once, round 2 submitted once)
+    follow1 = str(first[1]["job_id"])
+    wait_for(lambda: job_state(study, follow1)[0] == "RUNNING", 900, study)
+    time.sleep(3.0)
+    subprocess.run(["scancel", follow1], check=True)
+    wait_for(lambda: not job_state(study, follow1)[1], 120, study)
+    ligwf("slurm", "resubmit", str(study), env=env)
+
     # while round 2 is queued or running, the follow-up command by hand and a resubmit: at
     # any point of it they may wait, take the due look themselves or leave it to the job,
     # but never look twice or submit anything twice (checked on the record at the end)
@@ -115,17 +143,22 @@ def test_until_decided_runs_each_round_as_a_dependent_array(slurm_cluster, tmp_p
     ligwf("slurm", "next-round", str(study), "--no-snapshots", env=env)
     ligwf("slurm", "resubmit", str(study), env=env)
 
-    wait_until_stopped(study, timeout=1200)
+    wait_until_stopped(study, timeout=1200,
+                       on_stall=lambda: ligwf("slurm", "resubmit", str(study), env=env))
     rounds = read_rounds(study)
     assert [x.number for x in rounds.looks] == [1, 2], _logs(study)   # look 1 went on
     assert rounds.stopped and rounds.looks[-1].stop and not rounds.looks[0].stop
     assert all(x.alpha == pytest.approx(0.05 / 2) for x in rounds.looks)
 
-    # each round: one submission of its arrays and one follow-up job, exactly the cases
-    # its look added (new replicas by their folder, extended runs by their id)
+    # each round: one submission of its arrays, exactly the cases its look added (new
+    # replicas by their folder, extended runs by their id); besides the killed one, at most
+    # one follow-up job alone (the resubmit's, when the kill came before round 2's arrays)
     record = read_record(study)
-    assert {s.get("study_round") for s in record} == {1, 2}
-    assert [s["kind"] for s in record] == ["array", "analysis", "array", "analysis"]
+    arrays = [s for s in record if s["kind"] == "array"]
+    assert [s["study_round"] for s in arrays] == [1, 2]
+    follow = [s for s in record if s["kind"] == "analysis"]
+    assert all(s["steps"] == first[1]["steps"] for s in follow)
+    assert len(follow) <= 3 and len([s for s in follow if s.get("study_round") is None]) <= 1
     ids = Study.open(study).case_ids
     ran = {r: sorted(ids[i] for s in record if s["kind"] == "array" and s["study_round"] == r
                      for i in s["indices"]) for r in (1, 2)}
@@ -143,14 +176,15 @@ def test_until_decided_runs_each_round_as_a_dependent_array(slurm_cluster, tmp_p
         m = read_manifest(study / cid)
         assert len(m.attempts) == 2 and m.attempts[1].from_step > 0, (cid, m.attempts)
     done = task_records(slurm_cluster.jobcomp.read_text())
-    for s in record:                  # every task and job of both rounds ended well
+    for s in record:                  # every task and job ended well but the killed one
         states = {r.state for r in done if s["job_id"] in (r.array_job_id, r.job_id)}
-        assert states == {"COMPLETED"}, (s, states, _logs(study))
+        assert states == ({"CANCELLED"} if s["job_id"] == follow1 else {"COMPLETED"}), \
+            (s, states, _logs(study))
     assert (study / "report" / FIGURES_DIR / FIGURE_ROUNDS).is_file()
     assert "look 2" in (study / "report" / "summary.md").read_text()
     t1 = time.monotonic()
 
-    # run again (by hand, or a resubmit): no look, no submission
+    # after the stop, again (by hand, or a resubmit): no look, no submission
     again = ligwf("slurm", "next-round", str(study), "--no-snapshots", env=env)
     assert "stopped at look 2" in again.stdout
     resub = ligwf("slurm", "resubmit", str(study), env=env)
