@@ -228,25 +228,30 @@ def test_a_same_size_edit_of_a_contact_dump_is_refused_by_report_and_check(copy,
 
 @pytest.mark.engine
 @pytest.mark.mpi
-def test_a_frame_copied_over_the_next_is_a_skipped_frame(copy, capsys):
-    """Without a dump record (a case run by hand), a frame that is byte for byte the one
-    before it is refused by the analysis and listed by the report, not used twice."""
+@pytest.mark.parametrize("tail,status,words", [
+    (b"", "duplicate", "byte for byte the particle dump of step"),
+    (b"\n", "skipped", "every particle position is that of the frame of step"),  # array copy
+])
+def test_a_frame_copied_over_the_next_is_a_skipped_frame(copy, capsys, tail, status, words):
+    """Without a dump record (a case run by hand), a frame that is a copy of the one before
+    it (byte for byte, or its arrays in other bytes) is refused by the analysis and listed
+    by the report, not used twice."""
     (copy / R0 / "dumps.json").unlink()
     post = copy / R0 / "post"
     steps = sorted(int(p.stem.split("_")[1]) for p in post.glob("particles_*.vtu"))
     a, b = steps[-3], steps[-2]
     for kind in ("particles", "contacts"):
-        shutil.copyfile(post / f"{kind}_{a}.vtu", post / f"{kind}_{b}.vtu")
+        (post / f"{kind}_{b}.vtu").write_bytes((post / f"{kind}_{a}.vtu").read_bytes() + tail)
     code, _, err = run(capsys, "analyse", str(copy), "--no-vtu")
-    assert code == 0, err
+    assert code == 0 and f"{status} frame {R0} step {b}" in err, err
     frames = list(csv.DictReader(io.StringIO((copy / "analysis" / "frames.csv").read_text())))
     (row,) = [f for f in frames if f["case_id"] == R0 and int(f["step"]) == b]
-    assert row["status"] == "duplicate" and f"particle dump of step {a}" in row["reason"]
+    assert row["status"] == status and f"{words} {a}" in row["reason"], row
     code, _, err = run(capsys, "report", str(copy), "--no-snapshots")
     assert code == 0, err
     summary = (copy / "report" / "summary.md").read_text()
     frames_section = summary[summary.index("## Skipped or"):summary.index("## Analysis outputs")]
-    assert f"| {R0} | {b} | duplicate |" in frames_section
+    assert f"| {R0} | {b} | {status} |" in frames_section
 
 
 # ---------------------------------------------------------------- swapped, listed twice

@@ -9,7 +9,9 @@ frames and report the same reasons:
   steps of its scene up to the step the manifest says it reached
   (:meth:`~ligwf.study.case.CaseFolder.expected_dump_steps`). A missing particle or
   contact dump, a dump at a step the run never writes (beyond the run, or off the dump
-  interval) is a problem of that frame: listed with its reason, never analysed. When the
+  interval) is a problem of that frame: listed with its reason, never analysed, and so is a
+  particle dump that holds the same bytes as the frame before it (a copy; an array copy,
+  same positions in other bytes, fails :func:`check_particles`). When the
   run left a dump record (:meth:`~ligwf.study.case.CaseFolder.dump_record`),
   :meth:`FramePlan.check_record` refuses a file whose size or SHA-256 differs from what
   the run left (done by whoever reads the frame, so MPI ranks share the hashing).
@@ -31,7 +33,9 @@ file replaced in between has another identity and is checked again.
 
 from __future__ import annotations
 
+import hashlib
 import os
+import re
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,9 +43,10 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ligwf.analysis.frames.dumps import AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files
+from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files,
+                                         read_particles)
 from ligwf.errors import ConfigError, DumpReadError
-from ligwf.study.case import CaseFolder, DumpRecord
+from ligwf.study.case import CaseFolder, DumpRecord, file_digest
 
 #: Relative slack of the geometric checks (float32 positions, mesh facets vs circle).
 GEOMETRY_SLACK = 0.05
@@ -83,15 +88,15 @@ _VERDICTS: dict | None = None
 def shared_checks() -> Iterator[None]:
     """Within: each file's record check and each particle frame's check runs once (see
     the module doc); nested uses share the outermost's verdicts."""
-    global _VERDICTS
+    global _VERDICTS, _POSITIONS
     outer = _VERDICTS is not None
     if not outer:
-        _VERDICTS = {}
+        _VERDICTS, _POSITIONS = {}, {}
     try:
         yield
     finally:
         if not outer:
-            _VERDICTS = None
+            _VERDICTS, _POSITIONS = None, None
 
 
 def _once(kind: tuple, path: Path, check: Callable[[], None]) -> None:
@@ -159,9 +164,32 @@ def plan_frames(case: CaseFolder) -> FramePlan:
         elif s.granules and contact is None:
             refuse(step, f"missing frame: no contact dump for step {step} "
                    f"(its particle dump {part.name} is left)")
+        elif (copy := _copy_of(frames[-1] if frames else None, part, record)) is not None:
+            refuse(step, f"{part}: byte for byte the particle dump of step {copy} (a copy of "
+                   "it: the bed moves between two dumps of a turning drum)", "duplicate")
         else:
             frames.append(FrameFiles(step, part, contact))
     return FramePlan(case.case_id, tuple(frames), tuple(problems), len(expected), record)
+
+
+def _copy_of(prev: FrameFiles | None, part: Path, record: DumpRecord | None) -> int | None:
+    """The step of ``prev`` when ``part`` holds the same bytes as its particle dump (a frame
+    copied over its neighbour), else None. Files of different sizes differ; with a dump
+    record the run's own digests are compared (a copy made after the run fails the
+    record check anyway), without one the two files are hashed."""
+    if prev is None:
+        return None
+    try:
+        if os.stat(prev.particles).st_size != os.stat(part).st_size:
+            return None
+    except OSError:
+        return None
+    if record is not None:
+        a, b = record.files.get(prev.particles.name), record.files.get(part.name)
+        same = a is not None and b is not None and a[1] == b[1]
+    else:
+        same = file_digest(prev.particles) == file_digest(part)
+    return prev.step if same else None
 
 
 def _fail(p: ParticleFrame | ContactFrame, what: str) -> None:
@@ -200,6 +228,43 @@ def _check_particles(case: CaseFolder, p: ParticleFrame) -> None:
         _fail(p, f"a particle speed above {limit:.3g} m/s (not physical in this drum)")
     if p.liquid_content is not None and np.any((p.liquid_content < 0) | (p.liquid_content > 1)):
         _fail(p, "liquid content outside [0, 1]")
+    before = p.step - s.dump_every
+    if before >= case.production_start_step and \
+            _positions_digest(Path(p.path).with_name(_step_name(p, before)), case) == \
+            _positions_digest(Path(p.path), case, p):
+        _fail(p, f"every particle position is that of the frame of step {before} (an array "
+              "copy of it: the bed moves between two dumps of a turning drum)")
+
+
+def _step_name(p: ParticleFrame, step: int) -> str:
+    """The file name of the same kind of dump as ``p`` at another step."""
+    return re.sub(rf"_{p.step}(\.vt[ur])$", rf"_{step}\1", Path(p.path).name)
+
+
+#: SHA-256 of a particle frame's positions by (path, identity): kept inside
+#: :func:`shared_checks`, so a frame's neighbour is usually read once (see check_particles)
+_POSITIONS: dict | None = None
+
+
+def _positions_digest(path: Path, case: CaseFolder, frame: ParticleFrame | None = None
+                      ) -> str | None:
+    """SHA-256 of the positions of the particle dump ``path`` (``frame``: already read),
+    None when it is missing or unreadable."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    key = (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    if _POSITIONS is not None and key in _POSITIONS:
+        return _POSITIONS[key]
+    try:
+        frame = frame or read_particles(path, None, case.scaled.dt)
+    except (DumpReadError, OSError, ValueError):
+        return None
+    digest = hashlib.sha256(np.ascontiguousarray(frame.positions).tobytes()).hexdigest()
+    if _POSITIONS is not None:
+        _POSITIONS[key] = digest
+    return digest
 
 
 def check_contacts(p: ParticleFrame, c: ContactFrame, periodic_axis: int | None,
