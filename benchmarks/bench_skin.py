@@ -92,9 +92,9 @@ from ligwf.study.manifest import DONE  # noqa: E402
 from ligwf.engine.launch import run_case  # noqa: E402
 from ligwf.engine.render import grid_vars, shipped_template_dir  # noqa: E402
 from ligwf.study.layout import MESH_NAME  # noqa: E402
-from ligwf.engine.resume import (RESUME_INPUT, render_resume, restart_files,  # noqa: E402
-                                 resume_phase)
+from ligwf.engine.resume import render_resume, restart_files, resume_phase  # noqa: E402
 from ligwf.engine.site import EngineConfig  # noqa: E402
+from ligwf.study.layout import RESUME_INPUT  # noqa: E402
 from ligwf.scene.workflow import load_workflow  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 from ligwf.study.layout import SCREEN_FILE  # noqa: E402

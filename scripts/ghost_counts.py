@@ -31,7 +31,8 @@ sys.path.insert(0, str(ROOT))
 
 from ligwf.engine.decomposition import grid_cost, scene_bed  # noqa: E402
 from ligwf.engine.ghosts import last_run_spread  # noqa: E402
-from ligwf.engine.resume import RESUME_INPUT, render_resume, restart_files  # noqa: E402
+from ligwf.engine.resume import render_resume, restart_files  # noqa: E402
+from ligwf.study.layout import RESUME_INPUT  # noqa: E402
 from ligwf.engine.site import EngineConfig  # noqa: E402
 from ligwf.study.case import CaseFolder  # noqa: E402
 from ligwf.study.layout import MESH_NAME  # noqa: E402

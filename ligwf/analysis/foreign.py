@@ -154,7 +154,8 @@ def check_window(frames: list[FrameFiles], dt: float, settings: AnalysisSettings
 
 def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
                   settings: AnalysisSettings = AnalysisSettings(), steady_from_step: int = 0,
-                  particles: str = "particles_*.vtu", contacts: str = "contacts_*.vtu",
+                  particles: str = layout.PARTICLE_DUMP_GLOB,
+                  contacts: str = layout.CONTACT_DUMP_GLOB,
                   write_vtu: bool = True) -> dict:
     """Analyse the frames of ``dump_dir``; write the outputs as one set into ``out_dir``
     and return the analysis record (NothingAnalysed, outputs untouched, when no frame

@@ -44,7 +44,7 @@ class OutputSet:
 
     @property
     def stage(self) -> Path:
-        return self.out_dir / f".staging-{self.token}"
+        return self.out_dir / layout.staging_dir(self.token)
 
     def case_dir(self, case_id: str) -> Path:
         """Where the per-frame ``.vtu`` of a case are written while staging."""
@@ -68,7 +68,7 @@ class OutputSet:
         """Move the staged set into ``out_dir`` (``record_name`` last) and drop the old
         (series folders, and the files named in ``obsolete`` this set does not hold)."""
         out, stage = self.out_dir, self.stage
-        trash = out / f".replaced-{self.token}"
+        trash = out / layout.replaced_dir(self.token)
         trash.mkdir()
         for old in sorted(out.iterdir()):
             if not old.name.startswith(".") and is_series_dir(old):

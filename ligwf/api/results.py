@@ -124,7 +124,7 @@ class StudyResults:
     def figures(self) -> dict[str, Path]:
         """file name -> path of every figure the report wrote."""
         folder = self.report_dir / layout.FIGURES_DIR
-        return {p.name: p for p in sorted(folder.glob("*.png"))} if folder.is_dir() else {}
+        return {p.name: p for p in sorted(folder.glob(layout.FIGURE_GLOB))} if folder.is_dir() else {}
 
     # ------------------------------------------------------------- tables
     @property

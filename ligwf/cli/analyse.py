@@ -21,6 +21,7 @@ from pathlib import Path
 
 from ligwf.cli.common import folder_to_write
 from ligwf.errors import ConfigError, LigwfError
+from ligwf.study import layout
 
 
 def register(subparsers) -> None:
@@ -137,7 +138,7 @@ def submit_split(args: argparse.Namespace, count: int) -> int:
     entries = jobs.submit_jobs(study.path, planned, site)
     array, merge = entries[0]["job_id"], entries[-1]["job_id"]
     print(f"submitted analysis array {array} ({count} task(s)) and merge job {merge} "
-          f"(token {token}); logs in {study.path / 'slurm' / 'logs'}")
+          f"(token {token}); logs in {study.path / layout.SLURM_LOG_DIR}")
     return 0
 
 

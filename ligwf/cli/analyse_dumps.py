@@ -18,6 +18,7 @@ from ligwf import liquids
 from ligwf.cli.analyse import print_record
 from ligwf.cli.common import folder_to_write, number_in, step_number
 from ligwf.scene.values import MAX_LIQUID_CONTENT
+from ligwf.study import layout
 
 
 def register(subparsers) -> None:
@@ -52,8 +53,8 @@ def register(subparsers) -> None:
                    help="coarse-graining factor of the run")
     p.add_argument("--steady-from-step", type=step_number, default=0,
                    help="first step of the GSD window (default: every frame)")
-    p.add_argument("--particles", default="particles_*.vtu", help="particle file pattern")
-    p.add_argument("--contacts", default="contacts_*.vtu", help="contact file pattern")
+    p.add_argument("--particles", default=layout.PARTICLE_DUMP_GLOB, help="particle file pattern")
+    p.add_argument("--contacts", default=layout.CONTACT_DUMP_GLOB, help="contact file pattern")
     p.add_argument("--set", dest="settings", action="append", default=[], metavar="KEY=VALUE",
                    help="an analysis setting, e.g. max_velocity_angle=10 (repeatable)")
     p.add_argument("--no-vtu", action="store_true", help="do not write the .pvd/.vtu series")
@@ -78,7 +79,7 @@ def cmd_analyse_dumps(args: argparse.Namespace) -> int:
     run = ForeignRun(args.liquid, args.surface_tension, args.contact_angle,
                      args.angle_convention, args.periodic_axis, args.box_length, args.dt,
                      args.liquid_content, args.cg, args.bridge_volume_fraction)
-    out = args.out or args.dump_dir / "analysis"
+    out = args.out or args.dump_dir / layout.ANALYSIS_DIR
     record = analyse_dumps(args.dump_dir, run, out, settings, args.steady_from_step,
                            args.particles, args.contacts, not args.no_vtu)
     print_record(record, out)

@@ -22,6 +22,7 @@ from rich.text import Text
 from ligwf.engine.plan import MAX_RANKS, CasePlan, Schedule, particle_steps
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import Prepared, prepare_workflow
+from ligwf.study.layout import STUDY_FILE
 
 console = Console(width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True, soft_wrap=True)
@@ -148,7 +149,7 @@ def prepare_from_args(args: argparse.Namespace) -> Prepared:
     out = getattr(args, "out", None)
     if out is not None and Path(out).resolve() == Path(args.workflow).resolve().parent:
         raise ConfigError(f"--out {out} is the folder of the workflow file {args.workflow}: "
-                          "a study writes study.json and one folder per case there; name a "
+                          f"a study writes {STUDY_FILE} and one folder per case there; name a "
                           "folder of the study's own")
     prepared = prepare_workflow(args.workflow, args.overrides, args.templates,
                                 args.allow_unstable)

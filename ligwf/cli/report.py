@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ligwf.cli.common import console, err_console, folder_to_write
 from ligwf.pipeline.post import report_study
+from ligwf.study import layout
 from ligwf.study.study import Study
 
 
@@ -17,12 +18,12 @@ def print_report(study_dir: Path, out: Path) -> None:
     from ligwf.report.verdict_records import read_verdict
     from ligwf.report.verdict_text import verdict_renderables
 
-    console.print(f"report: {out / 'summary.md'} and {out / 'index.html'}")
+    console.print(f"report: {out / layout.SUMMARY_REPORT} and {out / layout.HTML_REPORT}")
     p = study_problems(Study.open(study_dir))
     if p.count:
         err_console.print(f"[yellow]ligwf: warning:[/] the report lists {len(p.cases)} skipped "
                           f"case(s), {len(p.frames)} skipped or missing frame(s) and "
-                          f"{len(p.outputs)} analysis output problem(s) (see summary.md)",
+                          f"{len(p.outputs)} analysis output problem(s) (see {layout.SUMMARY_REPORT})",
                           highlight=False)
     verdict = read_verdict(out)
     if verdict is not None:   # last: the answer is what the user reads

@@ -29,6 +29,7 @@ from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, start_rounds
 from ligwf.pipeline.submit_rounds import (INCOMPLETE, NEXT_ROUND, STOPPED, FollowUp, Moved,
                                           keep_going, progress, recorded_steps)
 from ligwf.scheduler import Scheduler
+from ligwf.study.layout import REPORT_DIR
 from ligwf.study.rounds import DEFAULT_LOOKS, read_rounds
 
 #: how long a follow-up job waits for case tasks Slurm still shows (a task that has just
@@ -134,7 +135,7 @@ def next_round(args: argparse.Namespace, study_dir: Path, scheduler: Scheduler,
                        wait_seconds=SETTLE_SECONDS if own else 0.0, own_job=own)
     print_moved(moved)
     if moved.progress.state == STOPPED:
-        print_report(study_dir, study_dir / "report")
+        print_report(study_dir, study_dir / REPORT_DIR)
     return 1 if moved.progress.state == INCOMPLETE else 0
 
 

@@ -29,7 +29,7 @@ from ligwf.pipeline.post import postprocess
 from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, until_decided
 from ligwf.pipeline.run import StudyRun, run_settings
 from ligwf.report.rounds import look_line
-from ligwf.study.layout import is_study_folder
+from ligwf.study.layout import REPORT_DIR, is_study_folder
 from ligwf.study.rounds import Look, Rounds
 
 
@@ -94,7 +94,7 @@ def cmd_until_decided(args: argparse.Namespace) -> int:
         console.print("some cases did not finish (see the table): the same command resumes "
                       "them and goes on with the rounds")
         return 1
-    print_report(args.out, args.out / "report")
+    print_report(args.out, args.out / REPORT_DIR)
     return 0
 
 

@@ -27,7 +27,7 @@ from ligwf.study.case import NO_DIGESTS, CaseFolder, KnownDigests
 from ligwf.study.manifest import DONE, FAILED, KILLED, RUNNING, UNSTABLE
 from ligwf.study.processes import start_time
 from ligwf.study.thermo_table import ThermoRow, rows_from_csv, rows_to_csv
-from ligwf.study.layout import SCREEN_FILE
+from ligwf.study.layout import POST_DIR, SCREEN_FILE, particle_dump
 from ligwf.study.manifest import Attempt, Manifest, now_iso, overwrite_manifest
 
 #: how the reason of an attempt ended by a full disk begins (the runner then stops)
@@ -162,7 +162,7 @@ def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | No
             holes.append((a.step, f"thermo rows missing or repeated between steps {a.step} "
                           f"and {b.step}"))
             break
-    post = case.path / "post"
+    post = case.path / POST_DIR
     reached = rows[-1].step if rows else 0
     if post.is_dir():
         names = set()
@@ -174,7 +174,7 @@ def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | No
                 if why is not None:
                     holes.append((int(m.group(1)) - 1, why))
         for step in case.expected_dump_steps(reached):
-            if f"particles_{step}.vtu" not in names:
+            if particle_dump(step) not in names:
                 holes.append((step - 1, f"particle dump of step {step} missing"))
                 break
     return min(holes) if holes else None

@@ -39,7 +39,6 @@ import time
 from pathlib import Path
 
 from ligwf.engine.attempt import DISK_FULL, finish_attempt, restart_unreadable, stamp_restarts
-from ligwf.engine.ensemble_worker import CLAIMS_DIR, QUEUE_FILE
 from ligwf.engine.health import log_errors
 from ligwf.engine.guard import RANK_NAMES, engine_env, engine_tree, release, watch
 from ligwf.engine.launch import (Monitor, NullMonitor, interrupted_reason, signal_engine,
@@ -50,11 +49,11 @@ from ligwf.engine.site import EngineConfig
 from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.errors import SimulationFailed
 from ligwf.fsio import FolderNotWritable, atomic_write_json
+from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import FAILED, KILLED, Manifest, overwrite_manifest
 from ligwf.study.processes import EngineProcess, process
 
-ENSEMBLE_DIR = ".ensemble"
 
 
 def worker_command(engine: EngineConfig, nprocs: int, ens_dir: Path, group_size: int) -> list[str]:
@@ -65,7 +64,7 @@ def worker_command(engine: EngineConfig, nprocs: int, ens_dir: Path, group_size:
 
 def _claims(ens_dir: Path) -> dict[int, dict]:
     out = {}
-    for p in (ens_dir / CLAIMS_DIR).glob("*.json"):
+    for p in (ens_dir / layout.ENSEMBLE_CLAIMS_DIR).glob(layout.ENSEMBLE_CLAIM_GLOB):
         try:
             out[int(p.stem)] = json.loads(p.read_text())
         except (ValueError, json.JSONDecodeError):
@@ -74,7 +73,7 @@ def _claims(ens_dir: Path) -> dict[int, dict]:
 
 
 def _done(ens_dir: Path, pos: int) -> bool:
-    return (ens_dir / CLAIMS_DIR / f"{pos}.done").exists()
+    return (ens_dir / layout.ENSEMBLE_CLAIMS_DIR / layout.ensemble_claim_done(pos)).exists()
 
 
 def _settle_in_flight(case: CaseFolder, exit_code: int | None) -> Manifest | None:
@@ -178,7 +177,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
     todo = [c for c in cases if plan_case(c, retry_unstable).action != SKIP]
     by_key = {_key(c): c for c in todo}
     outcome: dict[str, str] = {}
-    root = Path(study) / ENSEMBLE_DIR
+    root = Path(study) / layout.ENSEMBLE_DIR
     launches = 0
     limit = max_launches or (2 * len(todo) + 2)
     me = process(os.getpid())
@@ -186,11 +185,11 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
               "start": me.start if me is not None else None}
     while todo and not stop.is_set() and launches < limit:
         launches += 1
-        ens_dir = root / f"{label}-{launches}"
+        ens_dir = root / layout.ensemble_launch_dir(label, launches)
         if ens_dir.exists():
             shutil.rmtree(ens_dir)
-        (ens_dir / CLAIMS_DIR).mkdir(parents=True)
-        atomic_write_json(ens_dir / QUEUE_FILE, {"cases": [_key(c) for c in todo],
+        (ens_dir / layout.ENSEMBLE_CLAIMS_DIR).mkdir(parents=True)
+        atomic_write_json(ens_dir / layout.ENSEMBLE_QUEUE, {"cases": [_key(c) for c in todo],
                                                  "retry_unstable": retry_unstable,
                                                  "runner": runner,
                                                  "engine": identity.to_dict()})
@@ -200,7 +199,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
         tails: dict[int, tuple[LogTail, ThermoParser]] = {}
         ended: set[int] = set()
         shown: set[int] = set()      # claims whose end the monitor has been told
-        with open(ens_dir / "launch.log", "wb") as out:
+        with open(ens_dir / layout.ENSEMBLE_LOG, "wb") as out:
             proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT,
                                     stdin=subprocess.DEVNULL, env=engine_env(),
                                     start_new_session=True)
@@ -248,7 +247,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
         finally:
             release(watchdog)
         _stop_leftovers(list(ranks.values()), ens_dir)   # mpirun killed under its ranks
-        launch_log = (ens_dir / "launch.log").read_text(errors="replace")
+        launch_log = (ens_dir / layout.ENSEMBLE_LOG).read_text(errors="replace")
         claims = _claims(ens_dir)
         how = _job_end(launch_log, proc.returncode)
         progressed, retry, full = False, set(), None
@@ -289,7 +288,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                 if m is not None:
                     m.status = FAILED
                     m.reason = (f"ensemble job ended ({how}) with no member making progress "
-                                f"and no ERROR line; see {ens_dir / 'launch.log'}")
+                                f"and no ERROR line; see {ens_dir / layout.ENSEMBLE_LOG}")
                     _record(case, m)
                     outcome[case.path.name] = FAILED
                     monitor.end(case.path.name, m, plan_case(case))

@@ -43,13 +43,12 @@ from ligwf.engine.site import EngineIdentity
 from ligwf.fsio import atomic_write_json
 from ligwf.engine.resume import FRESH, RESUME, SKIP, discard_restart, input_for, plan_case
 from ligwf.study.case import CaseFolder
+from ligwf.study import layout
 from ligwf.study.layout import POST_DIR
 from ligwf.study.manifest import KILLED
 from ligwf.study.processes import process
 
-QUEUE_FILE = "queue.json"
 _libc = ctypes.CDLL(None)
-CLAIMS_DIR = "claims"
 
 
 def run_file(engine: Liggghts, comm, case: CaseFolder, input_name: str) -> None:
@@ -125,9 +124,9 @@ def _record_runner(case: CaseFolder, manifest, runner: dict, me) -> None:
 
 def claim_next(ens_dir: Path, cases: list[str], record: dict) -> tuple[int, str] | None:
     """Atomically claim the first unclaimed case: (queue position, case folder) or None."""
-    claims = ens_dir / CLAIMS_DIR
+    claims = ens_dir / layout.ENSEMBLE_CLAIMS_DIR
     for pos, case in enumerate(cases):
-        path = claims / f"{pos}.json"
+        path = claims / layout.ensemble_claim(pos)
         try:
             fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666)
         except FileExistsError:
@@ -156,7 +155,7 @@ def main(argv: list[str] | None = None) -> int:
     group = world.rank // k
     sub = world.Split(group, world.rank)
     ranks = list(range(group * k, group * k + k))
-    queue = json.loads((args.ens_dir / QUEUE_FILE).read_text())
+    queue = json.loads((args.ens_dir / layout.ENSEMBLE_QUEUE).read_text())
     runner = queue.get("runner", {})
     identity = EngineIdentity.from_dict(queue["engine"])
     engine = Liggghts(identity.library)     # the library of the executable the user named
@@ -182,7 +181,8 @@ def main(argv: list[str] | None = None) -> int:
                 case = CaseFolder.open(case_path)
                 plan = plan_case(case, queue.get("retry_unstable", False))
                 if plan.action == SKIP:
-                    atomic_write_json(args.ens_dir / CLAIMS_DIR / f"{pos}.done", {"skipped": True})
+                    atomic_write_json(args.ens_dir / layout.ENSEMBLE_CLAIMS_DIR
+                                      / layout.ensemble_claim_done(pos), {"skipped": True})
                     continue
                 job = (pos, case_path, plan)
                 break
@@ -221,7 +221,8 @@ def main(argv: list[str] | None = None) -> int:
                     plan = plan_case(case, queue.get("retry_unstable", False))
                     again = plan if plan.action in (FRESH, RESUME) else None
                 if again is None:
-                    atomic_write_json(args.ens_dir / CLAIMS_DIR / f"{pos}.done",
+                    atomic_write_json(args.ens_dir / layout.ENSEMBLE_CLAIMS_DIR
+                                      / layout.ensemble_claim_done(pos),
                                       {"group": group, "quit": quit})
                 stop_claiming = quit or manifest.reason.startswith(DISK_FULL)
             again = sub.bcast(again, root=0)

@@ -27,8 +27,6 @@ from ligwf.engine.site import EngineConfig
 
 #: the file a rank writes on SIGTERM, in the case folder (the engine's working folder)
 FORCED_RESTART_RE = re.compile(r"^restart_forced_liggghts_(\d+)\.data$")
-#: periodic restarts of the drum input, written alternately (templates/drum.in.j2)
-PERIODIC_RESTARTS = ("restart/restart_a.liggghts", "restart/restart_b.liggghts")
 
 
 def restart_step(path: Path) -> int | None:

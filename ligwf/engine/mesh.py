@@ -22,6 +22,7 @@ import numpy as np
 
 from ligwf.fsio import atomic_write_text
 from ligwf.scene.model import Drum, Scene
+from ligwf.study.layout import mesh_file
 
 #: Bump when the mesh algorithm changes, so cached meshes are rebuilt.
 MESH_VERSION = 5
@@ -202,7 +203,7 @@ def drum_stl(drum: Drum, sag: float) -> str:
 
 
 def mesh_file_name(drum: Drum, sag: float) -> str:
-    return f"drum_{geometry_key(drum, sag)}.stl"
+    return mesh_file(geometry_key(drum, sag))
 
 
 def cached_mesh(drum: Drum, sag: float, cache_dir: Path) -> Path:

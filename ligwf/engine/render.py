@@ -30,9 +30,6 @@ from ligwf.scene.model import GRAVITY
 from ligwf.scene.values import unsafe_chars
 from ligwf.study.layout import INPUT_NAME, MESH_NAME
 
-#: Sub-folders the input writes into (the case writer creates them).
-OUTPUT_DIRS = ("post", "restart")
-
 
 def shipped_template_dir() -> Path:
     """ligwf's own templates: inside the installed wheel, or the source tree's templates/."""

@@ -28,11 +28,10 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ligwf.engine.liggghts import FORCED_RESTART_RE, PERIODIC_RESTARTS, restart_step
+from ligwf.engine.liggghts import FORCED_RESTART_RE, restart_step
 from ligwf.fsio import FolderNotWritable, atomic_write_json
+from ligwf.study.layout import PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX
 
-#: suffix of a restart's identity sidecar
-SIDECAR_SUFFIX = ".id.json"
 #: a file the engine changed less than this many seconds ago may still be being written:
 #: the live poll stamps it on a later look
 SETTLE_SECONDS = 0.3
@@ -59,7 +58,7 @@ class CaseIdentity:
 
 
 def sidecar(path: Path) -> Path:
-    return path.with_name(path.name + SIDECAR_SUFFIX)
+    return path.with_name(path.name + RESTART_SIDECAR_SUFFIX)
 
 
 def restart_paths(case_dir: Path) -> list[Path]:

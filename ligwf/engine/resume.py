@@ -29,16 +29,16 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from ligwf.engine.liggghts import FORCED_RESTART_RE, PERIODIC_RESTARTS, restart_step
-from ligwf.engine.restart_id import SIDECAR_SUFFIX, CaseIdentity, remove_sidecar, why_not_own
-from ligwf.engine.render import OUTPUT_DIRS, render_template, template_context
+from ligwf.engine.liggghts import FORCED_RESTART_RE, restart_step
+from ligwf.engine.restart_id import CaseIdentity, remove_sidecar, why_not_own
+from ligwf.engine.render import render_template, template_context
 from ligwf.scene.scaling import ScaledScene
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import INPUT_NAME, MANIFEST_FILE, SCREEN_FILE, THERMO_FILE
+from ligwf.study.layout import (ENGINE_LOG, INPUT_NAME, MANIFEST_FILE, OUTPUT_DIRS,
+                                PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX, RESUME_INPUT,
+                                SCREEN_FILE, THERMO_FILE, screen_log)
 from ligwf.study.manifest import DONE, FAILED, RUNNING, UNSTABLE, effective_status
 
-#: Input file of a resumed attempt (next to ``in.liggghts``).
-RESUME_INPUT = "resume.in.liggghts"
 
 SKIP, FRESH, RESUME = "skip", "fresh", "resume"
 
@@ -188,8 +188,8 @@ def clean_outputs(case_dir: Path) -> None:
             shutil.rmtree(d)
         d.mkdir()
     for p in case_dir.iterdir():
-        if (FORCED_RESTART_RE.match(p.name.removesuffix(SIDECAR_SUFFIX))
-                or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT, "log.liggghts")
+        if (FORCED_RESTART_RE.match(p.name.removesuffix(RESTART_SIDECAR_SUFFIX))
+                or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT, ENGINE_LOG)
                 or re.fullmatch(r"run(\.\d+)?\.log", p.name)):
             p.unlink()
 
@@ -245,7 +245,7 @@ def rotate_screen(case_dir: Path) -> str | None:
     if not current.exists():
         return None
     n = 1
-    while (case_dir / f"run.{n}.log").exists():
+    while (case_dir / screen_log(n)).exists():
         n += 1
-    current.rename(case_dir / f"run.{n}.log")
-    return f"run.{n}.log"
+    current.rename(case_dir / screen_log(n))
+    return screen_log(n)

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ligwf.errors import ConfigError, EngineNotFound
+from ligwf.study.layout import ENGINE_LOG
 from ligwf.yamlio import read_yaml_mapping
 
 
@@ -133,7 +134,7 @@ class EngineConfig:
         cmd += list(self.mpirun_args) + ["-np", str(nprocs)]
         return cmd
 
-    def command(self, input_name: str, nprocs: int, log_name: str = "log.liggghts",
+    def command(self, input_name: str, nprocs: int, log_name: str = ENGINE_LOG,
                 extra: Sequence[str] = ()) -> list[str]:
         """Full command line running ``input_name`` in the case folder on ``nprocs`` ranks;
         ``extra``: further LIGGGHTS arguments (e.g. ``-var`` settings)."""

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from ligwf.engine.attempt import stamp_restarts
 from ligwf.engine.guard import RELEASED, engine_tree, stop_engines
+from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.processes import EngineProcess
 
@@ -24,9 +25,9 @@ def stamp_lost(folders: list[str]) -> None:
     or the case folders an ensemble folder's claims name."""
     cases: list[Path] = []
     for folder in map(Path, folders):
-        claims = folder / "claims"
+        claims = folder / layout.ENSEMBLE_CLAIMS_DIR
         if claims.is_dir():
-            for p in claims.glob("*.json"):
+            for p in claims.glob(layout.ENSEMBLE_CLAIM_GLOB):
                 try:
                     cases.append(Path(json.loads(p.read_text())["case"]))
                 except (OSError, ValueError, KeyError, TypeError):

@@ -32,11 +32,12 @@ from ligwf.pipeline.run import RunSettings, start_run
 from ligwf.scene.controls import COHESIONLESS_FACTOR
 from ligwf.scene.workflow import expand
 from ligwf.study.case import CaseFolder
+from ligwf.study.layout import (CALIBRATION_CANDIDATES_DIR, CALIBRATION_REFERENCE_DIR,
+                                CALIBRATION_TABLE)
 
 #: the share of each calibration run's production left out as spin-up
 SPIN_UP = 0.3
 #: file of the measured candidates in the calibration folder
-CALIBRATION_TABLE = "calibration.csv"
 
 
 @dataclass(frozen=True)
@@ -165,10 +166,10 @@ def run_calibration(raw: dict[str, Any], out: Path, grid: CalibrationGrid,
 
     ref_raw, cand_raw = calibration_workflows(raw, grid)
     if reference_case is None:
-        (reference_case,) = _run(ref_raw, out / "wet", settings, monitor, stop, allow_unstable)
+        (reference_case,) = _run(ref_raw, out / CALIBRATION_REFERENCE_DIR, settings, monitor, stop, allow_unstable)
     ref = angle_of(reference_case) | {"role": "wet reference"}
     cands = pd.DataFrame([angle_of(p) | {"role": "candidate"}
-                          for p in _run(cand_raw, out / "candidates", settings, monitor, stop,
+                          for p in _run(cand_raw, out / CALIBRATION_CANDIDATES_DIR, settings, monitor, stop,
                                         allow_unstable)])
     table = choose(ref, cands, grid.tolerance_deg)
     ref_row = pd.DataFrame([ref | {"angle_gap_deg": 0.0, "std_gap_deg": 0.0,

@@ -27,7 +27,7 @@ from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, ato
                         not_writable)
 from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
 from ligwf.engine.plan import CaseLoad, case_load
-from ligwf.engine.render import OUTPUT_DIRS, render
+from ligwf.engine.render import render
 from ligwf.scene.scaling import ScaledScene
 from ligwf.scene.regime import definition_warning, regime_warnings
 from ligwf.scene.stability import Preflight, check_rendered
@@ -35,13 +35,13 @@ from ligwf.scene.window import held_window_warnings
 from ligwf.scene.unused import unused_setting_warnings
 from ligwf.scene.workflow import Case, Workflow, comparison_warnings, load_workflow
 from ligwf.study.case import content_hash
-from ligwf.study.layout import MESH_NAME, SCENE_FILE, STUDY_FILE
+from ligwf.study.layout import MESH_CACHE_DIR, MESH_NAME, OUTPUT_DIRS, SCENE_FILE, STUDY_FILE
 from ligwf.study.study import Study
 
 
 def default_mesh_cache() -> Path:
     """Mesh cache folder: $LIGWF_MESH_CACHE, else meshes/ under the current folder."""
-    return Path(os.environ.get("LIGWF_MESH_CACHE", "meshes"))
+    return Path(os.environ.get("LIGWF_MESH_CACHE", MESH_CACHE_DIR))
 
 
 @dataclass(frozen=True)

@@ -11,9 +11,8 @@ from typing import Iterable, Iterator
 from ligwf.fsio import atomic_write_json
 from ligwf.pipeline.prepare import Prepared, prepare, write
 from ligwf.scene.stability_suite import load_suite
+from ligwf.study.layout import SUITE_RECORD
 
-#: the suite record written at the top of the suite's folder
-SUITE_RECORD = "suite.json"
 
 
 def write_suite(suite: Path, out: Path, template_dirs: Iterable[Path] = (),

@@ -319,7 +319,7 @@ def dictionary_markdown() -> str:
     for prefix, label, meaning in PREFIXES:
         lines.append(f"| `{prefix}x` | of x | {label.format(label='x')} | "
                      f"{_cell(meaning.format(name='x'))} |")
-    lines += ["", "Contract (conditions.csv): every metric `m` has `m`, `m_lo`, `m_hi`, "
+    lines += ["", f"Contract ({layout.CONDITIONS_REPORT}): every metric `m` has `m`, `m_lo`, `m_hi`, "
               "`m_se`; every error (an `_error` metric compared with CG1) also `m_floor`, "
               "`m_floor_source`, `m_vs_floor`; the GSD errors name their limit "
               "(`gsd_error_below_lower`, ...: `ligwf.analysis.records.gsd`).", ""]

@@ -142,15 +142,15 @@ COMMON: tuple[tuple[str, ...], ...] = (
      "above the upper limit (no upper limit located: every bin)"),
     ("error_all", "1", "GSD err all bins", "relative L1 error of the volume-weighted GSD "
      "against CG1 over all bins, no size limit: sum |cg - ref| / sum ref"),
-    ("gsd_lower_limit", "m^3", "GSD lower limit", "lower_limit of gsd_summary.csv (granule "
+    ("gsd_lower_limit", "m^3", "GSD lower limit", f"lower_limit of {layout.GSD_SUMMARY_TABLE} (granule "
      "volume; nan: none located)"),
     ("gsd_lower_limit_diameter", "m", "GSD lower limit d", "equivalent-sphere diameter of the "
      "GSD lower limit volume (nan: none located, every bin below it)", "mm"),
     ("gsd_error_below_lower", "1", "GSD err below lower limit", "error_below_lower of "
-     "gsd_summary.csv (no limit located: every bin, = GSD err all bins)"),
+     f"{layout.GSD_SUMMARY_TABLE} (no limit located: every bin, = GSD err all bins)"),
     ("gsd_error_above_lower", "1", "GSD err above lower limit", "error_above_lower of "
-     "gsd_summary.csv (nan when no lower limit is located)"),
-    ("gsd_error_all", "1", "GSD err all bins", "error_all of gsd_summary.csv: the whole GSD's "
+     f"{layout.GSD_SUMMARY_TABLE} (nan when no lower limit is located)"),
+    ("gsd_error_all", "1", "GSD err all bins", f"error_all of {layout.GSD_SUMMARY_TABLE}: the whole GSD's "
      "relative L1 error against CG1"),
     # flow fields (ligwf.analysis.records.field_errors)
     ("field_error", "1", "layer velocity err", "the field criterion (what the verdict's "

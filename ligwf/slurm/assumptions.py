@@ -19,6 +19,7 @@ from pathlib import PurePosixPath
 from typing import Sequence
 
 from ligwf.slurm.site import SlurmSite
+from ligwf.study.layout import INPUT_NAME
 
 #: the kinds of array job whose tasks run the engine (see ligwf.slurm.jobs.PlannedJob)
 _CASE_KINDS = ("array",)
@@ -28,8 +29,8 @@ def launch_line(launcher: str, ranks: str = "RANKS") -> str:
     """The engine's launch line inside an allocation for ``launcher`` (pure)."""
     words = shlex.split(launcher)
     if PurePosixPath(words[0]).name == "srun":
-        return shlex.join(words) + f" --ntasks={ranks} liggghts -in in.liggghts ..."
-    return shlex.join(words) + f" -np {ranks} liggghts -in in.liggghts ..."
+        return shlex.join(words) + f" --ntasks={ranks} liggghts -in {INPUT_NAME} ..."
+    return shlex.join(words) + f" -np {ranks} liggghts -in {INPUT_NAME} ..."
 
 
 def launcher_note(launcher: str) -> str:

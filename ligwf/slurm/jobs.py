@@ -29,17 +29,17 @@ from typing import Callable, Iterable, Mapping, Sequence
 from ligwf import __version__
 from ligwf.errors import ConfigError, SubmitError
 from ligwf.fsio import atomic_write_json, atomic_write_text
+from ligwf.study import layout
 from ligwf.study.manifest import MISSING, read_manifest
 from ligwf.study.study import Study
 from ligwf.slurm.budget import nodes_for
 from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_parsable,
                                parse_squeue, task_records)
-from ligwf.slurm.script import (LOG_DIR, SLURM_DIR, ScriptContext, analysis_array_script,
+from ligwf.slurm.script import (ScriptContext, analysis_array_script,
                                 analysis_merge_script, analysis_script, array_script,
                                 sbatch_command, scontrol_command, squeue_command)
 from ligwf.slurm.site import SlurmSite
 
-RECORD_FILE = "slurm/jobs.json"
 #: kinds of planned jobs that are arrays the job after them waits for
 ARRAY_KINDS = ("array", "analysis-array")
 Runner = Callable[[Sequence[str]], subprocess.CompletedProcess]
@@ -70,7 +70,7 @@ def run_command(argv: Sequence[str]) -> subprocess.CompletedProcess:
 
 def read_record(study_dir: Path) -> list[dict]:
     """The submissions recorded in ``slurm/jobs.json`` (oldest first; [] when none)."""
-    path = Path(study_dir) / RECORD_FILE
+    path = Path(study_dir) / layout.SLURM_RECORD
     if not path.is_file():
         return []
     return list(json.loads(path.read_text()).get("submissions", []))
@@ -79,7 +79,7 @@ def read_record(study_dir: Path) -> list[dict]:
 def append_record(study_dir: Path, entry: dict) -> None:
     """Add one submission to ``slurm/jobs.json`` (atomic rewrite)."""
     subs = read_record(study_dir) + [entry]
-    atomic_write_json(Path(study_dir) / RECORD_FILE, {"ligwf_version": __version__,
+    atomic_write_json(Path(study_dir) / layout.SLURM_RECORD, {"ligwf_version": __version__,
                                                       "submissions": subs})
 
 
@@ -157,8 +157,8 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
         members = tuple(classes[ntasks])
         job_site = replace(site, ntasks=ntasks)
         nodes = nodes_for(ntasks, site.cores_per_node) if ranks is not None else None
-        name = f"array-{round_no}.sh" if len(classes) == 1 else f"array-{round_no}-np{ntasks}.sh"
-        jobs.append(PlannedJob("array", Path(study) / SLURM_DIR / name,
+        name = layout.slurm_array_script(round_no, None if len(classes) == 1 else ntasks)
+        jobs.append(PlannedJob("array", Path(study) / layout.SLURM_DIR / name,
                                array_script(array_ctx, job_site, members, nodes), members,
                                site=job_site, planned=ranks is not None,
                                plan_cores=plan_cores if ranks is not None else None,
@@ -172,7 +172,8 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
                  replace(split[1], steps=tuple(rest), study_round=study_round)]
     elif analysis_steps:
         ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
-        jobs.append(PlannedJob("analysis", Path(study) / SLURM_DIR / f"analysis-{round_no}.sh",
+        jobs.append(PlannedJob("analysis", Path(study) / layout.SLURM_DIR
+                               / layout.slurm_analysis_script(round_no),
                                analysis_script(ctx, site, analysis_steps), idx,
                                after_array=bool(idx), steps=tuple(analysis_steps),
                                study_round=study_round))
@@ -186,10 +187,12 @@ def plan_analysis_array(study_dir: Path, study_name: str, site: SlurmSite, count
     token (``analysis-array-TOKEN.sh``, ``analysis-merge-TOKEN.sh``)."""
     study = PurePosixPath(Path(study_dir).resolve())
     ctx = ScriptContext(study, job_name(study_name, "analysis"), __version__)
-    return [PlannedJob("analysis-array", Path(study) / SLURM_DIR / f"analysis-array-{token}.sh",
+    return [PlannedJob("analysis-array", Path(study) / layout.SLURM_DIR
+                       / layout.slurm_analysis_array_script(token),
                        analysis_array_script(ctx, site, count, token),
                        tuple(range(count)), site=site),
-            PlannedJob("analysis-merge", Path(study) / SLURM_DIR / f"analysis-merge-{token}.sh",
+            PlannedJob("analysis-merge", Path(study) / layout.SLURM_DIR
+                       / layout.slurm_analysis_merge_script(token),
                        analysis_merge_script(ctx, site, count, token, steps),
                        after_array=True, site=site)]
 
@@ -219,7 +222,7 @@ def submit_jobs(study_dir: Path, jobs: Sequence[PlannedJob], site: SlurmSite,
     The array id is recorded before the analysis job is submitted, so a failing second
     sbatch never loses the first id.
     """
-    (Path(study_dir) / LOG_DIR).mkdir(parents=True, exist_ok=True)
+    (Path(study_dir) / layout.SLURM_LOG_DIR).mkdir(parents=True, exist_ok=True)
     entries: list[dict] = []
     array_ids: list[str] = []
     for job in jobs:

@@ -24,9 +24,8 @@ from typing import Iterable, Sequence
 
 from ligwf.errors import ConfigError
 from ligwf.slurm.site import SlurmSite
+from ligwf.study.layout import STUDY_FILE, SLURM_LOG_DIR
 
-SLURM_DIR = "slurm"
-LOG_DIR = "slurm/logs"
 #: squeue columns ligwf reads: job id, array job id, array task id, state, reason.
 SQUEUE_FORMAT = "%i|%F|%K|%T|%r"
 
@@ -125,13 +124,13 @@ def array_script(ctx: ScriptContext, site: SlurmSite, indices: Iterable[int],
         raise ConfigError(f"nodes = {nodes!r}: allowed range [1, ntasks = {site.ntasks}]")
     indices = sorted(set(indices))
     study = ctx.study_dir
-    log = f"{study}/{LOG_DIR}/{ctx.job_name}_%A_%a.out"
+    log = f"{study}/{SLURM_LOG_DIR}/{ctx.job_name}_%A_%a.out"
     lines = ["#!/bin/bash",
              *_directives(site, ctx.job_name, log, site.time, site.ntasks,
                           [f"#SBATCH --array={array_spec(indices, site.max_concurrent)}"],
                           nodes),
              f"# Written by ligwf {ctx.ligwf_version}: one array task per case of the study",
-             f"# {study} (task id = case index in study.json; {len(indices)} case(s)).",
+             f"# {study} (task id = case index in {STUDY_FILE}; {len(indices)} case(s)).",
              "set -eo pipefail",
              *_environment(site),
              *_launcher_env(site),
@@ -154,7 +153,7 @@ def analysis_script(ctx: ScriptContext, site: SlurmSite, steps: Sequence[str]) -
     if not steps:
         raise ConfigError("the analysis job needs at least one ligwf step")
     study = ctx.study_dir
-    log = f"{study}/{LOG_DIR}/{ctx.job_name}_%j.out"
+    log = f"{study}/{SLURM_LOG_DIR}/{ctx.job_name}_%j.out"
     lines = ["#!/bin/bash",
              *_directives(site, ctx.job_name, log, site.analysis_time or site.time, 1, []),
              f"# Written by ligwf {ctx.ligwf_version}: analysis of the study {study}",
@@ -171,7 +170,7 @@ def analysis_array_script(ctx: ScriptContext, site: SlurmSite, count: int, token
     """The array of a split analysis: task K of ``count`` runs ``ligwf analyse STUDY
     --part K/count --token TOKEN`` (one partial output each, :mod:`ligwf.analysis.parts`)."""
     study = ctx.study_dir
-    log = f"{study}/{LOG_DIR}/{ctx.job_name}_%A_%a.out"
+    log = f"{study}/{SLURM_LOG_DIR}/{ctx.job_name}_%A_%a.out"
     lines = ["#!/bin/bash",
              *_directives(site, ctx.job_name, log, site.analysis_time or site.time, 1,
                           [f"#SBATCH --array={array_spec(range(count), site.max_concurrent)}"]),
@@ -192,7 +191,7 @@ def analysis_merge_script(ctx: ScriptContext, site: SlurmSite, count: int, token
     count --token TOKEN`` (it names any task that left no part and fails), then ``ligwf
     <step> STUDY`` for each of ``steps`` (e.g. ``report``)."""
     study = ctx.study_dir
-    log = f"{study}/{LOG_DIR}/{ctx.job_name}_%j.out"
+    log = f"{study}/{SLURM_LOG_DIR}/{ctx.job_name}_%j.out"
     lines = ["#!/bin/bash",
              *_directives(site, ctx.job_name, log, site.analysis_time or site.time, 1, []),
              f"# Written by ligwf {ctx.ligwf_version}: merge of the {count} analysis task(s)",

@@ -11,13 +11,19 @@ A study folder (``ligwf render`` / ``run`` / ``study`` write it)::
                                      ended done (written with the done manifest)
     STUDY/<case_id>/extension.json   production added by a sequential study (optional)
     STUDY/<case_id>/post/, restart/  the engine's dumps and restarts
+    STUDY/<case_id>/.runner.lock     held by the one runner working on the case
+    STUDY/.ensemble/<phase>-<n>/     an ensemble launch's scratch: launch.log, queue.json,
+                                     claims/ (one claim per case)
+    STUDY/slurm/                     job scripts, jobs.json (the submissions), logs/
     STUDY/rounds.json                the looks of a sequential study (optional)
     STUDY/analysis/                  granule, GSD, kinetics and flow tables, the steady
                                      window, the analysis record, per case a granule series
     STUDY/report/                    tables, summary.md, index.html, figures/, paraview/
 
-Every file name a stage writes is declared here and nowhere else: the study folder's
-files are opened by :mod:`ligwf.study` (every stage asks its objects,
+Every file and folder name ligwf writes or reads is declared here and nowhere else
+(engine scratch, the scheduler's files, a stability suite's and a calibration's records
+included; tests/analysis/records/test_records_contract.py checks every module): the study
+folder's files are opened by :mod:`ligwf.study` (every stage asks its objects,
 :class:`~ligwf.study.case.CaseFolder`, :class:`~ligwf.study.study.Study`); the analysis
 stage (:mod:`ligwf.analysis`) owns the files of ``analysis/`` and the report stage
 (:mod:`ligwf.report`) those of ``report/``, each writing them once.
@@ -49,10 +55,47 @@ ROUNDS_FILE = "rounds.json"
 ROUNDS_LOCK = ".rounds.lock"
 #: Case level: the engine's dump folder.
 POST_DIR = "post"
+#: Case level: the engine's restart folder.
+RESTART_DIR = "restart"
+#: Case level: the folders the engine writes into (made before it starts).
+OUTPUT_DIRS = (POST_DIR, RESTART_DIR)
+#: Case level: the periodic restarts of the drum input, written alternately (the names the
+#: template ``templates/drum.in.j2`` writes them under).
+PERIODIC_RESTARTS = (f"{RESTART_DIR}/restart_a.liggghts", f"{RESTART_DIR}/restart_b.liggghts")
+#: Case level: suffix of a restart's identity sidecar (``<restart>.id.json``).
+RESTART_SIDECAR_SUFFIX = ".id.json"
+#: Case level: the lock a runner holds while it runs the case (released by the kernel).
+RUNNER_LOCK = ".runner.lock"
+#: Case level: the engine's own log file (LIGGGHTS ``-log``).
+ENGINE_LOG = "log.liggghts"
+#: Case level: the input of a resumed attempt (next to ``INPUT_NAME``).
+RESUME_INPUT = "resume.in.liggghts"
 #: Case level: the main LIGGGHTS input (the renderer writes it).
 INPUT_NAME = "in.liggghts"
 #: Case level: the drum mesh (the input refers to it by this name).
 MESH_NAME = "drum.stl"
+
+#: Study level: the scratch folder of an ensemble phase (one MPI launch running many cases).
+ENSEMBLE_DIR = ".ensemble"
+#: in ``ENSEMBLE_DIR``: the launcher's screen, the cases to claim, one claim file per case
+ENSEMBLE_LOG = "launch.log"
+ENSEMBLE_QUEUE = "queue.json"
+ENSEMBLE_CLAIMS_DIR = "claims"
+#: glob of the claim files in ``ENSEMBLE_CLAIMS_DIR``
+ENSEMBLE_CLAIM_GLOB = "*.json"
+#: Study level: the Slurm job scripts, their record and their logs (``ligwf slurm``).
+SLURM_DIR = "slurm"
+SLURM_LOG_DIR = f"{SLURM_DIR}/logs"
+SLURM_RECORD = f"{SLURM_DIR}/jobs.json"
+#: Suite level: the stability suite's record (``ligwf stability``).
+SUITE_RECORD = "suite.json"
+#: Calibration folder (``ligwf calibrate``): the measured candidates, the study of the wet
+#: reference and the study of the candidates
+CALIBRATION_TABLE = "calibration.csv"
+CALIBRATION_REFERENCE_DIR = "wet"
+CALIBRATION_CANDIDATES_DIR = "candidates"
+#: Default mesh cache (``LIGWF_MESH_CACHE`` or ``--mesh-cache`` to say otherwise).
+MESH_CACHE_DIR = "meshes"
 
 #: Study level: outputs of the analysis stage.
 ANALYSIS_DIR = "analysis"
@@ -87,6 +130,75 @@ FIELDS_DATA = "fields.npz"
 GRANULE_SERIES = "granules.pvd"
 #: glob of the labelled frames in a case's granule series folder
 GRANULE_FRAME_GLOB = "granules_*.vtu"
+
+
+def screen_log(attempt: int) -> str:
+    """Case level: the screen of an earlier attempt (``SCREEN_FILE`` renamed when the next
+    attempt starts)."""
+    return f"run.{attempt}.log"
+
+
+def particle_dump(step: int) -> str:
+    """Case level, in ``POST_DIR``: the engine's particle dump of ``step``."""
+    return f"particles_{step}.vtu"
+
+
+#: globs of the engine's particle and contact dumps (also of a foreign run's dump folder)
+PARTICLE_DUMP_GLOB = "particles_*.vtu"
+CONTACT_DUMP_GLOB = "contacts_*.vtu"
+
+
+def ensemble_claim(position: int) -> str:
+    """The claim file of the case at ``position`` of an ensemble's queue."""
+    return f"{position}.json"
+
+
+def ensemble_claim_done(position: int) -> str:
+    """The file saying the case at ``position`` of an ensemble's queue has ended."""
+    return f"{position}.done"
+
+
+def slurm_array_script(round_no: int, ntasks: int | None = None) -> str:
+    """A round's case array job script; ``ntasks`` when the round has one array per rank
+    count."""
+    return f"array-{round_no}.sh" if ntasks is None else f"array-{round_no}-np{ntasks}.sh"
+
+
+def slurm_analysis_script(round_no: int) -> str:
+    """A round's analysis job script."""
+    return f"analysis-{round_no}.sh"
+
+
+def slurm_analysis_array_script(token: str) -> str:
+    """The array job script of an analysis split over tasks (and its merge job's)."""
+    return f"analysis-array-{token}.sh"
+
+
+def slurm_analysis_merge_script(token: str) -> str:
+    """The job script merging an analysis split over tasks."""
+    return f"analysis-merge-{token}.sh"
+
+
+def staging_dir(token: str) -> str:
+    """Folder (in an output folder) of a set of outputs being written, named by its token,
+    before it replaces the old set."""
+    return f".staging-{token}"
+
+
+def replaced_dir(token: str) -> str:
+    """Folder (in an output folder) the outputs a new set replaces are moved into before
+    they are removed."""
+    return f".replaced-{token}"
+
+
+def ensemble_launch_dir(label: str, launch: int) -> str:
+    """Folder (in ``ENSEMBLE_DIR``) of one launch of an ensemble phase."""
+    return f"{label}-{launch}"
+
+
+def mesh_file(key: str) -> str:
+    """A drum mesh in the mesh cache, by its geometry key."""
+    return f"drum_{key}.stl"
 
 
 def granule_frame(step: int) -> str:
@@ -134,6 +246,8 @@ HTML_REPORT = "index.html"
 #: size and SHA-256 of every top-level report file, as the report wrote it (report.digests)
 REPORT_FILES_RECORD = "report_files.json"
 FIGURES_DIR = "figures"
+#: glob of the figures in ``FIGURES_DIR``
+FIGURE_GLOB = "*.png"
 #: ParaView collections: ``PARAVIEW_DIR/<case_id>.pvd`` + ``PARAVIEW_DIR/<case_id>/drum_<step>.vtu``
 PARAVIEW_DIR = "paraview"
 FIGURE_ERROR_VS_RUNTIME = "error_vs_runtime.png"

@@ -26,7 +26,7 @@ from typing import Any, Iterator
 
 from ligwf.errors import ConfigError
 from ligwf.fsio import NOT_WRITABLE, atomic_write_json, not_writable, overwrite_in_place
-from ligwf.study.layout import MANIFEST_FILE, SCREEN_FILE
+from ligwf.study.layout import INPUT_NAME, MANIFEST_FILE, RUNNER_LOCK, SCREEN_FILE
 from ligwf.study.processes import EngineProcess, start_time
 
 #: Case states a manifest can hold.
@@ -34,10 +34,6 @@ DONE, FAILED, UNSTABLE, KILLED, RUNNING = "done", "failed", "unstable", "killed"
 STATUSES = (DONE, FAILED, UNSTABLE, KILLED, RUNNING)
 #: Shown for a case without a (readable) manifest: not run yet. Never written to one.
 MISSING = "missing"
-
-#: Case level: locked (flock) by the one runner working on the case. The kernel drops the
-#: lock when that process dies, however it dies, so a stale lock cannot block a case.
-RUNNER_LOCK = ".runner.lock"
 
 
 def now_iso() -> str:
@@ -58,7 +54,7 @@ class Attempt:
     phases: dict[str, dict[str, float]] = field(default_factory=dict)
     nprocs: int = 1
     command: list[str] = field(default_factory=list)
-    input: str = "in.liggghts"
+    input: str = INPUT_NAME
     from_restart: str | None = None
     from_step: int = 0
     exit_code: int | None = None

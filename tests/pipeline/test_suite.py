@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import json
 
-from ligwf.pipeline.suite import SUITE_RECORD, write_suite
+from ligwf.pipeline.suite import write_suite
+from ligwf.study.layout import SUITE_RECORD
 from ligwf.scene.stability import REFUSED
 from ligwf.scene.stability_suite import load_suite
 from ligwf.study.layout import is_case_folder, is_study_folder

@@ -33,6 +33,7 @@ import numpy as np
 from ligwf.analysis.dumps_numba import first_of_each_pair
 from ligwf.analysis.frames.vtu import piece_counts, read_vtu
 from ligwf.errors import DumpReadError
+from ligwf.study.layout import POST_DIR
 
 PARTICLE_ARRAYS = ("id", "type", "v", "radius")
 CONTACT_ARRAYS = ("id1", "id2", "delta")
@@ -112,7 +113,7 @@ def dump_files(case_dir: Path) -> tuple[dict[int, Path], dict[int, Path]]:
     by step. The ``particles_boundingBox_*`` files LIGGGHTS writes next to each dump do
     not match."""
     case_dir = Path(case_dir)
-    post = case_dir / "post" if (case_dir / "post").is_dir() else case_dir
+    post = case_dir / POST_DIR if (case_dir / POST_DIR).is_dir() else case_dir
     parts: dict[int, Path] = {}
     contacts: dict[int, Path] = {}
     if not post.is_dir():
