@@ -18,7 +18,8 @@ Where the study stands (:func:`progress`) is read from two records, never guesse
 rounds record (k looks taken) and the scheduler's submission record, where every job
 names the round it runs (``study_round``; r the latest):
 
-* the last look stopped it: :data:`STOPPED` (only the final report remains);
+* the last look stopped it: :data:`STOPPED` (only the final report remains, written
+  once: :func:`final_report_written`);
 * r <= k: round k + 1 is :data:`ROUND_DUE` (written and submitted, tagged k + 1);
 * r = k + 1 and a case still queued: :data:`RUNNING`;
 * r = k + 1 and a case not done (failed, killed, unstable, or its task never ran):
@@ -48,6 +49,7 @@ from ligwf.pipeline.rounds import take_look, write_round
 from ligwf.pipeline.run import all_done, cases_to_run
 from ligwf.pipeline.submit import rerun_jobs
 from ligwf.scheduler import Scheduler
+from ligwf.study.layout import REPORT_FILES_RECORD, ROUNDS_FILE
 from ligwf.study.rounds import Look, Rounds, read_rounds, rounds_lock
 from ligwf.study.study import Study
 
@@ -241,12 +243,23 @@ def _submit_round(out: Path, scheduler: Scheduler, how: FollowUp,
                  tuple(indices), f"round {p.round} submitted: {what}")
 
 
+def final_report_written(out: Path) -> bool:
+    """Whether the report was written after the last look (the record of its files is
+    newer than the rounds record; the look's own report comes before the look is
+    written): a repeat of the follow-up command on a stopped study then leaves it."""
+    try:
+        written = (Study.open(out).report_dir / REPORT_FILES_RECORD).stat().st_mtime_ns
+        return written > (Path(out) / ROUNDS_FILE).stat().st_mtime_ns
+    except FileNotFoundError:
+        return False
+
+
 def _settle(out: Path, scheduler: Scheduler, how: FollowUp, p: Progress, take_looks: bool,
             looks: tuple[Look, ...]) -> Moved:
     """The states a call ends in: the final report of a stopped study, or what a
     login-node call submits to keep the study going, or nothing with the reason."""
     if p.state == STOPPED:
-        if take_looks:
+        if take_looks and not final_report_written(out):
             report_study(out, snapshots=how.snapshots)
         return Moved(p, looks, note=f"stopped at look {p.looks}: {p.stop}")
     names = ", ".join(p.not_done[:6]) + (" ..." if len(p.not_done) > 6 else "")
