@@ -17,7 +17,6 @@ not a setting of its own: it is the one the named executable links to
 from __future__ import annotations
 
 import ctypes
-import re
 import struct
 from pathlib import Path
 
@@ -25,8 +24,6 @@ from ligwf.engine.site import EngineConfig
 
 # --------------------------------------------------------------------------- restarts
 
-#: the file a rank writes on SIGTERM, in the case folder (the engine's working folder)
-FORCED_RESTART_RE = re.compile(r"^restart_forced_liggghts_(\d+)\.data$")
 
 
 def restart_step(path: Path) -> int | None:

@@ -28,9 +28,9 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from ligwf.engine.liggghts import FORCED_RESTART_RE, restart_step
+from ligwf.engine.liggghts import restart_step
 from ligwf.fsio import FolderNotWritable, atomic_write_json
-from ligwf.study.layout import PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX
+from ligwf.study.layout import FORCED_RESTART_RE, PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX
 
 #: a file the engine changed less than this many seconds ago may still be being written:
 #: the live poll stamps it on a later look

@@ -24,19 +24,18 @@ re-issues every fix with the same ID and runs the remaining phases with ``run N 
 from __future__ import annotations
 
 import dataclasses
-import re
 import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from ligwf.engine.liggghts import FORCED_RESTART_RE, restart_step
+from ligwf.engine.liggghts import restart_step
 from ligwf.engine.restart_id import CaseIdentity, remove_sidecar, why_not_own
 from ligwf.engine.render import render_template, template_context
 from ligwf.scene.scaling import ScaledScene
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import (ENGINE_LOG, INPUT_NAME, MANIFEST_FILE, OUTPUT_DIRS,
-                                PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX, RESUME_INPUT,
-                                SCREEN_FILE, THERMO_FILE, screen_log)
+from ligwf.study.layout import (ENGINE_LOG, FORCED_RESTART_RE, INPUT_NAME, MANIFEST_FILE,
+                                OUTPUT_DIRS, PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX,
+                                RESUME_INPUT, SCREEN_FILE, SCREEN_LOG_RE, THERMO_FILE, screen_log)
 from ligwf.study.manifest import DONE, FAILED, RUNNING, UNSTABLE, effective_status
 
 
@@ -190,7 +189,7 @@ def clean_outputs(case_dir: Path) -> None:
     for p in case_dir.iterdir():
         if (FORCED_RESTART_RE.match(p.name.removesuffix(RESTART_SIDECAR_SUFFIX))
                 or p.name in (MANIFEST_FILE, THERMO_FILE, RESUME_INPUT, ENGINE_LOG)
-                or re.fullmatch(r"run(\.\d+)?\.log", p.name)):
+                or SCREEN_LOG_RE.match(p.name)):
             p.unlink()
 
 

@@ -19,7 +19,6 @@ import dataclasses
 import hashlib
 import os
 import json
-import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,8 +29,8 @@ from ligwf.scene.model import Scene
 from ligwf.scene.scaling import ScaledScene, scale
 from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.extension import extension_steps
-from ligwf.study.layout import (DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME, POST_DIR,
-                                SCENE_FILE, SCREEN_FILE, THERMO_FILE)
+from ligwf.study.layout import (ANALYSED_DUMP_RE, DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME,
+                                POST_DIR, SCENE_FILE, SCREEN_FILE, THERMO_FILE)
 from ligwf.study.manifest import DONE, Manifest, read_manifest, write_manifest
 from ligwf.study.thermo_table import rows_from_csv, table_problem
 
@@ -167,8 +166,6 @@ def folder_fingerprint(path: Path) -> dict:
     return {"scene_hash": scene, "dump_record": _analysed_digest(record) if record.is_file() else None}
 
 
-#: the dumps an analysis reads (the engine's bounding-box files differ with the rank count)
-_ANALYSED_DUMP = re.compile(r"^(particles|contacts)_\d+\.vtu$")
 
 
 def _analysed_digest(record: Path) -> str:
@@ -176,7 +173,7 @@ def _analysed_digest(record: Path) -> str:
     digest when it is unreadable, so a damaged record still differs)."""
     try:
         files = json.loads(record.read_text())["files"]
-        kept = {k: v for k, v in files.items() if _ANALYSED_DUMP.match(k)}
+        kept = {k: v for k, v in files.items() if ANALYSED_DUMP_RE.match(k)}
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
         return file_digest(record)
     return hashlib.sha256(json.dumps(kept, sort_keys=True).encode()).hexdigest()

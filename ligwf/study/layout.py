@@ -31,6 +31,7 @@ stage (:mod:`ligwf.analysis`) owns the files of ``analysis/`` and the report sta
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 #: Study level: the workflow, its analysis settings and the case list.
@@ -146,6 +147,17 @@ def particle_dump(step: int) -> str:
 #: globs of the engine's particle and contact dumps (also of a foreign run's dump folder)
 PARTICLE_DUMP_GLOB = "particles_*.vtu"
 CONTACT_DUMP_GLOB = "contacts_*.vtu"
+#: the names of those dumps, their step as the group (the engine's bounding-box files,
+#: ``particles_boundingBox_*``, do not match)
+PARTICLE_DUMP_RE = re.compile(r"^particles_(\d+)\.vtu$")
+CONTACT_DUMP_RE = re.compile(r"^contacts_(\d+)\.vtu$")
+#: either of them: the dumps an analysis reads
+ANALYSED_DUMP_RE = re.compile(r"^(particles|contacts)_\d+\.vtu$")
+#: Case level: the restart a rank writes on SIGTERM (the engine's working folder), its step
+#: as the group
+FORCED_RESTART_RE = re.compile(r"^restart_forced_liggghts_(\d+)\.data$")
+#: Case level: the current screen or an earlier attempt's (:func:`screen_log`)
+SCREEN_LOG_RE = re.compile(r"^run(\.\d+)?\.log$")
 
 
 def ensemble_claim(position: int) -> str:

@@ -462,7 +462,8 @@ def test_foreign_truncated_and_garbled_restarts_are_never_resumed(tmp_path):
     other's periodic restart over its own, and its own forced restart is cut in half; the
     other replica's own periodic restart is garbled (same size). The re-run resumes each
     from an older restart of its own, and nothing is mixed or missing."""
-    from ligwf.engine.liggghts import FORCED_RESTART_RE, restart_step
+    from ligwf.engine.liggghts import restart_step
+    from ligwf.study.layout import FORCED_RESTART_RE
 
     out = tmp_path / "study"
     cases = [out / c for c in PAIR]
@@ -549,7 +550,7 @@ def test_ctrl_c_of_ligwf_study_stops_before_the_analysis(tmp_path):
     """`ligwf study` interrupted in production: forced restarts, both cases killed
     'interrupted by the user', no analysis and no report, exit 130; `ligwf run` then
     finishes both from their own restarts."""
-    from ligwf.engine.liggghts import FORCED_RESTART_RE
+    from ligwf.study.layout import FORCED_RESTART_RE
 
     out = tmp_path / "study"
     cases = [out / c for c in PAIR]

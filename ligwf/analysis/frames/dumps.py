@@ -33,7 +33,7 @@ import numpy as np
 from ligwf.analysis.dumps_numba import first_of_each_pair
 from ligwf.analysis.frames.vtu import piece_counts, read_vtu
 from ligwf.errors import DumpReadError
-from ligwf.study.layout import POST_DIR
+from ligwf.study.layout import CONTACT_DUMP_RE, PARTICLE_DUMP_RE, POST_DIR
 
 PARTICLE_ARRAYS = ("id", "type", "v", "radius")
 CONTACT_ARRAYS = ("id1", "id2", "delta")
@@ -41,8 +41,6 @@ _CONTACT_WANTED = frozenset(CONTACT_ARRAYS)     # contact geometry (Points) is n
 #: the axis letters in the order of a position's columns (``AXES.index("y") == 1``)
 AXES = "xyz"
 
-_PARTICLE_RE = re.compile(r"^particles_(\d+)\.vtu$")
-_CONTACT_RE = re.compile(r"^contacts_(\d+)\.vtu$")
 
 
 @dataclass(frozen=True)
@@ -119,9 +117,9 @@ def dump_files(case_dir: Path) -> tuple[dict[int, Path], dict[int, Path]]:
     if not post.is_dir():
         return parts, contacts
     for path in post.iterdir():
-        if m := _PARTICLE_RE.match(path.name):
+        if m := PARTICLE_DUMP_RE.match(path.name):
             parts[int(m.group(1))] = path
-        elif m := _CONTACT_RE.match(path.name):
+        elif m := CONTACT_DUMP_RE.match(path.name):
             contacts[int(m.group(1))] = path
     return parts, contacts
 
@@ -175,7 +173,7 @@ def read_particles(path: Path, step: int | None = None, dt: float | None = None,
     without it the time is nan (unknown), never 0.
     """
     path = Path(path)
-    step = _step_of(path, step, _PARTICLE_RE)
+    step = _step_of(path, step, PARTICLE_DUMP_RE)
     counts = piece_counts(path)
     if counts is not None and counts[0] == 0:
         raise DumpReadError(f"{path}: particle dump holds zero particles")
@@ -218,7 +216,7 @@ def read_contacts(path: Path, step: int | None = None, reader: str = "fast") -> 
     """Read one contact dump (zero contacts is a valid frame: a dispersed or dry bed);
     ``step`` defaults to the number in the file name (a name without one is an error)."""
     path = Path(path)
-    step = _step_of(path, step, _CONTACT_RE)
+    step = _step_of(path, step, CONTACT_DUMP_RE)
     counts = piece_counts(path)
     if counts is not None and counts[1] == 0:
         empty = np.zeros(0, dtype=np.int64)
