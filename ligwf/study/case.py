@@ -136,14 +136,15 @@ def _changed_fields(rec: dict, scaled: ScaledScene) -> list[str]:
                       for k in stored if k in expected and stored[k] != expected[k]]
 
 
-def scene_record_problem(path: Path, rec: dict, scaled: ScaledScene) -> str | None:
+def scene_record_problem(path: Path, rec: dict, scaled: ScaledScene,
+                         check_hash: bool = True) -> str | None:
     """Why a case folder's scene record is not the one rendering wrote (None: its content
     hash recomputes, its CG level and rule are the scaled scene's, and its original block
     scaled again gives its scaled values: the hash does not cover the original), naming
     the changed fields where they can be told."""
     if str(rec["rule"]) != scaled.rule or float(rec["cg"]) != scaled.cg:
         return "changed: " + "; ".join(_changed_fields(rec, scaled))
-    digest = recomputed_hash(path, scaled)
+    digest = recomputed_hash(path, scaled) if check_hash else None
     if digest is None or digest == rec["scene_hash"]:
         if fields := _changed_fields(rec, scaled):
             return ("its original scene block no longer gives its scaled values (changed: "
@@ -341,7 +342,7 @@ class CaseFolder:
         return None
 
     # ----------------------------------------------------------------- usability
-    def record_problem(self) -> str | None:
+    def record_problem(self, check_hash: bool = True) -> str | None:
         """Why the scene record is not the one rendering wrote (None: its content hash,
         recomputed from the scaled parameters, input and mesh in the folder, matches the
         stored one, and its CG level and rule are the scaled scene's). Asked by every stage
@@ -351,7 +352,7 @@ class CaseFolder:
             rec = json.loads((self.path / SCENE_FILE).read_text())
         except (OSError, ValueError) as exc:
             return f"{SCENE_FILE} unreadable: {exc}"
-        why = scene_record_problem(self.path, rec, self.rendered_scaled)
+        why = scene_record_problem(self.path, rec, self.rendered_scaled, check_hash)
         return (None if why is None else f"{SCENE_FILE}: {why}; the record no longer describes "
                 "the run (edited after rendering?): render and run the case again")
 
