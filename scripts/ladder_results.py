@@ -2,7 +2,7 @@
 """docs/results/ladder/: the committed tables of the ladder study and the README whose every
 number is read from them.
 
-    ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots
+    ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided --max-looks 3 --max-core-hours 2.7
     .venv/bin/python scripts/ladder_results.py runs/ladder          # copies tables, writes README
     .venv/bin/python scripts/ladder_results.py --check               # README == text from tables
 
@@ -21,10 +21,16 @@ from pathlib import Path
 
 import pandas as pd
 
+from ligwf.report.rounds import look_line
+from ligwf.study.rounds import read_rounds
+
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "results" / "ladder"
 TABLES = ("verdict.csv", "cases.csv", "conditions.csv", "summary.md")
-COMMAND = "ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots"
+#: the sequential study's record (in the study folder, beside report/)
+ROUNDS = "rounds.json"
+COMMAND = ("ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided "
+           "--max-looks 3 --max-core-hours 2.7")
 
 
 def _n(v: float, digits: int = 3) -> str:
@@ -32,8 +38,25 @@ def _n(v: float, digits: int = 3) -> str:
         else f"{v:.{digits}g}"
 
 
-def readme(verdict: pd.DataFrame, cases: pd.DataFrame) -> str:
-    """The README text, every number from ``verdict`` (verdict.csv) and ``cases``."""
+def rounds_lines(rounds) -> list[str]:
+    """The looks of the sequential study (rounds.json), as the report words them."""
+    if not rounds.looks:
+        return ["One look at alpha = 0.05 (no rounds record)."]
+    lines = [f"At most {rounds.max_looks} looks, each at alpha {rounds.alpha_per_look:.3g} "
+             f"(Bonferroni spending of {rounds.alpha:g}), Hsu's degrees of freedom; cap "
+             + (f"{rounds.max_core_hours:g} core-h." if rounds.max_core_hours else "none."), ""]
+    lines += [f"- {look_line(x)}" for x in rounds.looks]
+    if not rounds.looks[-1].stop:
+        lines += ["", f"The run was ended after look {rounds.looks[-1].number} by the session's "
+                  "clock (SIGTERM), before the round it planned: the cap was not reached and "
+                  "the looks were not spent. The same command on the run folder would continue "
+                  "it; run folders are not committed."]
+    return lines
+
+
+def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None) -> str:
+    """The README text, every number from ``verdict`` (verdict.csv), ``cases`` and the
+    rounds record."""
     lines = ["# The ladder: which CG level and rule keeps the flow of the we_vs_bo drum",
              "",
              "Pre-registration (budget, statistics, looks, cap), committed before the runs: "
@@ -50,8 +73,10 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame) -> str:
              "CG1 runs used 2 ranks, the CG-n runs 1: the speedups (production core-seconds "
              "per simulated second, CG1 over CG-n) are indicative, not a benchmark "
              "(benchmarks/bench_cg_speedup.py is). The design was amended to two CG1 seeds "
-             "before any result was analysed (criterion.md); the sequential rounds "
-             "(`--until-decided`) are not built, so this is one look at alpha = 0.05.",
+             "before any result was analysed (criterion.md); amendment 2 registered the "
+             "sequential run (`--until-decided`) before it started.",
+             "", "## Looks (`rounds.json`)", "", *rounds_lines(rounds if rounds is not None
+                                                             else read_rounds(OUT / "none")),
              "", "## Runs", ""]
     runs = cases.groupby(["cg", "rule"], sort=True)
     lines += ["| condition | runs | particles | angle of repose per run [deg] | rigid-block "
@@ -112,7 +137,9 @@ def main(argv=None) -> int:
             ap.error("give the study folder (or --check)")
         for name in TABLES:
             shutil.copyfile(args.study / "report" / name, OUT / name)
-    text = readme(pd.read_csv(OUT / "verdict.csv"), pd.read_csv(OUT / "cases.csv"))
+        shutil.copyfile(args.study / ROUNDS, OUT / ROUNDS)
+    text = readme(pd.read_csv(OUT / "verdict.csv"), pd.read_csv(OUT / "cases.csv"),
+                  read_rounds(OUT))
     if args.check:
         if (OUT / "README.md").read_text() != text:
             print("docs/results/ladder/README.md differs from its tables: run "
