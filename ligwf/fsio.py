@@ -14,12 +14,14 @@ command line ends with one line instead of an ``OSError`` traceback.
 from __future__ import annotations
 
 import errno
+import fcntl
 import json
 import os
 import stat
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterator
 
 from ligwf.errors import LigwfError
 
@@ -150,3 +152,26 @@ def space_left(folder: Path) -> int:
     except OSError:
         return LOW_SPACE_BYTES
     return st.f_bavail * st.f_frsize
+
+
+@contextmanager
+def try_lock(path: Path) -> Iterator[bool]:
+    """Try to take the exclusive lock file ``path`` without waiting: yields whether it was
+    taken (released when the block ends or the process dies: flock). A folder that cannot
+    hold the lock file is FolderNotWritable (one line), as for every file ligwf writes."""
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
+    except OSError as exc:
+        if exc.errno in NOT_WRITABLE:
+            raise not_writable(exc, path.parent) from exc
+        raise
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            yield False
+            return
+        yield True
+    finally:
+        os.close(fd)

@@ -13,19 +13,17 @@ attempts of the case (a resumed case adds its continuation's time).
 
 from __future__ import annotations
 
-import fcntl
 import json
 import os
 import socket
 import time
-from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
 
 from ligwf.errors import ConfigError
-from ligwf.fsio import NOT_WRITABLE, atomic_write_json, not_writable, overwrite_in_place
+from ligwf.fsio import atomic_write_json, overwrite_in_place, try_lock
 from ligwf.study.layout import INPUT_NAME, MANIFEST_FILE, RUNNER_LOCK, SCREEN_FILE
 from ligwf.study.processes import EngineProcess, start_time
 
@@ -182,26 +180,10 @@ def effective_status(m: Manifest) -> str:
     return m.status
 
 
-@contextmanager
-def case_lock(case_dir: Path) -> Iterator[bool]:
-    """Try to become the one runner of a case: yields whether the lock was taken (no
-    waiting). Two ``ligwf run`` on one study split its cases this way."""
-    path = Path(case_dir) / RUNNER_LOCK
-    try:
-        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
-    except OSError as exc:
-        if exc.errno in NOT_WRITABLE:
-            raise not_writable(exc, path.parent) from exc
-        raise
-    try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            yield False
-            return
-        yield True
-    finally:
-        os.close(fd)
+def case_lock(case_dir: Path):
+    """Try to become the one runner of a case: a context that yields whether the lock was
+    taken (no waiting). Two ``ligwf run`` on one study split its cases this way."""
+    return try_lock(Path(case_dir) / RUNNER_LOCK)
 
 
 def case_busy(case_dir: Path) -> bool:

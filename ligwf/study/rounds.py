@@ -19,17 +19,13 @@ sequential study decides at that level from its first look on.
 
 from __future__ import annotations
 
-import fcntl
 import json
 import math
-import os
-from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Iterator
 
 from ligwf.errors import ConfigError
-from ligwf.fsio import atomic_write_json
+from ligwf.fsio import atomic_write_json, try_lock
 from ligwf.study.layout import ROUNDS_FILE, ROUNDS_LOCK
 
 #: the family error rate of a study's decisions
@@ -133,18 +129,8 @@ def write_rounds(study_path: Path, rounds: Rounds) -> None:
     atomic_write_json(Path(study_path) / ROUNDS_FILE, rec)
 
 
-@contextmanager
-def rounds_lock(study_path: Path) -> Iterator[bool]:
+def rounds_lock(study_path: Path):
     """Try to become the one process that moves the sequential study on (takes its next
-    look, submits its next round): yields whether the lock was taken (no waiting; released
-    when the block ends or the process dies)."""
-    fd = os.open(Path(study_path) / ROUNDS_LOCK, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o666)
-    try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            yield False
-            return
-        yield True
-    finally:
-        os.close(fd)
+    look, submits its next round): a context that yields whether the lock was taken (no
+    waiting; released when the block ends or the process dies)."""
+    return try_lock(Path(study_path) / ROUNDS_LOCK)
