@@ -38,7 +38,8 @@ SETTLE_SECONDS = 60.0
 
 
 def add_until_decided_args(p: argparse.ArgumentParser) -> None:
-    """``--until-decided``, ``--max-looks``, ``--max-core-hours``, ``--no-snapshots``."""
+    """``--until-decided``, ``--max-looks``, ``--max-core-hours``, ``--every-level``,
+    ``--no-snapshots``."""
     p.add_argument("--until-decided", action="store_true",
                    help="a sequential study (as 'ligwf study --until-decided'): each round a "
                    "dependent array whose follow-up job ('ligwf slurm next-round') takes the "
@@ -49,6 +50,9 @@ def add_until_decided_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--max-core-hours", type=number_in(1e-6, 1e9, "core-h"), default=None,
                    metavar="H", help="with --until-decided: stop before a round would take "
                    "the study's runs past H core-hours")
+    p.add_argument("--every-level", action="store_true",
+                   help="with --until-decided: the rounds work on the undecided criteria of "
+                   "every CG level, not only on the cheapest level that can still pass")
     p.add_argument("--no-snapshots", action="store_true", help="with --until-decided: the "
                    "final report without the pyvista snapshots (the slowest figures)")
 
@@ -112,7 +116,7 @@ def submit_until_decided(args: argparse.Namespace, prepared: Prepared, out: Path
                          scheduler: Scheduler, how: FollowUp) -> int:
     """After the study is written: its rounds record, then what its state asks for (round
     1 on a new study)."""
-    start_rounds(out, RoundPlan(args.max_looks, args.max_core_hours))
+    start_rounds(out, RoundPlan(args.max_looks, args.max_core_hours, args.every_level))
     print_moved(keep_going(out, scheduler, how, prepared=lambda: prepared))
     return 0
 

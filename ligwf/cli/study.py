@@ -88,7 +88,8 @@ def cmd_until_decided(args: argparse.Namespace) -> int:
         return done
 
     rounds = until_decided(prepared, args.out, settings,
-                           RoundPlan(args.max_looks, args.max_core_hours), run_round,
+                           RoundPlan(args.max_looks, args.max_core_hours, args.every_level),
+                           run_round,
                            show_look, args.mesh_cache, snapshots=not args.no_snapshots)
     if not rounds.stopped:
         console.print("some cases did not finish (see the table): the same command resumes "
@@ -114,4 +115,8 @@ def register(subparsers) -> None:
     p.add_argument("--max-core-hours", type=number_in(1e-6, 1e9, "core-h"), default=None,
                    metavar="H", help="with --until-decided: stop before a round would take "
                    "the study's runs past H core-hours")
+    p.add_argument("--every-level", action="store_true",
+                   help="with --until-decided: the rounds work on the undecided criteria of "
+                   "every CG level (a ladder: each level's error decided), not only on the "
+                   "cheapest level that can still pass")
     p.set_defaults(func=cmd_study)

@@ -2,7 +2,9 @@
 
 Rounds of run, analyse, verdict: after each look (:func:`plan_look`), the cheapest level
 of each sweep group that can still pass (the fastest condition that does not fail) is
-the round's target; each of its undecided criteria names the cheapest way to HALVE its
+the round's target (with ``--every-level``: every level with an undecided criterion, so
+that each level's error is decided, as a ladder study asks; an arm several levels share,
+their CG1 runs, gets the most any of them asks, not the sum); each of its undecided criteria names the cheapest way to HALVE its
 interval's half-width (:mod:`ligwf.analysis.records.sampling`: more production on the runs
 there are, or more replicas of an arm); the round does all of them (per arm the longest
 extension and the most replicas asked for) and looks again, until the target meets the
@@ -55,15 +57,21 @@ from ligwf.study.study import Study
 @dataclass(frozen=True)
 class RoundPlan:
     """How a sequential study runs: at most ``max_looks`` looks and ``max_core_hours``
-    core-hours of runs in all (None: no cap)."""
+    core-hours of runs in all (None: no cap); ``every_level``: the rounds work on every
+    level's undecided criteria (:attr:`~ligwf.study.rounds.Rounds.every_level`)."""
 
     max_looks: int = 3
     max_core_hours: float | None = None
+    every_level: bool = False
 
 
 def start_rounds(out: Path, plan: RoundPlan) -> Rounds:
     """The study's rounds record: created at the first look, and refused when a later call
-    asks for another number of looks (its level was fixed before any data were seen)."""
+    asks for another number of looks (its level was fixed before any data were seen). A
+    last look that stopped because no planned way decided it (``stuck``) or because the cap
+    was reached and the cap is now raised is taken again (same number, same data, same
+    level: no new test) and plans the round it could not: the scope (``every_level``) or
+    the cap of this call may plan one."""
     rounds = read_rounds(out)
     if rounds.looks and rounds.max_looks != plan.max_looks:
         raise ConfigError(f"--max-looks = {plan.max_looks}: this study was started with "
@@ -72,13 +80,14 @@ def start_rounds(out: Path, plan: RoundPlan) -> Rounds:
                           f"--max-looks {rounds.max_looks}")
     looks = rounds.looks
     last = looks[-1] if looks else None
-    if (last is not None and last.stop_kind == CAPPED and (
+    if last is not None and (last.stop_kind == STUCK or (last.stop_kind == CAPPED and (
             plan.max_core_hours is None
-            or last.core_hours + last.planned_core_hours <= plan.max_core_hours)):
-        # the cap was raised past the round it stopped: that look is taken again (same
-        # number, same data, same level) and plans the round it could not afford
+            or last.core_hours + last.planned_core_hours <= plan.max_core_hours))):
+        # the cap was raised past the round it stopped, or it found no planned way: that
+        # look is taken again (same number, same data, same level) and plans the round
         looks = looks[:-1]
-    rounds = Rounds(plan.max_looks, rounds.alpha, plan.max_core_hours, looks)
+    rounds = Rounds(plan.max_looks, rounds.alpha, plan.max_core_hours, looks,
+                    plan.every_level)
     write_rounds(out, rounds)
     return rounds
 
@@ -167,72 +176,98 @@ def _arm_cases(study: Study, group: str, cg: float, rule: str) -> list[CaseFolde
             and (cg == REFERENCE_CG or c.rule == rule)]
 
 
-def _actions(study: Study, group: str, cg: float, rule: str, criteria) -> tuple[list[dict], float]:
-    """The round's actions on one condition (and its CG1 arm) from its undecided
-    criteria's cheapest options, merged per arm, and their planned core-hours."""
-    arms = {"CG-n": _arm_cases(study, group, cg, rule),
-            "CG1": _arm_cases(study, group, REFERENCE_CG, "none")}
-    extend = {"CG-n": 0.0, "CG1": 0.0}
-    add = {"CG-n": 0, "CG1": 0}
+def _needs(criteria, group: str, cg: float, rule: str,
+           needs: dict[tuple, list[float]]) -> None:
+    """Add to ``needs`` (per arm ``(group, cg, rule)``: [seconds of production more per
+    run, replicas more]) what one condition's undecided ``criteria`` ask for; an arm shared
+    by several conditions (their CG1 runs) gets the most any of them asks, not the sum."""
+    keys = {"CG-n": (group, cg, rule), "CG1": (group, REFERENCE_CG, "none")}
     for r in criteria:
-        if r.round_by == EXTEND:
-            for arm in ("CG-n", "CG1"):
-                if arm in r.round_arm.split(" and "):
-                    extend[arm] = max(extend[arm], r.round_amount)
-        elif r.round_by == REPLICAS:
-            if "CG-n" in r.round_arm:
-                add["CG-n"] = max(add["CG-n"], int(r.round_amount))
-            if "CG1" in r.round_arm:
-                cg1 = r.round_amount_cg1 if math.isfinite(r.round_amount_cg1) else 0
-                add["CG1"] = max(add["CG1"], int(cg1))
+        for arm, key in keys.items():
+            if arm not in r.round_arm.split(" and "):
+                continue
+            need = needs.setdefault(key, [0.0, 0])
+            if r.round_by == EXTEND:
+                need[0] = max(need[0], r.round_amount)
+            elif r.round_by == REPLICAS:
+                amount = r.round_amount if arm == "CG-n" else r.round_amount_cg1
+                need[1] = max(need[1], int(amount) if math.isfinite(amount) else 0)
+
+
+def _calibration(cases: list[CaseFolder]) -> float:
+    """Measured over planned core-seconds of the arm's fastest finished run (1 without
+    one): the planner's rates scaled to what this machine did, so that the cap is checked
+    against real costs; the fastest, so that a run slowed by a shared machine or a retry
+    does not inflate the plan."""
+    ratios = []
+    for c in cases:
+        m = c.manifest()
+        planned = run_costs(c.scaled)[0]
+        if m is not None and m.core_seconds > 0 and planned > 0:
+            ratios.append(m.core_seconds / planned)
+    return min(ratios) if ratios else 1.0
+
+
+def _actions(study: Study, needs: dict[tuple, list[float]]) -> tuple[list[dict], float]:
+    """The round's actions on each arm ``needs`` names (longer production on its runs,
+    then new replicas as long as them) and their planned core-hours (the planner's rates
+    calibrated by the arm's own runs, :func:`_calibration`)."""
     actions, hours = [], 0.0
-    for arm, cases in arms.items():
+    for (group, cg, rule), (extend, add) in needs.items():
+        cases = _arm_cases(study, group, cg, rule)
         if not cases:
             continue
+        rate = _calibration(cases)
+        arm = "CG1" if cg == REFERENCE_CG else "CG-n"
         steps_now = max(c.scaled.run_steps for c in cases)
-        if extend[arm] > 0:
-            more = math.ceil(extend[arm] / cases[0].scaled.dt)
+        if extend > 0:
+            more = math.ceil(extend / cases[0].scaled.dt)
             run_steps = {c.case_id: steps_now + more for c in cases}
-            actions.append({"kind": EXTEND, "arm": arm, "seconds": extend[arm],
+            actions.append({"kind": EXTEND, "arm": arm, "seconds": extend,
                             "case_ids": [c.case_id for c in cases], "run_steps": run_steps})
-            hours += sum(run_costs(c.scaled)[1] * extend[arm] for c in cases) / 3600.0
+            hours += rate * sum(run_costs(c.scaled)[1] * extend for c in cases) / 3600.0
             steps_now += more
-        if add[arm] > 0:
+        if add > 0:
             first = max(c.replica for c in cases) + 1
-            reps = list(range(first, first + add[arm]))
-            a_cg, a_rule = (cg, rule) if arm == "CG-n" else (REFERENCE_CG, "none")
+            reps = list(range(first, first + add))
             # new replicas run as long as the arm's runs (extended ones included)
-            actions.append({"kind": REPLICAS, "arm": arm, "group": group, "cg": a_cg,
-                            "rule": a_rule, "replicas": reps, "each_run_steps": steps_now,
-                            "condition": Condition(group, a_cg, a_rule).name})
+            actions.append({"kind": REPLICAS, "arm": arm, "group": group, "cg": cg,
+                            "rule": rule, "replicas": reps, "each_run_steps": steps_now,
+                            "condition": Condition(group, cg, rule).name})
             scaled = dataclasses.replace(cases[0].scaled, run_steps=steps_now)
-            hours += add[arm] * run_costs(scaled)[0] / 3600.0
+            hours += rate * add * run_costs(scaled)[0] / 3600.0
     return actions, hours
+
+
+def _targets(group, every_level: bool) -> list:
+    """The conditions of a sweep group a round works on: the cheapest level that can still
+    pass (none once it meets the budget), or with ``every_level`` each level with an
+    undecided criterion."""
+    by_speed = sorted(group.conditions, key=lambda c: -c.speedup
+                      if math.isfinite(c.speedup) else math.inf)
+    if every_level:
+        return [c for c in by_speed if any(r.state == UNDECIDED for r in c.criteria)]
+    open_ = [c for c in by_speed if c.state != FAILS]
+    return [] if not open_ or open_[0].state == MEETS else open_[:1]
 
 
 def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Look:
     """The look ``number`` of ``verdict``: what the next round does, or why the study stops."""
     base = dict(number=number, alpha=rounds.alpha_per_look,
                 core_hours=spent_core_hours(study), criteria=_criteria_rows(verdict))
-    targets, actions, hours, stuck = [], [], 0.0, []
+    targets, needs, stuck = [], {}, []
     for g in verdict.groups:
         if is_control_group(g.group) or not g.conditions:
             continue
-        open_ = [c for c in sorted(g.conditions, key=lambda c: -c.speedup
-                                   if math.isfinite(c.speedup) else math.inf)
-                 if c.state != FAILS]
-        if not open_ or open_[0].state == MEETS:
-            continue
-        c = open_[0]
-        undecided = [r for r in c.criteria if r.state == UNDECIDED]
-        if not undecided or any(not r.round_by for r in undecided):
+        for c in _targets(g, rounds.every_level):
+            undecided = [r for r in c.criteria if r.state == UNDECIDED]
+            planned = [r for r in undecided if r.round_by]
             stuck += [f"{c.name} {r.label}: {r.note}" for r in undecided if not r.round_by]
             stuck += [] if undecided else [f"{c.name}: no criterion of the budget assessed"]
-            continue
-        acts, h = _actions(study, g.group, c.cg, c.rule, undecided)
-        targets.append(c.name)
-        actions += acts
-        hours += h
+            if planned:
+                _needs(planned, g.group, c.cg, c.rule, needs)
+                targets.append(c.name)
+    actions, hours = _actions(study, needs)
     if not targets:
         why = ("decided: " + "; ".join(g.sentence for g in verdict.groups
                                        if not is_control_group(g.group))) if not stuck else (

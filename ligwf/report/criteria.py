@@ -4,8 +4,9 @@
 Signed criteria (angle of repose in deg, rigid-block share, flowing-layer thickness
 relative to CG1) are the difference of run means CG-n - CG1 with Welch's interval, decided
 by two one-sided tests against +-budget; the velocity profile is the noise-corrected
-distance of the mean profiles with bin-wise bounds; the GSD and field errors keep the
-analysis' intervals against the tolerance. Holm's step-down over a level's fail tests
+distance of the mean profiles with noncentral-F bounds; the GSD and field errors keep the
+analysis' intervals against the tolerance (the field criterion's at the verdict's alpha,
+with the replicas that would decide it from its noise pieces). Holm's step-down over a level's fail tests
 decides which fails stand. The statistics: :mod:`ligwf.analysis.records.equivalence`.
 """
 
@@ -22,6 +23,7 @@ from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records import sampling
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.report import planning
+from ligwf.report.deciding import decide_text, field_plan, profile_plan, signed_plan
 from ligwf.scene.accept import AcceptSettings
 
 #: the states of a criterion beside the tests' own (pass, fail, undecided)
@@ -145,44 +147,12 @@ def _arm(runs: pd.DataFrame, column: str, noise: pd.DataFrame | None,
                             col(planning.PRODUCTION_COST)))).scaled(scale)
 
 
-def _round_fields(o: "sampling.Option | None") -> dict:
-    """A sequential round's option (see :attr:`CriterionResult.round_by`) as fields."""
-    if o is None:
-        return {}
-    return dict(round_by=o.kind, round_arm=o.arm, round_amount=o.amount,
-                round_amount_cg1=o.amount_cg1 if o.kind == sampling.REPLICAS else math.nan,
-                round_core_hours=o.core_hours)
-
-
 def _replica_cost(runs: pd.DataFrame, noise: pd.DataFrame | None) -> float:
     """Mean core-seconds of a new replica of an arm (nan without a noise table)."""
     if noise is None or noise.empty or runs is None or planning.REPLICA_COST not in noise:
         return math.nan
     costs = [float(noise[planning.REPLICA_COST].get(i, math.nan)) for i in runs["case_id"]]
     return float(np.nanmean(costs)) if np.isfinite(costs).any() else math.nan
-
-
-def _decide_fields(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
-                   alpha: float, unit: str, df_rule: str = eq.WELCH) -> tuple[dict, str]:
-    """What would decide an undecided signed criterion: the cheapest option's fields and
-    its sentence (the arms' variances and the difference as measured)."""
-    if x.n < 2 or y.n < 2:
-        who = "CG-n" if x.n < 2 else "CG1"
-        return {}, f"{who} has one run: no variance, no interval (run at least 2 replicas)"
-    best = sampling.cheapest(x, y, e.value, budget, alpha, df_rule)
-    fields = _round_fields(sampling.cheapest(x, y, budget + 0.5 * (e.hi - e.lo) / 2, budget,
-                                             alpha, df_rule)) if e.has_interval else {}
-    if best is None:
-        return fields, (f"the difference sits near the budget for its spread: neither "
-                        f"{sampling.MOST_REPLICAS} replicas of an arm nor "
-                        f"{sampling.MOST_EXTENSION:g}x longer runs would decide it")
-    fields |= dict(decide_by=best.kind, decide_arm=best.arm, decide_amount=best.amount,
-                  decide_amount_cg1=(best.amount_cg1 if best.kind == sampling.REPLICAS
-                                     else math.nan),
-                  decide_core_hours=best.core_hours,
-                  decide_half_width=best.predicted_half_width)
-    return fields, (f"cheapest to decide: {best.text(unit)}; the {sampling.dominant_arm(x, y)} "
-                    "scatter dominates the width now")
 
 
 def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.Arm,
@@ -210,7 +180,7 @@ def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.
                 else "indistinguishable from CG1 seed noise at these replicas")
     note, decide = vs_noise, {}
     if test.state == UNDECIDED:
-        decide, how = _decide_fields(x.scaled(scale), y.scaled(scale), e, tolerance, alpha,
+        decide, how = signed_plan(x.scaled(scale), y.scaled(scale), e, tolerance, alpha,
                                      spec.unit, df_rule)
         note = "; ".join(part for part in (how, vs_noise) if part)
     bound = max(abs(e.lo), abs(e.hi)) if e.has_interval else math.nan
@@ -229,38 +199,15 @@ def _holm_replan(r: CriterionResult, x: sampling.Arm, y: sampling.Arm, alpha: fl
         ref = float(np.nanmean(y.values))
         scale = 1.0 / ref if ref > 0 else math.nan
     e = eq.scaled(eq.difference_estimate(x.values, y.values, alpha, df_rule), scale)
-    fields, _ = _decide_fields(x.scaled(scale), y.scaled(scale), e, r.budget, alpha, r.unit,
+    fields, _ = signed_plan(x.scaled(scale), y.scaled(scale), e, r.budget, alpha, r.unit,
                                df_rule)
     return dataclasses.replace(r, **(_NO_DECIDE | fields))
-
-
-def _profile_replicas(x: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
-                      costs: tuple[float, float]) -> dict:
-    """The fewest replicas added to each arm (the same number, the profile's noise is both
-    arms') whose predicted bin-wise bounds would decide the profile criterion."""
-    out: dict = {}
-    width = eq.norm_estimate(x, y, alpha)
-    width = width.hi - width.lo
-    hours = lambda k: k * (costs[0] + costs[1]) / 3600.0   # noqa: E731
-    for k in range(1, sampling.MOST_REPLICAS - max(len(x), len(y)) + 1):
-        p = eq.norm_estimate(x, y, alpha, add=(k, k))
-        if not p.has_interval:
-            break
-        if not out.get("round_by") and p.hi - p.lo <= 0.5 * width:
-            out.update(round_by=sampling.REPLICAS, round_arm="CG-n and CG1", round_amount=k,
-                       round_amount_cg1=k, round_core_hours=hours(k))
-        if eq.norm_decision(p, tolerance) != UNDECIDED:
-            out.update(decide_by=sampling.REPLICAS, decide_arm="CG-n and CG1",
-                       decide_amount=k, decide_amount_cg1=k, decide_core_hours=hours(k),
-                       decide_half_width=0.5 * (p.hi - p.lo))
-            break
-    return out
 
 
 def _norm(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
           alpha: float, costs: tuple[float, float] = (math.nan, math.nan)) -> CriterionResult:
     """The velocity profile: the noise-corrected relative L2 distance between the arms'
-    mean profiles, decided by its bin-wise bounds (``costs``: core-seconds of a replica of
+    mean profiles, decided by its noncentral-F bounds (``costs``: core-seconds of a replica of
     each arm, for what would decide it)."""
     base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
                 budget_source="tolerance")
@@ -271,11 +218,11 @@ def _norm(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
     decide = {}
     note = f"raw distance {e.raw:.3g} before the noise of both arms is taken off"
     if state == UNDECIDED and e.has_interval:
-        decide = _profile_replicas(x, y, tolerance, alpha, costs)
+        decide = profile_plan(x, y, tolerance, alpha, costs)
         r = CriterionResult(**base, state=state, **decide)
         how = decide_text(r) or (f"over {sampling.MOST_REPLICAS} replicas of both arms "
                                  "would be needed")
-        note = (f"raw distance {e.raw:.3g}; the bin-wise bounds [{e.lo:.3g}, {e.hi:.3g}] "
+        note = (f"raw distance {e.raw:.3g}; the bounds [{e.lo:.3g}, {e.hi:.3g}] "
                 f"straddle the budget; {how}")
     if not e.has_interval:
         note = "an arm has one run: no variance, no bounds (run at least 2 replicas)"
@@ -283,8 +230,11 @@ def _norm(spec: CriterionSpec, tolerance: float, x: np.ndarray, y: np.ndarray,
                            note=note, **decide)
 
 
-def _analysis_interval(spec: CriterionSpec, tolerance: float, row) -> CriterionResult:
-    """GSD and field errors: their interval from the analysis against the tolerance."""
+def _analysis_interval(spec: CriterionSpec, tolerance: float, row, alpha: float = eq.ALPHA,
+                       costs: tuple[float, float] = (math.nan, math.nan)) -> CriterionResult:
+    """GSD and field errors: their interval from the analysis against the tolerance (the
+    field criterion's at the verdict's alpha, :func:`ligwf.report.fields.add_field_errors`,
+    with what would decide it)."""
     base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
                 budget_source="tolerance")
     value, lo, hi = band(row, spec.column)
@@ -295,8 +245,15 @@ def _analysis_interval(spec: CriterionSpec, tolerance: float, row) -> CriterionR
         return CriterionResult(**base, state=UNDECIDED, value=value,
                                note="no interval (add replicas)")
     state = PASS if hi <= tolerance else FAIL if lo > tolerance else UNDECIDED
+    decide = (field_plan(row, tolerance, alpha, costs)
+              if state == UNDECIDED and spec.name == "field_error" else {})
+    note = ""
+    if state == UNDECIDED:
+        how = decide_text(CriterionResult(**base, state=state, **decide))
+        note = how or (f"over {sampling.MOST_REPLICAS} replicas of an arm would be needed"
+                       if decide else "more replicas of both arms")
     return CriterionResult(**base, state=state, value=value, lo=lo, hi=hi, bound=hi,
-                           note="" if state != UNDECIDED else "more replicas of both arms")
+                           note=note, **decide)
 
 
 def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs: pd.DataFrame,
@@ -341,7 +298,8 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
                                        note=f"not measured: the study has no {spec.column}"))
             p_fail.append(math.nan)
         else:
-            out.append(_analysis_interval(spec, tol, row))
+            costs = (_replica_cost(runs, noise), _replica_cost(ref_runs, noise))
+            out.append(_analysis_interval(spec, tol, row, alpha, costs))
             p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
     rejected = eq.holm_rejects(p_fail, alpha)
     family = sum(math.isfinite(p) for p in p_fail)
@@ -349,16 +307,6 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
            if r.state == FAIL and not ok and i in arms else r
            for i, (r, ok) in enumerate(zip(out, rejected))]
     return tuple(_after_holm(r, ok, family) for r, ok in zip(out, rejected))
-
-
-def decide_text(r: CriterionResult) -> str:
-    """The cheapest way to decide ``r`` in words (empty when none is stored)."""
-    if not r.decide_by:
-        return ""
-    cg1 = r.decide_amount_cg1 if math.isfinite(r.decide_amount_cg1) else 0.0
-    return "cheapest to decide: " + sampling.Option(
-        r.decide_by, r.decide_arm, r.decide_amount, r.decide_core_hours,
-        r.decide_half_width, 0, cg1).text(r.unit)
 
 
 _NO_DECIDE = dict(decide_by="", decide_arm="", decide_amount=math.nan, decide_amount_cg1=math.nan,

@@ -28,10 +28,11 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis.records.conditions import Conditions
-from ligwf.analysis.records.equivalence import NormEstimate
-from ligwf.analysis.records.field_errors import (ERRORS, KERNEL_COLUMNS, LAYER_SPEED,
-                                                 MATERIAL_SOLID, condition_mean, field_floor,
-                                                 field_intervals, layer_error, null_split,
+from ligwf.analysis.records.equivalence import ALPHA, NormEstimate
+from ligwf.analysis.records.field_errors import (ERRORS, FIELD_NOISE_COLUMNS, KERNEL_COLUMNS,
+                                                 LAYER_SPEED, MATERIAL_SOLID, condition_mean,
+                                                 field_floor, field_intervals,
+                                                 layer_components, layer_error, null_split,
                                                  same_grid, whole_windows)
 from ligwf.analysis.records.fields import CaseFields, read_fields
 from ligwf.analysis.records.provenance import StaleAnalysis
@@ -81,22 +82,34 @@ def _criterion_row(row: dict, est: dict[str, NormEstimate]) -> None:
         row[col], row[f"{col}_lo"], row[f"{col}_hi"] = e.value, e.lo, e.hi
 
 
-def _criterion(cases: list, refs: list, kernel: float) -> dict[str, NormEstimate]:
+def _criterion(cases: list, refs: list, kernel: float, alpha: float = ALPHA
+               ) -> dict[str, NormEstimate]:
     """The field criterion at the verdict's width ``kernel`` and at every reported width,
-    by column (runs: (case, part of its window))."""
-    out = {"field_error": layer_error(cases, refs, kernel)}
-    out.update({col: layer_error(cases, refs, k) for k, col in KERNEL_COLUMNS.items()})
+    by column (runs: (case, part of its window)), bounds at ``alpha``."""
+    out = {"field_error": layer_error(cases, refs, kernel, alpha)}
+    out.update({col: layer_error(cases, refs, k, alpha) for k, col in KERNEL_COLUMNS.items()})
     return out
 
 
+def _noise_row(row: dict, noise) -> None:
+    """The pieces of the field criterion's bounds (:class:`LayerNoise`) as columns: what
+    the verdict plans more replicas from."""
+    values = ((math.nan,) * 3 + (0, 0)) if noise is None else (
+        noise.distance, noise.run_variance, noise.reference_variance, noise.runs,
+        noise.reference_runs)
+    row.update(zip(FIELD_NOISE_COLUMNS, values))
+
+
 def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
-                     fields: dict[str, CaseFields], draws: int, seed: int, kernel: float
-                     ) -> tuple[pd.DataFrame, pd.DataFrame]:
+                     fields: dict[str, CaseFields], draws: int, seed: int, kernel: float,
+                     alpha: float = ALPHA) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The case table with each case's field errors against its group's CG1 cases (the
     criterion raw: one run has no noise estimate), and the condition table with the field
     criterion at the verdict's width ``kernel`` (CG1 diameters) and at each reported width,
     and the solid-fraction error, each with bounds, floor and mark (nan and ``–`` without
-    fields)."""
+    fields). The field criterion's bounds are at ``alpha`` (a sequential study's looks:
+    its level per look) and its noise pieces (``FIELD_NOISE_COLUMNS``) are kept for the
+    verdict's planning."""
     cases, conditions = cases.copy(), conditions.copy()
     for name in ("field_error", "field_solid_error"):
         cases[name] = math.nan
@@ -108,6 +121,8 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
     for col in KERNEL_COLUMNS.values():
         for sfx in ("", "_lo", "_hi"):
             conditions[f"{col}{sfx}"] = math.nan
+    for col in FIELD_NOISE_COLUMNS:
+        conditions[col] = math.nan
     if cases.empty or conditions.empty or not fields:
         return cases, conditions
     groups = Conditions.of(cases.itertuples())
@@ -127,10 +142,12 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
         ref_ids = groups.reference_cases(row["group"])
         members, refs = _members(ids, fields), _members(ref_ids, fields)
         reference = bool(ids) and groups.condition(ids[0]).is_reference
-        est = _criterion(whole_windows(members), whole_windows(refs), kernel)
-        null = layer_error(*null_split(refs)[:2], kernel)
+        est = _criterion(whole_windows(members), whole_windows(refs), kernel, alpha)
+        null = layer_error(*null_split(refs)[:2], kernel, alpha)
         values: dict = {}
         _criterion_row(values, est)
+        _noise_row(values, layer_components(whole_windows(members), whole_windows(refs),
+                                            kernel))
         for col, v in values.items():
             conditions.at[i, col] = v
         e = est["field_error"]

@@ -37,6 +37,7 @@ from ligwf.report.uncertainty import (ConditionStats, case_series, cost_interval
                                       report_metrics)
 from ligwf.study import layout
 from ligwf.study.case import group_label
+from ligwf.study.rounds import read_rounds
 from ligwf.study.study import Study
 
 #: run costs (a Student-t interval on the logarithm over replicas)
@@ -257,5 +258,6 @@ def build_tables(study: Study, flow: FlowRecord, granules: bool = True
     df = compare_to_cg1(merged, stats, list(flow.error_metrics))
     df, conditions = add_field_errors(df, condition_table(df, stats, metric_columns(flow)),
                                       case_fields(analysis_dir), settings.bootstrap,
-                                      settings.seed, settings.field_kernel)
+                                      settings.seed, settings.field_kernel,
+                                      read_rounds(study.path).alpha_per_look)
     return df, conditions, skipped, noise_floor_table(df, stats)

@@ -13,8 +13,8 @@ verdicts (:func:`granule_gates`). The statistics are
   ``fail`` when it lies wholly outside, else ``undecided`` (saying which arm's replicas
   would decide it);
 - the **velocity profile** is the relative L2 distance of the mean profiles, less the noise
-  of both arms, with bin-wise (Bonferroni) bounds: ``pass`` when the upper bound is within
-  the budget, ``fail`` when the lower bound exceeds it;
+  of both arms, with one-sided bounds from the noncentral F distribution: ``pass`` when the
+  upper bound is within the budget, ``fail`` when the lower bound exceeds it;
 - the GSD and field errors keep the analysis' intervals against the tolerance;
 - ``not assessed`` (the GSD where the granules did not beat their cohesionless control)
   or ``not measured`` (no value).

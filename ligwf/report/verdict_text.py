@@ -128,7 +128,7 @@ def verdict_section(verdict: Verdict) -> str:
              "layer) are the difference of run means CG-n - CG1 with Welch's 90 % interval: "
              "they pass when it lies inside +-budget and fail when it lies wholly outside "
              "(two one-sided tests, 5 % each); the velocity profile is the distance of the "
-             "mean profiles less the noise of both arms, with bin-wise bounds. A level meets "
+             "mean profiles less the noise of both arms, with noncentral-F bounds. A level meets "
              "the budget when every criterion it was assessed on passes, and fails when one "
              "fails after Holm's step-down over its criteria; coverage measured by "
              "`benchmarks/bench_coverage.py`. Control twins are not candidates.", ""]

@@ -61,12 +61,16 @@ class Look:
 
 @dataclass(frozen=True)
 class Rounds:
-    """A sequential study's plan and its looks (the default: one look at ``alpha``)."""
+    """A sequential study's plan and its looks (the default: one look at ``alpha``).
+    ``every_level``: the rounds work on the undecided criteria of every CG level (a
+    ladder: what each level is shown to stay within), not only on the cheapest level that
+    can still pass."""
 
     max_looks: int = 1
     alpha: float = FAMILY_ALPHA
     max_core_hours: float | None = None
     looks: tuple[Look, ...] = field(default_factory=tuple)
+    every_level: bool = False
 
     @property
     def alpha_per_look(self) -> float:
@@ -80,7 +84,8 @@ class Rounds:
     def with_look(self, look: Look) -> "Rounds":
         """The record with ``look`` added (or replacing a look of the same number)."""
         kept = tuple(x for x in self.looks if x.number < look.number)
-        return Rounds(self.max_looks, self.alpha, self.max_core_hours, kept + (look,))
+        return Rounds(self.max_looks, self.alpha, self.max_core_hours, kept + (look,),
+                      self.every_level)
 
 
 def _clean(obj):
@@ -112,7 +117,8 @@ def read_rounds(study_path: Path) -> Rounds:
                       for x in rec.get("looks", ()))
         cap = rec.get("max_core_hours")
         return Rounds(int(rec["max_looks"]), float(rec["alpha"]),
-                      None if cap is None else float(cap), looks)
+                      None if cap is None else float(cap), looks,
+                      bool(rec.get("every_level", False)))
     except (KeyError, TypeError, ValueError) as exc:
         raise ConfigError(f"{path}: unreadable record of the study's rounds "
                           f"({type(exc).__name__}: {exc})") from None
@@ -124,7 +130,7 @@ def write_rounds(study_path: Path, rounds: Rounds) -> None:
            "alpha_per_look": rounds.alpha_per_look, "method": "Bonferroni alpha spending "
            "over max_looks looks (each look at alpha / max_looks), Hsu's conservative "
            "degrees of freedom (min(R1, R2) - 1)",
-           "max_core_hours": rounds.max_core_hours,
+           "max_core_hours": rounds.max_core_hours, "every_level": rounds.every_level,
            "looks": [_clean(asdict(x)) for x in rounds.looks]}
     atomic_write_json(Path(study_path) / ROUNDS_FILE, rec)
 

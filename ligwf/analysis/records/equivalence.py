@@ -12,9 +12,9 @@ use Welch's standard error and Satterthwaite's degrees of freedom.
 A criterion is then decided by **two one-sided tests** (Schuirmann 1987) on the signed
 difference CG-n - CG1 against +-budget: ``pass`` when the (1 - 2 alpha) interval lies
 inside +-budget, ``fail`` when it lies wholly outside, otherwise ``undecided``. Norm
-criteria (the velocity profile) use bin-wise Welch intervals (Bonferroni over the bins):
-their norm bounds hold whenever every bin's interval holds, and the point estimate is the
-squared distance less the noise of both arms.
+criteria (the velocity profile) use one-sided bounds from inverting the noncentral F
+distribution of the bins' squared differences (:func:`norm_estimate`), and the point
+estimate is the squared distance less the noise of both arms.
 
 Everything here is pure (arrays in, numbers out) and is what the benchmark measures.
 """

@@ -65,6 +65,10 @@ MATERIAL_SOLID = 0.1
 LAYER_SPEED = 0.2
 #: the field criterion at each width of CRITERION_KERNELS: column name per width
 KERNEL_COLUMNS = {k: f"field_error_k{k:g}" for k in CRITERION_KERNELS}
+#: the pieces of the verdict's field criterion's bounds (:class:`LayerNoise`), by column:
+#: raw distance, per-run noise of the CG-n and the CG1 arm, and their numbers of runs
+FIELD_NOISE_COLUMNS = ("field_error_distance", "field_error_run_var", "field_error_ref_var",
+                       "field_error_runs", "field_error_ref_runs")
 #: bootstrap draws evaluated at once (bounds the memory: draws x grid nodes x moments)
 CHUNK = 100
 #: the error columns this module computes, by name
@@ -226,33 +230,75 @@ def _velocity(sums: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             np.where(ok, sums[..., 2, :, :] / safe, np.nan))
 
 
-def layer_norm(runs: np.ndarray, reference: np.ndarray, weights: np.ndarray, scale: float,
-               alpha: float = ALPHA) -> NormEstimate:
-    """The noise-corrected weighted RMS distance between two arms' mean vector fields, in
-    units of ``scale`` (module docstring). ``runs`` (R_n, C, K) and ``reference`` (R_1,
-    C, K): per run C components at K nodes; ``weights`` (K,) >= 0. Without two runs in
-    each arm: the raw distance and no bounds."""
+@dataclass(frozen=True)
+class LayerNoise:
+    """What the field criterion's bounds are made of: the raw distance between the arms'
+    mean fields (sqrt(D^2), units of omega R), each arm's per-run noise (sum_x w s^2 over
+    its runs, units of (omega R)^2) and its number of runs. Its bounds at other run counts
+    are what more replicas would give, the distance and the per-run scatter as measured
+    (what would decide the criterion, :mod:`ligwf.report.criteria`)."""
+
+    distance: float
+    run_variance: float
+    reference_variance: float
+    runs: int
+    reference_runs: int
+
+    def noise(self, add: tuple[int, int] = (0, 0)) -> tuple[float, float]:
+        """(S, its Satterthwaite degrees of freedom) with ``add`` more runs per arm."""
+        nx, ny = self.runs + add[0], self.reference_runs + add[1]
+        return (self.run_variance / nx + self.reference_variance / ny,
+                welch_df(self.run_variance, nx, self.reference_variance, ny))
+
+    def half_width(self, alpha: float = ALPHA, add: tuple[int, int] = (0, 0)) -> float:
+        """t sqrt(S): how far each bound lies from the raw distance."""
+        noise, df = self.noise(add)
+        t = float(stats.t.ppf(1.0 - alpha / 2.0, df)) if math.isfinite(df) else float(
+            stats.norm.ppf(1.0 - alpha / 2.0))
+        return t * math.sqrt(noise)
+
+    def estimate(self, alpha: float = ALPHA) -> NormEstimate:
+        """The noise-corrected distance and its bounds (module docstring)."""
+        noise, _ = self.noise()
+        half = self.half_width(alpha)
+        value = math.sqrt(max(0.0, self.distance ** 2 - noise))
+        return NormEstimate(value, max(0.0, self.distance - half), self.distance + half,
+                            self.distance)
+
+
+def layer_noise(runs: np.ndarray, reference: np.ndarray, weights: np.ndarray,
+                scale: float) -> LayerNoise | None:
+    """The pieces of the field criterion (:class:`LayerNoise`) of two arms' vector
+    fields: ``runs`` (R_n, C, K) and ``reference`` (R_1, C, K), per run C components at K
+    nodes; ``weights`` (K,) >= 0. None when the shapes or the weights do not fit; nan
+    variances with fewer than two runs in an arm."""
     x, y = np.asarray(runs, float), np.asarray(reference, float)
     w = np.asarray(weights, float)
     if (x.ndim != 3 or y.ndim != 3 or x.shape[1:] != y.shape[1:] or not len(x) or not len(y)
             or w.shape != x.shape[2:] or not np.sum(w) > 0 or not scale > 0):
-        return NO_NORM
+        return None
     w = w / np.sum(w)
     d = x.mean(axis=0) - y.mean(axis=0)                                  # (C, K)
-    d2 = float(np.sum(w * d * d))
-    raw = math.sqrt(d2) / scale
-    if len(x) < 2 or len(y) < 2:
-        return NormEstimate(raw, math.nan, math.nan, raw)
-    a = float(np.sum(w * x.var(axis=0, ddof=1))) / len(x)
-    b = float(np.sum(w * y.var(axis=0, ddof=1))) / len(y)
-    noise = a + b
-    df = welch_df(a * len(x), len(x), b * len(y), len(y))
-    t = float(stats.t.ppf(1.0 - alpha / 2.0, df)) if math.isfinite(df) else float(
-        stats.norm.ppf(1.0 - alpha / 2.0))
-    half = t * math.sqrt(noise)
-    value = math.sqrt(max(0.0, d2 - noise)) / scale
-    return NormEstimate(value, max(0.0, math.sqrt(d2) - half) / scale,
-                        (math.sqrt(d2) + half) / scale, raw)
+    distance = math.sqrt(float(np.sum(w * d * d))) / scale
+
+    def per_run(a: np.ndarray) -> float:
+        return (float(np.sum(w * a.var(axis=0, ddof=1))) / scale ** 2 if len(a) > 1
+                else math.nan)
+
+    return LayerNoise(distance, per_run(x), per_run(y), len(x), len(y))
+
+
+def layer_norm(runs: np.ndarray, reference: np.ndarray, weights: np.ndarray, scale: float,
+               alpha: float = ALPHA) -> NormEstimate:
+    """The noise-corrected weighted RMS distance between two arms' mean vector fields, in
+    units of ``scale`` (module docstring; arrays as :func:`layer_noise`). Without two runs
+    in each arm: the raw distance and no bounds."""
+    noise = layer_noise(runs, reference, weights, scale)
+    if noise is None:
+        return NO_NORM
+    if noise.runs < 2 or noise.reference_runs < 2:
+        return NormEstimate(noise.distance, math.nan, math.nan, noise.distance)
+    return noise.estimate(alpha)
 
 
 def _means(cases: list[CaseFields], kernel: float) -> list[WindowMeans] | None:
@@ -265,22 +311,20 @@ def _one_grid(means: list[WindowMeans]) -> bool:
                 for m in means}) == 1
 
 
-def layer_error(cases: list[tuple[CaseFields, str]], refs: list[tuple[CaseFields, str]],
-                kernel: float, alpha: float = ALPHA) -> NormEstimate:
-    """The field criterion of the runs ``cases`` against the CG1 runs ``refs`` at
-    ``kernel`` CG1 diameters; each run a (case, part of its window: ``WINDOW_PARTS``).
-    nan when a run lacks the window means (an analysis from before them), the grids
-    differ, the drum's omega R is unknown or there is no flowing layer."""
+def _layer_arrays(cases: list[tuple[CaseFields, str]], refs: list[tuple[CaseFields, str]],
+                  kernel: float):
+    """(runs, reference, weights, omega R) of the field criterion (arrays as
+    :func:`layer_noise`), or None (see :func:`layer_error`)."""
     if not cases or not refs:
-        return NO_NORM
+        return None
     cm = _means([c for c, _ in cases], kernel)
     rm = _means([c for c, _ in refs], kernel)
     if cm is None or rm is None or not _one_grid(cm + rm):
-        return NO_NORM
+        return None
     omega, radius = refs[0][0].omega, refs[0][0].radius
     scale = abs(omega) * radius
     if not (math.isfinite(scale) and scale > 0):
-        return NO_NORM
+        return None
     x = np.stack([m.part(p) for m, (_, p) in zip(cm, cases)])           # (R, 3, n, n)
     y = np.stack([m.part(p) for m, (_, p) in zip(rm, refs)])
     grid = rm[0].grid
@@ -293,10 +337,27 @@ def layer_error(cases: list[tuple[CaseFields, str]], refs: list[tuple[CaseFields
     layer = ((phi1 >= MATERIAL_SOLID) & moving & np.isfinite(xu).all(axis=0)
              & np.isfinite(yu).all(axis=0))
     if not layer.any():
-        return NO_NORM
+        return None
     runs = np.stack([xu[:, layer], xv[:, layer]], axis=1)                 # (R, 2, K)
     ref = np.stack([yu[:, layer], yv[:, layer]], axis=1)
-    return layer_norm(runs, ref, phi1[layer], scale, alpha)
+    return runs, ref, phi1[layer], scale
+
+
+def layer_error(cases: list[tuple[CaseFields, str]], refs: list[tuple[CaseFields, str]],
+                kernel: float, alpha: float = ALPHA) -> NormEstimate:
+    """The field criterion of the runs ``cases`` against the CG1 runs ``refs`` at
+    ``kernel`` CG1 diameters; each run a (case, part of its window: ``WINDOW_PARTS``).
+    nan when a run lacks the window means (an analysis from before them), the grids
+    differ, the drum's omega R is unknown or there is no flowing layer."""
+    arrays = _layer_arrays(cases, refs, kernel)
+    return NO_NORM if arrays is None else layer_norm(*arrays, alpha=alpha)
+
+
+def layer_components(cases: list[tuple[CaseFields, str]], refs: list[tuple[CaseFields, str]],
+                     kernel: float) -> LayerNoise | None:
+    """The pieces of :func:`layer_error`'s bounds (None where it is nan)."""
+    arrays = _layer_arrays(cases, refs, kernel)
+    return None if arrays is None else layer_noise(*arrays)
 
 
 def whole_windows(cases: list[CaseFields]) -> list[tuple[CaseFields, str]]:

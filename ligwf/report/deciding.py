@@ -1,0 +1,142 @@
+"""What would decide an undecided criterion of the verdict, and what a sequential round
+does instead (:mod:`ligwf.report.criteria` decides; this module plans).
+
+Two plans per undecided criterion, both from the variance components as measured
+(:mod:`ligwf.analysis.records.sampling`): the cheapest way to **decide** it (longer
+production or more replicas of an arm, the difference as measured: what the report tells
+a user) and the cheapest way to **halve** its half-width (what a round of ``ligwf study
+--until-decided`` does: it depends on the variances only, so it does not bias the next
+look's test). Signed criteria plan on the arms' run values, the velocity profile on its
+noncentral-F bounds with the same number more of both arms, the field criterion on its
+noise pieces (:class:`~ligwf.analysis.records.field_errors.LayerNoise`) with more CG-n
+replicas, more CG1 replicas or both.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ligwf.analysis.records import equivalence as eq
+from ligwf.analysis.records import sampling
+from ligwf.analysis.records.equivalence import UNDECIDED
+from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
+
+
+def round_fields(o: "sampling.Option | None") -> dict:
+    """A sequential round's option (see :attr:`CriterionResult.round_by`) as fields."""
+    if o is None:
+        return {}
+    return dict(round_by=o.kind, round_arm=o.arm, round_amount=o.amount,
+                round_amount_cg1=o.amount_cg1 if o.kind == sampling.REPLICAS else math.nan,
+                round_core_hours=o.core_hours)
+
+
+def signed_plan(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
+                   alpha: float, unit: str, df_rule: str = eq.WELCH) -> tuple[dict, str]:
+    """What would decide an undecided signed criterion: the cheapest option's fields and
+    its sentence (the arms' variances and the difference as measured)."""
+    if x.n < 2 or y.n < 2:
+        who = "CG-n" if x.n < 2 else "CG1"
+        return {}, f"{who} has one run: no variance, no interval (run at least 2 replicas)"
+    best = sampling.cheapest(x, y, e.value, budget, alpha, df_rule)
+    fields = round_fields(sampling.cheapest(x, y, budget + 0.5 * (e.hi - e.lo) / 2, budget,
+                                             alpha, df_rule)) if e.has_interval else {}
+    if best is None:
+        return fields, (f"the difference sits near the budget for its spread: neither "
+                        f"{sampling.MOST_REPLICAS} replicas of an arm nor "
+                        f"{sampling.MOST_EXTENSION:g}x longer runs would decide it")
+    fields |= dict(decide_by=best.kind, decide_arm=best.arm, decide_amount=best.amount,
+                  decide_amount_cg1=(best.amount_cg1 if best.kind == sampling.REPLICAS
+                                     else math.nan),
+                  decide_core_hours=best.core_hours,
+                  decide_half_width=best.predicted_half_width)
+    return fields, (f"cheapest to decide: {best.text(unit)}; the {sampling.dominant_arm(x, y)} "
+                    "scatter dominates the width now")
+
+
+def profile_plan(x: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
+                      costs: tuple[float, float]) -> dict:
+    """The fewest replicas added to each arm (the same number, the profile's noise is both
+    arms') whose predicted bounds would decide the profile criterion."""
+    out: dict = {}
+    width = eq.norm_estimate(x, y, alpha)
+    width = width.hi - width.lo
+    hours = lambda k: k * (costs[0] + costs[1]) / 3600.0   # noqa: E731
+    for k in range(1, sampling.MOST_REPLICAS - max(len(x), len(y)) + 1):
+        p = eq.norm_estimate(x, y, alpha, add=(k, k))
+        if not p.has_interval:
+            break
+        if not out.get("round_by") and p.hi - p.lo <= 0.5 * width:
+            out.update(round_by=sampling.REPLICAS, round_arm="CG-n and CG1", round_amount=k,
+                       round_amount_cg1=k, round_core_hours=hours(k))
+        if eq.norm_decision(p, tolerance) != UNDECIDED:
+            out.update(decide_by=sampling.REPLICAS, decide_arm="CG-n and CG1",
+                       decide_amount=k, decide_amount_cg1=k, decide_core_hours=hours(k),
+                       decide_half_width=0.5 * (p.hi - p.lo))
+            break
+    return out
+
+
+def _value(row, col: str) -> float:
+    try:
+        return float(row.get(col, math.nan))
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def field_plan(row, tolerance: float, alpha: float, costs: tuple[float, float]) -> dict:
+    """What would decide the field criterion and what halves its bounds' half-width, from
+    its noise pieces in the condition table (:class:`LayerNoise`, the distance and the
+    per-run scatter as measured): the cheapest of more CG-n replicas, more CG1 replicas or
+    the same number more of both (core-hours from ``costs``, a replica of each arm)."""
+    values = [_value(row, c) for c in FIELD_NOISE_COLUMNS]
+    if not all(math.isfinite(v) for v in values) or min(values[3:]) < 2:
+        return {}
+    noise = LayerNoise(values[0], values[1], values[2], int(values[3]), int(values[4]))
+    half = noise.half_width(alpha)
+    options = []       # (core-hours, kind of option, CG-n replicas, CG1 replicas, half-width)
+    for arm, step in (("CG-n", (1, 0)), ("CG1", (0, 1)), ("CG-n and CG1", (1, 1))):
+        cost = step[0] * costs[0] + step[1] * costs[1]
+        if not math.isfinite(cost):
+            continue
+        halved = decided = None
+        for k in range(1, sampling.MOST_REPLICAS + 1):
+            h = noise.half_width(alpha, (k * step[0], k * step[1]))
+            if halved is None and h <= 0.5 * half:
+                halved = k
+            if decided is None and (noise.distance + h <= tolerance
+                                    or noise.distance - h > tolerance):
+                decided = (k, h)
+            if halved is not None and decided is not None:
+                break
+        if halved is not None:
+            options.append((halved * cost / 3600.0, "round", arm, halved * step[0],
+                            halved * step[1]))
+        if decided is not None:
+            k, h = decided
+            options.append((k * cost / 3600.0, "decide", arm, k * step[0], k * step[1], h))
+    out: dict = {}
+    rounds = sorted(o for o in options if o[1] == "round")
+    if rounds:
+        hours, _, arm, kx, ky = rounds[0]
+        out.update(round_by=sampling.REPLICAS, round_arm=arm, round_amount=kx,
+                   round_amount_cg1=ky, round_core_hours=hours)
+    decides = sorted(o for o in options if o[1] == "decide")
+    if decides:
+        hours, _, arm, kx, ky, h = decides[0]
+        out.update(decide_by=sampling.REPLICAS, decide_arm=arm, decide_amount=kx,
+                   decide_amount_cg1=ky, decide_core_hours=hours, decide_half_width=h)
+    return out
+
+
+def decide_text(r) -> str:
+    """The cheapest way to decide ``r`` (a criterion result) in words (empty when none is
+    stored)."""
+    if not r.decide_by:
+        return ""
+    cg1 = r.decide_amount_cg1 if math.isfinite(r.decide_amount_cg1) else 0.0
+    return "cheapest to decide: " + sampling.Option(
+        r.decide_by, r.decide_arm, r.decide_amount, r.decide_core_hours,
+        r.decide_half_width, 0, cg1).text(r.unit)
