@@ -69,7 +69,7 @@ class Study:
             raise ConfigError(f"{path}: no readable workflow in its study record ({exc})") from None
         if not isinstance(raw, dict) or not raw:
             raise ConfigError(f"{path}: its study record holds no workflow")
-        return raw
+        return _numeric_cg_keys(raw)
 
     # ----------------------------------------------------------------- cases
     @property
@@ -125,3 +125,33 @@ def studies_below(root: Path) -> list[Study]:
     if not root.is_dir():
         return []
     return [Study.open(p) for p in sorted(root.iterdir()) if is_study_folder(p)]
+
+
+#: the sweep's maps keyed by CG level (JSON stores their keys as text)
+CG_KEYED = ("replicas", "per_cg")
+
+
+def _number(key):
+    """A JSON object key back as the number it was written from ("2" -> 2, "1.5" -> 1.5);
+    any other text as it is (the workflow's validation names it)."""
+    if not isinstance(key, str):
+        return key
+    for kind in (int, float):
+        try:
+            return kind(key)
+        except ValueError:
+            continue
+    return key
+
+
+def _numeric_cg_keys(raw: dict) -> dict:
+    """The stored workflow with the CG levels of the sweep's per-level maps
+    (:data:`CG_KEYED`) as numbers again: JSON turned ``replicas: {1: 2}`` into ``{"1": 2}``,
+    which the workflow's strict validation refuses as text."""
+    sweep = raw.get("sweep")
+    if not isinstance(sweep, dict):
+        return raw
+    fixed = {name: {_number(k): v for k, v in sweep[name].items()}
+             for name in CG_KEYED if isinstance(sweep.get(name), dict)}
+    return {**raw, "sweep": {**sweep, **fixed}} if fixed else raw
+
