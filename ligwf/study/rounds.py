@@ -98,6 +98,21 @@ def _clean(obj):
     return obj
 
 
+#: how a record written before ``stop_kind`` existed words each kind of stop
+_STOP_WORDS = (("decided", DECIDED), ("no planned way", STUCK), ("the cap of", CAPPED))
+
+
+def _legacy_kind(stop: str) -> str:
+    """The kind of a stop recorded before looks stored it, from its words (empty for a
+    look that did not stop)."""
+    if not stop:
+        return ""
+    for words, kind in _STOP_WORDS:
+        if stop.startswith(words):
+            return kind
+    return LOOKS_SPENT if "looks are spent" in stop else ""
+
+
 def read_rounds(study_path: Path) -> Rounds:
     """The record of the study folder ``study_path`` (the one-look default when it has
     none); ConfigError when it is unreadable."""
@@ -113,7 +128,7 @@ def read_rounds(study_path: Path) -> Rounds:
                            tuple(x.get("criteria", ())), str(x.get("target", "")),
                            tuple(x.get("actions", ())),
                            float(x.get("planned_core_hours") or 0.0), str(x.get("stop", "")),
-                           str(x.get("stop_kind", "")))
+                           str(x.get("stop_kind", "")) or _legacy_kind(str(x.get("stop", ""))))
                       for x in rec.get("looks", ()))
         cap = rec.get("max_core_hours")
         return Rounds(int(rec["max_looks"]), float(rec["alpha"]),
