@@ -205,6 +205,26 @@ def test_study_folder_file_names_only_in_the_study_model():
     assert not hits, "the study model owns these file names:\n" + "\n".join(hits)
 
 
+#: the one module that reads and writes each JSON record of a study folder (issue 33)
+RECORD_OWNERS = {"STUDY_FILE": "ligwf.study.study_record",
+                 "ANALYSIS_RECORD": "ligwf.analysis.records.analysis_record"}
+#: a record opened by hand: its path read, or handed to a JSON reader or writer
+OPENED = r"{name}\)?\.(read_text|read_bytes|open)\(|json\.(loads?|dumps?)\(.*{name}|atomic_write_json\(.*{name}"
+
+
+def test_each_record_is_parsed_by_its_type_only():
+    hits = [h for name, owner in RECORD_OWNERS.items()
+            for h in _occurrences(OPENED.format(name=name), owner)]
+    assert not hits, ("read and write these records through StudyRecord / AnalysisRecord:\n"
+                      + "\n".join(hits))
+    # the pattern sees what the modules did before the record types
+    rx = re.compile(OPENED.format(name="ANALYSIS_RECORD"))
+    assert rx.search("record = json.loads((where / layout.ANALYSIS_RECORD).read_text())")
+    assert re.search(OPENED.format(name="STUDY_FILE"),
+                     "atomic_write_json(out_dir / STUDY_FILE, {")
+    assert not rx.search('raise MissingAnalysis(f"no record ({layout.ANALYSIS_RECORD})")')
+
+
 def test_liquid_models_named_only_in_their_modules():
     hits = _occurrences(r"""["'](washino|easo)["']""", "ligwf.liquids")
     assert not hits, "ask ligwf.liquids instead of comparing model names:\n" + "\n".join(hits)

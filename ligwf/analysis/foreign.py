@@ -27,7 +27,8 @@ from pathlib import Path
 from ligwf import liquids
 from ligwf.analysis.granules.case import GranuleAnalysis, RunFacts
 from ligwf.analysis.frames.dumps import AXES, FrameFiles, read_particles
-from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
+from ligwf.analysis.records.analysis_record import AnalysisRecord
+from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, frame_tables,
                                           nothing_analysed, stage_granules)
 from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.analysis.outputs import OutputSet, new_token
@@ -196,7 +197,7 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
                   "cases": [{"case_id": facts.case_id, "cg": facts.cg, "frames": len(frames),
                              "analysed": index.get(facts.case_id, 0)}],
                   "skipped_cases": [], "skipped_frames": skipped}
-        commit(outputs, record, obsolete=GRANULE_OUTPUTS)
+        AnalysisRecord.commit(outputs, record, obsolete=GRANULE_OUTPUTS)
         return record
     except BaseException:
         outputs.discard()

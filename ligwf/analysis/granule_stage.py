@@ -6,14 +6,14 @@ stages the same set for a study (:mod:`ligwf.analysis.runner`) and for dumps lig
 not write (:mod:`ligwf.analysis.foreign`): granule and frame tables, GSD and GSD summary
 (steady window), replica pooling and its summary, kinetics and its summary, the
 definition sensitivity, the granule controls (a study's twins) and per case the granule
-series; :func:`commit` writes the analysis record and moves the set into place. File
-names in :mod:`ligwf.study.layout`.
+series; :meth:`~ligwf.analysis.records.analysis_record.AnalysisRecord.commit` then
+writes the analysis record and moves the set into place. File names in
+:mod:`ligwf.study.layout`.
 """
 
 from __future__ import annotations
 
 import io
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -192,14 +192,3 @@ GRANULE_OUTPUTS = (layout.GRANULES_TABLE, layout.FRAMES_TABLE, layout.GSD_TABLE,
                    layout.GSD_SUMMARY_TABLE, layout.GSD_POOLING_TABLE,
                    layout.GSD_POOLING_SUMMARY_TABLE, layout.KINETICS_TABLE,
                    layout.KINETICS_SUMMARY_TABLE, layout.SENSITIVITY_TABLE, layout.CONTROLS_TABLE)
-
-
-def commit(outputs: OutputSet, record: dict, obsolete: tuple[str, ...] = ()) -> None:
-    """Stage the analysis record and move the whole set into place (record last). The
-    record lists the size and SHA-256 of every staged table (``outputs``), so a reader can
-    tell a truncated or replaced table from the one written here; ``obsolete``: outputs of
-    an earlier analysis to remove with the set when this one did not write them."""
-    record = {**record, "outputs": outputs.digests()}
-    outputs.write(layout.ANALYSIS_RECORD,
-                  (json.dumps(record, indent=2, sort_keys=True) + "\n").encode())
-    outputs.commit(layout.ANALYSIS_RECORD, obsolete)

@@ -2,7 +2,7 @@
 
 A big study's analysis can run as N independent processes (a Slurm array, ``ligwf
 analyse STUDY --slurm N``): task K computes exactly the share MPI rank K of N would
-(:meth:`ligwf.analysis.runner.AnalysisPlan.share`: a contiguous run of the (case, frame)
+(:meth:`ligwf.analysis.runner.AnalysisShares.share`: a contiguous run of the (case, frame)
 tasks, and the flow of the cases whose middle frame it holds) and writes it as one file,
 atomically (:func:`write_part`), into ``OUT/.parts-<token>/``; its labelled ``.vtu``
 frames go into the analysis' staging folder of the same token. The merge (``--merge N``)

@@ -3,7 +3,7 @@
 The MPI runner (:func:`analyse`) gives each rank a contiguous run of the (case, frame)
 tasks (a frame depends only on its own dumps, a ``held`` window on the frames after it,
 which then stay on one rank) and the flow of the cases whose middle frame it holds
-(:meth:`AnalysisPlan.share`), gathers the results on rank 0, which alone sorts them and
+(:meth:`AnalysisShares.share`), gathers the results on rank 0, which alone sorts them and
 writes the outputs: the same files whatever the number of ranks (each rank writes the
 ``.vtu`` files of its own frames into the staging folder). The same shares can run as
 the tasks of a Slurm array instead (:func:`analyse_part`, each writing one partial
@@ -67,8 +67,9 @@ from pathlib import Path
 from ligwf.analysis.granules.case import FrameResult, GranuleAnalysis, RunFacts
 from ligwf.analysis.frames.dumps import FrameFiles
 from ligwf.analysis.flow.stage import field_files, flow_cases, flow_record, flow_table
-from ligwf.analysis.frames.checks import FramePlan, plan_frames, shared_checks
-from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, commit, frame_tables,
+from ligwf.analysis.frames.checks import ExpectedFrames, plan_frames, shared_checks
+from ligwf.analysis.records.analysis_record import AnalysisRecord
+from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, frame_tables,
                                           nothing_analysed, stage_granules)
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.analysis.parts import Share, check_token, drop_parts, read_parts, write_part
@@ -80,7 +81,7 @@ from ligwf.study import layout
 from ligwf.study.case import CaseFolder, folder_fingerprint, granules_absent
 from ligwf.study.study import Study
 
-__all__ = ["AnalysisOptions", "AnalysisPlan", "analyse", "analyse_part", "merge_parts", "mpi_comm"]
+__all__ = ["AnalysisOptions", "AnalysisShares", "analyse", "analyse_part", "merge_parts", "mpi_comm"]
 
 def mpi_comm():
     """MPI.COMM_WORLD when started under mpirun with more than one rank, else None."""
@@ -107,7 +108,7 @@ class AnalysisOptions:
 
 
 @dataclass
-class AnalysisPlan:
+class AnalysisShares:
     """What an analysis decides before computing anything, the same on every MPI rank and
     in every array task (:mod:`ligwf.analysis.parts`): the study, its usable cases, the
     (case, frame) tasks and the cases' run facts."""
@@ -156,8 +157,8 @@ class AnalysisPlan:
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
 
 
-def plan_analysis(run_dir: Path, options: AnalysisOptions = AnalysisOptions()) -> AnalysisPlan:
-    """The :class:`AnalysisPlan` of a study (or one case) folder."""
+def plan_analysis(run_dir: Path, options: AnalysisOptions = AnalysisOptions()) -> AnalysisShares:
+    """The :class:`AnalysisShares` of a study (or one case) folder."""
     study = Study.open(run_dir)
     settings = options.settings or study.analysis
     usable, skipped_cases = study.usable_cases(options.require_manifest)
@@ -173,11 +174,11 @@ def plan_analysis(run_dir: Path, options: AnalysisOptions = AnalysisOptions()) -
         except ConfigError as exc:
             skipped_cases.append({"case_id": c.case_id, "reason": str(exc)})
     tasks = [(fi, ff) for fi, f in enumerate(facts) for ff in f.plan.frames]
-    return AnalysisPlan(study, settings, options, usable, unusable, skipped_cases, absent,
+    return AnalysisShares(study, settings, options, usable, unusable, skipped_cases, absent,
                         facts, tasks)
 
 
-def compute_share(plan: AnalysisPlan, outputs: OutputSet, rank: int, size: int) -> Share:
+def compute_share(plan: AnalysisShares, outputs: OutputSet, rank: int, size: int) -> Share:
     """Rank ``rank`` of ``size``'s frame results and flows (each dump checked once:
     :func:`~ligwf.analysis.frames.checks.shared_checks`)."""
     tasks, flow_of = plan.share(rank, size)
@@ -197,7 +198,7 @@ def compute_share(plan: AnalysisPlan, outputs: OutputSet, rank: int, size: int) 
     return share
 
 
-def finish(plan: AnalysisPlan, outputs: OutputSet, shares: list[Share]) -> dict:
+def finish(plan: AnalysisShares, outputs: OutputSet, shares: list[Share]) -> dict:
     """Merge the shares (any split: the same outputs) and write the outputs as one set."""
     results = [r for s in shares for r in s.results]
     by_case = {k: v for s in shares for k, v in s.flows.items()}
@@ -333,7 +334,8 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
             raise nothing_analysed(study.path, skipped_cases, skipped_frames)
         record = {**base, "cases": []}
         stage_flow(outputs, flows)
-        commit(outputs, record, obsolete=GRANULE_OUTPUTS + field_outputs(outputs.out_dir))
+        AnalysisRecord.commit(outputs, record,
+                              obsolete=GRANULE_OUTPUTS + field_outputs(outputs.out_dir))
         return record
     cases = [f.case for f in analysed]
     steady_from = {c.case_id: flows.cases[c.case_id].steady_from_step for c in cases}
@@ -341,7 +343,7 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
     steady = stage_granules(outputs, tables, analysed, cases, steady_from, settings,
                             options.implementation, options.write_vtu, controls=True)
     steady_frames = steady.groupby("case_id")["step"].nunique() if len(steady) else {}
-    plans: dict[str, FramePlan] = {f.case_id: f.plan for f in analysed}
+    plans: dict[str, ExpectedFrames] = {f.case_id: f.plan for f in analysed}
     record = {
         **base,
         "cases": [{"case_id": c.case_id, "cg": c.cg, "rule": c.rule, "replica": c.replica,
@@ -352,7 +354,8 @@ def write_outputs(study: Study, outputs: OutputSet, facts: list[RunFacts], skipp
                    "steady_frames": int(steady_frames.get(c.case_id, 0))} for c in cases],
     }
     # e.g. no twins now: no controls.csv; a case no longer measured: no fields_<case>.vti
-    commit(outputs, record, obsolete=GRANULE_OUTPUTS + field_outputs(outputs.out_dir))
+    AnalysisRecord.commit(outputs, record,
+                          obsolete=GRANULE_OUTPUTS + field_outputs(outputs.out_dir))
     return record
 
 

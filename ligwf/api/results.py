@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
+from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.records.fields import CaseFields, read_fields
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.api import fields, plots
@@ -30,6 +31,7 @@ from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.study import Study
+from ligwf.study.study_record import StudyRecord
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -79,14 +81,14 @@ class StudyResults:
         return self.study.accept
 
     @cached_property
-    def record(self) -> dict[str, Any]:
+    def record(self) -> StudyRecord:
         """The study record (``study.json``): name, workflow, analysis settings, cases."""
-        return json.loads((self.path / layout.STUDY_FILE).read_text())
+        return StudyRecord.read(self.path)
 
     @property
     def workflow(self) -> dict[str, Any]:
         """The workflow the study was rendered from (scene, sweep, analysis, as validated)."""
-        return dict(self.record.get("workflow") or {})
+        return dict(self.record.workflow)
 
     @property
     def case_ids(self) -> tuple[str, ...]:
@@ -387,12 +389,8 @@ class StudyResults:
     def _why_no_granules(self) -> str | None:
         """Why the analysis wrote no granule tables, from its record (None: no such
         reason recorded, the tables are simply missing)."""
-        try:
-            record = json.loads((self.analysis_dir / layout.ANALYSIS_RECORD).read_text())
-        except (OSError, ValueError):
-            return None
-        raw = record.get("granules_absent") if isinstance(record, dict) else None  # damaged
-        absent = [a for a in raw if isinstance(a, dict)] if isinstance(raw, list) else []
+        record = AnalysisRecord.read(self.analysis_dir)
+        absent = record.granules_absent if record is not None else ()
         if not absent:
             return None
         reasons = sorted({str(a.get("reason", "")) for a in absent})

@@ -19,7 +19,7 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
-from ligwf.engine.plan import MAX_RANKS, CasePlan, Schedule, particle_steps
+from ligwf.engine.plan import MAX_RANKS, RankPlan, Schedule, particle_steps
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import Prepared, prepare_workflow
 from ligwf.study.layout import STUDY_FILE
@@ -251,7 +251,7 @@ def duration(seconds: float) -> str:
     return f"{seconds / 3600:.1f} h"
 
 
-def case_plan_table(plans: Sequence[CasePlan], title: str, notes: Sequence[str]) -> Group:
+def case_plan_table(plans: Sequence[RankPlan], title: str, notes: Sequence[str]) -> Group:
     """Ranks per case, what limited them and the estimated wall time; ``notes`` below,
     one line each."""
     table = Table(title=title)

@@ -36,7 +36,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)
     wf = prepared.workflow
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s), valid"))
-    for line in analysis_plan(prepared):
+    for line in analysis_lines(prepared):
         console.print(line, highlight=False, soft_wrap=True)
     settings = run_settings(cores=args.cores)
     schedule = planned_schedule(prepared, settings)
@@ -70,7 +70,7 @@ def regime_table(prepared) -> Table:
     return table
 
 
-def analysis_plan(prepared) -> list[str]:
+def analysis_lines(prepared) -> list[str]:
     """What `ligwf study` will and will not analyse, case by case, before anything runs."""
     absent = {rc.case.case_id: why for rc in prepared.rendered
               if (why := granules_absent(rc.scaled)) is not None}
@@ -123,6 +123,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def os_error_text(exc: Exception) -> str:
+    """An OSError in words, without Python's ``[Errno N]`` prefix: what went wrong and on
+    which file(s) (any other error: its own text)."""
+    if not getattr(exc, "strerror", None):
+        return str(exc)
+    files = [str(f) for f in (exc.filename, exc.filename2) if f is not None]
+    return exc.strerror + (f": {' -> '.join(files)}" if files else "")
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     try:
@@ -133,8 +142,8 @@ def main(argv: list[str] | None = None) -> int:
         return int(args.func(args) or 0)
     except OSError as exc:  # a stage writing into a full or read-only folder: one line
         exc = not_writable(exc, Path.cwd()) if exc.errno in NOT_WRITABLE else exc
-        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {escape(str(exc))}",
-                          highlight=False)
+        err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] "
+                          f"{escape(os_error_text(exc))}", highlight=False)
         return 2
     except Interrupted as exc:         # Ctrl-C / SIGTERM: 130 / 143, as a shell would
         err_console.print(f"[bold red]ligwf: {type(exc).__name__}:[/] {escape(str(exc))}",

@@ -61,7 +61,7 @@ def skipped_restarts(cases, retry_unstable: bool) -> list[str]:
     """The restart files a case to be resumed or extended does not use (unreadable: killed
     while writing or a full disk; or not its own: another case's, edited, past its
     recorded progress), each with what the case does instead: said here, one line each,
-    and recorded in its manifest's issues by the runner (:class:`ligwf.engine.resume.Plan`)."""
+    and recorded in its manifest's issues by the runner (:class:`ligwf.engine.resume.NextAttempt`)."""
     from ligwf.engine.resume import SKIP, plan_case
 
     out = []

@@ -46,7 +46,7 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, 
 from ligwf.cli.slurm_rounds import (add_next_round_parser, add_until_decided_args,
                                     dry_run_note, follow_up_of, next_round, print_submitted,
                                     resubmit_rounds, submit_until_decided)
-from ligwf.engine.plan import CasePlan
+from ligwf.engine.plan import RankPlan
 from ligwf.engine.progress import shown_reason
 from ligwf.engine.site import EngineConfig
 from ligwf.pipeline.prepare import prepared_loads
@@ -100,7 +100,7 @@ def _warn(lines: list[str]) -> None:
         print_warning(line)
 
 
-def plan_caption(plans: tuple[CasePlan, ...], jobs: list[PlannedJob], rows: tuple[PlanRow, ...],
+def plan_caption(plans: tuple[RankPlan, ...], jobs: list[PlannedJob], rows: tuple[PlanRow, ...],
                  site: SlurmSite) -> list[str]:
     """How the arrays split the cases, where the nodes come from, the slab limits and the
     estimated total cost."""

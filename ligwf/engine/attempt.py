@@ -18,7 +18,7 @@ from ligwf.engine.health import (Expectation, assess, engine_signal, kinetic_ene
                                  verdict)
 from ligwf.engine.restart_id import CaseIdentity, stamp
 from ligwf.engine.site import EngineIdentity
-from ligwf.engine.resume import (FRESH, RESTART_SKIPPED, RESUME, Plan, clean_outputs,
+from ligwf.engine.resume import (FRESH, RESTART_SKIPPED, RESUME, NextAttempt, clean_outputs,
                                  input_for, own_restarts, phase_steps_between, render_resume,
                                  rotate_screen)
 from ligwf.engine.thermo import parse_screen, phase_group
@@ -55,7 +55,7 @@ def engine_version(lines: list[str]) -> str | None:
     return None
 
 
-def begin_attempt(case: CaseFolder, plan: Plan, nprocs: int, launcher: str,
+def begin_attempt(case: CaseFolder, plan: NextAttempt, nprocs: int, launcher: str,
                   command: list[str] | None = None, template_dirs=(),
                   engine: EngineIdentity | None = None) -> tuple[Manifest, Attempt]:
     """Prepare the folder for ``plan`` (clean or write the resume input) and record the

@@ -33,7 +33,7 @@ from ligwf.engine.guard import (STOP_GRACE_SECONDS, descendants, engine_env, eng
                                 live_engines, release, stop_engines, watch)
 from ligwf.engine.health import Expectation, physics_issues
 from ligwf.engine.render import grid_vars
-from ligwf.engine.resume import FRESH, RESUME, SKIP, Plan, discard_restart, input_for, plan_case
+from ligwf.engine.resume import FRESH, RESUME, SKIP, NextAttempt, discard_restart, input_for, plan_case
 from ligwf.engine.site import EngineConfig
 from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.fsio import NOT_WRITABLE, FolderNotWritable, not_writable
@@ -49,7 +49,7 @@ class Monitor(Protocol):
 
     def start(self, case_id: str, total_steps: int, from_step: int) -> None: ...
     def update(self, case_id: str, parser: ThermoParser) -> None: ...
-    def end(self, case_id: str, manifest: Manifest | None, plan: Plan) -> None: ...
+    def end(self, case_id: str, manifest: Manifest | None, plan: NextAttempt) -> None: ...
 
 
 class NullMonitor:
@@ -61,7 +61,7 @@ class NullMonitor:
     def update(self, case_id: str, parser: ThermoParser) -> None:
         pass
 
-    def end(self, case_id: str, manifest: Manifest | None, plan: Plan) -> None:
+    def end(self, case_id: str, manifest: Manifest | None, plan: NextAttempt) -> None:
         pass
 
 
@@ -202,7 +202,7 @@ def run_case(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Monit
     try:
         with case_lock(case.path) as mine:
             if not mine:
-                monitor.end(case_id, None, Plan(SKIP, "running in another ligwf process"))
+                monitor.end(case_id, None, NextAttempt(SKIP, "running in another ligwf process"))
                 return None
             take_over(case)
             manifest = _run_locked(case, nprocs, engine, monitor, stop, retry_unstable,

@@ -78,7 +78,7 @@ MIN_GRID_EFFICIENCY = 0.25
 #: 0.23 each)
 MIN_MARGINAL_EFFICIENCY = 0.2
 
-#: What limited a case's ranks (:attr:`CasePlan.bound`).
+#: What limited a case's ranks (:attr:`RankPlan.bound`).
 BOUND_PARTICLES, BOUND_SLAB, BOUND_CORES = "particles", "slab", "cores"
 #: a grid across the drum set the ranks (fastest one within MIN_GRID_EFFICIENCY)
 BOUND_GRID = "grid"
@@ -161,7 +161,7 @@ def estimated_seconds(load: CaseLoad, ranks: int) -> float:
 
 
 @dataclass(frozen=True)
-class CasePlan:
+class RankPlan:
     """Ranks of one case, what limited them, and its estimated wall time."""
 
     name: str
@@ -173,14 +173,14 @@ class CasePlan:
     grid: tuple[int, int] = (1, 1)   # ranks (along the axis, across); (0, 0): none fits
 
 
-def case_plan(load: CaseLoad, ranks: int, bound: str) -> CasePlan:
-    """The :class:`CasePlan` of ``load`` on ``ranks`` ranks (its grid, efficiency, time)."""
+def case_plan(load: CaseLoad, ranks: int, bound: str) -> RankPlan:
+    """The :class:`RankPlan` of ``load`` on ``ranks`` ranks (its grid, efficiency, time)."""
     try:
         grid = case_grid(load, ranks)
         axes = (grid.axial, grid.across)
     except ConfigError:             # --np no grid fits: the runner cuts it as it can
         axes = (0, 0)
-    return CasePlan(load.name, ranks, bound, load.particle_steps,
+    return RankPlan(load.name, ranks, bound, load.particle_steps,
                     estimated_seconds(load, ranks), efficiency(load, ranks), axes)
 
 
@@ -197,7 +197,7 @@ def rank_limits(load: CaseLoad, cores: int | None,
 
 
 def plan_ranks(load: CaseLoad, cores: int | None,
-               min_particles_per_rank: int = MIN_PARTICLES_PER_RANK) -> CasePlan:
+               min_particles_per_rank: int = MIN_PARTICLES_PER_RANK) -> RankPlan:
     """Ranks for one case: the smallest of :func:`rank_limits` (``cores`` None: no core
     limit, as for a Slurm array task that gets its own allocation); beyond the slabs, when
     the particles and cores allow more, the fastest grid across the drum
@@ -266,7 +266,7 @@ class Schedule:
     """How a study's cases run on ``cores`` cores: per case ranks, then phases in order."""
 
     cores: int
-    cases: tuple[CasePlan, ...]     # in study order
+    cases: tuple[RankPlan, ...]     # in study order
     phases: tuple[Phase, ...]       # in run order
     planned: bool                   # False: what --np / --ensemble ask for
 
@@ -343,7 +343,7 @@ def allocation_schedule(loads: Sequence[CaseLoad], cores_per_case: int | None = 
                     planned=fixed is None)
 
 
-def fixed_ranks(loads: Sequence[CaseLoad], ranks: int, bound: str) -> tuple[CasePlan, ...]:
+def fixed_ranks(loads: Sequence[CaseLoad], ranks: int, bound: str) -> tuple[RankPlan, ...]:
     """Every case on ``ranks`` ranks because option ``bound`` says so (no planning)."""
     at_least(bound, ranks, 1)
     return tuple(case_plan(l, ranks, bound) for l in loads)

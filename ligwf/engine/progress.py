@@ -15,7 +15,7 @@ from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TaskID, Text
 from rich.markup import escape
 from rich.table import Table
 
-from ligwf.engine.resume import Plan
+from ligwf.engine.resume import NextAttempt
 from ligwf.engine.thermo import ThermoParser
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import (DONE, FAILED, KILLED, MISSING, RUNNING, UNSTABLE, Manifest,
@@ -36,7 +36,7 @@ class RichMonitor:
             TextColumn("atoms {task.fields[atoms]}"), TextColumn("KE {task.fields[ke]:.3g} J"),
             console=self.console, transient=False, refresh_per_second=2)
         self.tasks: dict[str, TaskID] = {}
-        self.results: list[tuple[str, Manifest | None, Plan]] = []
+        self.results: list[tuple[str, Manifest | None, NextAttempt]] = []
 
     def __enter__(self) -> "RichMonitor":
         self.progress.start()
@@ -61,7 +61,7 @@ class RichMonitor:
         self.progress.update(task, completed=row.step, sim_time=row.get("time", 0.0),
                              atoms=f"{row.get('atoms'):.0f}", ke=row.get("ke", 0.0))
 
-    def end(self, case_id: str, manifest: Manifest | None, plan: Plan) -> None:
+    def end(self, case_id: str, manifest: Manifest | None, plan: NextAttempt) -> None:
         self.results.append((case_id, manifest, plan))
         task = self.tasks.get(case_id)
         if task is not None and manifest is not None:

@@ -51,7 +51,7 @@ class RestartFile:
 
 
 @dataclass(frozen=True)
-class Plan:
+class NextAttempt:
     """What the runner does with one case, and why; ``skipped``: one line per restart file
     of the case it does not use (unreadable, or not its own) and what it does instead, for
     the run output and the manifest's issues (:data:`RESTART_SKIPPED`)."""
@@ -123,46 +123,46 @@ def discard_restart(case_dir: Path, restart: RestartFile) -> None:
         p.rename(p.with_name(p.name + ".corrupt"))
 
 
-def plan_case(case: CaseFolder, retry_unstable: bool = False) -> Plan:
+def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
     """What to do with a case folder now (see the module docstring)."""
     m = case.manifest()
     if m is None:
-        return Plan(FRESH, "not run yet")
+        return NextAttempt(FRESH, "not run yet")
     if m.scene_hash != case.scene_hash:
-        return Plan(FRESH, "scene changed since the last run")
+        return NextAttempt(FRESH, "scene changed since the last run")
     status = effective_status(m)
     if status == DONE and m.steps_done < case.scaled.total_steps and case.extension_steps:
         return _extension_plan(case, m.steps_done)
     if status == DONE:
-        return Plan(SKIP, DONE)
+        return NextAttempt(SKIP, DONE)
     if status == UNSTABLE and not retry_unstable:
-        return Plan(SKIP, f"unstable: {m.reason}")
+        return NextAttempt(SKIP, f"unstable: {m.reason}")
     if status in (FAILED, UNSTABLE):
-        return Plan(FRESH, f"re-run after {status}: {m.reason}")
+        return NextAttempt(FRESH, f"re-run after {status}: {m.reason}")
     if status == RUNNING:
-        return Plan(SKIP, f"running in process {m.pid} on {m.host}")
+        return NextAttempt(SKIP, f"running in process {m.pid} on {m.host}")
     limit = m.steps_done + case.scaled.thermo_every
     if m.complete_upto is not None:
         limit = min(limit, m.complete_upto)
     restarts, refused = own_restarts(case, limit)
     ignored = f" (ignored {'; '.join(refused)})" if refused else ""
     if restarts:
-        return _with_skipped(Plan(RESUME, f"killed at step {m.steps_done}; resume from "
+        return _with_skipped(NextAttempt(RESUME, f"killed at step {m.steps_done}; resume from "
                                   f"{restarts[0].path}{ignored}", restarts[0]), refused)
     none = (f"no restart file of its own at or before step {limit} (its record is whole up "
             "to there)" if m.complete_upto is not None and m.complete_upto < m.steps_done
             else "before any restart file of its own was written")
-    return _with_skipped(Plan(FRESH, f"killed at step {m.steps_done} {none}{ignored}: runs "
+    return _with_skipped(NextAttempt(FRESH, f"killed at step {m.steps_done} {none}{ignored}: runs "
                               "again from step 0"), refused)
 
 
-def _with_skipped(plan: Plan, refused: list[str]) -> Plan:
+def _with_skipped(plan: NextAttempt, refused: list[str]) -> NextAttempt:
     """``plan`` with one line per refused restart and what the case does instead."""
     return dataclasses.replace(plan, skipped=tuple(
         f"restart file {why}, not used: the case {plan.instead()}" for why in refused))
 
 
-def _extension_plan(case: CaseFolder, steps_done: int) -> Plan:
+def _extension_plan(case: CaseFolder, steps_done: int) -> NextAttempt:
     """A done case whose production was extended (:mod:`ligwf.study.extension`): continue
     it from its newest own restart to the new end (never from one past the steps it ran);
     afresh only when it has none."""
@@ -170,10 +170,10 @@ def _extension_plan(case: CaseFolder, steps_done: int) -> Plan:
     restarts, refused = own_restarts(case, steps_done)
     ignored = f" (ignored {'; '.join(refused)})" if refused else ""
     if restarts:
-        return _with_skipped(Plan(RESUME, f"production extended to step {target} (done at "
+        return _with_skipped(NextAttempt(RESUME, f"production extended to step {target} (done at "
                                   f"{steps_done}); continue from {restarts[0].path}{ignored}",
                                   restarts[0]), refused)
-    return _with_skipped(Plan(FRESH, f"production extended to step {target}, but no restart "
+    return _with_skipped(NextAttempt(FRESH, f"production extended to step {target}, but no restart "
                               f"file of its own to continue from{ignored}: run again from "
                               "step 0"), refused)
 
@@ -232,7 +232,7 @@ def render_resume(s: ScaledScene, restart: RestartFile, template_dirs=()) -> dic
     return {RESUME_INPUT: render_template("resume.in.j2", ctx, template_dirs)}
 
 
-def input_for(plan: Plan) -> str:
+def input_for(plan: NextAttempt) -> str:
     """Input file an attempt runs."""
     return RESUME_INPUT if plan.action == RESUME else INPUT_NAME
 

@@ -35,8 +35,9 @@ from ligwf.scene.window import held_window_warnings
 from ligwf.scene.unused import unused_setting_warnings
 from ligwf.scene.workflow import Case, Workflow, comparison_warnings, load_workflow
 from ligwf.study.case import content_hash
-from ligwf.study.layout import MESH_CACHE_DIR, MESH_NAME, OUTPUT_DIRS, SCENE_FILE, STUDY_FILE
+from ligwf.study.layout import MESH_CACHE_DIR, MESH_NAME, OUTPUT_DIRS, SCENE_FILE
 from ligwf.study.study import Study
+from ligwf.study.study_record import CaseEntry, StudyRecord
 
 
 def default_mesh_cache() -> Path:
@@ -157,17 +158,11 @@ def write_study(wf: Workflow, rendered: list[RenderedCase], out_dir: Path,
         if exc.errno in NOT_WRITABLE:
             raise not_writable(exc, out_dir) from exc
         raise
-    atomic_write_json(out_dir / STUDY_FILE, {
-        "ligwf_version": __version__,
-        "name": wf.name,
-        "description": wf.description,
-        "workflow": wf.raw,
-        "analysis": wf.analysis.model_dump(mode="json"),
-        "accept": wf.accept.model_dump(mode="json"),
-        "cases": [{"index": rc.case.index, "case_id": rc.case.case_id, "cg": rc.case.cg,
-                   "rule": rc.scaled.rule, "replica": rc.case.replica,
-                   "scene_hash": rc.scene_hash} for rc in rendered],
-    })
+    StudyRecord(wf.name, wf.raw, wf.analysis.model_dump(mode="json"),
+                wf.accept.model_dump(mode="json"),
+                tuple(CaseEntry(rc.case.index, rc.case.case_id, rc.case.cg, rc.scaled.rule,
+                                rc.case.replica, rc.scene_hash) for rc in rendered),
+                wf.description, __version__).write(out_dir)
     return Study.open(out_dir)
 
 

@@ -169,6 +169,17 @@ COMMON: tuple[tuple[str, ...], ...] = (
      "mean diameters"),
     ("field_error_k4", "1", "layer velocity err k4", "field_error at a kernel width of 4 CG1 "
      "mean diameters"),
+    ("field_error_distance", "1", "layer velocity raw distance", "the field criterion's raw "
+     "distance between the arms' mean fields (before the noise is taken off), omega R; its "
+     "bounds lie this +- t sqrt(run_var / runs + ref_var / ref_runs)"),
+    ("field_error_run_var", "1", "layer velocity CG-n run noise", "the field criterion's "
+     "per-run noise of the CG-n arm: sum over the layer's nodes of w x the runs' variance, "
+     "(omega R)^2 (what more CG-n replicas would shrink; nan with one run)"),
+    ("field_error_ref_var", "1", "layer velocity CG1 run noise", "the same for the CG1 arm"),
+    ("field_error_runs", "count", "layer velocity CG-n runs", "CG-n runs in the field "
+     "criterion"),
+    ("field_error_ref_runs", "count", "layer velocity CG1 runs", "CG1 runs in the field "
+     "criterion"),
     ("field_solid_error", "1", "solid fraction field err (L1)", "relative L1 error of the "
      "solid-fraction field over the cross-section against CG1: sum |phi_n - phi_1| / sum "
      "phi_1"),

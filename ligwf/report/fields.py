@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.equivalence import ALPHA, NormEstimate
 from ligwf.analysis.records.field_errors import (ERRORS, FIELD_NOISE_COLUMNS, KERNEL_COLUMNS,
@@ -59,11 +60,8 @@ def case_fields(analysis_dir: Path) -> dict[str, CaseFields]:
     archive an older analysis left is never read). StaleAnalysis (one line) when the
     listed archive cannot be read."""
     path = Path(analysis_dir) / layout.FIELDS_DATA
-    try:
-        record = json.loads((Path(analysis_dir) / layout.ANALYSIS_RECORD).read_text())
-    except (OSError, ValueError):
-        return {}
-    if layout.FIELDS_DATA not in (record.get("outputs") or {}) or not path.is_file():
+    record = AnalysisRecord.read(analysis_dir)
+    if record is None or not record.wrote(layout.FIELDS_DATA) or not path.is_file():
         return {}
     try:
         return read_fields(path)

@@ -14,6 +14,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
+from ligwf.analysis.records.analysis_record import AnalysisRecord, UnreadableRecord
 from ligwf.study import layout
 
 #: The files of a complete granule analysis (the report reads all of them).
@@ -80,6 +81,19 @@ def _read_json(path: Path, what: str, outputs: list[str]) -> dict:
     return {}
 
 
+def _analysis_record(analysis_dir: Path, outputs: list[str]) -> AnalysisRecord:
+    """The analysis record (an empty one, with a line in ``outputs`` saying why, when it
+    is missing or unreadable)."""
+    what = "granules were not analysed (run `ligwf analyse`)"
+    try:
+        return AnalysisRecord.load(analysis_dir)
+    except FileNotFoundError:
+        outputs.append(f"{layout.ANALYSIS_RECORD} missing: {what}")
+    except UnreadableRecord as exc:
+        outputs.append(f"{layout.ANALYSIS_RECORD} unreadable ({exc}): {what}")
+    return AnalysisRecord(analysis_dir)
+
+
 def _items(record: dict, key: str) -> list:
     """``record[key]`` when it is a list (a damaged record may hold anything there)."""
     value = record.get(key)
@@ -90,20 +104,19 @@ def collect(study_skipped: list[dict], analysis_dir: Path) -> Problems:
     """The problems of a study: its own skipped cases, the analysis record's and the flow
     stage's (read from ``analysis_dir``), and missing analysis outputs."""
     outputs: list[str] = []
-    record = _read_json(analysis_dir / layout.ANALYSIS_RECORD,
-                        "granules were not analysed (run `ligwf analyse`)", outputs)
-    if record.get("cases"):        # granules were analysed: the tables must be there
+    record = _analysis_record(analysis_dir, outputs)
+    if record.analysed_granules:   # granules were analysed: the tables must be there
         outputs += [f"{name} missing: rerun `ligwf analyse` (granule and GSD columns are empty)"
                     for name in ANALYSIS_OUTPUTS if not (analysis_dir / name).is_file()]
     absent = tuple((str(a.get("case_id", "?")), str(a.get("reason", "")))
-                   for a in _items(record, "granules_absent") if isinstance(a, dict))
+                   for a in record.granules_absent)
     flow = _read_json(analysis_dir / layout.FLOW_PROFILES, "flow metrics missing", [])
     cases: dict[str, str] = {}
-    for s in [*study_skipped, *_items(record, "skipped_cases"), *_items(flow, "skipped_cases")]:
+    for s in [*study_skipped, *record.items("skipped_cases"), *_items(flow, "skipped_cases")]:
         if isinstance(s, dict):
             cases.setdefault(str(s.get("case_id", "?")), str(s.get("reason", "")))
     frames = {(str(f.get("case_id")), str(f.get("step")), str(f.get("kind", "skipped")),
-               str(f.get("reason"))) for f in _items(record, "skipped_frames")
+               str(f.get("reason"))) for f in record.items("skipped_frames")
               if isinstance(f, dict)}
     notes = flow.get("skipped_frames", {})
     for cid, reasons in (notes.items() if isinstance(notes, dict) else []):

@@ -11,7 +11,6 @@ missing analysis outputs -- is listed with its reason (:mod:`ligwf.report.proble
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,8 +21,8 @@ from ligwf.analysis.records.conditions import REFERENCE_CG
 from ligwf.analysis.records.equivalence import HSU, WELCH
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import LOWER_LIMIT
-from ligwf.analysis.records.provenance import (StaleAnalysis, changed_dumps, damaged_outputs,
-                                               provenance_mismatch)
+from ligwf.analysis.records.analysis_record import AnalysisRecord
+from ligwf.analysis.records.provenance import StaleAnalysis, changed_dumps
 from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
@@ -255,18 +254,15 @@ def checked_analysis(study: Study) -> FlowRecord:
     naming what changed) when the outputs are of another study, of an earlier run, or were
     edited, or the dumps changed since."""
     where = study.analysis_dir
-    try:
-        record = json.loads((where / layout.ANALYSIS_RECORD).read_text())
-    except (OSError, ValueError):
-        record = None
-    if not isinstance(record, dict):
+    record = AnalysisRecord.read(where)
+    if record is None:
         raise MissingAnalysis(f"{where}: no readable analysis record "
                               f"({layout.ANALYSIS_RECORD}): run `ligwf analyse` first (or "
                               "`ligwf study`, which does)")
-    if (why := provenance_mismatch(study, study.analysis, record)) is not None:
+    if (why := record.stale(study, study.analysis)) is not None:
         raise StaleAnalysis(f"{where}: the analysis outputs are stale: {why}; run `ligwf "
                             "analyse` again (or `ligwf study`, which does)")
-    if damaged := damaged_outputs(where, record):
+    if damaged := record.damaged():
         raise StaleAnalysis(f"{where}/{damaged[0]}" + (f" (and {len(damaged) - 1} more)"
                             if len(damaged) > 1 else "") + "; run `ligwf analyse` again")
     try:

@@ -18,7 +18,7 @@ from typing import Hashable, Sequence
 from ligwf.engine.decomposition import (GHOST_COST, HALO_DIAMETERS, MIN_AXIAL_SLAB,
                                         PLANNING_SURFACE_DEG)
 from ligwf.engine.plan import (BOUND_PARTICLES, BOUND_SLAB, MIN_GRID_EFFICIENCY,
-                               MIN_MARGINAL_EFFICIENCY, MULTI_RANK_EFFICIENCY, WET_RATE, CaseLoad, CasePlan, case_grid,
+                               MIN_MARGINAL_EFFICIENCY, MULTI_RANK_EFFICIENCY, WET_RATE, CaseLoad, RankPlan, case_grid,
                                rank_limits)
 from ligwf.errors import ConfigError
 from ligwf.slurm.site import slurm_time_problem
@@ -84,10 +84,10 @@ class PlanRow:
     cases: tuple[str, ...]      # case names, study order
     load: CaseLoad              # the first case's (every case of a row has the same load)
     ranks: int
-    bound: str                  # what limited the ranks (CasePlan.bound)
+    bound: str                  # what limited the ranks (RankPlan.bound)
     nodes: int | None           # None: cores per node unknown
     estimated_seconds: float    # wall seconds of ONE of the cases (each is its own task)
-    efficiency: float = 1.0     # modelled share of the ideal speed-up (CasePlan.efficiency)
+    efficiency: float = 1.0     # modelled share of the ideal speed-up (RankPlan.efficiency)
 
     @property
     def label(self) -> str:
@@ -106,7 +106,7 @@ class PlanRow:
         return time_limit_seconds is not None and self.estimated_seconds > time_limit_seconds
 
 
-def plan_rows(loads: Sequence[CaseLoad], plans: Sequence[CasePlan],
+def plan_rows(loads: Sequence[CaseLoad], plans: Sequence[RankPlan],
               groups: Sequence[Hashable], cores_per_node: int | None) -> tuple[PlanRow, ...]:
     """The plan table's rows: ``loads[i]`` planned as ``plans[i]``; cases with the same
     ``groups[i]`` (e.g. CG level and rule, so replicas) AND the same load and ranks share
@@ -114,7 +114,7 @@ def plan_rows(loads: Sequence[CaseLoad], plans: Sequence[CasePlan],
     if not len(loads) == len(plans) == len(groups):
         raise ConfigError(f"plan rows: {len(loads)} loads, {len(plans)} plans and "
                           f"{len(groups)} groups must be as many")
-    rows: dict[tuple, tuple[CaseLoad, CasePlan, list[str]]] = {}
+    rows: dict[tuple, tuple[CaseLoad, RankPlan, list[str]]] = {}
     for load, plan, group in zip(loads, plans, groups):
         if plan.name != load.name:
             raise ConfigError(f"plan rows: plan {plan.name!r} is not case {load.name!r}")

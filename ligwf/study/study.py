@@ -9,14 +9,14 @@ status and resubmit -- lists cases through it, in case-index order.
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 
 from ligwf.errors import ConfigError
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import ANALYSIS_DIR, REPORT_DIR, STUDY_FILE, is_case_folder, is_study_folder
+from ligwf.study.layout import ANALYSIS_DIR, REPORT_DIR, is_case_folder, is_study_folder
+from ligwf.study.study_record import StudyRecord
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.settings import AnalysisSettings, build_analysis_settings
 
@@ -38,21 +38,9 @@ class Study:
         """Open a study folder or a case folder; ConfigError when it is neither."""
         path = Path(path)
         if is_study_folder(path):
-            try:
-                rec = json.loads((path / STUDY_FILE).read_text())
-                cases = sorted(rec["cases"], key=lambda c: int(c["index"]))
-                ids = tuple(str(c["case_id"]) for c in cases)
-            except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
-                raise ConfigError(f"{path}: unreadable study record ({exc})") from None
-            twice = sorted({i for i in ids if ids.count(i) > 1})
-            if twice:
-                raise ConfigError(f"{path / STUDY_FILE}: lists case {', '.join(twice)} more than "
-                                  "once (edited or merged by hand?): render the study again")
-            workflow = rec.get("workflow") if isinstance(rec.get("workflow"), dict) else {}
-            accept = rec["accept"] if "accept" in rec else workflow.get("accept")
-            return cls(path, str(rec.get("name", path.name)),
-                       build_analysis_settings(rec.get("analysis"), "study analysis"), ids,
-                       accept=build_accept_settings(accept, "study accept"))
+            rec = StudyRecord.read(path)
+            return cls(path, rec.name, build_analysis_settings(rec.analysis, "study analysis"),
+                       rec.case_ids, accept=build_accept_settings(rec.accept, "study accept"))
         if is_case_folder(path):
             case = CaseFolder.open(path)
             return cls(path, case.case_id, AnalysisSettings(), (case.case_id,), True)
@@ -63,13 +51,10 @@ class Study:
     def workflow_of(path: Path | str) -> dict:
         """The workflow (raw mapping, ``--set`` overrides applied) a study folder was
         written from; ConfigError when the folder has none."""
-        try:
-            raw = json.loads((Path(path) / STUDY_FILE).read_text())["workflow"]
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise ConfigError(f"{path}: no readable workflow in its study record ({exc})") from None
-        if not isinstance(raw, dict) or not raw:
+        raw = StudyRecord.read(path).workflow
+        if not raw:
             raise ConfigError(f"{path}: its study record holds no workflow")
-        return _numeric_cg_keys(raw)
+        return raw
 
     # ----------------------------------------------------------------- cases
     @property
@@ -125,33 +110,3 @@ def studies_below(root: Path) -> list[Study]:
     if not root.is_dir():
         return []
     return [Study.open(p) for p in sorted(root.iterdir()) if is_study_folder(p)]
-
-
-#: the sweep's maps keyed by CG level (JSON stores their keys as text)
-CG_KEYED = ("replicas", "per_cg")
-
-
-def _number(key):
-    """A JSON object key back as the number it was written from ("2" -> 2, "1.5" -> 1.5);
-    any other text as it is (the workflow's validation names it)."""
-    if not isinstance(key, str):
-        return key
-    for kind in (int, float):
-        try:
-            return kind(key)
-        except ValueError:
-            continue
-    return key
-
-
-def _numeric_cg_keys(raw: dict) -> dict:
-    """The stored workflow with the CG levels of the sweep's per-level maps
-    (:data:`CG_KEYED`) as numbers again: JSON turned ``replicas: {1: 2}`` into ``{"1": 2}``,
-    which the workflow's strict validation refuses as text."""
-    sweep = raw.get("sweep")
-    if not isinstance(sweep, dict):
-        return raw
-    fixed = {name: {_number(k): v for k, v in sweep[name].items()}
-             for name in CG_KEYED if isinstance(sweep.get(name), dict)}
-    return {**raw, "sweep": {**sweep, **fixed}} if fixed else raw
-

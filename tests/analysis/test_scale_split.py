@@ -13,11 +13,11 @@ from types import SimpleNamespace
 import pytest
 
 import ligwf.study.case as case_module
-from ligwf.analysis.frames.checks import FramePlan, shared_checks
+from ligwf.analysis.frames.checks import ExpectedFrames, shared_checks
 from ligwf.analysis.frames.dumps import FrameFiles
 from ligwf.analysis.parts import (AnalysisIncomplete, Share, check_count, check_token,
                                   parse_part, read_parts, write_part)
-from ligwf.analysis.runner import AnalysisPlan
+from ligwf.analysis.runner import AnalysisShares
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study.case import DumpRecord, file_digest
 
@@ -47,12 +47,12 @@ def test_count_and_token_checks():
             check_token(bad)
 
 
-def _plan(frames_per_case: list[int], extra_cases: int = 0) -> AnalysisPlan:
+def _plan(frames_per_case: list[int], extra_cases: int = 0) -> AnalysisShares:
     facts = [SimpleNamespace(case_id=f"c{k}") for k in range(len(frames_per_case))]
     usable = [SimpleNamespace(case_id=f"c{k}") for k in range(len(frames_per_case) + extra_cases)]
     tasks = [(fi, FrameFiles(step, Path(f"p{step}"), None))
              for fi, n in enumerate(frames_per_case) for step in range(n)]
-    return AnalysisPlan(None, None, None, usable, [], [], [], facts, tasks)
+    return AnalysisShares(None, None, None, usable, [], [], [], facts, tasks)
 
 
 @pytest.mark.parametrize("size", [1, 2, 3, 7, 40])
@@ -96,7 +96,7 @@ def test_merge_names_missing_and_foreign_parts(tmp_path):
 def test_each_dump_is_hashed_once_per_analysis_and_again_when_changed(tmp_path, monkeypatch):
     dump = tmp_path / "particles_10.vtu"
     dump.write_bytes(b"<VTKFile>one</VTKFile>")
-    plan = FramePlan("c", (), (), 1, DumpRecord("h", 10, {dump.name: (dump.stat().st_size,
+    plan = ExpectedFrames("c", (), (), 1, DumpRecord("h", 10, {dump.name: (dump.stat().st_size,
                                                                          file_digest(dump))}))
     calls = []
 

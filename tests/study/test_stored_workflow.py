@@ -18,7 +18,7 @@ from ligwf.study.study import Study
 
 
 def _store(tmp_path, workflow: dict):
-    (tmp_path / STUDY_FILE).write_text(json.dumps({"workflow": workflow}))
+    (tmp_path / STUDY_FILE).write_text(json.dumps({"workflow": workflow, "cases": []}))
     return Study.workflow_of(tmp_path)
 
 

@@ -13,7 +13,7 @@ frames and report the same reasons:
   particle dump that holds the same bytes as the frame before it (a copy; an array copy,
   same positions in other bytes, fails :func:`check_particles`). When the
   run left a dump record (:meth:`~ligwf.study.case.CaseFolder.dump_record`),
-  :meth:`FramePlan.check_record` refuses a file whose size or SHA-256 differs from what
+  :meth:`ExpectedFrames.check_record` refuses a file whose size or SHA-256 differs from what
   the run left (done by whoever reads the frame, so MPI ranks share the hashing).
 * :func:`check_particles` / :func:`check_contacts` (after reading): the particle count
   and ids are the scene's (1..N: the fill deletes the surplus of the top-up wave, so the
@@ -57,7 +57,7 @@ OVERLAP_TOLERANCE = 1e-3
 
 
 @dataclass(frozen=True)
-class FramePlan:
+class ExpectedFrames:
     """The frames of a case to read, and those refused before reading (with reasons)."""
 
     case_id: str
@@ -136,7 +136,7 @@ def end_step(case: CaseFolder) -> int:
     return case.scaled.total_steps
 
 
-def plan_frames(case: CaseFolder) -> FramePlan:
+def plan_frames(case: CaseFolder) -> ExpectedFrames:
     """The case's frames to read and the refused ones; ConfigError when its dump record is
     unreadable or belongs to another scene (nothing of the case can be trusted)."""
     record = case.dump_record()
@@ -169,7 +169,7 @@ def plan_frames(case: CaseFolder) -> FramePlan:
                    "it: the bed moves between two dumps of a turning drum)", "duplicate")
         else:
             frames.append(FrameFiles(step, part, contact))
-    return FramePlan(case.case_id, tuple(frames), tuple(problems), len(expected), record)
+    return ExpectedFrames(case.case_id, tuple(frames), tuple(problems), len(expected), record)
 
 
 def _copy_of(prev: FrameFiles | None, part: Path, record: DumpRecord | None) -> int | None:

@@ -22,7 +22,7 @@ import pandas as pd
 from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame,
                                          read_contacts, read_particles)
 from ligwf.analysis.granules.persistent import Frame, bridge_keys, persistent_labels, presence_run
-from ligwf.analysis.frames.checks import FramePlan, check_contacts, check_particles, plan_frames
+from ligwf.analysis.frames.checks import ExpectedFrames, check_contacts, check_particles, plan_frames
 from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
 from ligwf.analysis.granules.bonds import bonded_contacts, granule_table
 from ligwf.analysis.granules.bridge_law import Liquid
@@ -45,7 +45,7 @@ class RunFacts:
     box_length: float              # m, periodic length (the box spans [0, L] on that axis)
     dt: float                      # s per step
     case: CaseFolder | None = None     # a ligwf case: frames checked against its run
-    plan: FramePlan | None = None      # ... and its dump record
+    plan: ExpectedFrames | None = None      # ... and its dump record
     omega: float | None = None         # rad/s about +rotation_axis (None: unknown)
     rotation_axis: int = 1             # the drum axis through the origin (0, 1, 2)
 
@@ -58,7 +58,7 @@ class RunFacts:
             raise ConfigError(f"{self.case_id}: the time step must be > 0 s, got {self.dt!r}")
 
     @classmethod
-    def of_case(cls, case: CaseFolder, plan: FramePlan | None = None) -> "RunFacts":
+    def of_case(cls, case: CaseFolder, plan: ExpectedFrames | None = None) -> "RunFacts":
         """The facts of a ligwf case (the drum axis spans [0, L], see templates/drum.in.j2)."""
         s = case.scaled
         return cls(case.case_id, case.cg, case_liquid(case), periodic_axis(case),
