@@ -14,17 +14,18 @@ README from the committed tables and fails when the committed README differs.
 
 from __future__ import annotations
 
-import argparse
-import math
 import shutil
 import sys
 from pathlib import Path
 
 import pandas as pd
 
-from ligwf.yamlio import read_yaml_mapping
-
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from ligwf.yamlio import read_yaml_mapping  # noqa: E402
+from scripts.results_readme import copy_files, number as _n, parser, write_or_check  # noqa: E402
+
 WORKFLOW = ROOT / "workflows" / "demo.yaml"
 OUT = ROOT / "docs" / "results" / "demo"
 TABLES = ("verdict.csv", "verdict.json", "cases.csv", "conditions.csv", "noise_floor.csv",
@@ -32,14 +33,6 @@ TABLES = ("verdict.csv", "verdict.json", "cases.csv", "conditions.csv", "noise_f
 COMMAND = "ligwf study workflows/demo.yaml --out runs/demo"
 #: the flow criteria whose decisions the README counts
 FLOW = ("angle_deg", "profile_error", "rigid_share", "flowing_layer", "field_error")
-
-
-def _n(v, digits: int = 3) -> str:
-    try:
-        v = float(v)
-    except (TypeError, ValueError):
-        return "–"
-    return f"{v:.{digits}g}" if math.isfinite(v) else "–"
 
 
 def scene_text(wf: dict) -> str:
@@ -119,20 +112,17 @@ def _text() -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("study", nargs="?", type=Path, help="the demo's study folder")
+    ap = parser(__doc__, "demo")
     ap.add_argument("--wall-seconds", type=float, help="measured wall time of the study")
     ap.add_argument("--machine", default="2 cores", help="where it ran (for timing.csv)")
     ap.add_argument("--loaded", action="store_true",
                     help="the machine was shared: the wall time is no claim")
-    ap.add_argument("--check", action="store_true")
     args = ap.parse_args(argv)
     if not args.check:
         if args.study is None or args.wall_seconds is None:
             ap.error("give the study folder and --wall-seconds (or --check)")
         report = args.study / "report"
-        for name in TABLES:
-            shutil.copyfile(report / name, OUT / name)
+        copy_files(report, OUT, TABLES)
         if (OUT / "figures").exists():
             shutil.rmtree(OUT / "figures")
         shutil.copytree(report / "figures", OUT / "figures")
@@ -141,16 +131,8 @@ def main(argv=None) -> int:
         pd.DataFrame([{"wall_seconds": args.wall_seconds, "machine": args.machine,
                        "quiet": not args.loaded}]).to_csv(
             OUT / "timing.csv", index=False)
-    text = _text()
-    if args.check:
-        if (OUT / "README.md").read_text() != text:
-            print("docs/results/demo/README.md differs from its tables: run "
-                  "scripts/demo_results.py runs/demo --wall-seconds S", file=sys.stderr)
-            return 1
-        return 0
-    (OUT / "README.md").write_text(text)
-    print(text)
-    return 0
+    return write_or_check(OUT, _text, args.check,
+                          "scripts/demo_results.py runs/demo --wall-seconds S")
 
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@
 number is read from them.
 
     ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided --max-looks 3 --max-core-hours 2.7
+    ligwf study runs/ladder --out runs/ladder --no-snapshots --until-decided --every-level --max-looks 3 --max-core-hours 6.2
     .venv/bin/python scripts/ladder_results.py runs/ladder          # copies tables, writes README
     .venv/bin/python scripts/ladder_results.py --check               # README == text from tables
 
@@ -13,29 +14,30 @@ from its table.
 
 from __future__ import annotations
 
-import argparse
-import math
-import shutil
 import sys
 from pathlib import Path
 
 import pandas as pd
 
-from ligwf.report.rounds import look_line
-from ligwf.study.rounds import read_rounds
-
 ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from ligwf.report.rounds import look_line  # noqa: E402
+from ligwf.study.rounds import read_rounds  # noqa: E402
+from scripts.results_readme import copy_files, number as _n, parser, write_or_check  # noqa: E402
+
 OUT = ROOT / "docs" / "results" / "ladder"
 TABLES = ("verdict.csv", "cases.csv", "conditions.csv", "summary.md")
 #: the sequential study's record (in the study folder, beside report/)
 ROUNDS = "rounds.json"
-COMMAND = ("ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided "
-           "--max-looks 3 --max-core-hours 2.7")
-
-
-def _n(v: float, digits: int = 3) -> str:
-    return "–" if not (isinstance(v, float) and math.isfinite(v)) and not isinstance(v, int) \
-        else f"{v:.{digits}g}"
+#: the runs' commands: the sequential run of amendment 2 (stopped at look 1, stuck), then
+#: its continuation (amendment 3) on the same study folder
+COMMANDS = ("ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided "
+            "--max-looks 3 --max-core-hours 2.7",
+            "ligwf study runs/ladder --out runs/ladder --no-snapshots --until-decided "
+            "--every-level --max-looks 3 --max-core-hours 6.2")
+#: look 1 as amendment 2's run first took it (stuck), before the continuation re-took it
+FIRST_LOOK = "rounds_look1_first.json"
 
 
 def rounds_lines(rounds) -> list[str]:
@@ -62,19 +64,22 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None) -> str:
              "Pre-registration (budget, statistics, looks, cap), committed before the runs: "
              "[criterion.md](criterion.md). Made by:",
              "",
-             "```", COMMAND, ".venv/bin/python scripts/ladder_results.py runs/ladder", "```",
+             "```", *COMMANDS, ".venv/bin/python scripts/ladder_results.py runs/ladder", "```",
              "",
              "Tables: `verdict.csv` (one row per CG level, rule and criterion), `cases.csv` "
              "(one row per run), `conditions.csv`, the report's `summary.md`. This README is "
              "written from them by `scripts/ladder_results.py` and checked against them by "
              "`tests/report/test_committed_ladder.py`.",
              "",
-             "Timings: the runs shared the machine with the developer's tests (niced) and the "
-             "CG1 runs used 2 ranks, the CG-n runs 1: the speedups (production core-seconds "
-             "per simulated second, CG1 over CG-n) are indicative, not a benchmark "
-             "(benchmarks/bench_cg_speedup.py is). The design was amended to two CG1 seeds "
-             "before any result was analysed (criterion.md); amendment 2 registered the "
-             "sequential run (`--until-decided`) before it started.",
+             "Timings: the first 14 runs (look 1) shared the machine with the developer's "
+             "tests (niced; CG1 r1 took 6,645 core-s against r0's 3,070); the continuation's "
+             "runs had the 2 cores to themselves. The CG1 runs used 2 ranks, the CG-n runs 1: "
+             "the speedups (production core-seconds per simulated second, CG1 over CG-n) are "
+             "indicative, not a benchmark (benchmarks/bench_cg_speedup.py is). The design was "
+             "amended to two CG1 seeds before any result was analysed (criterion.md); "
+             "amendment 2 registered the sequential run (`--until-decided`) before it started, "
+             "amendment 3 its continuation (`--every-level`, look 1 re-taken on the same data "
+             f"at the same level; look 1 as first taken: `{FIRST_LOOK}`).",
              "", "## Looks (`rounds.json`)", "", *rounds_lines(rounds if rounds is not None
                                                              else read_rounds(OUT / "none")),
              "", "## Runs", ""]
@@ -87,8 +92,10 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None) -> str:
                      + ", ".join(f"{a:.2f}" for a in sub["rigid_frame_share"]) + " | "
                      + ", ".join(f"{a:.0f}" for a in sub["core_seconds"]) + " |")
     lines += ["", "## Verdict (budget: the workflow's `accept:` block)", ""]
+    alpha = rounds.alpha_per_look if rounds is not None and rounds.looks else 0.05
     lines += ["| condition | speedup (core-s) | verdict | criterion | state | CG-n - CG1 "
-              "[90 % interval] | shown within | budget |", "|---|---|---|---|---|---|---|---|"]
+              f"[{100 * (1 - 2 * alpha):.3g} % interval] | shown within | budget |",
+              "|---|---|---|---|---|---|---|---|"]
     for _, r in verdict.iterrows():
         unit = f" {r['unit']}" if isinstance(r["unit"], str) and r["unit"] else ""
         lines.append(f"| {r['condition']} | {_n(r['speedup_core'])} | {r['condition_state']} | "
@@ -128,27 +135,20 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("study", nargs="?", type=Path, help="the ladder's study folder")
-    ap.add_argument("--check", action="store_true")
+    ap = parser(__doc__, "ladder")
     args = ap.parse_args(argv)
     if not args.check:
         if args.study is None:
             ap.error("give the study folder (or --check)")
-        for name in TABLES:
-            shutil.copyfile(args.study / "report" / name, OUT / name)
-        shutil.copyfile(args.study / ROUNDS, OUT / ROUNDS)
-    text = readme(pd.read_csv(OUT / "verdict.csv"), pd.read_csv(OUT / "cases.csv"),
-                  read_rounds(OUT))
-    if args.check:
-        if (OUT / "README.md").read_text() != text:
-            print("docs/results/ladder/README.md differs from its tables: run "
-                  "scripts/ladder_results.py runs/ladder", file=sys.stderr)
-            return 1
-        return 0
-    (OUT / "README.md").write_text(text)
-    print(text)
-    return 0
+        copy_files(args.study / "report", OUT, TABLES)
+        copy_files(args.study, OUT, [ROUNDS])
+        first = args.study.parent / "ladder_rounds_look1_amendment2.json"
+        if first.is_file():
+            copy_files(first.parent, OUT, [first.name])
+            (OUT / first.name).rename(OUT / FIRST_LOOK)
+    return write_or_check(OUT, lambda: readme(pd.read_csv(OUT / "verdict.csv"),
+                                              pd.read_csv(OUT / "cases.csv"), read_rounds(OUT)),
+                          args.check, "scripts/ladder_results.py runs/ladder")
 
 
 if __name__ == "__main__":

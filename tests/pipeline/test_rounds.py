@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -128,3 +129,81 @@ def test_the_record_round_trips_and_its_looks_are_fixed(study):
     with pytest.raises(ConfigError, match="--max-looks = 4: this study was started with 3"):
         start_rounds(s.path, RoundPlan(4, None))
     assert read_rounds(s.path / "nowhere").alpha_per_look == 0.05     # a study of one look
+
+
+# ---------------------------------------------------------------- every level, stuck looks
+@pytest.fixture
+def two_rules(tmp_path):
+    """rounds_tiny with both rules: two CG-n conditions sharing one CG1 arm."""
+    import yaml
+    raw = yaml.safe_load(WORKFLOW.read_text())
+    raw["sweep"]["rules"] = ["weber", "bond"]
+    path = tmp_path / "two_rules.yaml"
+    path.write_text(yaml.safe_dump(raw))
+    prepared = prepare_workflow(path)
+    return prepared, write(prepared, tmp_path / "study2", tmp_path / "meshes")
+
+
+def _cond(rule: str, speedup: float, *criteria: CriterionResult) -> ConditionVerdict:
+    return ConditionVerdict("{}", 1.5, rule, 2, speedup, math.nan, math.nan, criteria)
+
+
+def _levels(*conds: ConditionVerdict) -> Verdict:
+    return Verdict((GroupVerdict("{}", conds, "sentence"),), {"angle_deg": 1.0})
+
+
+def test_every_level_works_on_each_level_and_a_shared_cg1_arm_gets_the_most_asked(two_rules):
+    """The default works on the cheapest level that can still pass (bond here: weber, the
+    faster, fails); --every-level also on weber's undecided criterion, and the CG1 arm both
+    ask replicas of gets the larger request (2), not the sum (3)."""
+    _, s = two_rules
+    fails = dataclasses.replace(angle("fail"), name="profile_error")
+    weber = _cond("weber", 9.0, angle("undecided", round_by=REPLICAS, round_arm="CG1",
+                                      round_amount=0, round_amount_cg1=1), fails)
+    bond = _cond("bond", 5.0, angle("undecided", round_by=REPLICAS, round_arm="CG-n and CG1",
+                                    round_amount=1, round_amount_cg1=2))
+    v = _levels(weber, bond)
+    cheapest = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None)), 1)
+    assert cheapest.target == "cg1.5-bond"
+    every = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None, every_level=True)), 1)
+    assert every.target == "cg1.5-weber, cg1.5-bond"
+    reps = {a["condition"]: a["replicas"] for a in every.actions if a["kind"] == REPLICAS}
+    assert reps == {"cg1": [2, 3], "cg1.5-bond": [2]}
+    assert read_rounds(s.path).every_level is True
+
+
+def test_an_unplanned_criterion_does_not_hold_back_the_planned_ones(study):
+    _, s = study
+    v = verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n", round_amount=1),
+                dataclasses.replace(angle("undecided"), name="rigid_share"))
+    look = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None)), 1)
+    assert not look.stop and [a["replicas"] for a in look.actions] == [[2]]
+
+
+def test_a_stuck_look_is_taken_again_by_the_next_call(study):
+    """Same number, same data, same level: the next call (e.g. with --every-level) may plan
+    what the stuck look could not; a decided look stays."""
+    _, s = study
+    rounds = start_rounds(s.path, RoundPlan(3, None))
+    stuck = plan_look(verdict(angle("undecided")), s, rounds, 1)
+    assert stuck.stop_kind == STUCK
+    write_rounds(s.path, rounds.with_look(stuck))
+    again = start_rounds(s.path, RoundPlan(3, None, every_level=True))
+    assert again.looks == () and again.every_level
+
+
+def test_round_costs_are_calibrated_by_the_arms_fastest_run(study):
+    """A round's planned core-hours scale the planner's rates by measured / planned of the
+    arm's fastest finished run (a run slowed by a loaded machine does not inflate it)."""
+    from ligwf.report.planning import run_costs
+    from ligwf.study.manifest import Manifest, write_manifest
+    _, s = study
+    v = verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n", round_amount=1))
+    plain = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None)), 1).planned_core_hours
+    for case, factor in zip(s.cases[2:4], (3.0, 7.0)):
+        planned = run_costs(case.scaled)[0]
+        write_manifest(case.path, Manifest(case.case_id, case.index, case.scene_hash, "", "",
+                                           status="done", core_seconds=factor * planned))
+    s = Study.open(s.path)
+    calibrated = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None)), 1)
+    assert calibrated.planned_core_hours == pytest.approx(3.0 * plain)

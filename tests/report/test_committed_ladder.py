@@ -25,10 +25,14 @@ def test_signed_criteria_recompute_from_the_runs():
     cg1 = cases[cases["cg"] == 1.0]
     rounds = read_rounds(OUT)              # a sequential study: alpha / looks, Hsu's df
     alpha, df_rule = ((rounds.alpha_per_look, eq.HSU) if rounds.looks else (eq.ALPHA, eq.WELCH))
-    for _, r in verdict[verdict["criterion"].isin(["angle_deg", "rigid_share"])].iterrows():
-        col = {"angle_deg": "angle_of_repose", "rigid_share": "rigid_frame_share"}[r["criterion"]]
+    columns = {"angle_deg": "angle_of_repose", "rigid_share": "rigid_frame_share",
+               "flowing_layer": "flowing_layer_thickness_mean"}
+    for _, r in verdict[verdict["criterion"].isin(list(columns))].iterrows():
+        col = columns[r["criterion"]]
         arm = cases[(cases["cg"] == r["cg"]) & (cases["rule"] == r["rule"])]
         e = eq.difference_estimate(arm[col], cg1[col], alpha, df_rule)
+        if r["criterion"] == "flowing_layer":     # relative to the CG1 mean
+            e = eq.scaled(e, 1.0 / float(cg1[col].mean()))
         assert e.value == pytest.approx(r["value"], abs=1e-9)
         if e.has_interval:
             assert (e.lo, e.hi) == (pytest.approx(r["lo"], abs=1e-9),

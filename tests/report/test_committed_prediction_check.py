@@ -27,3 +27,22 @@ def test_readme_counts_are_the_tables():
         assert float(m.group(4)) == round(ratios.max(), 2)
         # the flag is what the ratio says
         assert list(sub["within_30_percent"]) == [abs(r - 1) <= 0.3 for r in ratios]
+
+
+def test_ladder_counts_are_its_table():
+    """The ladder's rows (registered in the README before the check ran): counts over the
+    rows with a ratio (a statistic without an interval has none)."""
+    table = pd.read_csv(HERE / "ladder.csv")
+    text = (HERE / "README.md").read_text()
+    for kind, label in (("replicas", "Ladder replicas"), ("extension", "Ladder extension")):
+        sub = table[table["kind"] == kind]
+        ratios = sub["measured_over_predicted"].dropna()
+        ok = int(sub["within_30_percent"].sum())
+        m = re.search(rf"{label}: .*?holds in (\d+) of (\d+) rows \(measured / predicted "
+                      rf"([\d.]+)-([\d.]+)\)", text, re.S)
+        assert m, label
+        assert (int(m.group(1)), int(m.group(2))) == (ok, len(ratios))
+        assert (float(m.group(3)), float(m.group(4))) == (round(ratios.min(), 2),
+                                                          round(ratios.max(), 2))
+    ext = table[table["kind"] == "extension"]["measured_over_predicted"].dropna()
+    assert "Every miss is\n  on the same side" in text and (ext[(ext - 1).abs() > 0.3] < 1).all()
