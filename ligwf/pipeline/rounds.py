@@ -43,7 +43,7 @@ from ligwf.pipeline.post import postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
 from ligwf.pipeline.run import (RunSettings, StudyRun, cases_to_run, site_engine,
                                 study_schedule)
-from ligwf.report.planning import run_costs
+from ligwf.report.planning import calibration, run_costs
 from ligwf.report.verdict import FAILS, MEETS, Verdict, is_control_group
 from ligwf.report.verdict_records import read_verdict
 from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
@@ -194,30 +194,17 @@ def _needs(criteria, group: str, cg: float, rule: str,
                 need[1] = max(need[1], int(amount) if math.isfinite(amount) else 0)
 
 
-def _calibration(cases: list[CaseFolder]) -> float:
-    """Measured over planned core-seconds of the arm's fastest finished run (1 without
-    one): the planner's rates scaled to what this machine did, so that the cap is checked
-    against real costs; the fastest, so that a run slowed by a shared machine or a retry
-    does not inflate the plan."""
-    ratios = []
-    for c in cases:
-        m = c.manifest()
-        planned = run_costs(c.scaled)[0]
-        if m is not None and m.core_seconds > 0 and planned > 0:
-            ratios.append(m.core_seconds / planned)
-    return min(ratios) if ratios else 1.0
-
-
 def _actions(study: Study, needs: dict[tuple, list[float]]) -> tuple[list[dict], float]:
     """The round's actions on each arm ``needs`` names (longer production on its runs,
     then new replicas as long as them) and their planned core-hours (the planner's rates
-    calibrated by the arm's own runs, :func:`_calibration`)."""
+    calibrated by the arm's own runs,
+    :func:`~ligwf.report.planning.calibration`)."""
     actions, hours = [], 0.0
     for (group, cg, rule), (extend, add) in needs.items():
         cases = _arm_cases(study, group, cg, rule)
         if not cases:
             continue
-        rate = _calibration(cases)
+        rate = calibration(cases)
         arm = "CG1" if cg == REFERENCE_CG else "CG-n"
         steps_now = max(c.scaled.run_steps for c in cases)
         if extend > 0:

@@ -10,7 +10,9 @@ Per usable case (one row, indexed by case id):
   run's steady fraction: the window is a fraction of the production time);
 * ``replica_core_seconds``: a new replica from its fill to its end, and
   ``production_core_seconds``: one simulated second of production, both on one rank from
-  the planner's measured rates (:func:`ligwf.engine.plan.estimated_seconds`).
+  the planner's measured rates (:func:`ligwf.engine.plan.estimated_seconds`) times what
+  this machine did: measured over planned core-seconds of the fastest finished run of the
+  case's condition (:func:`calibration`; 1 without one).
 
 Pure given its inputs (the study's case folders and its flow record).
 """
@@ -77,12 +79,30 @@ def _window_seconds(flow: FlowRecord, case_id: str) -> float:
     return float(len(t) * np.median(np.diff(t)))
 
 
+def calibration(cases: list[CaseFolder]) -> float:
+    """Measured over planned core-seconds of the fastest finished run among ``cases`` (1
+    without one): the planner's rates scaled to what this machine did; the fastest, so that
+    a run slowed by a shared machine or a retry does not inflate the prices."""
+    ratios = []
+    for c in cases:
+        m = c.manifest()
+        planned = run_costs(c.scaled)[0]
+        if m is not None and m.core_seconds > 0 and planned > 0:
+            ratios.append(m.core_seconds / planned)
+    return min(ratios) if ratios else 1.0
+
+
 def noise_table(cases: list[CaseFolder], flow: FlowRecord, columns: tuple[str, ...]
                 ) -> pd.DataFrame:
     """The noise and prices of every case (see the module docstring), indexed by case id."""
     rows = []
+    arms: dict[tuple, list[CaseFolder]] = {}
     for case in cases:
-        replica, production = run_costs(case.scaled)
+        arms.setdefault((case.group, case.cg, case.rule), []).append(case)
+    rate = {key: calibration(arm) for key, arm in arms.items()}
+    for case in cases:
+        replica, production = (rate[(case.group, case.cg, case.rule)] * x
+                               for x in run_costs(case.scaled))
         c = flow.cases.get(case.case_id)
         share = 1.0 - float(c.steady_fraction) if c is not None else math.nan
         row = {"case_id": case.case_id, WINDOW: _window_seconds(flow, case.case_id),
