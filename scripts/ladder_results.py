@@ -35,7 +35,9 @@ ROUNDS = "rounds.json"
 COMMANDS = ("ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided "
             "--max-looks 3 --max-core-hours 2.7",
             "ligwf study runs/ladder --out runs/ladder --no-snapshots --until-decided "
-            "--every-level --max-looks 3 --max-core-hours 6.2")
+            "--every-level --max-looks 3 --max-core-hours 6.2",
+            "ligwf report runs/ladder --no-snapshots   # the same looks; prices at this "
+            "machine's measured rates")
 #: look 1 as amendment 2's run first took it (stuck), before the continuation re-took it
 FIRST_LOOK = "rounds_look1_first.json"
 
