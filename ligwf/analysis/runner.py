@@ -278,7 +278,7 @@ def analyse_frame(ana: GranuleAnalysis, ff: FrameFiles) -> FrameResult:
     skipped frame with that reason (one bad frame never blocks the others)."""
     f = ana.case
     try:
-        return ana.run([ff]).results[0]
+        return ana.frame(ff)
     except (ConfigError, MemoryError, KeyboardInterrupt):
         raise
     except Exception as exc:   # a frame that passed its checks and still breaks the analysis

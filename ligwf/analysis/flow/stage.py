@@ -21,6 +21,7 @@ scalars and the value of every registered metric) and the flow record
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -28,7 +29,8 @@ import pandas as pd
 from ligwf.analysis.flow import registry as flow_metrics
 from ligwf.analysis.frames.dumps import read_particles
 from ligwf.analysis.flow.frame import DrumGeometry, frame_flow, summarise, velocity_field
-from ligwf.analysis.frames.checks import check_particles, plan_frames
+from ligwf.analysis.frames.checks import ExpectedFrames, check_particles, plan_frames
+from ligwf.analysis.frames.loop import FrameAnalysis
 from ligwf.analysis.records.flow import CaseFlow, FlowRecord
 from ligwf.analysis.flow.steady import auto_fraction, is_auto
 from ligwf.analysis.flow.fields import case_fields, kernel_width
@@ -56,36 +58,57 @@ def steady_fraction(case: CaseFolder, steady_after, flows: list) -> float:
                          case.production_start_step * dt, case.scaled.run_steps * dt)
 
 
-def _production_frames(case: CaseFolder, plan) -> tuple[list, list, list, list[dict]]:
-    """Checked particle frames of the production phase, their flows, their registered
-    series, and the frames refused or missing (``{"step", "reason"}``)."""
-    geo = DrumGeometry.from_scaled(case.scaled)
-    production = case.production_start_step
-    frames, flows, series = [], [], []
-    problems = [p for p in plan.problems if p["step"] >= production]
-    for ff in plan.frames:
-        if ff.step < production:
-            continue
+@dataclass
+class FlowFrames(FrameAnalysis):
+    """The flow metrics' pass over a case's production frames (a
+    :class:`~ligwf.analysis.frames.loop.FrameAnalysis`): each frame checked against its run
+    (dump record, particles), its flow (:func:`~ligwf.analysis.flow.frame.frame_flow`) and
+    registered series; ``results``: (frame, files, flow, series) of the usable frames,
+    ``problems``: ``{"step", "reason"}`` of the frames refused, missing or broken."""
+
+    case: CaseFolder
+    plan: ExpectedFrames
+    results: list = field(default_factory=list)
+    problems: list[dict] = field(default_factory=list)
+
+    def _prepare(self, frames) -> list:
+        self.results = []
+        self._geo = DrumGeometry.from_scaled(self.case.scaled)
+        production = self.case.production_start_step
+        self.problems = [p for p in self.plan.problems if p["step"] >= production]
+        return [ff for ff in (self.plan.frames if frames is None else frames)
+                if ff.step >= production]
+
+    def _single_frame(self, ff):
         try:
-            plan.check_record(ff)
-            frame = read_particles(ff.particles, ff.step, case.scaled.dt)
-            check_particles(case, frame)
+            self.plan.check_record(ff)
+            frame = read_particles(ff.particles, ff.step, self.case.scaled.dt)
+            check_particles(self.case, frame)
         except DumpReadError as exc:
-            problems.append({"step": ff.step, "reason": str(exc)})
-            continue
+            self.problems.append({"step": ff.step, "reason": str(exc)})
+            return None
         try:
-            flow = frame_flow(frame, geo)
-            values = flow_metrics.frame_series(frame, geo, flow)
+            flow = frame_flow(frame, self._geo)
+            values = flow_metrics.frame_series(frame, self._geo, flow)
         except (MemoryError, KeyboardInterrupt):
             raise
         except Exception as exc:   # a frame that passed its checks and still breaks a metric
-            problems.append({"step": ff.step, "reason": f"{ff.particles}: flow metrics failed "
-                             f"on this frame ({type(exc).__name__}: {exc})"})
-            continue
-        frames.append((frame, ff))
-        flows.append(flow)
-        series.append(values)
-    return frames, flows, series, problems
+            self.problems.append({"step": ff.step, "reason": f"{ff.particles}: flow metrics "
+                                  f"failed on this frame ({type(exc).__name__}: {exc})"})
+            return None
+        return frame, ff, flow, values
+
+    def _conclude(self) -> None:
+        self.results = [r for r in self.results if r is not None]
+
+
+def _production_frames(case: CaseFolder, plan) -> tuple[list, list, list, list[dict]]:
+    """Checked particle frames of the production phase, their flows, their registered
+    series, and the frames refused or missing (``{"step", "reason"}``)."""
+    done = FlowFrames(case, plan).run()
+    return ([(frame, ff) for frame, ff, _, _ in done.results],
+            [flow for _, _, flow, _ in done.results],
+            [values for *_, values in done.results], done.problems)
 
 
 def _listed(v) -> list | float:

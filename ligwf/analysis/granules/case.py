@@ -1,8 +1,8 @@
 """Granules of the frames of one run (MDAnalysis-style life cycle), and their ParaView files.
 
-:class:`GranuleAnalysis` takes its parameters in the constructor; :meth:`GranuleAnalysis.run`
-calls ``_prepare``, ``_single_frame`` for each frame it is given and ``_conclude``, and
-fills ``results``. What it needs to know about the run that wrote the frames is a
+:class:`GranuleAnalysis` takes its parameters in the constructor; the frame loop is its
+base class's (:class:`~ligwf.analysis.frames.loop.FrameAnalysis`): ``run`` calls
+``_prepare``, ``_single_frame`` for each frame and ``_conclude`` and fills ``results``. What it needs to know about the run that wrote the frames is a
 :class:`RunFacts`: for a ligwf case it comes from the case's scaled scene
 (:meth:`RunFacts.of_case`), and the frames are also checked against the run (its dump
 record, particle count and ids, radii, drum, contact geometry:
@@ -23,6 +23,7 @@ from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, Particl
                                          read_contacts, read_particles)
 from ligwf.analysis.granules.persistent import Frame, bridge_keys, persistent_labels, presence_run
 from ligwf.analysis.frames.checks import ExpectedFrames, check_contacts, check_particles, plan_frames
+from ligwf.analysis.frames.loop import FrameAnalysis
 from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
 from ligwf.analysis.granules.bonds import bonded_contacts, granule_table
 from ligwf.analysis.granules.bridge_law import Liquid
@@ -97,8 +98,9 @@ class FrameResult:
 
 
 @dataclass
-class GranuleAnalysis:
-    """Granules of every frame of one case (MDAnalysis-style life cycle).
+class GranuleAnalysis(FrameAnalysis):
+    """Granules of every frame of one case (a :class:`~ligwf.analysis.frames.loop.FrameAnalysis`:
+    :meth:`run` over a list of frames, or :meth:`frame` one at a time).
 
     ``case``: a :class:`~ligwf.study.case.CaseFolder` or the :class:`RunFacts` of a run.
     ``definition``: the study's analysis settings, whose granule definition is used
@@ -116,22 +118,10 @@ class GranuleAnalysis:
     louvain: bool = False
     results: list[FrameResult] = field(default_factory=list)
 
-    def run(self, frames: list[FrameFiles] | None = None) -> "GranuleAnalysis":
-        """Analyse ``frames`` (default: every frame the case's run should have left that is
-        there, :func:`~ligwf.analysis.frames.checks.plan_frames`) and fill ``results``."""
-        self._prepare()
-        if frames is None:
-            if self._facts.case is None:
-                raise ConfigError(f"{self._facts.case_id}: pass the frames to analyse")
-            frames = list(self._facts.plan.frames)
-        if self._facts.plan is None:
-            self._sequence = sorted(frames, key=lambda ff: ff.step)   # held windows of foreign dumps
-        for ff in frames:
-            self.results.append(self._single_frame(ff))
-        self._conclude()
-        return self
-
-    def _prepare(self) -> None:
+    def _prepare(self, frames: list[FrameFiles] | None) -> list[FrameFiles]:
+        """The run's facts, and the frames to analyse: ``frames``, by default every frame
+        the case's run should have left that is there
+        (:func:`~ligwf.analysis.frames.checks.plan_frames`)."""
         if self.implementation not in ("fast", "reference"):
             raise ConfigError(f"implementation {self.implementation!r}: use fast or reference")
         self.results = []
@@ -139,6 +129,13 @@ class GranuleAnalysis:
         if isinstance(facts, CaseFolder):
             facts = RunFacts.of_case(facts, plan_frames(facts))
         self._facts = facts
+        if frames is None:
+            if facts.case is None:
+                raise ConfigError(f"{facts.case_id}: pass the frames to analyse")
+            frames = list(facts.plan.frames)
+        if facts.plan is None:
+            self._sequence = sorted(frames, key=lambda ff: ff.step)   # held windows of foreign dumps
+        return list(frames)
 
     def _single_frame(self, ff: FrameFiles) -> FrameResult:
         f = self._facts
