@@ -1,4 +1,14 @@
-"""The batch-scheduler interface: what ligwf asks of Slurm (or PBS, LSF, ...).
+"""The executor interface: what ligwf asks of whatever runs a study's cases -- this machine
+(:class:`ligwf.local.LocalExecutor`) or a batch scheduler (Slurm, or PBS, LSF, ...).
+
+Every :class:`Executor` runs cases (:meth:`Executor.run_cases`: on this machine now; on a
+scheduler as a job array it waits for), says where each case stands
+(:meth:`Executor.status`: its manifest beside the executor's own view of it, a live runner
+or a queued task) and stops them (:meth:`Executor.cancel`). The pipeline runs cases only
+through this interface (:func:`ligwf.pipeline.run.run_study`).
+
+A batch scheduler (:class:`Scheduler`) is an executor that can also hand a whole study to
+the queue and return at once: job arrays and a follow-up job, as below.
 
 A scheduler runs a written study as job arrays: one task per case (each runs ``ligwf
 run-case STUDY --index I``, the local runner with its manifests, health checks and
@@ -74,6 +84,31 @@ def active_tasks(cases: Iterable[CaseView]) -> list[CaseView]:
     return [c for c in cases if c.queued]
 
 
+@runtime_checkable
+class Executor(Protocol):
+    """What runs a study's cases (see the module docstring)."""
+
+    #: the name shown to users and recorded with submissions (``local``, ``slurm``)
+    name: str
+
+    def require(self) -> None:
+        """A one-line error unless the executor can run anything (the engine, the
+        scheduler's commands): checked before anything is written."""
+
+    def run_cases(self, study, cases: Sequence, monitor=None, stop=None) -> bool:
+        """Run ``cases`` (:class:`ligwf.study.case.CaseFolder`) of ``study`` to their end
+        and return whether all of them are done; ``stop`` (a threading.Event) set: stop
+        them resumably (forced restarts, ``killed``) and return; ``monitor``: live
+        progress where the executor can see it."""
+
+    def status(self, study_dir: Path, tolerant: bool = False) -> StudyStatus:
+        """Every case's manifest beside the executor's view of it (``tolerant``: an
+        executor that cannot be asked leaves its view empty and says why)."""
+
+    def cancel(self, study_dir: Path) -> list[str]:
+        """Stop the study's cases that are still queued or running; what was stopped."""
+
+
 class BatchJob(Protocol):
     """A planned script: its kind (``array`` or the follow-up ``analysis``), where it is
     written, its text and the case indices it covers."""
@@ -85,15 +120,8 @@ class BatchJob(Protocol):
 
 
 @runtime_checkable
-class Scheduler(Protocol):
+class Scheduler(Executor, Protocol):
     """A batch scheduler ligwf submits studies to (see the module docstring)."""
-
-    #: the name shown to users and recorded with the submissions (``slurm``)
-    name: str
-
-    def require(self) -> None:
-        """SubmitError unless the scheduler's commands are reachable (checked before
-        anything is written)."""
 
     def plan_jobs(self, study_dir: Path, study_name: str, indices: Iterable[int],
                   ranks: Mapping[int, int] | None, post_steps: Sequence[str], round_no: int,
@@ -113,13 +141,6 @@ class Scheduler(Protocol):
 
     def submit(self, study_dir: Path, jobs: Sequence[BatchJob]) -> list[dict]:
         """Write and submit ``jobs`` in order, recording each; the new record entries."""
-
-    def status(self, study_dir: Path, tolerant: bool = False) -> StudyStatus:
-        """Every case's manifest beside the scheduler's view of its latest task
-        (``tolerant``: an unreachable scheduler leaves its view empty and says why)."""
-
-    def cancel(self, study_dir: Path) -> list[str]:
-        """Cancel the study's jobs that are still queued or running; their ids."""
 
     def next_round(self, study_dir: Path) -> int:
         """1 + the submission rounds recorded in the study folder so far."""

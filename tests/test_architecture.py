@@ -88,7 +88,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("engine", ("ligwf.engine",)),
     ("analysis", ("ligwf.analysis",)),
     ("report", ("ligwf.report",)),
-    ("scheduler", ("ligwf.scheduler", "ligwf.slurm")),
+    ("executors", ("ligwf.scheduler", "ligwf.local", "ligwf.slurm")),
     ("pipeline", ("ligwf.pipeline",)),
     ("cli", ("ligwf.cli",)),
     ("api", ("ligwf.api",)),

@@ -14,7 +14,8 @@ import pytest
 from helpers import ROOT
 from ligwf.cli.main import build_parser
 from ligwf.pipeline.prepare import prepare_workflow
-from ligwf.pipeline.run import planned_schedule, run_settings
+from ligwf.local import run_settings
+from ligwf.pipeline.run import planned_schedule
 
 README = ROOT / "README.md"
 GUIDES = sorted((ROOT / "docs" / "guide").glob("*.md"))

@@ -18,7 +18,7 @@ from ligwf.cli.common import (add_cores_arg, add_workflow_args, console, folder_
 from ligwf.engine.progress import RichMonitor
 from ligwf.errors import ConfigError
 from ligwf.pipeline.calibrate import CalibrationGrid, run_calibration
-from ligwf.pipeline.run import run_settings
+from ligwf.local import run_settings
 from ligwf.scene.workflow import apply_override, parse_override
 from ligwf.study.layout import CALIBRATION_TABLE, SCENE_FILE, is_case_folder
 from ligwf.yamlio import read_yaml_mapping

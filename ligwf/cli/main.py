@@ -24,7 +24,8 @@ from rich.markup import escape
 from rich.table import Table
 from ligwf.fsio import NOT_WRITABLE, not_writable
 from ligwf.pipeline.prepare import write
-from ligwf.pipeline.run import Interrupted, planned_schedule, run_settings, site_engine
+from ligwf.local import run_settings
+from ligwf.pipeline.run import Interrupted, planned_schedule, site_engine
 from ligwf.study.case import granules_absent
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.

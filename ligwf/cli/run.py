@@ -1,4 +1,5 @@
-"""Command line of the run stage: ``ligwf run``, ``ligwf run-case``, ``ligwf status``.
+"""Command line of the run stage: ``ligwf run``, ``ligwf run-case``, ``ligwf status``,
+``ligwf cancel``.
 
 ``run`` prepares a workflow into a study folder (identical cases are rewritten byte for
 byte, so their outputs stay) and runs every case that is not finished. By default the rank
@@ -23,7 +24,8 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, 
                               folder_to_write, plan_table, prepare_from_args,
                               print_warning, rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
-from ligwf.pipeline.run import StudyRun, run_case_of, run_settings, start_run
+from ligwf.local import LocalExecutor, run_settings
+from ligwf.pipeline.run import StudyRun, run_case_of, start_run
 from ligwf.study.study import Study
 
 
@@ -47,12 +49,12 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
 
 def elsewhere(cases, retry_unstable: bool) -> list[str]:
     """The cases another live ligwf process is running (left to it, not in the plan)."""
-    from ligwf.engine.resume import SKIP, plan_case
+    from ligwf.engine.resume import Why, plan_case
 
     out = []
     for c in cases:
         plan = plan_case(c, retry_unstable)
-        if plan.action == SKIP and plan.reason.startswith("running in process"):
+        if plan.why is Why.HELD:
             out.append(f"{c.path.name}: {plan.reason}: left to that runner")
     return out
 
@@ -96,6 +98,25 @@ def cmd_run_case(args: argparse.Namespace) -> int:
 def cmd_status(args: argparse.Namespace) -> int:
     study = Study.open(args.study)
     console.print(summary_table(study.cases, f"{args.study}: {len(study.cases)} case(s)"))
+    held = [c for c in LocalExecutor().status(args.study).cases if c.queued]
+    for runner in sorted({c.job for c in held}):
+        names = [c.case_id for c in held if c.job == runner]
+        console.print(f"running in ligwf process {runner}: {', '.join(names)}",
+                      highlight=False, soft_wrap=True)
+    return 0
+
+
+def cmd_cancel(args: argparse.Namespace) -> int:
+    """SIGTERM the live runners of a study on this machine (the local executor's cancel)."""
+    Study.open(args.study)          # a folder that is no study: one line, nothing sent
+    sent = LocalExecutor().cancel(args.study)
+    if not sent:
+        console.print(f"{args.study}: no live ligwf runner on this machine holds a case",
+                      highlight=False)
+        return 0
+    console.print(f"sent SIGTERM to the ligwf runner(s) {', '.join(sent)}: their engines write "
+                  "forced restarts and the cases end killed; the same run command resumes "
+                  "them", highlight=False, soft_wrap=True)
     return 0
 
 
@@ -115,7 +136,7 @@ def add_run_args(p: argparse.ArgumentParser) -> None:
 
 
 def register(subparsers) -> None:
-    """Add ``run``, ``run-case`` and ``status`` to the ligwf command line."""
+    """Add ``run``, ``run-case``, ``status`` and ``cancel`` to the ligwf command line."""
     p = subparsers.add_parser("run", help="render and run every case with the real engine "
                               "(resumes: finished cases are skipped)")
     add_workflow_args(p)
@@ -134,3 +155,9 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("status", help="list the cases of a study folder and their state")
     p.add_argument("study", type=Path, help="study folder")
     p.set_defaults(func=cmd_status)
+
+    p = subparsers.add_parser("cancel", help="stop the ligwf runners of a study folder on this "
+                              "machine (SIGTERM: forced restarts, cases killed; the same run "
+                              "command resumes them)")
+    p.add_argument("study", type=Path, help="study folder")
+    p.set_defaults(func=cmd_cancel)

@@ -27,7 +27,8 @@ from ligwf.cli.run import add_run_args, run_with_progress, start_from_args
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.pipeline.post import postprocess
 from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, until_decided
-from ligwf.pipeline.run import StudyRun, run_settings
+from ligwf.local import run_settings
+from ligwf.pipeline.run import StudyRun
 from ligwf.report.rounds import look_line
 from ligwf.study.layout import REPORT_DIR, is_study_folder
 from ligwf.study.rounds import Look, Rounds

@@ -28,10 +28,8 @@ from ligwf.study.manifest import DONE, FAILED, KILLED, RUNNING, UNSTABLE
 from ligwf.study.processes import start_time
 from ligwf.study.thermo_table import ThermoRow, rows_from_csv, rows_to_csv
 from ligwf.study.layout import POST_DIR, SCREEN_FILE, particle_dump
-from ligwf.study.manifest import Attempt, Manifest, now_iso, overwrite_manifest
-
-#: how the reason of an attempt ended by a full disk begins (the runner then stops)
-DISK_FULL = "disk full"
+from ligwf.study.manifest import (DISK_FULL_REASON, Attempt, Manifest, Stop, now_iso,
+                                  overwrite_manifest)
 
 _VERSION_RE = re.compile(r"^LIGGGHTS \((Version .*)\)\s*$")
 
@@ -90,6 +88,7 @@ def begin_attempt(case: CaseFolder, plan: NextAttempt, nprocs: int, launcher: st
     manifest.issues = said + [{"kind": RESTART_SKIPPED, "step": from_step, "message": line}
                               for line in plan.skipped]
     manifest.status, manifest.reason, manifest.reason_step = RUNNING, plan.reason, None
+    manifest.stop = Stop.NONE
     manifest.host, manifest.pid = os.uname().nodename, os.getpid()
     manifest.pid_start, manifest.engine = start_time(os.getpid()), []
     manifest.launcher, manifest.nprocs = launcher, nprocs
@@ -259,13 +258,17 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
             and engine_version(parser.lines) is None:
         reason = launcher_failed(attempt, exit_code, parser.lines)
     hole = record_hole(case, rows) if status in (DONE, KILLED) else None
+    stop = Stop.NONE
     if hole is not None and status == DONE:
         # never done with a gap or an empty frame: resume from a restart before the hole
         status, reason = KILLED, f"incomplete record ({hole[1]}): {resume_before(case, hole[0])}"
+        stop = Stop.INCOMPLETE_RECORD
     left = space_left(case.path)
     if status in (FAILED, KILLED) and left < LOW_SPACE_BYTES:
         # a full disk makes LIGGGHTS segfault: the case resumes once there is room
-        status, reason = KILLED, f"{DISK_FULL} ({left} bytes left in {case.path}): {reason}"
+        status = KILLED
+        reason = f"{DISK_FULL_REASON} ({left} bytes left in {case.path}): {reason}"
+        stop = Stop.DISK_FULL
 
     attempt.ended = now_iso()
     attempt.wall_seconds = wall_seconds
@@ -275,7 +278,7 @@ def finish_attempt(case: CaseFolder, manifest: Manifest, attempt: Attempt,
     walls, steps = parser.phase_walls(), parser.phase_steps()
     attempt.phases = {ph: {"wall_seconds": walls.get(ph, 0.0), "steps": steps.get(ph, 0)}
                       for ph in walls.keys() | steps.keys()}
-    manifest.status, manifest.reason = status, reason
+    manifest.status, manifest.reason, manifest.stop = status, reason, stop
     manifest.reason_step = _cause_step(issues, status)
     manifest.issues = ([i for i in manifest.issues if isinstance(i, dict)
                         and i.get("kind") == RESTART_SKIPPED] + [i.to_dict() for i in issues])

@@ -38,7 +38,7 @@ import threading
 import time
 from pathlib import Path
 
-from ligwf.engine.attempt import DISK_FULL, finish_attempt, restart_unreadable, stamp_restarts
+from ligwf.engine.attempt import finish_attempt, restart_unreadable, stamp_restarts
 from ligwf.engine.health import log_errors
 from ligwf.engine.guard import RANK_NAMES, engine_env, engine_tree, release, watch
 from ligwf.engine.launch import (Monitor, NullMonitor, interrupted_reason, signal_engine,
@@ -51,7 +51,7 @@ from ligwf.errors import SimulationFailed
 from ligwf.fsio import FolderNotWritable, atomic_write_json
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import FAILED, KILLED, Manifest, overwrite_manifest
+from ligwf.study.manifest import FAILED, KILLED, Manifest, Stop, overwrite_manifest
 from ligwf.study.processes import EngineProcess, process
 
 
@@ -96,6 +96,7 @@ def _settle_in_flight(case: CaseFolder, exit_code: int | None) -> Manifest | Non
             discard_restart(case.path, RestartFile(attempt.from_restart, attempt.from_step))
             m.status = KILLED
             m.reason = f"restart {attempt.from_restart} unreadable ({m.reason}); set aside"
+            m.stop = Stop.RESTART_SET_ASIDE
             _record(case, m)
         return m
     return finish_attempt(case, m, attempt, None, wall, killed=True)
@@ -257,19 +258,20 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
             if m is None:
                 continue
             if m.status == KILLED and m.attempts and m.attempts[-1].started_at >= t_launch - 1:
-                if m.reason.startswith(DISK_FULL):
+                if m.stop is Stop.DISK_FULL:
                     full = full or f"{case.path}: {m.reason}"
                 elif stop.is_set():
                     m.reason = interrupted_reason(stop, m.steps_done, m.total_steps)
-                elif not m.reason.startswith("incomplete record") and \
-                        not m.reason.startswith("restart "):
+                    m.stop = Stop.INTERRUPTED
+                elif m.stop not in (Stop.INCOMPLETE_RECORD, Stop.RESTART_SET_ASIDE):
                     m.reason = (f"stopped when the ensemble job ended ({how}) at step "
                                 f"{m.steps_done} of {m.total_steps}")
+                    m.stop = Stop.JOB_ENDED
                 m.attempts[-1].reason = m.reason
                 _record(case, m)
             outcome[case.path.name] = m.status
             if (m.status != KILLED or m.steps_done > before.get(_key(case), 0)
-                    or m.reason.startswith("restart ")):   # a restart set aside is progress
+                    or m.stop is Stop.RESTART_SET_ASIDE):   # a restart set aside is progress
                 progressed = True
             if m.status == KILLED:
                 retry.add(_key(case))
@@ -287,6 +289,7 @@ def run_ensemble(study: Path, cases: list[CaseFolder], nprocs: int, group_size: 
                 m = case.manifest()
                 if m is not None:
                     m.status = FAILED
+                    m.stop = Stop.NO_PROGRESS
                     m.reason = (f"ensemble job ended ({how}) with no member making progress "
                                 f"and no ERROR line; see {ens_dir / layout.ENSEMBLE_LOG}")
                     _record(case, m)

@@ -35,7 +35,7 @@ import sys
 import time
 from pathlib import Path
 
-from ligwf.engine.attempt import DISK_FULL, begin_attempt, finish_attempt, restart_unreadable
+from ligwf.engine.attempt import begin_attempt, finish_attempt, restart_unreadable
 from ligwf.engine.dump_hasher import DumpHasher
 from ligwf.engine.guard import ENSEMBLE_RANK_NAME
 from ligwf.engine.liggghts import Liggghts
@@ -45,7 +45,7 @@ from ligwf.engine.resume import FRESH, RESUME, SKIP, discard_restart, input_for,
 from ligwf.study.case import CaseFolder
 from ligwf.study import layout
 from ligwf.study.layout import POST_DIR
-from ligwf.study.manifest import KILLED
+from ligwf.study.manifest import KILLED, Stop
 from ligwf.study.processes import process
 
 _libc = ctypes.CDLL(None)
@@ -224,7 +224,7 @@ def main(argv: list[str] | None = None) -> int:
                     atomic_write_json(args.ens_dir / layout.ENSEMBLE_CLAIMS_DIR
                                       / layout.ensemble_claim_done(pos),
                                       {"group": group, "quit": quit})
-                stop_claiming = quit or manifest.reason.startswith(DISK_FULL)
+                stop_claiming = quit or manifest.stop is Stop.DISK_FULL
             again = sub.bcast(again, root=0)
             if again is None:
                 break

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Callable, Protocol, Sequence
 
 from ligwf.engine.dump_hasher import DumpHasher
-from ligwf.engine.attempt import (DISK_FULL, begin_attempt, close_lost_attempt, expectation,
+from ligwf.engine.attempt import (begin_attempt, close_lost_attempt, expectation,
                                   finish_attempt, history, merge_rows, restart_unreadable,
                                   stamp_restarts)
 from ligwf.engine.restart_id import SETTLE_SECONDS, CaseIdentity, stamp
@@ -33,13 +33,14 @@ from ligwf.engine.guard import (STOP_GRACE_SECONDS, descendants, engine_env, eng
                                 live_engines, release, stop_engines, watch)
 from ligwf.engine.health import Expectation, physics_issues
 from ligwf.engine.render import grid_vars
-from ligwf.engine.resume import FRESH, RESUME, SKIP, NextAttempt, discard_restart, input_for, plan_case
+from ligwf.engine.resume import (FRESH, RESUME, SKIP, NextAttempt, Why, discard_restart,
+                                 input_for, plan_case)
 from ligwf.engine.site import EngineConfig
 from ligwf.engine.thermo import LogTail, ThermoParser
 from ligwf.fsio import NOT_WRITABLE, FolderNotWritable, not_writable
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import POST_DIR, SCREEN_FILE
-from ligwf.study.manifest import KILLED, RUNNING, Manifest, case_lock, runner_alive
+from ligwf.study.manifest import KILLED, RUNNING, Manifest, Stop, case_lock, runner_alive
 from ligwf.study.processes import EngineProcess
 from ligwf.study.thermo_table import ThermoRow
 
@@ -202,7 +203,8 @@ def run_case(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Monit
     try:
         with case_lock(case.path) as mine:
             if not mine:
-                monitor.end(case_id, None, NextAttempt(SKIP, "running in another ligwf process"))
+                monitor.end(case_id, None, NextAttempt(SKIP, "running in another ligwf process",
+                                                     why=Why.HELD))
                 return None
             take_over(case)
             manifest = _run_locked(case, nprocs, engine, monitor, stop, retry_unstable,
@@ -211,7 +213,7 @@ def run_case(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Monit
         if exc.errno in NOT_WRITABLE:   # e.g. removing old outputs on a read-only mount
             raise not_writable(exc, case.path) from exc
         raise
-    if manifest is not None and manifest.reason.startswith(DISK_FULL):
+    if manifest is not None and manifest.stop is Stop.DISK_FULL:
         raise FolderNotWritable(f"{case.path}: {manifest.reason}")
     return manifest
 
@@ -251,6 +253,7 @@ def _run_locked(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Mo
         if result.killed and manifest.status == KILLED:
             manifest.reason = interrupted_reason(stop, manifest.steps_done,
                                                  manifest.total_steps)
+            manifest.stop = Stop.INTERRUPTED
             attempt.reason = manifest.reason
             case.write_manifest(manifest)
         if restart_unreadable(manifest, attempt) and plan.restart is not None:

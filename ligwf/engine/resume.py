@@ -26,6 +26,7 @@ from __future__ import annotations
 import dataclasses
 import shutil
 from dataclasses import dataclass
+from enum import StrEnum
 from pathlib import Path
 
 from ligwf.engine.liggghts import restart_step
@@ -39,7 +40,29 @@ from ligwf.study.layout import (ENGINE_LOG, FORCED_RESTART_RE, INPUT_NAME, MANIF
 from ligwf.study.manifest import DONE, FAILED, RUNNING, UNSTABLE, effective_status
 
 
-SKIP, FRESH, RESUME = "skip", "fresh", "resume"
+class Action(StrEnum):
+    """What the runner does with a case (the value is the word the run output shows)."""
+
+    SKIP = "skip"
+    FRESH = "fresh"
+    RESUME = "resume"
+
+
+SKIP, FRESH, RESUME = Action.SKIP, Action.FRESH, Action.RESUME
+
+
+class Why(StrEnum):
+    """Why :func:`plan_case` chose its action: callers branch on this, never on the
+    reason's words (which are for people)."""
+
+    NOT_RUN = "not_run"                   # no manifest yet
+    SCENE_CHANGED = "scene_changed"       # the manifest is of another scene
+    DONE = "done"
+    EXTENDED = "extended"                 # done, production extended since
+    UNSTABLE = "unstable"                 # left alone: the same input blows up the same way
+    RERUN = "rerun"                       # failed (or unstable, asked to retry)
+    HELD = "held"                         # a live runner (this or another process) has it
+    KILLED = "killed"                     # stopped before its end: resume or run again
 
 
 @dataclass(frozen=True)
@@ -56,10 +79,11 @@ class NextAttempt:
     of the case it does not use (unreadable, or not its own) and what it does instead, for
     the run output and the manifest's issues (:data:`RESTART_SKIPPED`)."""
 
-    action: str                         # skip | fresh | resume
+    action: Action
     reason: str
     restart: RestartFile | None = None
     skipped: tuple[str, ...] = ()
+    why: Why = Why.NOT_RUN
 
     def instead(self) -> str:
         """What the case does instead of the restarts it skips, in words."""
@@ -127,20 +151,20 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
     """What to do with a case folder now (see the module docstring)."""
     m = case.manifest()
     if m is None:
-        return NextAttempt(FRESH, "not run yet")
+        return NextAttempt(FRESH, "not run yet", why=Why.NOT_RUN)
     if m.scene_hash != case.scene_hash:
-        return NextAttempt(FRESH, "scene changed since the last run")
+        return NextAttempt(FRESH, "scene changed since the last run", why=Why.SCENE_CHANGED)
     status = effective_status(m)
     if status == DONE and m.steps_done < case.scaled.total_steps and case.extension_steps:
         return _extension_plan(case, m.steps_done)
     if status == DONE:
-        return NextAttempt(SKIP, DONE)
+        return NextAttempt(SKIP, DONE, why=Why.DONE)
     if status == UNSTABLE and not retry_unstable:
-        return NextAttempt(SKIP, f"unstable: {m.reason}")
+        return NextAttempt(SKIP, f"unstable: {m.reason}", why=Why.UNSTABLE)
     if status in (FAILED, UNSTABLE):
-        return NextAttempt(FRESH, f"re-run after {status}: {m.reason}")
+        return NextAttempt(FRESH, f"re-run after {status}: {m.reason}", why=Why.RERUN)
     if status == RUNNING:
-        return NextAttempt(SKIP, f"running in process {m.pid} on {m.host}")
+        return NextAttempt(SKIP, f"running in process {m.pid} on {m.host}", why=Why.HELD)
     limit = m.steps_done + case.scaled.thermo_every
     if m.complete_upto is not None:
         limit = min(limit, m.complete_upto)
@@ -148,12 +172,13 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
     ignored = f" (ignored {'; '.join(refused)})" if refused else ""
     if restarts:
         return _with_skipped(NextAttempt(RESUME, f"killed at step {m.steps_done}; resume from "
-                                  f"{restarts[0].path}{ignored}", restarts[0]), refused)
+                                         f"{restarts[0].path}{ignored}", restarts[0],
+                                         why=Why.KILLED), refused)
     none = (f"no restart file of its own at or before step {limit} (its record is whole up "
             "to there)" if m.complete_upto is not None and m.complete_upto < m.steps_done
             else "before any restart file of its own was written")
     return _with_skipped(NextAttempt(FRESH, f"killed at step {m.steps_done} {none}{ignored}: runs "
-                              "again from step 0"), refused)
+                              "again from step 0", why=Why.KILLED), refused)
 
 
 def _with_skipped(plan: NextAttempt, refused: list[str]) -> NextAttempt:
@@ -172,10 +197,10 @@ def _extension_plan(case: CaseFolder, steps_done: int) -> NextAttempt:
     if restarts:
         return _with_skipped(NextAttempt(RESUME, f"production extended to step {target} (done at "
                                   f"{steps_done}); continue from {restarts[0].path}{ignored}",
-                                  restarts[0]), refused)
+                                  restarts[0], why=Why.EXTENDED), refused)
     return _with_skipped(NextAttempt(FRESH, f"production extended to step {target}, but no restart "
                               f"file of its own to continue from{ignored}: run again from "
-                              "step 0"), refused)
+                              "step 0", why=Why.EXTENDED), refused)
 
 
 def clean_outputs(case_dir: Path) -> None:

@@ -27,8 +27,9 @@ it imports every stage, no stage imports it.
 
 from ligwf.pipeline.post import POSTPROCESS_COMMANDS, analyse_study, postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, prepare_workflow, prepared_loads, write
-from ligwf.pipeline.run import (Interrupted, RunSettings, StudyRun, planned_schedule,
-                                run_case_of, run_settings, run_study, start_run)
+from ligwf.local import RunSettings, run_settings
+from ligwf.pipeline.run import (Interrupted, StudyRun, planned_schedule, run_case_of, run_study,
+                                start_run)
 from ligwf.pipeline.submit import (Resubmission, Submission, plan_resubmission, plan_submission,
                                    write_for_submit)
 

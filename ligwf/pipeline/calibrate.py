@@ -28,7 +28,8 @@ import pandas as pd
 from ligwf.analysis.flow.stage import case_flow
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import prepare
-from ligwf.pipeline.run import RunSettings, start_run
+from ligwf.local import RunSettings
+from ligwf.pipeline.run import start_run
 from ligwf.scene.controls import COHESIONLESS_FACTOR
 from ligwf.scene.workflow import expand
 from ligwf.study.case import CaseFolder

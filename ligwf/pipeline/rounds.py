@@ -41,8 +41,8 @@ from ligwf.analysis.records.equivalence import UNDECIDED
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
-from ligwf.pipeline.run import (RunSettings, StudyRun, cases_to_run, site_engine,
-                                study_schedule)
+from ligwf.local import LocalExecutor, RunSettings
+from ligwf.pipeline.run import StudyRun, scheduled, site_engine
 from ligwf.report.planning import calibration, run_costs
 from ligwf.report.verdict import FAILS, MEETS, Verdict, is_control_group
 from ligwf.report.verdict_records import read_verdict
@@ -288,8 +288,7 @@ def until_decided(prepared: Prepared, out: Path, settings: RunSettings, plan: Ro
     while not rounds.stopped:
         engine, identity = site_engine()        # refused before anything is written
         study = write_round(prepared, out, rounds, mesh_cache)
-        run = StudyRun(study, study_schedule(cases_to_run(study.cases, settings.retry_unstable),
-                                             settings), engine, settings, identity)
+        run = scheduled(study, LocalExecutor(settings, engine), identity)
         if not run_round(run):
             return rounds
         rounds = take_look(out, rounds)

@@ -9,7 +9,7 @@ analyses and reports the study and takes the look
 (:func:`~ligwf.pipeline.rounds.take_look`: written into the rounds record first); if the
 study goes on it writes the next round's case folders and extensions exactly as the local
 loop does (:func:`~ligwf.pipeline.rounds.write_round`) and submits the cases that must run
-(:func:`~ligwf.pipeline.run.cases_to_run`: new replicas and extended done cases -- an
+(:func:`~ligwf.local.cases_to_run`: new replicas and extended done cases -- an
 extended done case still reads ``done`` in its manifest, so the scheduler's resubmit rule
 would skip it) with another follow-up job of the same kind; once it stops, the final
 report.
@@ -46,7 +46,7 @@ from ligwf.errors import ConfigError
 from ligwf.pipeline.post import report_study
 from ligwf.pipeline.prepare import Prepared
 from ligwf.pipeline.rounds import take_look, write_round
-from ligwf.pipeline.run import all_done, cases_to_run
+from ligwf.local import all_done, cases_to_run
 from ligwf.pipeline.submit import rerun_jobs
 from ligwf.scheduler import Scheduler
 from ligwf.study.layout import REPORT_FILES_RECORD, ROUNDS_FILE

@@ -63,6 +63,19 @@ def log_ticks(ax: Axes, axis: str = "x") -> None:
     target.set_minor_formatter(NullFormatter())
 
 
+def log_scale(ax: Axes, axis: str, values, empty: str) -> None:
+    """A log ``axis`` with :func:`log_ticks` when some of ``values`` is positive; otherwise
+    the axis stays linear and says ``empty`` (matplotlib cannot place log ticks on no data:
+    a study without recorded run costs would end its report in a traceback)."""
+    v = np.asarray(values, float)
+    if np.any(np.isfinite(v) & (v > 0)):
+        (ax.set_xscale if axis == "x" else ax.set_yscale)("log")
+        log_ticks(ax, axis)
+    else:
+        ax.text(0.5, 0.5, empty, transform=ax.transAxes, ha="center", va="center",
+                color="grey", fontsize=9)
+
+
 def group_suffix(group) -> str:
     """" (cohesionless control)" for a sweep group recorded as JSON, "" for the study's
     main group (``{}``); the words are :func:`ligwf.study.case.group_label`'s."""
@@ -122,9 +135,8 @@ def error_ax(ax: Axes, conditions: pd.DataFrame, col: str, title: str) -> Axes:
             suffix = group_suffix(r.get("group", "")) if len(groups) > 1 else ""
             ax.axhline(100 * r[f"{col}_floor"], ls=":", color="grey", lw=1 + k / 2,
                        label=floor_label(r[f"{col}_floor_source"]) + suffix)
-    ax.set_xscale("log")
     ax.margins(x=0.15)
-    log_ticks(ax, "x")
+    log_scale(ax, "x", conditions["production_core_rate_k"], "no production cost recorded")
     ax.set_ylim(bottom=0)
     ax.set_xlabel("production core-s / simulated s / 1k original particles")
     ax.set_ylabel("error [%]")
@@ -140,16 +152,17 @@ def run_cost_ax(ax: Axes, conditions: pd.DataFrame) -> Axes:
     labels = [_label(r).replace(" (", "\n(") for _, r in conditions.iterrows()]
     x = np.arange(len(labels))
     width = 0.8 / len(PHASES)
+    recorded = []
     for k, phase in enumerate(PHASES):
         vals = conditions.get(f"{phase}_core_seconds",
                               pd.Series(np.nan, index=conditions.index)).to_numpy(float)
+        recorded.extend(vals)
         bars = ax.bar(x + (k - 1) * width, np.where(vals > 0, vals, np.nan), width,
                       label=phase, color=f"C{k}")
         ax.bar_label(bars, labels=[f"{v:.3g}" if v > 0 else "" for v in vals], fontsize=6,
                      padding=1)
     ax.set_xticks(x, labels, fontsize=8)
-    ax.set_yscale("log")
-    log_ticks(ax, "y")
+    log_scale(ax, "y", recorded, "no run cost recorded")
     ax.set_ylabel("core-seconds per run (mean over replicas)")
     ax.set_title("run cost by phase", fontsize=10)
     ax.grid(alpha=0.3, axis="y")

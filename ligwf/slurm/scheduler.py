@@ -1,15 +1,18 @@
 """Slurm as a :class:`ligwf.scheduler.Scheduler`: the pure builders of :mod:`ligwf.slurm.script`,
 the parsers of :mod:`ligwf.slurm.parse` and the study-folder I/O of :mod:`ligwf.slurm.jobs`
-behind the four operations the pipeline asks of a scheduler (script building, submit,
-status, cancel), with the site settings (:class:`ligwf.slurm.site.SlurmSite`) it builds
-the scripts from."""
+behind the operations the pipeline asks of a scheduler (script building, submit, status,
+cancel) and of any executor (run cases and wait for them), with the site settings
+(:class:`ligwf.slurm.site.SlurmSite`) it builds the scripts from."""
 
 from __future__ import annotations
 
+import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar, Iterable, Mapping, Sequence
 
+from ligwf.engine.plan import allocation_schedule, case_load
 from ligwf.errors import SubmitError
 from ligwf.slurm.jobs import (PlannedJob, Runner, StudyStatus, dry_run_text, next_round,
                               plan_jobs, read_record, recorded_plan, require_scheduler,
@@ -17,6 +20,7 @@ from ligwf.slurm.jobs import (PlannedJob, Runner, StudyStatus, dry_run_text, nex
 from ligwf.slurm.parse import FINISHED_STATES
 from ligwf.slurm.script import scancel_command
 from ligwf.slurm.site import SlurmSite
+from ligwf.study.manifest import DONE
 
 
 @dataclass(frozen=True)
@@ -27,6 +31,8 @@ class SlurmScheduler:
     site: SlurmSite
     run: Runner = run_command
     name: ClassVar[str] = "slurm"
+    #: seconds between looks at the queue while :meth:`run_cases` waits
+    poll_seconds: float = 5.0
 
     def require(self) -> None:
         require_scheduler()
@@ -38,6 +44,36 @@ class SlurmScheduler:
                   ) -> list[PlannedJob]:
         return plan_jobs(study_dir, study_name, self.site, indices, post_steps, round_no, ranks,
                          plan_cores, analysis_tasks, token, study_round)
+
+    def run_cases(self, study, cases: Sequence, monitor=None,
+                  stop: threading.Event | None = None) -> bool:
+        """Submit ``cases`` as job arrays (ranks from the allocation rank plan, each case
+        in an allocation of its own; no follow-up job) and wait until none of them is
+        queued or running; whether all of them are done. ``stop`` set: the arrays are
+        cancelled (the runners write forced restarts, the cases end ``killed``) and the
+        wait goes on until Slurm has ended them. ``monitor`` is not fed: the engines run
+        on other nodes (``ligwf slurm status`` shows them)."""
+        stop = stop or threading.Event()
+        cases = list(cases)
+        if not cases:
+            return True
+        schedule = allocation_schedule([case_load(c.path.name, c.scaled) for c in cases])
+        ranks = {c.index: schedule.ranks_of(c.path.name) for c in cases}
+        indices = {c.index for c in cases}
+        self.require()
+        jobs = self.plan_jobs(study.path, study.name, sorted(indices), ranks, [],
+                              self.next_round(study.path))
+        self.submit(study.path, jobs)
+        cancelled = False
+        while True:
+            st = self.status(study.path)
+            if not any(c.queued for c in st.cases if c.index in indices):
+                break
+            if stop.is_set() and not cancelled:
+                self.cancel(study.path)
+                cancelled = True
+            time.sleep(self.poll_seconds)
+        return all((m := c.manifest()) is not None and m.status == DONE for c in cases)
 
     def dry_run_text(self, jobs: Sequence[PlannedJob]) -> str:
         return dry_run_text(jobs)

@@ -19,6 +19,7 @@ import socket
 import time
 from dataclasses import asdict, dataclass, field
 from datetime import datetime, timezone
+from enum import StrEnum
 from pathlib import Path
 from typing import Any
 
@@ -32,6 +33,37 @@ DONE, FAILED, UNSTABLE, KILLED, RUNNING = "done", "failed", "unstable", "killed"
 STATUSES = (DONE, FAILED, UNSTABLE, KILLED, RUNNING)
 #: Shown for a case without a (readable) manifest: not run yet. Never written to one.
 MISSING = "missing"
+
+#: how the reason of an attempt ended by a full disk begins (the runner then stops)
+DISK_FULL_REASON = "disk full"
+
+
+class Stop(StrEnum):
+    """Why a case's last attempt stopped short of done in a way the runners act on (the
+    manifest's ``stop``; ``reason`` says it in words for people): the runners branch on this,
+    never on the reason's words."""
+
+    NONE = ""                               # ran to its verdict (done, failed, unstable, ...)
+    DISK_FULL = "disk_full"                 # the folder filled up: the runner stops
+    INCOMPLETE_RECORD = "incomplete_record"  # a hole in its rows or dumps: resume before it
+    RESTART_SET_ASIDE = "restart_set_aside"  # the engine could not read its restart
+    INTERRUPTED = "interrupted"             # stopped on request (Ctrl-C, SIGTERM, scancel)
+    JOB_ENDED = "job_ended"                 # an ensemble job ended under it (another member)
+    NO_PROGRESS = "no_progress"             # ensemble launches that moved no member on
+
+    @classmethod
+    def from_reason(cls, reason: str) -> "Stop":
+        """The stop of a manifest written before ``stop`` was recorded, from its words."""
+        for words, stop in ((DISK_FULL_REASON, cls.DISK_FULL),
+                            ("incomplete record", cls.INCOMPLETE_RECORD),
+                            ("interrupted by the user", cls.INTERRUPTED),
+                            ("stopped when the ensemble job ended", cls.JOB_ENDED),
+                            ("ensemble job ended", cls.NO_PROGRESS)):
+            if reason.startswith(words):
+                return stop
+        if reason.startswith("restart ") and reason.endswith("set aside"):
+            return cls.RESTART_SET_ASIDE
+        return cls.NONE
 
 
 def now_iso() -> str:
@@ -75,6 +107,7 @@ class Manifest:
     status: str = RUNNING
     reason: str = ""
     reason_step: int | None = None
+    stop: Stop = Stop.NONE
     issues: list[dict] = field(default_factory=list)
     launcher: str = "mpirun"            # "mpirun" or "ensemble"
     nprocs: int = 1
@@ -128,6 +161,11 @@ class Manifest:
         fields = Attempt.__dataclass_fields__
         data["attempts"] = [Attempt(**{k: v for k, v in a.items() if k in fields})
                             for a in data.get("attempts", [])]
+        try:
+            data["stop"] = Stop(data["stop"]) if "stop" in data else Stop.from_reason(
+                str(data.get("reason", "")))
+        except ValueError:              # a stop word of a newer ligwf: read its words
+            data["stop"] = Stop.from_reason(str(data.get("reason", "")))
         known = {f for f in cls.__dataclass_fields__}
         return cls(**{k: v for k, v in data.items() if k in known})
 

@@ -117,7 +117,7 @@ def test_check_plans_for_the_cores_of_a_slurm_allocation(tmp_path, monkeypatch, 
 ])
 def test_run_plans_unless_np_or_ensemble_is_given(tmp_path, argv, planned, nprocs, ensemble):
     from ligwf.cli.main import build_parser
-    from ligwf.pipeline.run import run_settings
+    from ligwf.local import run_settings
 
     for command in ("run", "study"):
         args = build_parser().parse_args([command, str(DRUM), "--out", str(tmp_path / "s"),

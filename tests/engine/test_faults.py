@@ -596,3 +596,34 @@ def test_sigterm_in_the_last_fill_wave_resumes_from_its_forced_restart(tmp_path)
     assert any(read_manifest(c).attempts[1].from_restart for c in cases), \
         [read_manifest(c).attempts for c in cases]
     assert_pair_complete(cases)
+
+
+def test_ligwf_cancel_stops_a_planned_ensemble_run_in_another_process(tmp_path):
+    """`ligwf status` names the runner that holds the cases, `ligwf cancel` (the local
+    executor's cancel) sends it SIGTERM: forced restarts, both ensemble members killed
+    'interrupted by the user (SIGTERM)', the runner exits 143; `ligwf run` then finishes
+    both from their own restarts, and a second cancel finds nothing to stop."""
+    from ligwf.study.layout import FORCED_RESTART_RE
+
+    out = tmp_path / "study"
+    cases = [out / c for c in PAIR]
+    p = start_pair(out)
+    wait_for(lambda: all(in_phase(c, "ligwf-phase settle", 0) for c in cases)
+             or p.poll() is not None, timeout=180, what="settling in both")
+    status = run("status", str(out))
+    assert f"running in ligwf process {p.pid}@" in status.stdout, status.stdout
+    r = run("cancel", str(out))
+    assert r.returncode == 0 and f"sent SIGTERM to the ligwf runner(s) {p.pid}@" in r.stdout, \
+        r.stdout + r.stderr
+    assert p.wait(timeout=120) == 143, p.stderr.read()
+    for case in cases:
+        m = read_manifest(case)
+        assert m.status == "killed" and m.reason.startswith("interrupted by the user (SIGTERM)")
+        assert m.stop == "interrupted"
+        assert any(FORCED_RESTART_RE.match(f.name) for f in case.iterdir()), case.name
+        assert not engines_in(case)
+    again = run("cancel", str(out))
+    assert again.returncode == 0 and "no live ligwf runner" in again.stdout
+    r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS)
+    assert r.returncode == 0, r.stderr
+    assert_pair_complete(cases)

@@ -188,3 +188,30 @@ def test_srun_launcher_inside_the_allocation(slurm_cluster, tmp_path, env):
     command = Study.open(study).case(0).manifest().command
     assert Path(command[0]).name == "srun", command
     assert "--ntasks=1" in command and "--allow-run-as-root" not in command
+
+
+def test_the_pipeline_runs_cases_on_slurm_through_the_executor_interface(slurm_cluster,
+                                                                          tmp_path, env,
+                                                                          monkeypatch):
+    """`run_study` with the Slurm scheduler as its executor (issue 33 item 1): the cases go
+    out as a job array with the allocation rank plan's ranks, the call waits for them and
+    returns done; a second call runs nothing again (every case done: an empty array is
+    not submitted)."""
+    from ligwf.pipeline.prepare import prepare_workflow, write
+    from ligwf.pipeline.run import run_study
+    from ligwf.slurm.scheduler import SlurmScheduler
+    from ligwf.slurm.site import load_slurm_site
+
+    for key, value in env.items():
+        monkeypatch.setenv(key, value)
+    monkeypatch.delenv("LIGWF_SLURM_PARTITION", raising=False)
+    study = write(prepare_workflow(WORKFLOW, ["sweep.replicas=2"]), tmp_path / "executor",
+                  tmp_path / "meshes")
+    slurm = SlurmScheduler(load_slurm_site(), poll_seconds=1.0)
+    assert run_study(study, study.cases, slurm)
+    assert manifest_states(study.path) == {c.case_id: "done" for c in study.cases}, \
+        _logs(study.path)
+    (array,) = read_record(study.path)
+    assert array["kind"] == "array" and sorted(array["indices"]) == [0, 1], array
+    assert run_study(study, [c for c in study.cases if c.manifest().status != "done"], slurm)
+    assert len(read_record(study.path)) == 1

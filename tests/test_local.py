@@ -1,5 +1,5 @@
-"""How run_study launches a study's cases: the rank plan by default, --np / --ensemble as
-overrides. The launchers are replaced by recorders (no engine, no MPI): these tests pin
+"""How the local executor (ligwf.local) launches a study's cases: the rank plan by default,
+--np / --ensemble as overrides. The launchers are replaced by recorders (no engine, no MPI): these tests pin
 which launcher gets which cases on how many ranks, in which order."""
 
 from __future__ import annotations
@@ -8,10 +8,11 @@ import threading
 
 import pytest
 
-import ligwf.pipeline.run as pipeline
+import ligwf.local as local
 from ligwf.engine.site import EngineConfig
 from ligwf.pipeline.prepare import prepare_workflow, write
-from ligwf.pipeline.run import RunSettings, cases_to_run, run_study, study_schedule
+from ligwf.local import LocalExecutor, RunSettings, cases_to_run, study_schedule
+from ligwf.pipeline.run import run_study
 from ligwf.study.manifest import case_lock
 
 from helpers import DRUM
@@ -35,9 +36,9 @@ def launches(monkeypatch):
                       label.split("-")[0]))
         return {}
 
-    monkeypatch.setattr(pipeline, "run_case", fake_run_case)
-    monkeypatch.setattr(pipeline, "run_ensemble", fake_run_ensemble)
-    monkeypatch.setattr(pipeline, "take_over", lambda case: None)
+    monkeypatch.setattr(local, "run_case", fake_run_case)
+    monkeypatch.setattr(local, "run_ensemble", fake_run_ensemble)
+    monkeypatch.setattr(local, "take_over", lambda case: None)
     return calls
 
 
@@ -48,7 +49,7 @@ def make_study(tmp_path, overrides):
 
 def run(study, settings):
     stop = threading.Event()
-    return run_study(study, study.cases, EngineConfig(), settings, None, stop)
+    return run_study(study, study.cases, LocalExecutor(settings, EngineConfig()), None, stop)
 
 
 def test_planned_small_cases_run_side_by_side_longest_first(tmp_path, launches):
@@ -94,9 +95,9 @@ def test_a_planned_ensemble_leaves_out_the_cases_another_runner_holds(tmp_path, 
     members = [c for c in study.cases]
     with case_lock(held.path) as mine:
         assert mine
-        pipeline._ensemble_phase(study, members, phase, "phase1-x", EngineConfig(),
-                                 RunSettings(nprocs=None, cores=2), None, threading.Event(),
-                                 lambda case, n: launches.append(("mpirun", n, case.path.name)))
+        LocalExecutor(RunSettings(nprocs=None, cores=2)).ensemble_phase(
+            study, members, phase, "phase1-x", EngineConfig(), None, threading.Event(),
+            lambda case, n: launches.append(("mpirun", n, case.path.name)))
     assert launches == [("ensemble", 2, 1, tuple(c.path.name for c in members[1:]), "phase1")]
 
 
@@ -105,9 +106,9 @@ def test_a_planned_ensemble_with_one_free_case_runs_it_alone(tmp_path, launches)
     members = list(study.cases)
     phase = study_schedule(members, RunSettings(nprocs=None, cores=2)).phases[0]
     with case_lock(members[0].path), case_lock(members[1].path), case_lock(members[2].path):
-        pipeline._ensemble_phase(study, members, phase, "phase1-x", EngineConfig(),
-                                 RunSettings(nprocs=None, cores=2), None, threading.Event(),
-                                 lambda case, n: launches.append(("mpirun", n, case.path.name)))
+        LocalExecutor(RunSettings(nprocs=None, cores=2)).ensemble_phase(
+            study, members, phase, "phase1-x", EngineConfig(), None, threading.Event(),
+            lambda case, n: launches.append(("mpirun", n, case.path.name)))
     assert launches == [("mpirun", 1, members[3].path.name)]
 
 

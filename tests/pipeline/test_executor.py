@@ -1,0 +1,112 @@
+"""The pipeline runs cases only through the executor interface (issue 33 item 1): a study
+written, run by an executor that is not this machine's, analysed and reported, in the
+fast lane. The executor here replays the committed real engine output of
+``tests/data/cg3_slice`` (its dumps are what the committed input of that scene wrote,
+``tests/data/README.md``) into the case it is asked to run, so the analysis and the report
+read real LIGGGHTS dumps; the local and Slurm executors satisfy the same interface."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from helpers import DRUM, ROOT
+from ligwf.local import LocalCase, LocalExecutor, LocalStatus
+from ligwf.pipeline.post import postprocess
+from ligwf.pipeline.prepare import prepare_workflow, write
+from ligwf.pipeline.run import Interrupted, run_study
+from ligwf.scheduler import Executor, Scheduler
+from ligwf.slurm.scheduler import SlurmScheduler
+from ligwf.slurm.site import SlurmSite
+from ligwf.study import layout
+from ligwf.study.manifest import MISSING, Manifest
+from ligwf.study.study import Study
+
+DATA = ROOT / "tests" / "data" / "cg3_slice" / "cg3-weber-r0"
+# the scene of tests/data/cg3_slice (the command in tests/data/README.md)
+SCENE = ["sweep.cg_levels=[3]", "sweep.rules=[weber]", "scene.process.settle_time=0.1",
+         "scene.process.run_time=0.6", "scene.numerics.dump_interval=0.2"]
+
+
+@dataclass
+class ReplayExecutor:
+    """Runs a case by copying the committed engine output of its scene into its folder
+    and recording it done, as the engine's runner would; a case of another scene fails."""
+
+    ran: list[str] = field(default_factory=list)
+    name = "replay"
+
+    def require(self) -> None:
+        pass
+
+    def run_cases(self, study, cases, monitor=None, stop=None) -> bool:
+        done = True
+        for case in cases:
+            if stop is not None and stop.is_set():
+                return False
+            recorded = Manifest.from_dict(json.loads((DATA / layout.MANIFEST_FILE).read_text()))
+            ok = recorded.scene_hash == case.scene_hash
+            if ok:
+                for dump in (DATA / layout.POST_DIR).iterdir():
+                    shutil.copy2(dump, case.path / layout.POST_DIR / dump.name)
+                shutil.copy2(DATA / layout.THERMO_FILE, case.path / layout.THERMO_FILE)
+            case.write_manifest(Manifest(
+                case_id=case.case_id, index=case.index, scene_hash=case.scene_hash,
+                ligwf_version="", liggghts_version="3.8.0 (replayed)",
+                status="done" if ok else "failed",
+                reason="" if ok else "no committed output of this scene",
+                steps_done=case.scaled.total_steps, total_steps=case.scaled.total_steps,
+                atoms_start=222, atoms_end=222, wall_seconds=41.0, core_seconds=41.0))
+            self.ran.append(case.case_id)
+            done = done and ok
+        return done
+
+    def status(self, study_dir: Path, tolerant: bool = False) -> LocalStatus:
+        return LocalStatus([LocalCase(c.index, c.case_id,
+                                      m.status if (m := c.manifest()) else MISSING)
+                            for c in Study.open(study_dir).cases])
+
+    def cancel(self, study_dir: Path) -> list[str]:
+        return []
+
+
+def test_every_executor_has_the_one_interface():
+    for ex in (ReplayExecutor(), LocalExecutor(), SlurmScheduler(SlurmSite())):
+        assert isinstance(ex, Executor), ex
+    assert isinstance(SlurmScheduler(SlurmSite()), Scheduler)
+    assert not isinstance(LocalExecutor(), Scheduler)      # this machine queues nothing
+
+
+def test_the_whole_pipeline_runs_through_an_executor(tmp_path):
+    study = write(prepare_workflow(DRUM, SCENE), tmp_path / "study", tmp_path / "meshes")
+    (case,) = study.cases
+    ex = ReplayExecutor()
+    assert run_study(study, study.cases, ex)
+    assert ex.ran == [case.case_id]
+    postprocess(study.path, snapshots=False)
+    analysis = pd.read_csv(study.path / layout.ANALYSIS_DIR / "flow.csv")
+    assert list(analysis["case_id"]) == [case.case_id]
+    cases = pd.read_csv(study.report_dir / layout.CASES_REPORT)
+    assert list(cases["case_id"]) == [case.case_id]
+    # the flow metrics of the replayed frames (the engine's own dumps), as measured
+    assert 30 < cases["angle_of_repose"].iloc[0] < 60
+    assert (study.report_dir / "summary.md").is_file()
+    assert [c.manifest for c in ex.status(study.path).cases] == ["done"]
+
+
+def test_a_case_the_executor_cannot_run_is_not_done_and_nothing_else_runs_after_a_stop(
+        tmp_path):
+    study = write(prepare_workflow(DRUM, [*SCENE, "scene.process.run_time=0.4"]),
+                  tmp_path / "study", tmp_path / "meshes")
+    assert not run_study(study, study.cases, ReplayExecutor())    # another scene: failed
+    assert study.cases[0].manifest().status == "failed"
+    stop = threading.Event()
+    stop.set()
+    with pytest.raises(Interrupted):
+        run_study(study, study.cases, ReplayExecutor(), None, stop)
