@@ -98,6 +98,10 @@ GRANULE_METRICS = ("largest_cluster_fraction", "one_granule_frame_share")
 FIELD_ERRORS = ("field_error", "field_solid_error")
 #: the field criterion at each reported kernel width (field_errors.KERNEL_COLUMNS)
 FIELD_KERNEL_ERRORS = ("field_error_k1", "field_error_k2", "field_error_k4")
+#: the field criterion's noise pieces, from which its replica plan is made
+#: (report/deciding.py: raw distance, the run variances of each side, their run counts)
+FIELD_NOISE = ("field_error_distance", "field_error_run_var", "field_error_ref_var",
+               "field_error_runs", "field_error_ref_runs")
 GSD_REPORT = ("gsd_lower_limit", "gsd_lower_limit_diameter", "gsd_error_below_lower",
               "gsd_error_above_lower", "gsd_error_all")
 COSTS = ("core_seconds", "wall_seconds", "production_core_rate", "production_core_rate_k",
@@ -177,7 +181,7 @@ TABLES: dict[str, Table] = {
                                     "rule)", (
         "group", "group_label", "cg", "rule", "replicas", *RUN, *COSTS, *FLOW_METRICS,
         *GRANULE_METRICS, *GSD_REPORT, *FIELD_ERRORS, "field_error_kernel",
-        *FIELD_KERNEL_ERRORS), CONDITION),
+        *FIELD_KERNEL_ERRORS, *FIELD_NOISE), CONDITION),
     layout.VERDICT_TABLE: Table(layout.REPORT_DIR, "sweep group, CG level, rule and "
                                 "criterion of the verdict", (
         "group", "cg", "rule", "condition", "replicas", "condition_state", "speedup_core",

@@ -607,9 +607,13 @@ def test_ligwf_cancel_stops_a_planned_ensemble_run_in_another_process(tmp_path):
 
     out = tmp_path / "study"
     cases = [out / c for c in PAIR]
-    p = start_pair(out)
-    wait_for(lambda: all(in_phase(c, "ligwf-phase settle", 0) for c in cases)
-             or p.poll() is not None, timeout=180, what="settling in both")
+    # a production long enough to outlast two ligwf start-ups (status, cancel) on quiet cores
+    args = [*PAIR_ARGS, "--set", "scene.process.run_time=4.0"]
+    p = subprocess.Popen(ligwf_cmd("run", str(WORKFLOW), "--out", str(out), *args),
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                         start_new_session=True)
+    wait_for(lambda: all(in_phase(c, "ligwf-phase production", 0) for c in cases)
+             or p.poll() is not None, timeout=180, what="production in both")
     status = run("status", str(out))
     assert f"running in ligwf process {p.pid}@" in status.stdout, status.stdout
     r = run("cancel", str(out))
@@ -624,6 +628,6 @@ def test_ligwf_cancel_stops_a_planned_ensemble_run_in_another_process(tmp_path):
         assert not engines_in(case)
     again = run("cancel", str(out))
     assert again.returncode == 0 and "no live ligwf runner" in again.stdout
-    r = run("run", str(WORKFLOW), "--out", str(out), *PAIR_ARGS)
+    r = run("run", str(WORKFLOW), "--out", str(out), *args)
     assert r.returncode == 0, r.stderr
     assert_pair_complete(cases)

@@ -183,3 +183,15 @@ def test_every_column_of_every_real_table_is_documented(real_study):
     summary = (real_study / layout.REPORT_DIR / layout.SUMMARY_REPORT).read_text()
     assert "cohesionless control" in summary and "| {} |" not in summary
     assert "GSD err below lower limit" in summary and "angle [deg]" in summary
+
+
+def test_the_field_columns_of_the_dictionary_are_the_ones_the_report_writes():
+    """The field criterion's columns (kernel widths, noise pieces) are listed once in
+    analysis/records/field_errors and once in the dictionary: kept in step here, in the
+    fast lane (the real-study test above found the noise pieces missing only in CI)."""
+    from ligwf.analysis.records import field_errors
+
+    assert dic.FIELD_NOISE == field_errors.FIELD_NOISE_COLUMNS
+    assert dic.FIELD_KERNEL_ERRORS == tuple(field_errors.KERNEL_COLUMNS.values())
+    for column in (*dic.FIELD_NOISE, *dic.FIELD_KERNEL_ERRORS):
+        assert not undocumented(layout.CONDITIONS_REPORT, [column]), column
