@@ -128,9 +128,16 @@ def find_frames(dump_dir: Path, particles: str, contacts: str) -> list[FrameFile
         raise ConfigError(f"{dump_dir}: no such folder")
     found: dict[str, dict[int, Path]] = {"p": {}, "c": {}}
     for key, rx in (("p", regex(particles)), ("c", regex(contacts))):
-        for path in dump_dir.iterdir():
+        for path in sorted(dump_dir.iterdir()):
             if m := rx.match(path.name):
-                found[key][int(m.group(1))] = path
+                step = int(m.group(1))
+                if step in found[key]:
+                    # particles_100.vtu and particles_0100.vtu: one frame twice, or two
+                    # runs' dumps in one folder; taking either would be a silent guess
+                    raise ConfigError(f"{dump_dir}: {found[key][step].name} and {path.name} "
+                                      f"are both step {step}; keep one dump per step (or "
+                                      "narrow --particles / --contacts)")
+                found[key][step] = path
     if not found["p"]:
         raise ConfigError(f"{dump_dir}: no particle dump named {particles}")
     return [FrameFiles(s, found["p"][s], found["c"].get(s)) for s in sorted(found["p"])]

@@ -129,3 +129,24 @@ def test_no_silent_defaults_in_the_python_api(tmp_path):
         RunFacts("foreign", 1.0, Liquid("washino", 0.02, 0.5, 0.02), 1, 0.0, 1e-5)
     with pytest.raises(ConfigError, match="time step"):
         RunFacts("foreign", 1.0, Liquid("washino", 0.02, 0.5, 0.02), None, 0.0, 0.0)
+
+
+def test_two_dumps_of_one_step_are_refused_naming_both(tmp_path, capsys):
+    """particles_13618.vtu and particles_013618.vtu are one step: which to analyse would be
+    a guess (the folder's listing order), so the command names both and stops, nothing
+    written. On the committed real CG3 dumps (tests/data/cg3_slice)."""
+    from helpers import ROOT
+
+    real = ROOT / "tests" / "data" / "cg3_slice" / "cg3-weber-r0" / "post"
+    dumps = tmp_path / "dumps"
+    shutil.copytree(real, dumps)
+    shutil.copy2(dumps / "particles_13618.vtu", dumps / "particles_013618.vtu")
+    out = tmp_path / "out"
+    assert main(["analyse-dumps", str(dumps), "--out", str(out), "--cg", "3", *ARGS]) != 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "Traceback" not in err[0], err
+    assert "particles_013618.vtu and particles_13618.vtu are both step 13618" in err[0]
+    assert not out.exists()
+    (dumps / "particles_013618.vtu").unlink()              # one per step: it runs
+    assert main(["analyse-dumps", str(dumps), "--out", str(out), "--cg", "3", *ARGS]) == 0
+    assert (pd.read_csv(out / "frames.csv")["status"] == "ok").all()
