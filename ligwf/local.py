@@ -104,13 +104,19 @@ class LocalCase:
     index: int
     case_id: str
     manifest: str
-    job: str | None = None
+    runner_pid: int | None = None       # the live runner holding it, on ``runner_host``
+    runner_host: str = ""
     reason: str = ""
+
+    @property
+    def job(self) -> str | None:
+        """The runner as ``pid@host`` (a scheduler's task id), None when none holds it."""
+        return None if self.runner_pid is None else f"{self.runner_pid}@{self.runner_host}"
 
     @property
     def queued(self) -> bool:
         """A live runner has it (it will write its manifest itself)."""
-        return self.job is not None
+        return self.runner_pid is not None
 
 
 @dataclass(frozen=True)
@@ -221,7 +227,7 @@ class LocalExecutor:
             held = m is not None and m.status == RUNNING and runner_alive(m)
             rows.append(LocalCase(c.index, c.case_id,
                                   effective_status(m) if m is not None else MISSING,
-                                  f"{m.pid}@{m.host}" if held else None,
+                                  m.pid if held else None, m.host if held else "",
                                   m.reason if m is not None else ""))
         return LocalStatus(rows)
 
@@ -229,8 +235,8 @@ class LocalExecutor:
         """SIGTERM every live runner of this host holding a case of the study (its engines
         write forced restarts, its cases end ``killed``); the runners, as ``pid@host``."""
         sent = []
-        for job in sorted({c.job for c in self.status(study_dir).cases if c.job}):
-            pid = int(job.split("@")[0])
+        runners = {(c.runner_pid, c.job) for c in self.status(study_dir).cases if c.queued}
+        for pid, job in sorted(runners):
             try:
                 os.kill(pid, signal.SIGTERM)
             except ProcessLookupError:

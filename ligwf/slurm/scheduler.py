@@ -14,13 +14,13 @@ from typing import ClassVar, Iterable, Mapping, Sequence
 
 from ligwf.engine.plan import allocation_schedule, case_load
 from ligwf.errors import SubmitError
+from ligwf.local import all_done
 from ligwf.slurm.jobs import (PlannedJob, Runner, StudyStatus, dry_run_text, next_round,
                               plan_jobs, read_record, recorded_plan, require_scheduler,
                               run_command, study_status, submit_jobs)
 from ligwf.slurm.parse import FINISHED_STATES
 from ligwf.slurm.script import scancel_command
 from ligwf.slurm.site import SlurmSite
-from ligwf.study.manifest import DONE
 
 
 @dataclass(frozen=True)
@@ -73,7 +73,7 @@ class SlurmScheduler:
                 self.cancel(study.path)
                 cancelled = True
             time.sleep(self.poll_seconds)
-        return all((m := c.manifest()) is not None and m.status == DONE for c in cases)
+        return all_done(cases)
 
     def dry_run_text(self, jobs: Sequence[PlannedJob]) -> str:
         return dry_run_text(jobs)
