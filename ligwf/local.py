@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
+import sys
 import threading
 from contextlib import ExitStack
 from dataclasses import dataclass, field
@@ -33,6 +35,7 @@ from ligwf.engine.launch import Monitor, run_case, take_over
 from ligwf.engine.plan import Phase, Schedule, case_load, override_schedule, plan_study
 from ligwf.engine.resume import SKIP, plan_case
 from ligwf.engine.site import EngineConfig
+from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import (DONE, MISSING, RUNNING, case_busy, case_lock,
                                   effective_status, runner_alive)
@@ -218,6 +221,42 @@ class LocalExecutor:
                 return
         for case in mine:               # lock released: run_case takes it again
             one(case, phase.ranks)
+
+    def analyse(self, study: Study, tasks: int = 1,
+                stop: threading.Event | None = None) -> dict | None:
+        """The study's analysis (its stored settings) into its analysis folder, here:
+        ``tasks`` 1 in this process (frame-parallel when this process runs under mpirun);
+        more, as that many processes of this interpreter each computing one share
+        (``ligwf analyse --part K/N``), then merged in this one into the same bytes. A share
+        that failed is named by the merge with the command that re-runs it; ``stop`` set
+        ends the shares (SIGTERM) and returns None with nothing merged."""
+        from ligwf.analysis.outputs import new_token
+        from ligwf.analysis.runner import AnalysisOptions, analyse, merge_parts
+
+        if tasks <= 1:
+            return analyse(study.path, None, AnalysisOptions(), None)
+        stop = stop or threading.Event()
+        token = new_token()
+        logs = study.path / layout.ANALYSIS_SHARE_LOG_DIR
+        logs.mkdir(parents=True, exist_ok=True)
+        procs = []
+        for index in range(tasks):
+            with open(logs / layout.analysis_share_log(token, index), "wb") as log:
+                procs.append(subprocess.Popen(
+                    [sys.executable, "-m", "ligwf", "analyse", str(study.path), "--part",
+                     f"{index}/{tasks}", "--token", token],
+                    stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL))
+        while any(p.poll() is None for p in procs):
+            if stop.wait(WAIT_SECONDS):
+                for p in procs:
+                    if p.poll() is None:
+                        p.terminate()
+                for p in procs:
+                    p.wait()
+                return None
+        return merge_parts(study.path, token, tasks, None, AnalysisOptions(),
+                           rerun=f"{sys.executable} -m ligwf analyse {study.path} "
+                                 f"--part {{index}}/{tasks} --token {token}")
 
     def status(self, study_dir: Path, tolerant: bool = False) -> LocalStatus:
         """Every case's manifest status beside the live runner holding it (if any)."""

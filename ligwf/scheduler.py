@@ -4,8 +4,10 @@
 Every :class:`Executor` runs cases (:meth:`Executor.run_cases`: on this machine now; on a
 scheduler as a job array it waits for), says where each case stands
 (:meth:`Executor.status`: its manifest beside the executor's own view of it, a live runner
-or a queued task) and stops them (:meth:`Executor.cancel`). The pipeline runs cases only
-through this interface (:func:`ligwf.pipeline.run.run_study`).
+or a queued task), stops them (:meth:`Executor.cancel`) and analyses what they wrote
+(:meth:`Executor.analyse`: shares side by side, merged). The pipeline runs cases and the
+analysis only through this interface (:func:`ligwf.pipeline.run.run_study`,
+:func:`ligwf.pipeline.post.postprocess`).
 
 A batch scheduler (:class:`Scheduler`) is an executor that can also hand a whole study to
 the queue and return at once: job arrays and a follow-up job, as below.
@@ -34,7 +36,9 @@ the pipeline (:mod:`ligwf.pipeline.submit`) chains preparation, rank plan and sc
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Iterable, Mapping, Protocol, Sequence, runtime_checkable
 
 from ligwf.study.manifest import FAILED, KILLED, MISSING, RUNNING, UNSTABLE
@@ -101,12 +105,48 @@ class Executor(Protocol):
         them resumably (forced restarts, ``killed``) and return; ``monitor``: live
         progress where the executor can see it."""
 
+    def analyse(self, study, tasks: int = 1, stop=None) -> dict | None:
+        """Analyse ``study``'s runs with its stored analysis settings into its analysis
+        folder, split into ``tasks`` shares run side by side (1: one; the outputs are the
+        same bytes however it is split) and merged; the analysis record (None when
+        ``stop`` ended it first)."""
+
     def status(self, study_dir: Path, tolerant: bool = False) -> StudyStatus:
         """Every case's manifest beside the executor's view of it (``tolerant``: an
         executor that cannot be asked leaves its view empty and says why)."""
 
     def cancel(self, study_dir: Path) -> list[str]:
         """Stop the study's cases that are still queued or running; what was stopped."""
+
+
+@dataclass(frozen=True)
+class JobRound:
+    """What one submission round asks of a scheduler (:meth:`Scheduler.plan_jobs`).
+
+    ``indices``: the cases to run (none: the follow-up job alone); ``ranks``: case index
+    -> MPI ranks from the rank plan (None: the site's fixed task count), planned on
+    ``plan_cores`` cores (recorded, so a resubmit plans again on as many);
+    ``post_steps``: the ``ligwf <step> STUDY`` commands of the follow-up job, in order;
+    ``analysis_tasks`` > 1: its ``analyse`` step as an array of that many tasks staged
+    under ``token``, then a merge job running the other steps; ``round_no``: the
+    submission round the scripts are numbered by; ``study_round``: the round of a
+    sequential study the jobs run (recorded with them)."""
+
+    indices: tuple[int, ...] = ()
+    round_no: int = 1
+    ranks: Mapping[int, int] | None = None
+    post_steps: tuple[str, ...] = ()
+    plan_cores: int | None = None
+    analysis_tasks: int = 1
+    token: str | None = None
+    study_round: int | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "indices", tuple(sorted({int(i) for i in self.indices})))
+        object.__setattr__(self, "post_steps", tuple(self.post_steps))
+        if self.ranks is not None:
+            object.__setattr__(self, "ranks", MappingProxyType(
+                {int(k): int(v) for k, v in self.ranks.items()}))
 
 
 class BatchJob(Protocol):
@@ -123,18 +163,17 @@ class BatchJob(Protocol):
 class Scheduler(Executor, Protocol):
     """A batch scheduler ligwf submits studies to (see the module docstring)."""
 
-    def plan_jobs(self, study_dir: Path, study_name: str, indices: Iterable[int],
-                  ranks: Mapping[int, int] | None, post_steps: Sequence[str], round_no: int,
-                  plan_cores: int | None = None, analysis_tasks: int = 1,
-                  token: str | None = None, study_round: int | None = None
+    def plan_jobs(self, study_dir: Path, study_name: str, request: JobRound
                   ) -> Sequence[BatchJob]:
         """The scripts of one submission round (pure): one array per rank count of
-        ``ranks`` (case index -> MPI ranks; None: the site's fixed task count) and, with
-        ``post_steps``, the follow-up job running ``ligwf <step> STUDY`` for each
-        (``analysis_tasks`` > 1: ``analyse`` as an array of that many tasks staged under
-        ``token``, then a merge job running the other steps). No ``indices``: the
-        follow-up job alone. The submission records the follow-up's steps and
-        ``study_round``, the round of a sequential study the jobs run."""
+        ``request.ranks`` and, with ``request.post_steps``, the follow-up job (see
+        :class:`JobRound`)."""
+
+    def plan_analysis(self, study_dir: Path, study_name: str, tasks: int, token: str
+                      ) -> Sequence[BatchJob]:
+        """The scripts of a split analysis of a written study (pure): an array of ``tasks``
+        analysis tasks, each one share of the study's (case, frame) tasks staged under
+        ``token``, and the job that merges them into the analysis folder."""
 
     def dry_run_text(self, jobs: Sequence[BatchJob]) -> str:
         """Every script and the command that would submit it."""

@@ -90,7 +90,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("report", ("ligwf.report",)),
     ("executors", ("ligwf.scheduler", "ligwf.local", "ligwf.slurm")),
     ("pipeline", ("ligwf.pipeline",)),
-    ("cli", ("ligwf.cli",)),
+    ("cli", ("ligwf.cli", "ligwf.__main__")),
     ("api", ("ligwf.api",)),
 )
 

@@ -118,7 +118,7 @@ def cmd_split(args: argparse.Namespace, options) -> int:
 def submit_split(args: argparse.Namespace, count: int) -> int:
     """Plan (and unless ``--dry-run`` submit) the analysis array and its merge job."""
     from ligwf.analysis.outputs import new_token
-    from ligwf.slurm import jobs
+    from ligwf.slurm.scheduler import SlurmScheduler
     from ligwf.slurm.site import load_slurm_site
     from ligwf.study.study import Study
 
@@ -129,13 +129,13 @@ def submit_split(args: argparse.Namespace, count: int) -> int:
                           "are for a local run")
     study = Study.open(args.run_dir)
     token = new_token()
-    site = load_slurm_site()
-    planned = jobs.plan_analysis_array(study.path, study.path.name, site, count, token)
+    scheduler = SlurmScheduler(load_slurm_site())
+    planned = scheduler.plan_analysis(study.path, study.path.name, count, token)
     if args.dry_run:
-        print(jobs.dry_run_text(planned))
+        print(scheduler.dry_run_text(planned))
         return 0
-    jobs.require_scheduler()
-    entries = jobs.submit_jobs(study.path, planned, site)
+    scheduler.require()
+    entries = scheduler.submit(study.path, planned)
     array, merge = entries[0]["job_id"], entries[-1]["job_id"]
     print(f"submitted analysis array {array} ({count} task(s)) and merge job {merge} "
           f"(token {token}); logs in {study.path / layout.SLURM_LOG_DIR}")

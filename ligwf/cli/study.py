@@ -27,7 +27,7 @@ from ligwf.cli.run import add_run_args, run_with_progress, start_from_args
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.pipeline.post import postprocess
 from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, until_decided
-from ligwf.local import run_settings
+from ligwf.local import LocalExecutor, run_settings
 from ligwf.pipeline.run import StudyRun
 from ligwf.report.rounds import look_line
 from ligwf.study.layout import REPORT_DIR, is_study_folder
@@ -39,7 +39,7 @@ def cmd_study(args: argparse.Namespace) -> int:
         return cmd_until_decided(args)
     run = start_from_args(args)
     done = run_with_progress(run, args)
-    _, out = postprocess(run.study.path, snapshots=not args.no_snapshots)
+    _, out = postprocess(run.study.path, run.executor, snapshots=not args.no_snapshots)
     print_report(run.study.path, out)
     return 0 if done else 1
 
@@ -88,7 +88,7 @@ def cmd_until_decided(args: argparse.Namespace) -> int:
         console.print(summary_table(run.study.cases, f"{run.study.name}: {args.out}"))
         return done
 
-    rounds = until_decided(prepared, args.out, settings,
+    rounds = until_decided(prepared, args.out, LocalExecutor(settings),
                            RoundPlan(args.max_looks, args.max_core_hours, args.every_level),
                            run_round,
                            show_look, args.mesh_cache, snapshots=not args.no_snapshots)

@@ -8,7 +8,7 @@ a notebook calls the same functions::
     prepared = pipeline.prepare_workflow(Path("workflows/demo.yaml"), ["sweep.cg_levels=[1,2]"])
     run = pipeline.start_run(prepared, Path("runs/demo"), pipeline.run_settings(cores=2))
     run.run()
-    record, report_dir = pipeline.postprocess(run.study.path)
+    record, report_dir = pipeline.postprocess(run.study.path, run.executor)
 
 * :mod:`~ligwf.pipeline.prepare` validates, scales, renders and pre-flights a workflow in
   memory, then writes the study folder;

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 from ligwf.errors import ConfigError
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.workflow import apply_override, parse_override
+from ligwf.scheduler import Executor
 from ligwf.study.study import Study
 
 if TYPE_CHECKING:  # the analysis and report stages load numba / matplotlib: imported on use
@@ -68,8 +69,10 @@ def overridden_accept(accept: AcceptSettings, overrides: tuple[str, ...]) -> Acc
     return build_accept_settings(raw["accept"], "accept")
 
 
-def postprocess(path: Path, snapshots: bool = True) -> tuple[dict | None, Path]:
-    """Analyse, then report, a study with its stored settings: what ``ligwf study`` does
-    after the run and what a scheduler's follow-up job does (:data:`POSTPROCESS_COMMANDS`)."""
-    record = analyse_study(path)
+def postprocess(path: Path, executor: Executor, snapshots: bool = True,
+                analysis_tasks: int = 1) -> tuple[dict | None, Path]:
+    """Analyse on ``executor`` (in ``analysis_tasks`` shares), then report, a study with its
+    stored settings: what ``ligwf study`` does after the run and what a scheduler's
+    follow-up job does (:data:`POSTPROCESS_COMMANDS`)."""
+    record = executor.analyse(Study.open(path), analysis_tasks)
     return record, report_study(path, snapshots=snapshots)

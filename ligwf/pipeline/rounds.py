@@ -41,11 +41,12 @@ from ligwf.analysis.records.equivalence import UNDECIDED
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
-from ligwf.local import LocalExecutor, RunSettings
+from ligwf.local import LocalExecutor
 from ligwf.pipeline.run import StudyRun, scheduled, site_engine
 from ligwf.report.planning import calibration, run_costs
 from ligwf.report.verdict import FAILS, MEETS, Verdict, is_control_group
 from ligwf.report.verdict_records import read_verdict
+from ligwf.scheduler import Executor
 from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
 from ligwf.study.case import CaseFolder, group_of
 from ligwf.study.extension import write_extension
@@ -277,21 +278,21 @@ def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Lo
 
 
 # ---------------------------------------------------------------- the loop
-def until_decided(prepared: Prepared, out: Path, settings: RunSettings, plan: RoundPlan,
+def until_decided(prepared: Prepared, out: Path, executor: LocalExecutor, plan: RoundPlan,
                   run_round: Callable[[StudyRun], bool], show: Callable[[Look, Rounds], None],
                   mesh_cache: Path | None = None, snapshots: bool = True) -> Rounds:
-    """Run, analyse and judge the study in rounds until it decides (module docstring);
-    ``run_round`` runs a scheduled round (the CLI's progress display), ``show`` prints a
-    look. Returns the rounds record; stops early (no look recorded) when a case did not
+    """Run, analyse and judge the study in rounds until it decides (module docstring), its
+    cases and analysis on ``executor``; ``run_round`` runs a scheduled round (the CLI's
+    progress display), ``show`` prints a look. Returns the rounds record; stops early (no look recorded) when a case did not
     finish (the same command resumes it)."""
     rounds = start_rounds(out, plan)
     while not rounds.stopped:
-        engine, identity = site_engine()        # refused before anything is written
+        _, identity = site_engine()             # refused before anything is written
         study = write_round(prepared, out, rounds, mesh_cache)
-        run = scheduled(study, LocalExecutor(settings, engine), identity)
+        run = scheduled(study, executor, identity)
         if not run_round(run):
             return rounds
-        rounds = take_look(out, rounds)
+        rounds = take_look(out, rounds, executor)
         show(rounds.looks[-1], rounds)
     report_study(out, snapshots=snapshots)
     return rounds
@@ -311,11 +312,11 @@ def write_round(prepared: Prepared, out: Path, rounds: Rounds,
     return Study.open(out)
 
 
-def take_look(out: Path, rounds: Rounds) -> Rounds:
-    """Analyse and report the study (no snapshots), plan the next look from the report's
-    verdict (:func:`plan_look`) and write it into the rounds record before anything acts
-    on it; the record with that look."""
-    postprocess(out, snapshots=False)
+def take_look(out: Path, rounds: Rounds, executor: Executor) -> Rounds:
+    """Analyse (on ``executor``) and report the study (no snapshots), plan the next look
+    from the report's verdict (:func:`plan_look`) and write it into the rounds record
+    before anything acts on it; the record with that look."""
+    postprocess(out, executor, snapshots=False)
     study = Study.open(out)
     verdict = read_verdict(study.report_dir)
     if verdict is None:

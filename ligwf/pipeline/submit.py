@@ -22,7 +22,8 @@ from ligwf.engine.plan import Schedule, allocation_schedule, case_load
 from ligwf.errors import SubmitError
 from ligwf.pipeline.post import POSTPROCESS_COMMANDS
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
-from ligwf.scheduler import BatchJob, CaseView, Scheduler, active_tasks, cases_to_resubmit
+from ligwf.scheduler import (BatchJob, CaseView, JobRound, Scheduler, active_tasks,
+                             cases_to_resubmit)
 from ligwf.study.study import Study
 
 
@@ -65,10 +66,9 @@ def plan_submission(prepared: Prepared, out: Path, scheduler: Scheduler, cores: 
         rc.case.index: schedule.ranks_of(rc.case.case_id) for rc in prepared.rendered}
     steps = (list(post_steps) if post_steps is not None
              else list(POSTPROCESS_COMMANDS) if analysis else [])
-    jobs = scheduler.plan_jobs(out, prepared.workflow.name,
-                               [rc.case.index for rc in prepared.rendered], ranks, steps,
-                               scheduler.next_round(out), cores, analysis_tasks,
-                               _token(analysis_tasks), study_round)
+    jobs = scheduler.plan_jobs(out, prepared.workflow.name, JobRound(
+        tuple(rc.case.index for rc in prepared.rendered), scheduler.next_round(out), ranks,
+        tuple(steps), cores, analysis_tasks, _token(analysis_tasks), study_round))
     return Submission(out, schedule, tuple(jobs))
 
 
@@ -143,6 +143,6 @@ def rerun_jobs(study: Study, scheduler: Scheduler, indices: Sequence[int], cores
         schedule = submission_schedule([case_load(c.path.name, c.scaled) for c in again],
                                        cores, None)
         ranks = {c.index: schedule.ranks_of(c.path.name) for c in again}
-    return scheduler.plan_jobs(study.path, study.name, indices, ranks, list(steps),
-                               scheduler.next_round(study.path), cores, analysis_tasks,
-                               _token(analysis_tasks), study_round)
+    return scheduler.plan_jobs(study.path, study.name, JobRound(
+        tuple(indices), scheduler.next_round(study.path), ranks, tuple(steps), cores,
+        analysis_tasks, _token(analysis_tasks), study_round))

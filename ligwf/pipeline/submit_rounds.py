@@ -46,7 +46,7 @@ from ligwf.errors import ConfigError
 from ligwf.pipeline.post import report_study
 from ligwf.pipeline.prepare import Prepared
 from ligwf.pipeline.rounds import take_look, write_round
-from ligwf.local import all_done, cases_to_run
+from ligwf.local import LocalExecutor, all_done, cases_to_run
 from ligwf.pipeline.submit import rerun_jobs
 from ligwf.scheduler import Scheduler
 from ligwf.study.layout import REPORT_FILES_RECORD, ROUNDS_FILE
@@ -207,7 +207,7 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
                 time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
                 continue
             if take_looks and p.state == LOOK_DUE:
-                rounds = take_look(out, read_rounds(out))
+                rounds = take_look(out, read_rounds(out), LocalExecutor())
                 looks.append(rounds.looks[-1])
                 if show is not None:
                     show(rounds.looks[-1], rounds)
@@ -215,7 +215,7 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
             if p.state == ROUND_DUE and prepared is not None:
                 moved = _submit_round(out, scheduler, how, prepared, p, take_looks)
                 if moved is None:           # nothing to run: look again at once
-                    rounds = take_look(out, read_rounds(out))
+                    rounds = take_look(out, read_rounds(out), LocalExecutor())
                     looks.append(rounds.looks[-1])
                     if show is not None:
                         show(rounds.looks[-1], rounds)

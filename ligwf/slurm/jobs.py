@@ -29,6 +29,7 @@ from typing import Callable, Iterable, Mapping, Sequence
 from ligwf import __version__
 from ligwf.errors import ConfigError, SubmitError
 from ligwf.fsio import atomic_write_json, atomic_write_text
+from ligwf.scheduler import JobRound
 from ligwf.study import layout
 from ligwf.study.manifest import MISSING, read_manifest
 from ligwf.study.study import Study
@@ -118,14 +119,11 @@ class PlannedJob:
     study_round: int | None = None
 
 
-def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterable[int],
-              analysis_steps: Sequence[str], round_no: int,
-              ranks: Mapping[int, int] | None = None,
-              plan_cores: int | None = None, analysis_tasks: int = 1,
-              token: str | None = None, study_round: int | None = None) -> list[PlannedJob]:
-    """The array job over ``indices`` and (if steps are given) its analysis job (pure).
-    No ``indices``: the follow-up job alone, depending on nothing. ``study_round`` is
-    recorded with every job (the round of a sequential study they run).
+def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite,
+              request: JobRound) -> list[PlannedJob]:
+    """The array job over the request's ``indices`` and (if it names ``post_steps``) its
+    analysis job (pure). No ``indices``: the follow-up job alone, depending on nothing.
+    ``study_round`` is recorded with every job (the round of a sequential study they run).
 
     ``analysis_tasks`` > 1 (a big study): the ``analyse`` step is split over an array of
     that many analysis tasks, after the case arrays, and the merge job after them runs the
@@ -139,7 +137,10 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite, indices: Iterab
     ceil(ntasks / ``site.cores_per_node``) nodes when the cores per node are known; an
     array on ``--ntasks`` / the site's ntasks asks for tasks only, as before."""
     study = PurePosixPath(Path(study_dir).resolve())
-    idx = tuple(sorted(set(indices)))
+    idx, ranks, round_no = request.indices, request.ranks, request.round_no
+    analysis_steps, study_round = request.post_steps, request.study_round
+    plan_cores, analysis_tasks, token = (request.plan_cores, request.analysis_tasks,
+                                         request.token)
     array_ctx = ScriptContext(study, job_name(study_name, "array"), __version__)
     if not idx:
         classes: dict[int, Sequence[int]] = {}

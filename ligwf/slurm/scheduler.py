@@ -15,12 +15,14 @@ from typing import ClassVar, Iterable, Mapping, Sequence
 from ligwf.engine.plan import allocation_schedule, case_load
 from ligwf.errors import SubmitError
 from ligwf.local import all_done
+from ligwf.scheduler import JobRound
 from ligwf.slurm.jobs import (PlannedJob, Runner, StudyStatus, dry_run_text, next_round,
-                              plan_jobs, read_record, recorded_plan, require_scheduler,
+                              plan_analysis_array, plan_jobs, read_record, recorded_plan, require_scheduler,
                               run_command, study_status, submit_jobs)
 from ligwf.slurm.parse import FINISHED_STATES
 from ligwf.slurm.script import scancel_command
 from ligwf.slurm.site import SlurmSite
+from ligwf.study import layout
 
 
 @dataclass(frozen=True)
@@ -33,17 +35,20 @@ class SlurmScheduler:
     name: ClassVar[str] = "slurm"
     #: seconds between looks at the queue while :meth:`run_cases` waits
     poll_seconds: float = 5.0
+    #: looks in a row in which Slurm does not know a job it was given before the wait
+    #: gives up on it (a job that ended before the first look, with no accounting)
+    forget_polls: int = 3
 
     def require(self) -> None:
         require_scheduler()
 
-    def plan_jobs(self, study_dir: Path, study_name: str, indices: Iterable[int],
-                  ranks: Mapping[int, int] | None, post_steps: Sequence[str], round_no: int,
-                  plan_cores: int | None = None, analysis_tasks: int = 1,
-                  token: str | None = None, study_round: int | None = None
+    def plan_jobs(self, study_dir: Path, study_name: str, request: JobRound
                   ) -> list[PlannedJob]:
-        return plan_jobs(study_dir, study_name, self.site, indices, post_steps, round_no, ranks,
-                         plan_cores, analysis_tasks, token, study_round)
+        return plan_jobs(study_dir, study_name, self.site, request)
+
+    def plan_analysis(self, study_dir: Path, study_name: str, tasks: int, token: str
+                      ) -> list[PlannedJob]:
+        return plan_analysis_array(study_dir, study_name, self.site, tasks, token)
 
     def run_cases(self, study, cases: Sequence, monitor=None,
                   stop: threading.Event | None = None) -> bool:
@@ -61,8 +66,8 @@ class SlurmScheduler:
         ranks = {c.index: schedule.ranks_of(c.path.name) for c in cases}
         indices = {c.index for c in cases}
         self.require()
-        jobs = self.plan_jobs(study.path, study.name, sorted(indices), ranks, [],
-                              self.next_round(study.path))
+        jobs = self.plan_jobs(study.path, study.name, JobRound(
+            tuple(indices), self.next_round(study.path), ranks))
         self.submit(study.path, jobs)
         cancelled = False
         while True:
@@ -74,6 +79,42 @@ class SlurmScheduler:
                 cancelled = True
             time.sleep(self.poll_seconds)
         return all_done(cases)
+
+    def analyse(self, study, tasks: int = 1,
+                stop: threading.Event | None = None) -> dict | None:
+        """The study's analysis as a job array of ``tasks`` shares and the merge job after
+        it (what ``ligwf analyse --slurm N`` submits), waited for; the merged analysis
+        record. ``stop`` set: both jobs are cancelled and None is returned once Slurm has
+        ended them. SubmitError when the merge job ends without a record (its log, in
+        the study's Slurm log folder, says why: a share that failed is named there with
+        the command that re-runs it)."""
+        from ligwf.analysis.outputs import new_token
+        from ligwf.analysis.records.analysis_record import AnalysisRecord
+
+        stop = stop or threading.Event()
+        self.require()
+        jobs = self.plan_analysis(study.path, study.name, max(1, tasks), new_token())
+        merge = str(self.submit(study.path, jobs)[-1]["job_id"])
+        cancelled, unseen = False, 0
+        while True:
+            entry = next(j for j in self.status(study.path).jobs
+                         if str(j["job_id"]) == merge)
+            state = entry.get("state")
+            unseen = unseen + 1 if state is None else 0
+            if (state is not None and not entry["active"]) or unseen > self.forget_polls:
+                break
+            if stop.is_set() and not cancelled:
+                self.cancel(study.path)
+                cancelled = True
+            time.sleep(self.poll_seconds)
+        if cancelled:
+            return None
+        if state is None or state.split()[0] != "COMPLETED":
+            raise SubmitError(f"the analysis merge job {merge} ended "
+                              f"{state or 'unknown to Slurm'}: its log in "
+                              f"{study.path / layout.SLURM_LOG_DIR} says why")
+        record = AnalysisRecord.read(study.analysis_dir)
+        return record.data if record is not None else None
 
     def dry_run_text(self, jobs: Sequence[PlannedJob]) -> str:
         return dry_run_text(jobs)

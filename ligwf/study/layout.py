@@ -88,6 +88,9 @@ ENSEMBLE_CLAIM_GLOB = "*.json"
 SLURM_DIR = "slurm"
 SLURM_LOG_DIR = f"{SLURM_DIR}/logs"
 SLURM_RECORD = f"{SLURM_DIR}/jobs.json"
+#: Study level: the screens of the analysis shares a local executor runs side by side
+#: (:meth:`ligwf.local.LocalExecutor.analyse`), one per share: :func:`analysis_share_log`.
+ANALYSIS_SHARE_LOG_DIR = ".analysis-shares"
 #: Suite level: the stability suite's record (``ligwf stability``).
 SUITE_RECORD = "suite.json"
 #: Calibration folder (``ligwf calibrate``): the measured candidates, the study of the wet
@@ -189,6 +192,11 @@ def slurm_analysis_array_script(token: str) -> str:
 def slurm_analysis_merge_script(token: str) -> str:
     """The job script merging an analysis split over tasks."""
     return f"analysis-merge-{token}.sh"
+
+
+def analysis_share_log(token: str, index: int) -> str:
+    """The screen of share ``index`` of the local split analysis ``token``."""
+    return f"share-{token}-{index}.log"
 
 
 def staging_dir(token: str) -> str:

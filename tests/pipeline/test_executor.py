@@ -40,6 +40,7 @@ class ReplayExecutor:
     and recording it done, as the engine's runner would; a case of another scene fails."""
 
     ran: list[str] = field(default_factory=list)
+    analysed: list[int] = field(default_factory=list)
     name = "replay"
 
     def require(self) -> None:
@@ -67,6 +68,11 @@ class ReplayExecutor:
             done = done and ok
         return done
 
+    def analyse(self, study, tasks: int = 1, stop=None) -> dict | None:
+        """The replayed dumps lie on this machine: analysed here."""
+        self.analysed.append(tasks)
+        return LocalExecutor().analyse(study, tasks, stop)
+
     def status(self, study_dir: Path, tolerant: bool = False) -> LocalStatus:
         return LocalStatus([LocalCase(c.index, c.case_id,
                                       m.status if (m := c.manifest()) else MISSING)
@@ -89,7 +95,8 @@ def test_the_whole_pipeline_runs_through_an_executor(tmp_path):
     ex = ReplayExecutor()
     assert run_study(study, study.cases, ex)
     assert ex.ran == [case.case_id]
-    postprocess(study.path, snapshots=False)
+    postprocess(study.path, ex, snapshots=False)
+    assert ex.analysed == [1]
     analysis = pd.read_csv(study.path / layout.ANALYSIS_DIR / "flow.csv")
     assert list(analysis["case_id"]) == [case.case_id]
     cases = pd.read_csv(study.report_dir / layout.CASES_REPORT)
@@ -110,3 +117,26 @@ def test_a_case_the_executor_cannot_run_is_not_done_and_nothing_else_runs_after_
     stop.set()
     with pytest.raises(Interrupted):
         run_study(study, study.cases, ReplayExecutor(), None, stop)
+
+
+def test_a_local_analysis_split_into_shares_writes_the_same_bytes(tmp_path):
+    """LocalExecutor.analyse in 2 shares (2 processes, then the merge) against 1, on the
+    replayed real dumps: every table byte for byte, the share screens kept."""
+    study = write(prepare_workflow(DRUM, SCENE), tmp_path / "study", tmp_path / "meshes")
+    assert run_study(study, study.cases, ReplayExecutor())
+    one = LocalExecutor().analyse(study, 1)
+    tables = {p.name: p.read_bytes() for p in study.analysis_dir.glob("*.csv")}
+    assert "flow.csv" in tables
+    two = LocalExecutor().analyse(study, 2)
+    assert {p.name: p.read_bytes() for p in study.analysis_dir.glob("*.csv")} == tables
+    assert [c["analysed"] for c in two["cases"]] == [c["analysed"] for c in one["cases"]]
+    assert len(list((study.path / layout.ANALYSIS_SHARE_LOG_DIR).glob("share-*.log"))) == 2
+
+
+def test_a_local_analysis_stopped_mid_way_merges_nothing(tmp_path):
+    study = write(prepare_workflow(DRUM, SCENE), tmp_path / "study", tmp_path / "meshes")
+    assert run_study(study, study.cases, ReplayExecutor())
+    stop = threading.Event()
+    stop.set()
+    assert LocalExecutor().analyse(study, 2, stop) is None
+    assert not (study.analysis_dir / layout.ANALYSIS_RECORD).exists()

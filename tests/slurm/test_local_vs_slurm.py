@@ -18,6 +18,7 @@ from pathlib import Path
 
 import pytest
 
+from ligwf.local import LocalExecutor
 from ligwf.pipeline.post import POSTPROCESS_COMMANDS, postprocess
 from ligwf.slurm.jobs import read_record
 from ligwf.study.study import Study
@@ -123,7 +124,7 @@ def test_local_and_slurm_give_identical_analysis(slurm_cluster, tmp_path, env):
     # the Slurm job's post-processing is the local one: rerun locally on a copy, same bytes
     again = tmp_path / "again"
     shutil.copytree(slurm, again, ignore=shutil.ignore_patterns("analysis", "report"))
-    postprocess(again, snapshots=False)
+    postprocess(again, LocalExecutor(), snapshots=False)
     for name in TABLES:
         assert (again / "analysis" / name).read_bytes() == (slurm / "analysis" / name).read_bytes()
     assert _record(again) == rec_slurm

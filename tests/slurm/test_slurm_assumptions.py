@@ -12,6 +12,7 @@ import pytest
 
 from ligwf.engine.site import EngineConfig
 from ligwf.slurm.assumptions import launch_line, site_assumptions
+from ligwf.scheduler import JobRound
 from ligwf.slurm.jobs import plan_jobs
 from ligwf.slurm.site import SlurmSite
 
@@ -37,8 +38,8 @@ def test_launch_line_is_the_engines(launcher, tmp_path, monkeypatch):
 def test_block_names_launcher_cores_partition_and_account(tmp_path):
     site = SlurmSite(ligwf="/v/ligwf", partition="compute", time="02:00:00", cores_per_node=64,
                      launcher="srun --mpi=pmix")
-    jobs = plan_jobs(tmp_path, "s", site, [0, 1, 2], ["analyse"], 1,
-                     ranks={0: 119, 1: 8, 2: 8}, plan_cores=None)
+    jobs = plan_jobs(tmp_path, "s", site, JobRound(
+        (0, 1, 2), ranks={0: 119, 1: 8, 2: 8}, post_steps=("analyse",)))
     lines = site_assumptions(site, jobs, "mpirun")
     text = "\n".join(lines)
     assert lines[0].startswith("site assumptions") and len(lines) == 5
@@ -52,7 +53,7 @@ def test_block_names_launcher_cores_partition_and_account(tmp_path):
 
 def test_block_without_site_launcher_cores_or_partition(tmp_path):
     site = SlurmSite(ligwf="/v/ligwf", ntasks=4)
-    jobs = plan_jobs(tmp_path, "s", site, [0], [], 1)
+    jobs = plan_jobs(tmp_path, "s", site, JobRound((0,)))
     text = "\n".join(site_assumptions(site, jobs, "mpirun --bind-to core"))
     assert "mpirun --bind-to core (the engine settings; no slurm launcher set" in text
     assert "'mpirun --bind-to core -np RANKS liggghts" in text and "plm: slurm" in text

@@ -13,6 +13,7 @@ from ligwf.engine.plan import CaseLoad, fixed_ranks, plan_ranks
 from ligwf.errors import ConfigError
 from ligwf.slurm.budget import (hours_minutes, nodes_for, over_time_warning, plan_rows,
                                 slab_note, slurm_time_seconds)
+from ligwf.scheduler import JobRound
 from ligwf.slurm.jobs import plan_jobs
 from ligwf.slurm.script import ScriptContext, array_script
 from ligwf.slurm.site import SlurmSite, load_slurm_site
@@ -111,16 +112,16 @@ def test_over_time_compares_one_case_with_its_task_limit():
 
 def test_planned_arrays_ask_for_nodes_when_cores_per_node_are_known(tmp_path):
     site = SlurmSite(ligwf="/venv/bin/ligwf", cores_per_node=8)
-    jobs = plan_jobs(tmp_path, "s", site, [0, 1, 2], [], 1, ranks={0: 15, 1: 7, 2: 1})
+    jobs = plan_jobs(tmp_path, "s", site, JobRound((0, 1, 2), ranks={0: 15, 1: 7, 2: 1}))
     assert [(j.site.ntasks, j.nodes) for j in jobs] == [(15, 2), (7, 1), (1, 1)]
     assert "#SBATCH --ntasks=15\n#SBATCH --nodes=2\n" in jobs[0].script_text
     # unknown cores per node: tasks only, as before
-    plain = plan_jobs(tmp_path, "s", SlurmSite(ligwf="/venv/bin/ligwf"), [0], [], 1,
-                      ranks={0: 15})
+    plain = plan_jobs(tmp_path, "s", SlurmSite(ligwf="/venv/bin/ligwf"),
+                      JobRound((0,), ranks={0: 15}))
     assert plain[0].nodes is None and "--nodes" not in plain[0].script_text
     # --ntasks / site ntasks: every case on that many ranks, no --nodes (as before)
     fixed = plan_jobs(tmp_path, "s", SlurmSite(ligwf="x", ntasks=32, cores_per_node=8),
-                      [0, 1], [], 1)
+                      JobRound((0, 1)))
     assert fixed[0].nodes is None and "--nodes" not in fixed[0].script_text
 
 

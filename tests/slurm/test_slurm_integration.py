@@ -196,7 +196,8 @@ def test_the_pipeline_runs_cases_on_slurm_through_the_executor_interface(slurm_c
     """`run_study` with the Slurm scheduler as its executor (issue 33 item 1): the cases go
     out as a job array with the allocation rank plan's ranks, the call waits for them and
     returns done; a second call runs nothing again (every case done: an empty array is
-    not submitted)."""
+    not submitted); the analysis goes out as an array of shares and a merge job and
+    writes what the local executor writes."""
     from ligwf.pipeline.prepare import prepare_workflow, write
     from ligwf.pipeline.run import run_study
     from ligwf.slurm.scheduler import SlurmScheduler
@@ -215,3 +216,15 @@ def test_the_pipeline_runs_cases_on_slurm_through_the_executor_interface(slurm_c
     assert array["kind"] == "array" and sorted(array["indices"]) == [0, 1], array
     assert run_study(study, [c for c in study.cases if c.manifest().status != "done"], slurm)
     assert len(read_record(study.path)) == 1
+
+    # the analysis through the same interface: an array of 2 shares and the merge job,
+    # waited for; the tables are the bytes this machine's executor writes
+    from ligwf.local import LocalExecutor
+
+    record = slurm.analyse(study, 2)
+    assert record is not None and len(record["cases"]) == 2, _logs(study.path)
+    assert [j["kind"] for j in read_record(study.path)][1:] == ["analysis-array",
+                                                                "analysis-merge"]
+    tables = {p.name: p.read_bytes() for p in study.analysis_dir.glob("*.csv")}
+    assert LocalExecutor().analyse(study) is not None
+    assert {p.name: p.read_bytes() for p in study.analysis_dir.glob("*.csv")} == tables

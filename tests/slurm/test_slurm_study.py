@@ -12,6 +12,7 @@ import pytest
 
 from ligwf.errors import ConfigError
 from ligwf.scheduler import cases_to_resubmit
+from ligwf.scheduler import JobRound
 from ligwf.slurm.jobs import (CaseStatus, append_record, dry_run_text, job_name, next_round,
                               plan_jobs, read_record, recorded_plan, recorded_site, submit_jobs)
 from ligwf.slurm.site import SlurmSite
@@ -40,7 +41,8 @@ def test_resubmit_picks_missing_failed_killed_and_stale_only():
 
 def test_plan_has_array_of_exact_indices_and_dependent_analysis(tmp_path):
     site = SlurmSite(ligwf="/venv/bin/ligwf", max_concurrent=3)
-    jobs = plan_jobs(tmp_path, "my study", site, [4, 1, 9], ["analyse", "report"], 2)
+    jobs = plan_jobs(tmp_path, "my study", site,
+                     JobRound((4, 1, 9), 2, post_steps=("analyse", "report")))
     array, analysis = jobs
     assert array.indices == (1, 4, 9) and not array.after_array
     assert array.script_path == tmp_path.resolve() / "slurm" / "array-2.sh"
@@ -52,13 +54,14 @@ def test_plan_has_array_of_exact_indices_and_dependent_analysis(tmp_path):
     text = dry_run_text(jobs)
     assert "--dependency=afterany:<array job id>" in text
     assert f"sbatch --parsable {array.script_path}" in text
-    assert plan_jobs(tmp_path, "s", site, [0], [], 1)[-1].kind == "array"
+    assert plan_jobs(tmp_path, "s", site, JobRound((0,)))[-1].kind == "array"
 
 
 def test_a_split_analysis_is_an_array_after_the_cases_then_a_merge_that_reports(tmp_path):
     site = SlurmSite(ligwf="/venv/bin/ligwf")
-    jobs = plan_jobs(tmp_path, "s", site, [0, 1], ["analyse", "report"], 1, ranks={0: 2, 1: 1},
-                     analysis_tasks=3, token="abc123")
+    jobs = plan_jobs(tmp_path, "s", site, JobRound(
+        (0, 1), ranks={0: 2, 1: 1}, post_steps=("analyse", "report"), analysis_tasks=3,
+        token="abc123"))
     assert [j.kind for j in jobs] == ["array", "array", "analysis-array", "analysis-merge"]
     tasks, merge = jobs[2:]
     assert tasks.after_array and merge.after_array and tasks.indices == (0, 1, 2)
@@ -73,10 +76,10 @@ def test_a_split_analysis_is_an_array_after_the_cases_then_a_merge_that_reports(
     assert "--dependency" not in runs[0] + runs[1]
     assert "--dependency=afterany:<array job id 1>:<array job id 2> " in runs[2]
     assert "--dependency=afterany:<array job id 1>:<array job id 2>:<array job id 3> " in runs[3]
-    one = plan_jobs(tmp_path, "s", site, [0], ["analyse", "report"], 1, analysis_tasks=1)
+    one = plan_jobs(tmp_path, "s", site, JobRound((0,), post_steps=("analyse", "report")))
     assert [j.kind for j in one] == ["array", "analysis"]
     with pytest.raises(ConfigError, match="token"):
-        plan_jobs(tmp_path, "s", site, [0], ["analyse"], 1, analysis_tasks=2)
+        plan_jobs(tmp_path, "s", site, JobRound((0,), post_steps=("analyse",), analysis_tasks=2))
 
 
 def test_record_round_and_recorded_site(tmp_path):
@@ -144,8 +147,8 @@ def test_cli_status_of_a_folder_that_is_not_a_study(tmp_path):
 
 def test_planned_ranks_give_one_array_per_rank_count_and_the_analysis_waits_for_all(tmp_path):
     site = SlurmSite(ligwf="/venv/bin/ligwf", ntasks=1)
-    jobs = plan_jobs(tmp_path, "s", site, [0, 1, 2, 3], ["analyse"], 1,
-                     ranks={0: 1, 1: 4, 2: 1, 3: 4}, plan_cores=8)
+    jobs = plan_jobs(tmp_path, "s", site, JobRound(
+        (0, 1, 2, 3), ranks={0: 1, 1: 4, 2: 1, 3: 4}, post_steps=("analyse",), plan_cores=8))
     arrays = [j for j in jobs if j.kind == "array"]
     assert [j.script_path.name for j in arrays] == ["array-1-np4.sh", "array-1-np1.sh"]
     assert [j.indices for j in arrays] == [(1, 3), (0, 2)]
@@ -157,16 +160,17 @@ def test_planned_ranks_give_one_array_per_rank_count_and_the_analysis_waits_for_
     assert ("--dependency=afterany:<array job id 1>:<array job id 2>"
             in dry_run_text(jobs))
     # one rank count: the usual single array-R.sh
-    one = plan_jobs(tmp_path, "s", site, [0, 1], [], 1, ranks={0: 2, 1: 2})
+    one = plan_jobs(tmp_path, "s", site, JobRound((0, 1), ranks={0: 2, 1: 2}))
     assert [j.script_path.name for j in one] == ["array-1.sh"]
     assert "#SBATCH --ntasks=2\n" in one[0].script_text
     with pytest.raises(ConfigError, match=r"no ranks for case index\(es\) \[1\]"):
-        plan_jobs(tmp_path, "s", site, [0, 1], [], 1, ranks={0: 2})
+        plan_jobs(tmp_path, "s", site, JobRound((0, 1), ranks={0: 2}))
 
 
 def test_submit_records_every_array_and_makes_the_analysis_wait_for_all(tmp_path):
     site = SlurmSite(ligwf="/venv/bin/ligwf")
-    jobs = plan_jobs(tmp_path, "s", site, [0, 1], ["analyse"], 1, ranks={0: 2, 1: 1})
+    jobs = plan_jobs(tmp_path, "s", site, JobRound((0, 1), ranks={0: 2, 1: 1},
+                                                post_steps=("analyse",)))
     ids = iter(["101", "102", "103"])
     commands = []
 
@@ -185,7 +189,7 @@ def test_submit_records_every_array_and_makes_the_analysis_wait_for_all(tmp_path
 
 def test_an_unplanned_submission_records_no_plan(tmp_path):
     site = SlurmSite(ligwf="/venv/bin/ligwf", ntasks=3)
-    jobs = plan_jobs(tmp_path, "s", site, [0], [], 1)
+    jobs = plan_jobs(tmp_path, "s", site, JobRound((0,)))
     ok = lambda argv: subprocess.CompletedProcess(argv, 0, stdout="7\n", stderr="")  # noqa: E731
     (entry,) = submit_jobs(tmp_path, jobs, site, run=ok)
     assert "planned" not in entry and entry["site"]["ntasks"] == 3
