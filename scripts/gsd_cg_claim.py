@@ -50,6 +50,7 @@ import pandas as pd
 
 from ligwf.analysis.gsd import bins as gsd
 from ligwf.analysis.gsd.pooling import frame_histograms, pooling_summary, pooling_table
+from ligwf.analysis.records.renamed import current_names
 from ligwf.fsio import atomic_write_bytes, atomic_write_text
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
@@ -58,7 +59,7 @@ GROUP = "gsd_cg"
 CONFIDENCE = 0.95
 FINE_PER_DECADE = 20          # bins of the bin-free distances (CDF resolution: 0.05 decade)
 QUANTILES = (0.1, 0.5, 0.9)
-FLOW_METRICS = {"angle_of_repose_mean": "angle of repose (deg)",
+FLOW_METRICS = {"angle_of_repose": "angle of repose (deg)",
                 "rigid_frame_share": "rigid-block share",
                 "flowing_layer_thickness_mean": "flowing layer (m)"}
 
@@ -80,7 +81,7 @@ def _load(study: Path, label: str | None) -> tuple[pd.DataFrame, list[CaseRecord
     ana = study / layout.ANALYSIS_DIR
     record = json.loads((ana / layout.ANALYSIS_RECORD).read_text())
     g = pd.read_parquet(ana / layout.GRANULES_TABLE)
-    flow = pd.read_csv(ana / layout.FLOW_TABLE)
+    flow = current_names(pd.read_csv(ana / layout.FLOW_TABLE), layout.FLOW_TABLE)
     steady = {c["case_id"]: c["steady_from_step"] for c in record["cases"]}
     g = g[g["step"] >= g["case_id"].map(steady).astype(float)].copy()
     cases = []
@@ -320,7 +321,8 @@ def main(argv=None) -> int:
         print(f"# {volume}: done", file=sys.stderr)
     limits_df, dist_df = pd.concat(limits), pd.concat(dists)
     flow_df = flow_table(flow, cases)
-    controls = pd.read_csv(args.runs / "main" / layout.ANALYSIS_DIR / layout.CONTROLS_TABLE)
+    controls = current_names(pd.read_csv(args.runs / "main" / layout.ANALYSIS_DIR
+                                         / layout.CONTROLS_TABLE), layout.CONTROLS_TABLE)
     for name, df in (("claim_limits.csv", limits_df), ("claim_distances.csv", dist_df),
                      ("claim_flow.csv", flow_df), ("claim_controls.csv", controls)):
         atomic_write_text(args.out / name, df.to_csv(index=False, float_format="%.6g"))
@@ -331,7 +333,7 @@ def main(argv=None) -> int:
     fmt = lambda x: f"{x:.3g}"   # noqa: E731
     print(controls[["case_id", "definition", "passes", "share_10", "twin_share_10",
                     "persist_quarter", "twin_persist_quarter", "comove_ratio",
-                    "percolating"]].to_string(index=False, float_format=fmt))
+                    "percolating_frames"]].to_string(index=False, float_format=fmt))
     print(limits_df[["volume", "condition", "rule", "k", "pools", "upper_limit_mean",
                      "upper_limit_nan_pools", "error_below_upper_mean", "error_above_upper_mean",
                      "lower_limit_mean", "error_above_lower_mean"]].to_string(index=False,

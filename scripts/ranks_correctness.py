@@ -99,7 +99,9 @@ def measure(case_dir: Path) -> dict:
     row = {"case": case.case_id, "status": man.status, "nprocs": man.nprocs,
            "atoms_after_settle": man.atoms_after_settle, "atoms_end": man.atoms_end,
            "wall_s": man.wall_seconds, "expected": case.scaled.particle_count}
-    row.update({m: float(flow.summary[f"{m}_mean"]) for m in FLOW})   # steady-window means
+    # steady-window means (the flow summary names the angle's mean angle_of_repose)
+    row.update({m: float(flow.summary[m if m == "angle_of_repose" else f"{m}_mean"])
+                for m in FLOW})
     row.update(bond_means(case, flow.steady_from_step))
     log = (case_dir / "log.liggghts").read_text(errors="replace")
     row["spread"] = last_run_spread(log)

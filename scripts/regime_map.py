@@ -30,7 +30,8 @@ def main(run_root: Path, out: Path) -> int:
             t0 = time.perf_counter()
             cached = point / "controls_rows.csv"       # beside the run: measured once
             if cached.is_file():
-                r = pd.read_csv(cached)
+                # a cache measured before percolating was renamed percolating_frames
+                r = pd.read_csv(cached).rename(columns={"percolating": "percolating_frames"})
             else:
                 r = control_rows(load_series(case_dir))
                 r.insert(0, "point", point.name)
@@ -81,7 +82,7 @@ def pair_verdicts(summary: pd.DataFrame) -> pd.DataFrame:
                      "comove_ratio": w["comove_ratio"], "ari": min(
                          v for v in (w.get("ari_seed", 1.0), w.get("ari_order", 1.0))
                          if pd.notna(v)),
-                     "percolating": w["percolating"],
+                     "percolating_frames": w["percolating_frames"],
                      **{c.name: c.passed for c in checks},
                      "passes": all(c.passed for c in checks)})
     return pd.DataFrame(rows)
@@ -99,14 +100,14 @@ def markdown(v: pd.DataFrame) -> str:
     crit = ["granules exist", "beats the twin", "survives", "moves together", "reproducible",
             "no bed-spanning granule"]
     head = ("| point | definition | St_v | Bo_g | share_10 wet / twin | persistence T/4 wet / twin"
-            " | co-movement | ARI | percolating | " + " | ".join(crit) + " | passes |")
+            " | co-movement | ARI | percolating frames | " + " | ".join(crit) + " | passes |")
     lines = [head, "|" + "---|" * (9 + len(crit) + 1)]
     f = lambda x: "–" if pd.isna(x) else f"{x:.3g}"
     for _, r in v.iterrows():
         lines.append(f"| {r['point']} | {r['definition']} | {f(r['St_v'])} | {f(r['Bo_g'])} | "
                      f"{f(r['share_10'])} / {f(r['twin_share_10'])} | "
                      f"{f(r['persist_quarter'])} / {f(r['twin_persist_quarter'])} | "
-                     f"{f(r['comove_ratio'])} | {f(r['ari'])} | {f(r['percolating'])} | "
+                     f"{f(r['comove_ratio'])} | {f(r['ari'])} | {f(r['percolating_frames'])} | "
                      + " | ".join(_mark(r.get(c)) for c in crit)
                      + f" | {'**yes**' if r['passes'] else 'no'} |")
     return "\n".join(lines) + "\n"

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
+from ligwf.analysis.records.renamed import current_names
 from ligwf.errors import LigwfError
 from ligwf.study import layout
 
@@ -123,11 +124,13 @@ def _is_flags(s: pd.Series) -> bool:
 
 def read_table(path: Path) -> pd.DataFrame:
     """A study table (``.csv`` or ``.parquet``) with the API's dtypes; an empty file is an
-    empty table."""
+    empty table. An analysis table written by the previous release has its renamed
+    columns under their current names (:func:`~ligwf.analysis.records.renamed.current_names`,
+    with a FutureWarning)."""
     if path.suffix == ".parquet":
-        return typed(pd.read_parquet(path))
+        return typed(current_names(pd.read_parquet(path), path.name, str(path)))
     try:
-        return typed(pd.read_csv(path))
+        return typed(current_names(pd.read_csv(path), path.name, str(path)))
     except pd.errors.EmptyDataError:
         return pd.DataFrame()
 

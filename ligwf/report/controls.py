@@ -13,12 +13,13 @@ from pathlib import Path
 
 import pandas as pd
 
+from ligwf.analysis.records.renamed import current_names
 from ligwf.study import layout
 
 #: (column, header) of the control table; each is shown as "wet / twin"
 COLUMNS = (("share_10", "bed in granules >= 10"), ("count_10", "granules >= 10"),
            ("d50_mm", "d50 [mm]"), ("persist_quarter", "persistence T/4"),
-           ("comove_ratio", "co-movement"), ("percolating", "percolating frames"))
+           ("comove_ratio", "co-movement"), ("percolating_frames", "percolating frames"))
 
 NO_CONTROL = ("This study ran no cohesionless control (`sweep.controls: [cohesionless]`), so "
               "its granules were never shown to differ from those of a bed without cohesion. "
@@ -29,11 +30,13 @@ NO_CONTROL = ("This study ran no cohesionless control (`sweep.controls: [cohesio
 
 
 def read_controls(analysis_dir: Path) -> pd.DataFrame | None:
-    """The controls table, or None when the study has no twins (or no analysis)."""
+    """The controls table, or None when the study has no twins (or no analysis); one
+    written by the previous release is read with its current column names
+    (:func:`~ligwf.analysis.records.renamed.current_names`)."""
     path = Path(analysis_dir) / layout.CONTROLS_TABLE
     if not path.is_file() or path.stat().st_size == 0:
         return None
-    table = pd.read_csv(path)
+    table = current_names(pd.read_csv(path), layout.CONTROLS_TABLE, str(path))
     return table if len(table) else None
 
 

@@ -126,8 +126,8 @@ class Table:
 TABLES: dict[str, Table] = {
     layout.FLOW_TABLE: Table(layout.ANALYSIS_DIR, "measured case", (
         "case_id", "cg", "rule", "replica", "group", "steady_fraction", "steady_from_step",
-        "frames", "angle_of_repose", "angle_of_repose_mean", "angle_of_repose_std", "com_angle_mean",
-        "com_angle_std", "rigid_frame_share", "rigid_fraction_mean", "rms_speed_mean",
+        "frames", "angle_of_repose", "angle_of_repose_std", "com_angle_mean", "com_angle_std",
+        "rigid_frame_share", "rigid_fraction_mean", "rms_speed_mean",
         "rms_speed_rel_fluctuation", "kinetic_energy_mean", "flowing_layer_thickness_mean",
         "flowing_layer_speed_mean")),
     layout.FRAMES_TABLE: Table(layout.ANALYSIS_DIR, "frame of a case", (
@@ -171,7 +171,7 @@ TABLES: dict[str, Table] = {
                                  "and its cohesionless twin (twin_*: the twin's value)", (
         "case_id", "twin_id", "definition", "passes", "verdict", "share_2", "share_10",
         "count_10", "d50_mm", "largest_share", "persist_short", "persist_quarter",
-        "comove_ratio", "ari_seed", "ari_order", "percolating"), ("twin_",)),
+        "comove_ratio", "ari_seed", "ari_order", "percolating_frames"), ("twin_",)),
     layout.CASES_REPORT: Table(layout.REPORT_DIR, "usable case", (
         "case_id", "group", "group_label", "cg", "rule", "replica", "original_particles",
         *RUN, "simulated_seconds", "production_seconds", "production_wall_rate", "nprocs",

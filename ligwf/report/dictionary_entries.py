@@ -69,10 +69,10 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("steady_fraction", "1", "steady from", "share of production left out as start-up before "
      "the steady window"),
     ("steady_from_step", "step", "steady from step", "first step of the steady window"),
-    ("angle_of_repose", "deg", "angle", "dynamic angle of repose of the free surface, mean over "
-     "the steady window"),
-    ("angle_of_repose_mean", "deg", "angle", "dynamic angle of repose, mean over the steady "
-     "window"),
+    ("angle_of_repose", "deg", "angle", "dynamic angle of repose of the free surface (signed: "
+     "positive rising towards the wall that moves up): of a case, the mean of its steady "
+     "frames' angles (frames where a surface was fitted); of a condition, the mean over its "
+     "replicas"),
     ("angle_of_repose_std", "deg", "angle std", "standard deviation of the angle of repose over "
      "the steady frames"),
     ("angle_error", "1", "angle err", "relative error of the angle of repose against the "
@@ -113,9 +113,10 @@ COMMON: tuple[tuple[str, ...], ...] = (
      "granules"),
     ("percolating_share", "1", "bed percolating", "share of the bed in percolating "
      "(bed-spanning) granules, left out of the GSD"),
-    ("percolating_frames", "1", "percolating frames", "share of frames holding a percolating "
-     "granule"),
-    ("percolating", "flag", "percolating", "the granule closes a cycle around the periodic axis"),
+    ("percolating_frames", "1", "percolating frames", "share of the steady frames holding a "
+     "percolating granule (controls: under the row's definition)"),
+    ("percolating", "flag", "percolating", "the granule closes a cycle around the periodic axis "
+     "(a flag of one granule; shares are percolating_share and percolating_frames)"),
     ("d10", "m", "d10", "10 % of the granule volume is in granules up to this equivalent-sphere "
      "diameter (volume-weighted GSD)", "mm"),
     ("d50", "m", "d50", "median equivalent-sphere diameter of the volume-weighted GSD", "mm"),

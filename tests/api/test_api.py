@@ -31,10 +31,6 @@ from ligwf.errors import ConfigError, LigwfError
 from ligwf.study import layout
 
 TINY = ROOT / "tests" / "workflows" / "tiny_study.yaml"
-#: column names with two meanings across tables (one name, two meanings: to be renamed by
-#: the analysis owner); their dtypes differ for that reason
-TWO_MEANINGS = {"percolating": "granules: the granule spans the periodic slice (flag); "
-                               "controls: the share of frames with a percolating cluster"}
 
 
 @pytest.fixture(scope="module")
@@ -92,7 +88,7 @@ def test_dtypes_are_typed_and_one_per_column_name(reported):
             else:   # a text column the API does not name is still text, never object
                 assert (pd.api.types.is_numeric_dtype(dtype) or dtype in ("boolean", "string")), \
                     f"{name}.{col}: {dtype}"
-            if col in seen and name != "profiles" and col not in TWO_MEANINGS:
+            if col in seen and name != "profiles":
                 kind = lambda d: "float" if str(d).startswith(("float", "int")) else str(d)
                 assert kind(dtype) == kind(seen[col]), f"{col}: {dtype} here, {seen[col]} before"
             seen.setdefault(col, dtype)

@@ -50,10 +50,10 @@ def test_speedup_and_errors_against_cg1(study):
     assert np.allclose(cases["production_core_rate_k"],
                        rate / cases["original_particles"] * 1000)
     rate = rate / cases["original_particles"]        # speedups on the original system
-    ang1 = flow.loc["cg1-none-r0", "angle_of_repose_mean"]
+    ang1 = flow.loc["cg1-none-r0", "angle_of_repose"]
     for cid, row in cases.iterrows():
         assert row["speedup_core"] == pytest.approx(rate["cg1-none-r0"] / rate[cid])
-        assert row["angle_of_repose"] == pytest.approx(flow.loc[cid, "angle_of_repose_mean"])
+        assert row["angle_of_repose"] == pytest.approx(flow.loc[cid, "angle_of_repose"])
         assert row["angle_error"] == pytest.approx(abs(row["angle_of_repose"] - ang1) / ang1)
         fr = frames[(frames["case_id"] == cid) & (frames["status"] == "ok")
                     & (frames["step"] >= flow.loc[cid, "steady_from_step"])]

@@ -170,10 +170,14 @@ def _flowing_layer(centres, prof, xi, down, depth) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class FlowSummary:
-    """Time statistics over the steady frames of one run."""
+    """Time statistics over the steady frames of one run.
+
+    ``angle_of_repose`` is the mean of the frames' angles (those with a fitted surface):
+    the value of the registered flow metric of that name, so the flow table has it once.
+    """
 
     frames: int
-    angle_of_repose_mean: float
+    angle_of_repose: float            # deg, mean over the frames
     angle_of_repose_std: float
     com_angle_mean: float
     com_angle_std: float
@@ -215,7 +219,7 @@ def summarise(flows: list[FrameFlow]) -> FlowSummary:
     rms_mean = float(np.mean(rms))
     return FlowSummary(
         frames=len(flows),
-        angle_of_repose_mean=_nanstat(ang, np.mean), angle_of_repose_std=_nanstat(ang, np.std),
+        angle_of_repose=_nanstat(ang, np.mean), angle_of_repose_std=_nanstat(ang, np.std),
         com_angle_mean=float(np.mean(com)), com_angle_std=float(np.std(com)),
         rigid_frame_share=float(np.mean(rig > RIGID_FRAME_SHARE)),
         rigid_fraction_mean=float(np.mean(rig)),

@@ -4,11 +4,13 @@ For each start frame t of the steady window and each definition, :func:`control_
 gives the granules at t and measures them (:mod:`ligwf.analysis.granules.controls`): share of the
 bed in granules of >= 2 and >= 10 particles, granule count, d50, pair persistence after
 ``short_dt`` and after a quarter revolution, co-movement over a quarter revolution and whether a
-granule percolates. Survival and co-movement start when the definition's window ends: a held
-granule at t is selected by bridges present through [t, t + W], so its pairs are together
-until t + W by construction; its persistence compares it with the granules of the window
-that starts at t + W + T/4, and its co-movement is measured over [t + W, t + W + T/4] (W = 0
-for a definition of one frame); for definitions with an optimiser or an order dependence, the adjusted
+granule percolates (``percolating_frames``: 1 or 0 in a row of one frame, so that the mean
+over the rows is the share of frames holding a percolating granule). Survival and
+co-movement start when the definition's window ends: a held granule at t is selected by
+bridges present through [t, t + W], so its pairs are together until t + W by construction;
+its persistence compares it with the granules of the window that starts at t + W + T/4,
+and its co-movement is measured over [t + W, t + W + T/4] (W = 0 for a definition of one
+frame); for definitions with an optimiser or an order dependence, the adjusted
 Rand index across seeds and across a shuffled contact order. :func:`summarise` averages
 the rows per definition. The same table of a wet bed beside its cohesionless twin says
 whether a definition finds granules or a tiling.
@@ -179,14 +181,13 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
             labels = lab(k)
             if labels is None:
                 continue
-            percolating = bool(np.any(cache[k].percolating))
             row = {"definition": name, "case_id": facts.case_id, "time": series.times[k],
                    "share_2": bed_share(labels, volumes, 2),
                    "share_10": bed_share(labels, volumes, 10),
                    "count_10": granule_count(labels, 10),
                    "d50_mm": 1e3 * volume_d50(labels, volumes, 10),
                    "largest_share": float(np.bincount(labels, weights=volumes).max() / volumes.sum()),
-                   "percolating": float(percolating)}
+                   "percolating_frames": float(np.any(cache[k].percolating))}
             for tag, dk in (("persist_short", d_short), ("persist_quarter", d_quarter)):
                 later = lab(k + span + dk)
                 row[tag] = pair_persistence(labels, later) if later is not None else np.nan

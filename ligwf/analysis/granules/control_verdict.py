@@ -76,7 +76,7 @@ def criteria(wet: dict, twin: dict) -> list[Criterion]:
         out.append(Criterion("reproducible", a >= MIN_ARI,
                              f"adjusted Rand index across seeds and contact orders {a:.3g} "
                              f"(needs >= {MIN_ARI:g})"))
-    f = _num(wet, "percolating")
+    f = _num(wet, "percolating_frames")
     out.append(Criterion("no bed-spanning granule", f <= MAX_PERCOLATING,
                          f"frames with a percolating granule {f:.3g} (needs <= "
                          f"{MAX_PERCOLATING:g})"))

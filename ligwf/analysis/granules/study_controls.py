@@ -79,7 +79,7 @@ def study_controls(cases: list[CaseFolder], definition: AnalysisSettings,
                    "passes": ok, "verdict": sentence}
             for k in ("share_2", "share_10", "count_10", "d50_mm", "largest_share",
                       "persist_short", "persist_quarter", "comove_ratio", "ari_seed",
-                      "ari_order", "percolating"):
+                      "ari_order", "percolating_frames"):
                 row[k] = w.get(k, float("nan"))
                 row[f"twin_{k}"] = t.get(k, float("nan"))
             rows.append(row)

@@ -20,6 +20,8 @@ from pathlib import Path
 
 from ligwf.analysis.records.fields import CaseFields
 from ligwf.analysis.records.metrics import MetricSpec
+from ligwf.analysis.records.renamed import RENAMED
+from ligwf.study import layout
 
 
 def _nums(values) -> list:
@@ -96,7 +98,8 @@ class CaseFlow:
                       "read_steps": tuple(int(s) for s in d.get("read_steps", ())),
                       "values": {k: nan if v is None else float(v)
                                  for k, v in d.get("values", {}).items()},
-                      "summary": {k: nan if v is None else v
+                      # a record of the previous release: its summary keys as now
+                      "summary": {RENAMED[layout.FLOW_TABLE].get(k, k): nan if v is None else v
                                   for k, v in d.get("summary", {}).items()}})
 
 

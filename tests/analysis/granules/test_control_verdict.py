@@ -3,7 +3,7 @@
 from ligwf.analysis.granules.control_verdict import criteria, verdict
 
 GOOD = {"share_10": 0.10, "persist_quarter": 0.8, "comove_ratio": 0.2, "ari_order": 1.0,
-        "percolating": 0.0}
+        "percolating_frames": 0.0}
 TWIN = {"share_10": 0.01, "persist_quarter": 0.1}
 
 
@@ -19,7 +19,7 @@ def test_each_criterion_fails_on_its_own():
         "survives": {**GOOD, "persist_quarter": 0.45},
         "moves together": {**GOOD, "comove_ratio": 0.8},
         "reproducible": {**GOOD, "ari_seed": 0.5},
-        "no bed-spanning granule": {**GOOD, "percolating": 0.5},
+        "no bed-spanning granule": {**GOOD, "percolating_frames": 0.5},
     }
     for name, wet in cases.items():
         failed = [c.name for c in criteria(wet, TWIN) if not c.passed]
