@@ -283,8 +283,8 @@ def until_decided(prepared: Prepared, out: Path, executor: LocalExecutor, plan: 
                   mesh_cache: Path | None = None, snapshots: bool = True) -> Rounds:
     """Run, analyse and judge the study in rounds until it decides (module docstring), its
     cases and analysis on ``executor``; ``run_round`` runs a scheduled round (the CLI's
-    progress display), ``show`` prints a look. Returns the rounds record; stops early (no look recorded) when a case did not
-    finish (the same command resumes it)."""
+    progress display), ``show`` prints a look. Returns the rounds record; stops early (no
+    look recorded) when a case did not finish (the same command resumes it)."""
     rounds = start_rounds(out, plan)
     while not rounds.stopped:
         _, identity = site_engine()             # refused before anything is written

@@ -10,15 +10,15 @@ import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import ClassVar, Iterable, Mapping, Sequence
+from typing import Callable, ClassVar, Sequence
 
 from ligwf.engine.plan import allocation_schedule, case_load
 from ligwf.errors import SubmitError
 from ligwf.local import all_done
 from ligwf.scheduler import JobRound
 from ligwf.slurm.jobs import (PlannedJob, Runner, StudyStatus, dry_run_text, next_round,
-                              plan_analysis_array, plan_jobs, read_record, recorded_plan, require_scheduler,
-                              run_command, study_status, submit_jobs)
+                              plan_analysis_array, plan_jobs, read_record, recorded_plan,
+                              require_scheduler, run_command, study_status, submit_jobs)
 from ligwf.slurm.parse import FINISHED_STATES
 from ligwf.slurm.script import scancel_command
 from ligwf.slurm.site import SlurmSite
@@ -69,16 +69,22 @@ class SlurmScheduler:
         jobs = self.plan_jobs(study.path, study.name, JobRound(
             tuple(indices), self.next_round(study.path), ranks))
         self.submit(study.path, jobs)
+        self._wait(study.path, stop,
+                   lambda st: any(c.queued for c in st.cases if c.index in indices))
+        return all_done(cases)
+
+    def _wait(self, study_dir: Path, stop: threading.Event,
+              pending: Callable[[StudyStatus], bool]) -> bool:
+        """Look at the queue every ``poll_seconds`` while ``pending(status)``; ``stop`` set:
+        cancel the study's jobs once and go on waiting until Slurm has ended them.
+        Whether it cancelled."""
         cancelled = False
-        while True:
-            st = self.status(study.path)
-            if not any(c.queued for c in st.cases if c.index in indices):
-                break
+        while pending(self.status(study_dir)):
             if stop.is_set() and not cancelled:
-                self.cancel(study.path)
+                self.cancel(study_dir)
                 cancelled = True
             time.sleep(self.poll_seconds)
-        return all_done(cases)
+        return cancelled
 
     def analyse(self, study, tasks: int = 1,
                 stop: threading.Event | None = None) -> dict | None:
@@ -95,20 +101,19 @@ class SlurmScheduler:
         self.require()
         jobs = self.plan_analysis(study.path, study.name, max(1, tasks), new_token())
         merge = str(self.submit(study.path, jobs)[-1]["job_id"])
-        cancelled, unseen = False, 0
-        while True:
-            entry = next(j for j in self.status(study.path).jobs
-                         if str(j["job_id"]) == merge)
-            state = entry.get("state")
-            unseen = unseen + 1 if state is None else 0
-            if (state is not None and not entry["active"]) or unseen > self.forget_polls:
-                break
-            if stop.is_set() and not cancelled:
-                self.cancel(study.path)
-                cancelled = True
-            time.sleep(self.poll_seconds)
-        if cancelled:
+        looks: list[str | None] = []         # the merge job's state at each look
+
+        def pending(st: StudyStatus) -> bool:
+            entry = next(j for j in st.jobs if str(j["job_id"]) == merge)
+            looks.append(entry.get("state"))
+            if looks[-1] is not None:
+                return bool(entry["active"])
+            # unknown to Slurm: waited for until it has been so forget_polls + 1 looks in a row
+            return looks[-self.forget_polls - 1:] != [None] * (self.forget_polls + 1)
+
+        if self._wait(study.path, stop, pending):
             return None
+        state = looks[-1]
         if state is None or state.split()[0] != "COMPLETED":
             raise SubmitError(f"the analysis merge job {merge} ended "
                               f"{state or 'unknown to Slurm'}: its log in "
