@@ -55,7 +55,7 @@ from ligwf.analysis.granules.bridge_law import Liquid, relative_energy
 from ligwf.analysis.granules.communities import cpm_labels
 from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
 from ligwf.scene.settings import AnalysisSettings
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 
 R = 0.0005
 #: the synthetic frames' liquid (``--model`` picks the law)
@@ -226,9 +226,9 @@ def main() -> None:
         scaled = ScaledScene.from_dict(json.loads((args.real / "scene.json").read_text())["scaled"])
         f = discover_frames(args.real)[-1]
         p, c = read_particles(f.particles), read_contacts(f.contacts)
-        report(f"real {args.real.name}", p, c, scaled.drum_length, Liquid.from_scaled(scaled),
+        report(f"real {args.real.name}", p, c, scaled.drum.length, Liquid.from_scaled(scaled),
                f.particles.parent, f.step, False)
-        report_communities(f"real {args.real.name}", p, c, scaled.drum_length,
+        report_communities(f"real {args.real.name}", p, c, scaled.drum.length,
                            Liquid.from_scaled(scaled))
 
 

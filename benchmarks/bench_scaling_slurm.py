@@ -97,9 +97,9 @@ def collect(out: Path) -> list[ScalingRow]:
             print(f"{folder}: no finished production run ({exc})", file=sys.stderr)
             continue
         case = CaseFolder.open(cases[0])
-        if spread.steps != case.scaled.run_steps:
+        if spread.steps != case.scaled.numerics.run_steps:
             print(f"{folder}: the last run block has {spread.steps} steps, not the "
-                  f"production's {case.scaled.run_steps} (still running?)", file=sys.stderr)
+                  f"production's {case.scaled.numerics.run_steps} (still running?)", file=sys.stderr)
             continue
         grid = _GRID_RE.findall(text)
         rows.append(ScalingRow(spread.procs, cases[0],

@@ -98,7 +98,7 @@ def measure(case_dir: Path) -> dict:
     flow, _ = case_flow(case, STEADY_AFTER)
     row = {"case": case.case_id, "status": man.status, "nprocs": man.nprocs,
            "atoms_after_settle": man.atoms_after_settle, "atoms_end": man.atoms_end,
-           "wall_s": man.wall_seconds, "expected": case.scaled.particle_count}
+           "wall_s": man.wall_seconds, "expected": case.scaled.particles.count}
     row.update({m: float(flow.summary[f"{m}_mean"]) for m in FLOW})   # steady-window means
     row.update(bond_means(case, flow.steady_from_step))
     log = (case_dir / "log.liggghts").read_text(errors="replace")

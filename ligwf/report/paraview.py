@@ -66,11 +66,11 @@ def case_collection(case: CaseFolder, frames, analysis_dir: Path, out_dir: Path)
     entries = []
     labelled = analysis_dir / case.case_id
     for step, dump in frames:
-        t = step * s.dt
+        t = step * s.numerics.dt
         g = labelled / layout.granule_frame(step)
         particles = g if g.is_file() else case.path / dump
         entries.append((t, 0, os.path.relpath(particles, out_dir)))
-        pts = points @ rotation_matrix(s.axis, case.drum_angle(step)).T
+        pts = points @ rotation_matrix(s.drum.axis, case.drum_angle(step)).T
         drum_file = case_out / layout.drum_frame(step)
         tmp = drum_file.with_suffix(".tmp.vtu")
         meshio.write(tmp, meshio.Mesh(pts, [("triangle", tri)]), binary=True)

@@ -17,6 +17,7 @@ from pydantic import Field, ValidationError, model_validator
 
 from ligwf import liquids
 from ligwf.errors import ConfigError
+from ligwf.scene.axis import Axis
 from ligwf.scene.liquid import Liquid
 from ligwf.scene.messages import format_validation_error
 from ligwf.scene.values import MIN_LENGTH, MIN_RESTITUTION, MIN_TIME, Frozen, SafeStr
@@ -50,7 +51,7 @@ class Drum(Frozen):
     diameter: float = Field(ge=1e-3, le=10.0, description="inner shell diameter, m")
     length: float = Field(ge=MIN_LENGTH, le=10.0,
                           description="axial length, m (the periodic length)")
-    axis: Literal["x", "y", "z"] = Field("y", description="rotation axis")
+    axis: Axis = Field(Axis.Y, description="rotation axis")
     periodic: bool = Field(True, description="periodic boundary along the axis; "
                            "otherwise the drum has end walls")
     lifters: Lifters = Field(default_factory=Lifters)

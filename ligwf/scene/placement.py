@@ -49,7 +49,7 @@ def wet_sphere_centres(radius: float, inner_radius: float, length: float, fill: 
 
 
 def wet_sphere_fields(scene, largest_diameter: float, cg: float) -> dict:
-    """The :class:`~ligwf.scene.scaling.ScaledScene` fields of placed liquid (none for a
+    """The :class:`~ligwf.scene.scaled.ScaledLiquidValues` fields of placed liquid (none for a
     uniformly wetted bed): the wet spheres (axial, across, vertical, radius) and their
     liquid content. A sphere smaller than the largest (CG-scaled) particle diameter is
     refused: it would hold no or a single particle centre, a dry bed in all but name."""

@@ -78,10 +78,10 @@ def test_the_bed_the_preflight_says_will_not_flow_turns_as_a_block(tmp_path):
     shares, angles = {}, {}
     for case in Study.open(out).cases:
         s = case.scaled
-        d_mean = sum(d * f for d, f in zip(s.diameters, s.number_fractions))
-        geo = DrumGeometry(radius=0.5 * s.drum_diameter, axis=s.axis, omega=s.omega,
+        d_mean = sum(d * f for d, f in zip(s.particles.diameters, s.particles.number_fractions))
+        geo = DrumGeometry(radius=0.5 * s.drum.diameter, axis=s.drum.axis, omega=s.drum.omega,
                            d_mean=d_mean)
-        spun_up = case.production_start_step + round(0.3 / s.dt)
+        spun_up = case.production_start_step + round(0.3 / s.numerics.dt)
         flows = [frame_flow(read_particles(case.path / "post" / f"particles_{step}.vtu"), geo)
                  for step in case.expected_dump_steps(s.total_steps) if step >= spun_up]
         assert len(flows) >= 8

@@ -159,7 +159,7 @@ def test_processor_grid_puts_ranks_along_the_axis_first():
 
     wf = load_workflow(DRUM, ["sweep.cg_levels=[1, 3]", "sweep.rules=[weber]"])
     cg1, cg3 = (c.scaled() for c in wf.cases)
-    slabs1 = int(cg1.drum_length / (MIN_AXIAL_SLAB * cg1.d_max))      # 9 mm / 4 mm = 2
+    slabs1 = int(cg1.drum.length / (MIN_AXIAL_SLAB * cg1.d_max))      # 9 mm / 4 mm = 2
     assert slabs1 == 2
     assert processor_grid(cg1, 1) == (1, 1)
     assert processor_grid(cg1, 2) == (1, 2)

@@ -104,7 +104,7 @@ def test_surface_fit_second_pass_too_few_strips_keeps_the_first_line(study):
     fits = []
     for p in sorted((case.path / "post").glob("particles_*.vtu")):
         step = int(p.stem.split("_")[1])
-        frame = read_particles(p, step, case.scaled.dt)
+        frame = read_particles(p, step, case.scaled.numerics.dt)
         u, v, _, _ = cross_section(frame, geo)
         fits.append(fit_surface(u, v, frame.radii, geo.radius, geo.d_mean, rising_side(geo),
                                 span=0.68))

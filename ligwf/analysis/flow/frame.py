@@ -40,7 +40,7 @@ from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.analysis.records.statistics import relative_l2
 from ligwf.analysis.flow.surface import fit_surface
 from ligwf.engine.mesh import axis_frame
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 
 RIGID_FRAME_SHARE = 0.9  # a frame is rigid when more than this share co-rotates
 PROFILE_HALF_WIDTH = 0.15  # profile band half-width / drum radius (CG-independent)
@@ -58,10 +58,10 @@ class DrumGeometry:
 
     @classmethod
     def from_scaled(cls, scaled: ScaledScene) -> "DrumGeometry":
-        d = np.asarray(scaled.diameters, float)
-        f = np.asarray(scaled.number_fractions, float)
-        return cls(radius=0.5 * scaled.drum_diameter, axis=scaled.axis,
-                   omega=scaled.omega, d_mean=float(np.sum(d * f)))
+        d = np.asarray(scaled.particles.diameters, float)
+        f = np.asarray(scaled.particles.number_fractions, float)
+        return cls(radius=0.5 * scaled.drum.diameter, axis=scaled.drum.axis,
+                   omega=scaled.drum.omega, d_mean=float(np.sum(d * f)))
 
 
 @dataclass(frozen=True)

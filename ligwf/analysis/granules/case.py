@@ -63,7 +63,7 @@ class RunFacts:
         """The facts of a ligwf case (the drum axis spans [0, L], see templates/drum.in.j2)."""
         s = case.scaled
         return cls(case.case_id, case.cg, case_liquid(case), periodic_axis(case),
-                   s.drum_length, s.dt, case, plan, float(s.omega), AXES.index(s.axis))
+                   s.drum.length, s.numerics.dt, case, plan, float(s.drum.omega), AXES.index(s.drum.axis))
 
     @property
     def motion(self) -> Motion:
@@ -78,7 +78,7 @@ def case_liquid(case: CaseFolder) -> Liquid:
 
 def periodic_axis(case: CaseFolder) -> int | None:
     """0, 1, 2 for a periodic drum axis x, y, z; None for a closed drum."""
-    return AXES.index(case.scaled.axis) if case.scaled.periodic else None
+    return AXES.index(case.scaled.drum.axis) if case.scaled.drum.periodic else None
 
 
 @dataclass

@@ -86,7 +86,7 @@ def load_series(case_dir: Path) -> Series:
     start = case.production_start_step
     times = (np.asarray(steps) - start) * facts.dt
     s = case.scaled
-    return Series(facts, tuple(frames), times, float(s.omega) * 0.5 * float(s.drum_diameter),
+    return Series(facts, tuple(frames), times, float(s.drum.omega) * 0.5 * float(s.drum.diameter),
                   float(2.0 * np.mean(frames[0].particles.radii)))
 
 
