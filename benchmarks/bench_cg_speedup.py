@@ -119,7 +119,7 @@ def main() -> int:
     check_quiet("the ratios below")
     overrides = ["sweep.cg_levels=[1,2,3]", "sweep.rules=[weber]", "sweep.replicas=1",
                  "sweep.per_cg={}", f"scene.process.settle_time={args.settle_time}",
-                 f"scene.process.run_time={args.run_time}", "scene.analysis.granules=true"]
+                 f"scene.process.run_time={args.run_time}", "scene.analysis.contact_dumps=true"]
     if args.length is not None:
         overrides.append(f"scene.drum.length={args.length}")
     wf = load_workflow(ROOT / "workflows" / "we_vs_bo.yaml", overrides + args.set)

@@ -120,7 +120,7 @@ def selection(cg: int, settle: float, run: float, skin_ratio: float | None) -> l
     """``--set`` values of the one weber case at ``cg`` with ``skin_ratio`` (None: default)."""
     sets = [f"sweep.cg_levels=[{cg}]", "sweep.rules=[weber]", "sweep.replicas=1",
             "sweep.per_cg={}", f"scene.process.settle_time={settle}",
-            f"scene.process.run_time={run}", "scene.analysis.granules=true"]
+            f"scene.process.run_time={run}", "scene.analysis.contact_dumps=true"]
     if skin_ratio is not None:
         sets.append(f"scene.numerics.skin_ratio={skin_ratio}")
     return sets

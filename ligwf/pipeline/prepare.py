@@ -32,6 +32,7 @@ from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.regime import definition_warning, regime_warnings
 from ligwf.scene.stability import Preflight, check_rendered
 from ligwf.scene.window import held_window_warnings
+from ligwf.scene.renamed import renamed_setting_warnings
 from ligwf.scene.unused import unused_setting_warnings
 from ligwf.scene.workflow import Case, Workflow, comparison_warnings, load_workflow
 from ligwf.study.case import content_hash
@@ -123,7 +124,8 @@ def prepare(wf: Workflow, template_dirs: Iterable[str | Path] = (),
     rendered = render_workflow(wf, template_dirs)
     reports, warnings = check_rendered(rendered, allow_unstable)
     return Prepared(wf, rendered, reports,
-                    warnings + regime_warnings(rendered) + comparison_warnings(wf)
+                    renamed_setting_warnings(wf) + warnings + regime_warnings(rendered)
+                    + comparison_warnings(wf)
                     + unused_setting_warnings(wf)
                     + held_window_warnings(wf)
                     + definition_warning(wf.analysis, rendered))

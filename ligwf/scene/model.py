@@ -221,7 +221,26 @@ class Numerics(Frozen):
 class Analysis(Frozen):
     """Which analyses the run must prepare output for."""
 
-    granules: bool = Field(False, description="write contact dumps for granule analysis")
+    contact_dumps: bool = Field(False, description="write contact dumps (the granule "
+                                "analysis reads them; the study's analysis: block says how)")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed_granules(cls, data: Any) -> Any:
+        """``granules`` is this switch's old name (scene records written before the rename
+        hold it; a workflow that uses it gets a warning, ligwf.scene.renamed)."""
+        if isinstance(data, dict) and RENAMED_ANALYSIS_KEY in data:
+            if "contact_dumps" in data:
+                raise ValueError(f"analysis.{RENAMED_ANALYSIS_KEY} and analysis.contact_dumps "
+                                 "are both set: they are one switch (contact_dumps is its "
+                                 "name now); keep contact_dumps")
+            data = {("contact_dumps" if k == RENAMED_ANALYSIS_KEY else k): v
+                    for k, v in data.items()}
+        return data
+
+
+#: the old name of ``analysis.contact_dumps`` (still read, with a warning in workflows)
+RENAMED_ANALYSIS_KEY = "granules"
 
 
 #: most particle (+ contact) dumps and thermo lines one production run may write
@@ -242,10 +261,10 @@ class Scene(Frozen):
     analysis: Analysis = Field(default_factory=Analysis)
 
     @model_validator(mode="after")
-    def _granules_need_liquid(self) -> "Scene":
-        if self.analysis.granules and not self.liquid.wet:
+    def _contact_dumps_need_liquid(self) -> "Scene":
+        if self.analysis.contact_dumps and not self.liquid.wet:
             wet = " or ".join(n for n in liquids.names() if liquids.get(n).wet)
-            raise ValueError("analysis.granules = true: needs a liquid model (granules are "
+            raise ValueError("analysis.contact_dumps = true: needs a liquid model (granules are "
                              f"held by liquid bridges); set liquid.model to {wet}")
         return self
 

@@ -247,5 +247,5 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
             radius=r_ins, waves=waves,
             wave_steps=max(thermo_every, _steps(fall_time, dt) // thermo_every * thermo_every),
             seeds=replica_seeds(num.seed, replica, count=len(diameters) + 1 + len(waves))),
-        contact_dumps=scene.analysis.granules,
+        contact_dumps=scene.analysis.contact_dumps,
     )

@@ -186,8 +186,8 @@ def granules_absent(scaled: ScaledScene) -> str | None:
         return (f"dry scene (liquid.model: {scaled.liquid_values.model}): no liquid bridges hold "
                 "particles together, so there are no granules to analyse")
     if not scaled.contact_dumps:
-        return ("scene.analysis.granules: false: the runs write no contact dumps (set it to "
-                "true to analyse granules and their size distribution)")
+        return ("scene.analysis.contact_dumps: false: the runs write no contact dumps (set it "
+                "to true to analyse granules and their size distribution)")
     return None
 
 

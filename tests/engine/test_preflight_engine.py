@@ -45,7 +45,7 @@ def test_a_bed_held_by_its_bridges_is_warned_that_it_will_not_flow():
     plain = findings(["sweep.rules=[weber]"])
     assert plain["bed_flow"].verdict == OK and plain["bed_flow"].value < 0.3
     dry = findings(["sweep.rules=[none]", "scene.liquid.model=none",
-                    "scene.analysis.granules=false"])
+                    "scene.analysis.contact_dumps=false"])
     assert "bed_flow" not in dry
     assert REFUSED not in {f.verdict for f in wet.values()}
 

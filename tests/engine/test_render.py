@@ -40,7 +40,7 @@ def commands(src: str) -> list[str]:
 
 
 def test_dry_scene_has_no_liquid():
-    src = text(overrides=["scene.liquid.model=none", "scene.analysis.granules=false",
+    src = text(overrides=["scene.liquid.model=none", "scene.analysis.contact_dumps=false",
                           "sweep.rules=[weber]"])
     body = "\n".join(commands(src))
     for word in ("cohesion", "surfaceTension", "fluidViscosity", "contactAngle",
@@ -65,7 +65,7 @@ def test_no_lifters_mentions_none():
 
 def test_contact_dump_only_with_granules():
     on = "\n".join(commands(text()))
-    off = "\n".join(commands(text(overrides=["scene.analysis.granules=false"])))
+    off = "\n".join(commands(text(overrides=["scene.analysis.contact_dumps=false"])))
     assert "pair/gran/local" in on and "local/gran/vtk" in on
     assert "pair/gran/local" not in off and "local/gran/vtk" not in off and "contacts" not in off
 

@@ -61,7 +61,7 @@ def test_check_warns_where_the_map_expects_no_granules(capsys):
     assert "St_v = 0.349, Bo_g = 3.39 is the regime map's closest point" in out.err
     assert "closest (unproven)" in out.out
     assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.001",
-                 "--set", "scene.analysis.granules=false"]) == 0
+                 "--set", "scene.analysis.contact_dumps=false"]) == 0
     assert "granule analysis asked for" not in capsys.readouterr().err
 
 
@@ -84,7 +84,7 @@ def test_cohesionless_twin_keeps_everything_but_the_bridge_forces():
 def test_controls_refused_on_a_dry_scene_and_at_a_missing_level():
     with pytest.raises(ConfigError, match="dry"):
         _case(["sweep.controls=[cohesionless]", "scene.liquid.model=none",
-               "sweep.rules=[weber]", "scene.analysis.granules=false"])
+               "sweep.rules=[weber]", "scene.analysis.contact_dumps=false"])
     with pytest.raises(ConfigError, match="control_cg_levels"):
         _case(["sweep.controls=[cohesionless]", "sweep.control_cg_levels=[3]"])
     with pytest.raises(ConfigError, match="controls"):

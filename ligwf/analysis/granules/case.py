@@ -143,7 +143,7 @@ class GranuleAnalysis(FrameAnalysis):
         try:
             if ff.contacts is None:
                 raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
-                                    "(was the case rendered with analysis.granules: true?)")
+                                    "(was the case rendered with analysis.contact_dumps: true?)")
             particles, contacts = self._read(ff)
             if self.definition.granules == "held":
                 ident = self._held(ff, particles, contacts)
@@ -178,7 +178,7 @@ class GranuleAnalysis(FrameAnalysis):
         f = self._facts
         if ff.contacts is None:
             raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
-                                "(was the case rendered with analysis.granules: true?)")
+                                "(was the case rendered with analysis.contact_dumps: true?)")
         if f.plan is not None:
             f.plan.check_record(ff)
         particles = read_particles(ff.particles, ff.step, f.dt)
