@@ -15,18 +15,17 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from ligwf.engine.mesh import axis_frame
+from ligwf.scene.axis import Axis
 from ligwf.study.layout import MESH_NAME
 from ligwf.fsio import atomic_write_text
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 
 
-def rotation_matrix(axis: str, angle: float) -> np.ndarray:
+def rotation_matrix(axis: Axis, angle: float) -> np.ndarray:
     """Right-handed rotation by ``angle`` (rad) about +axis."""
-    ia, _, _ = axis_frame(axis)
     k = np.zeros(3)
-    k[ia] = 1.0
+    k[axis.index] = 1.0
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
 

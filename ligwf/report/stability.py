@@ -85,7 +85,7 @@ def max_overlap_in_frame(positions: np.ndarray, radii: np.ndarray, s: ScaledScen
     cylindrical shell (radius R; its polygon facets lie inside, so this never overstates)."""
     from scipy.spatial import cKDTree
 
-    ia = "xyz".index(s.drum.axis)
+    ia = s.drum.axis.index
     pos, rad = positions, radii
     if s.drum.periodic:
         reach = 2.0 * rad.max()

@@ -5,7 +5,7 @@ chord lies at depth c = R cos(phi / 2) below the drum axis, phi - sin(phi) = 2 p
 wet spheres are spread across the chord (at 0.6 of its half-width, equal steps), each
 half-way between the free surface and the lifter tips below it, in the middle of the slice
 along the axis. Coordinates are the drum frame's (axial, across, vertical) of
-:func:`ligwf.engine.render.axis_frame`: the renderer maps them onto x, y, z.
+:attr:`ligwf.scene.axis.Axis.frame`: the renderer maps them onto x, y, z.
 """
 
 from __future__ import annotations

@@ -142,7 +142,7 @@ def test_installed_wheel_ships_templates(tmp_path):
                                         ("y", "${ligwf_pu} ${ligwf_pa} 1"),
                                         ("z", "${ligwf_pu} 1 ${ligwf_pa}")])
 def test_processor_grid_never_cuts_along_gravity(axis, grid):
-    # gravity is -z for axes x and y and -y for axis z (mesh.axis_frame); a cut along it
+    # gravity is -z for axes x and y and -y for axis z (Axis.frame); a cut along it
     # would leave the rank above the bed nearly idle
     src = text(overrides=[f"scene.drum.axis={axis}"])
     lines = commands(src)

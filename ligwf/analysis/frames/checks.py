@@ -43,7 +43,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files,
+from ligwf.analysis.frames.dumps import (ContactFrame, FrameFiles, ParticleFrame, dump_files,
                                          read_particles)
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study.case import CaseFolder, DumpRecord, file_digest
@@ -214,7 +214,7 @@ def _check_particles(case: CaseFolder, p: ParticleFrame) -> None:
     near = np.min(np.abs(p.radii[:, None] - radii[None, :]) / radii[None, :], axis=1)
     if np.any(near > 1e-6):
         _fail(p, f"radius {p.radii[near.argmax()]:.6g} m is none of the scene's size classes")
-    ia = AXES.index(s.drum.axis)
+    ia = s.drum.axis.index
     across = np.delete(p.positions, ia, axis=1)
     reach = 0.5 * s.drum.diameter * (1 + GEOMETRY_SLACK)
     if np.any(np.hypot(across[:, 0], across[:, 1]) > reach):
@@ -270,8 +270,8 @@ def _positions_digest(path: Path, case: CaseFolder, frame: ParticleFrame | None 
 def check_contacts(p: ParticleFrame, c: ContactFrame, periodic_axis: int | None,
                    box_length: float) -> None:
     """DumpReadError unless every pair's overlap matches the two particles' centres and
-    radii in ``p`` (nearest image along the periodic axis): the contact dump then belongs
-    to the same particles at the same step."""
+    radii in ``p`` (nearest image along the periodic axis, its column ``periodic_axis``):
+    the contact dump then belongs to the same particles at the same step."""
     if len(c) == 0:
         return
     i, j = p.index_of(c.id1), p.index_of(c.id2)

@@ -159,7 +159,7 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
     starts = [k for k in range(len(series.frames)) if series.times[k] >= steady_from - 1e-9]
     starts = starts[::series.frames_in(stride)]
     volumes = series.frames[0].particles.volumes
-    axis, length = facts.periodic_axis, facts.box_length
+    axis, length = facts.periodic_column, facts.box_length
     rows = []
     shared_keys: dict[tuple[int, bool], np.ndarray] = {}
     for name, kind, param in candidates:
