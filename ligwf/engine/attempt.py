@@ -36,9 +36,10 @@ _VERSION_RE = re.compile(r"^LIGGGHTS \((Version .*)\)\s*$")
 
 def expectation(s: ScaledScene) -> Expectation:
     """Healthy end state of a scaled scene: particle count, step counts, KE ceiling."""
-    mean_volume = sum(f * math.pi * d**3 / 6.0 for d, f in zip(s.particles.diameters, s.particles.number_fractions))
-    mass = s.particles.count * s.particles.density * mean_volume
-    return Expectation(particle_count=s.particles.count,
+    p = s.particles
+    mean_volume = sum(f * math.pi * d**3 / 6.0 for d, f in zip(p.diameters, p.number_fractions))
+    mass = p.count * p.density * mean_volume
+    return Expectation(particle_count=p.count,
                        settle_end_step=s.insertion_steps + s.numerics.settle_steps,
                        total_steps=s.total_steps,
                        ke_ceiling=kinetic_energy_ceiling(mass, s.drum.diameter, s.drum.omega))

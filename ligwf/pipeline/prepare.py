@@ -80,7 +80,8 @@ def check_run_lengths(case: Case, scaled: ScaledScene) -> None:
     with "Invalid run command N value" after the fill (a tiny dt with a long run)."""
     fall = "the fill's insertion wave (the fall across the drum)"
     for field, steps in (("process.settle_time", scaled.numerics.settle_steps),
-                         ("process.run_time", scaled.numerics.run_steps), (fall, scaled.fill.wave_steps)):
+                         ("process.run_time", scaled.numerics.run_steps),
+                         (fall, scaled.fill.wave_steps)):
         if steps > ENGINE_MAX_RUN_STEPS:
             seconds = steps * scaled.numerics.dt
             most = ENGINE_MAX_RUN_STEPS * scaled.numerics.dt

@@ -171,7 +171,8 @@ def report_figures(study: Study, flow: FlowRecord, cases: pd.DataFrame,
             found.gsd.append(Figure("GSD overlay", figs.gsd_overlay(
                 gsd, fig_dir / layout.FIGURE_GSD_OVERLAY, study.analysis.gsd_volume,
                 size_limits(study.analysis_dir))))
-    starts = {c.case_id: c.production_start_step * c.scaled.numerics.dt for c in study.usable_cases()[0]}
+    starts = {c.case_id: c.production_start_step * c.scaled.numerics.dt
+              for c in study.usable_cases()[0]}
     found.kinetics += [Figure(t, p) for t, p in granule_figures(study.analysis_dir, fig_dir,
                                                                 starts)]
     by_id = {c.case_id: c for c in study.usable_cases()[0]}

@@ -40,16 +40,18 @@ GRANULATING_BOND = 3.0
 def regime_numbers(s) -> dict[str, float]:
     """St_v, Bo_g, Ca and Fr of a :class:`~ligwf.scene.scaled.ScaledScene` (its own,
     scaled particles), for the number-mean radius."""
-    radius = 0.5 * sum(d * f for d, f in zip(s.particles.diameters, s.particles.number_fractions))
+    p, liq = s.particles, s.liquid_values
+    radius = 0.5 * sum(d * f for d, f in zip(p.diameters, p.number_fractions))
     v = float(s.drum.omega) * 0.5 * float(s.drum.diameter)
-    wet = s.liquid_values.model != "none" and s.liquid_values.surface_tension > 0
-    theta = math.radians(s.liquid_values.contact_angle_deg)
-    mu, gamma = float(s.liquid_values.viscosity), float(s.liquid_values.surface_tension)
-    stokes = 8.0 * s.particles.density * radius * v / (9.0 * mu) if wet and mu > 0 else math.inf
-    bond = 3.0 * gamma * math.cos(theta) / (4.0 * radius ** 2 * s.particles.density * GRAVITY) if wet else 0.0
+    wet = liq.model != "none" and liq.surface_tension > 0
+    theta = math.radians(liq.contact_angle_deg)
+    mu, gamma = float(liq.viscosity), float(liq.surface_tension)
+    stokes = 8.0 * p.density * radius * v / (9.0 * mu) if wet and mu > 0 else math.inf
+    bond = 3.0 * gamma * math.cos(theta) / (4.0 * radius ** 2 * p.density * GRAVITY) if wet else 0.0
     capillary = mu * v / gamma if wet else 0.0
     return {"stokes_viscous": stokes, "bond_granular": bond, "capillary": capillary,
-            "froude": float(s.drum.froude), "liquid_content": float(s.liquid_values.liquid_content) if wet else 0.0}
+            "froude": float(s.drum.froude),
+            "liquid_content": float(liq.liquid_content) if wet else 0.0}
 
 
 def granulation_warning(numbers: dict[str, float]) -> str:

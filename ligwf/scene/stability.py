@@ -177,7 +177,8 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
     timestep("dt_rayleigh", "Rayleigh time", sc.rayleigh_time,
              DT_RAYLEIGH_LIMIT_HARD if hard else DT_RAYLEIGH_LIMIT,
              " (dt_rayleigh_fraction <= {safe:.2g})",
-             f" (hard particles, E = {s.particles.youngs_modulus:.3g} Pa > {HARD_PARTICLE_MODULUS:g}: "
+             f" (hard particles, E = {s.particles.youngs_modulus:.3g} Pa > "
+             f"{HARD_PARTICLE_MODULUS:g}: "
              "the engine crashed at 0.19 with a nan position at a wall contact, "
              "tri_mesh_I.h:109)" if hard else "")
     timestep("dt_hertz", f"Hertz contact time at {2 * sc.impact_velocity:.2g} m/s", sc.hertz_time,
@@ -190,7 +191,8 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
     d = s.d_min
     ratio = sc.hertz_overlap / d
     verdict = REFUSED if ratio > OVERLAP_LIMIT else (MARGINAL if ratio > OVERLAP_WARN else OK)
-    msg = (f"particles.youngs_modulus: E = {s.particles.youngs_modulus:.3g} Pa gives an impact overlap "
+    msg = (f"particles.youngs_modulus: E = {s.particles.youngs_modulus:.3g} Pa "
+           "gives an impact overlap "
            f"of {ratio:.2%} of the smallest {tag} diameter at {sc.impact_velocity:.2g} m/s; "
            f"warn above {OVERLAP_WARN:.0%}, limit {OVERLAP_LIMIT:.0%}")
     if verdict != OK:
@@ -218,7 +220,8 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
         msg = (f"liquid.max_separation_ratio: bridges rupture at a gap of "
                f"{sc.rupture_distance:.2g} m; the neighbor lists reach a gap of "
                f"{sc.neighbor_cutoff:.2g} m (contact distance factor 1.1 x "
-               f"max_separation_ratio = {s.liquid_values.max_separation_ratio:g}) and the bridge force "
+               f"max_separation_ratio = {s.liquid_values.max_separation_ratio:g}) "
+               "and the bridge force "
                f"is cut at {sc.bridge_cutoff:.2g} m")
         if verdict != OK:
             need = (1.0 + sc.rupture_distance / d) / 1.1
@@ -230,7 +233,8 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
     if sc.rupture_distance and sc.bridge_cutoff is not None:
         ratio = sc.bridge_cutoff / sc.rupture_distance
         verdict = MARGINAL if ratio < BRIDGE_CUT_WARN else OK
-        msg = (f"liquid.max_separation_ratio = {s.liquid_values.max_separation_ratio:g}: the engine drops a "
+        msg = (f"liquid.max_separation_ratio = {s.liquid_values.max_separation_ratio:g}: "
+               "the engine drops a "
                f"bridge at a gap of {sc.bridge_cutoff:.2g} m, {ratio:.2g} of the force law's "
                f"own rupture gap {sc.rupture_distance:.2g} m; warn below {BRIDGE_CUT_WARN:g}")
         if verdict != OK:

@@ -166,36 +166,38 @@ def regime(froude: float) -> str:
 
 def time_scales(s: ScaledScene) -> TimeScales:
     """All time scales of the smallest scaled particle of a case (pure)."""
+    p, liq = s.particles, s.liquid_values
     r = 0.5 * s.d_min
     v_imp = impact_velocity(s.drum.omega, s.drum.diameter)
-    t_h = hertz_time(r, s.particles.density, s.particles.youngs_modulus, s.particles.poisson_ratio, 2.0 * v_imp)
-    overlap = hertz_max_overlap(r, s.particles.density, s.particles.youngs_modulus, s.particles.poisson_ratio, v_imp)
+    t_h = hertz_time(r, p.density, p.youngs_modulus, p.poisson_ratio, 2.0 * v_imp)
+    overlap = hertz_max_overlap(r, p.density, p.youngs_modulus, p.poisson_ratio, v_imp)
     t_c = cap_overlap = rupture = cutoff = reach = f0 = co = None
     # the bed the particles make (a particle_count may differ from the fill fraction)
-    v_mean = sum(f * math.pi * d**3 / 6.0 for d, f in zip(s.particles.diameters, s.particles.number_fractions))
-    fill = s.particles.count * v_mean / ((1.0 - BED_POROSITY) * math.pi
-                                        * (0.5 * s.drum.diameter) ** 2 * s.drum.length)
+    v_mean = sum(f * math.pi * d**3 / 6.0 for d, f in zip(p.diameters, p.number_fractions))
+    fill = p.count * v_mean / ((1.0 - BED_POROSITY) * math.pi
+                               * (0.5 * s.drum.diameter) ** 2 * s.drum.length)
     depth = bed_depth(s.drum.diameter, min(fill, 0.999))
     if s.wet:
         model = s.liquid
-        theta = applied_contact_angle_rad(s.liquid_values.contact_angle_deg, s.liquid_values.contact_angle_compensation)
-        f0, k_b = model.contact_force_and_stiffness(r, s.liquid_values.surface_tension, theta,
-                                                    s.liquid_values.liquid_content)
-        t_c = capillary_time(0.5 * sphere_mass(r, s.particles.density), k_b)
-        cap_overlap = capillary_overlap(r, s.particles.youngs_modulus, s.particles.poisson_ratio, f0, k_b)
-        vol = model.bridge_volume(r, r, s.liquid_values.liquid_content, s.liquid_values.liquid_content)
+        theta = applied_contact_angle_rad(liq.contact_angle_deg, liq.contact_angle_compensation)
+        f0, k_b = model.contact_force_and_stiffness(r, liq.surface_tension, theta,
+                                                    liq.liquid_content)
+        t_c = capillary_time(0.5 * sphere_mass(r, p.density), k_b)
+        cap_overlap = capillary_overlap(r, p.youngs_modulus, p.poisson_ratio, f0, k_b)
+        vol = model.bridge_volume(r, r, liq.liquid_content, liq.liquid_content)
         rupture = float(model.rupture_distance(vol, theta))
-        cutoff, reach = model.engine_cutoff_gaps(r, s.liquid_values.max_separation_ratio) or (None, None)
+        cutoff, reach = model.engine_cutoff_gaps(r, liq.max_separation_ratio) or (None, None)
         # the bed's typical particle (number-mean diameter) holds it together
-        d_mean = sum(d * f for d, f in zip(s.particles.diameters, s.particles.number_fractions))
-        f0_mean, _ = model.contact_force_and_stiffness(0.5 * d_mean, s.liquid_values.surface_tension, theta,
-                                                       s.liquid_values.liquid_content)
-        co = cohesion_number(f0_mean, d_mean, s.particles.density, depth)
+        d_mean = sum(d * f for d, f in zip(p.diameters, p.number_fractions))
+        f0_mean, _ = model.contact_force_and_stiffness(0.5 * d_mean, liq.surface_tension, theta,
+                                                       liq.liquid_content)
+        co = cohesion_number(f0_mean, d_mean, p.density, depth)
     radius = 0.5 * s.drum.diameter
     return TimeScales(
         rayleigh_time=s.particles.rayleigh_time, impact_velocity=v_imp, hertz_time=t_h,
         hertz_overlap=overlap, capillary_time=t_c, capillary_overlap=cap_overlap,
-        rupture_distance=rupture, bridge_cutoff=cutoff, neighbor_cutoff=reach, froude=s.drum.froude,
+        rupture_distance=rupture, bridge_cutoff=cutoff, neighbor_cutoff=reach,
+        froude=s.drum.froude,
         critical_rpm=60.0 / (2.0 * math.pi) * math.sqrt(GRAVITY / radius),
         regime=regime(s.drum.froude), bridge_force=f0 if f0 is None else float(f0),
         bed_depth=depth, cohesion_number=co)

@@ -223,7 +223,7 @@ def _check_particles(case: CaseFolder, p: ParticleFrame) -> None:
     slack = GEOMETRY_SLACK * s.drum.length
     if np.any(along < -slack) or np.any(along > s.drum.length + slack):
         _fail(p, f"a particle centre lies outside the drum length [0, {s.drum.length:g}] m")
-    limit = SPEED_FACTOR * (s.drum.omega * 0.5 * s.drum.diameter + np.sqrt(2 * 9.81 * s.drum.diameter))
+    limit = SPEED_FACTOR * (s.drum.omega * s.drum.radius + np.sqrt(2 * 9.81 * s.drum.diameter))
     if np.any(np.linalg.norm(p.velocities, axis=1) > limit):
         _fail(p, f"a particle speed above {limit:.3g} m/s (not physical in this drum)")
     if p.liquid_content is not None and np.any((p.liquid_content < 0) | (p.liquid_content > 1)):
