@@ -55,8 +55,8 @@ def run_mode(mode: str, wf, out: Path, cores: int) -> list[dict]:
         s = rc.scaled
         ranks = 1 if mode == "single" else plan_ranks(case_load(rc.case.case_id, s),
                                                       cores).ranks
-        print(f"[{mode}] {rc.case.case_id}: {s.particle_count} particles, {s.total_steps} "
-              f"steps, {ranks} rank(s), skin {s.skin / s.d_min:.3f} d ...", flush=True)
+        print(f"[{mode}] {rc.case.case_id}: {s.particles.count} particles, {s.total_steps} "
+              f"steps, {ranks} rank(s), skin {s.numerics.skin / s.d_min:.3f} d ...", flush=True)
         man = run_case(case, ranks, engine, None, stop) or case.manifest()
         if man is None or man.status != DONE:
             sys.exit(f"{rc.case.case_id} ended {getattr(man, 'status', 'without a manifest')}: "
@@ -65,13 +65,13 @@ def run_mode(mode: str, wf, out: Path, cores: int) -> list[dict]:
         if "production" not in phases:
             sys.exit(f"{rc.case.case_id}: the manifest has no production phase times")
         prod_core = phases["production"]["core_seconds"]
-        rows.append({"cg": s.cg, "particles": s.particle_count, "ranks": ranks,
+        rows.append({"cg": s.cg, "particles": s.particles.count, "ranks": ranks,
                      "steps": s.total_steps, "wall": man.wall_seconds,
                      "core": man.core_seconds,
                      **{f"{p}_core": phases.get(p, {}).get("core_seconds", float("nan"))
                         for p in PHASES},
-                     "rate_k": prod_core / (s.run_steps * s.dt)
-                     / s.original_particle_count * 1000.0})
+                     "rate_k": prod_core / (s.numerics.run_steps * s.numerics.dt)
+                     / s.particles.original_count * 1000.0})
     return rows
 
 
@@ -119,7 +119,7 @@ def main() -> int:
     check_quiet("the ratios below")
     overrides = ["sweep.cg_levels=[1,2,3]", "sweep.rules=[weber]", "sweep.replicas=1",
                  "sweep.per_cg={}", f"scene.process.settle_time={args.settle_time}",
-                 f"scene.process.run_time={args.run_time}", "scene.analysis.granules=true"]
+                 f"scene.process.run_time={args.run_time}", "scene.analysis.contact_dumps=true"]
     if args.length is not None:
         overrides.append(f"scene.drum.length={args.length}")
     wf = load_workflow(ROOT / "workflows" / "we_vs_bo.yaml", overrides + args.set)

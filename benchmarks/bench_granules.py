@@ -54,8 +54,9 @@ from ligwf.analysis.granules.bonds import (BondCriterion, bonded_contacts, bonde
 from ligwf.analysis.granules.bridge_law import Liquid, relative_energy
 from ligwf.analysis.granules.communities import cpm_labels
 from ligwf.analysis.granules.definitions import Motion, bond_criterion, identify_granules
+from ligwf.scene.axis import Axis
 from ligwf.scene.settings import AnalysisSettings
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 
 R = 0.0005
 #: the synthetic frames' liquid (``--model`` picks the law)
@@ -189,7 +190,7 @@ def report_communities(label: str, p, c, length: float, liquid: Liquid) -> None:
     the rupture-work quadrature, the CPM partition, the components of the intra-community
     bonds; frames/s on one core (target >= 0.5 at 360k)."""
     definition = AnalysisSettings(granules="communities")
-    motion = Motion(1, None, 1, length)
+    motion = Motion(Axis.Y, None, Axis.Y, length)
     t_all, ident = timed(lambda: identify_granules(p, c, liquid, definition, 1.0, motion), 1)
     t_bond, (i, j, force, rows) = timed(
         lambda: bonded_contacts(p, c, liquid, bond_criterion(definition), with_rows=True), 1)
@@ -226,9 +227,9 @@ def main() -> None:
         scaled = ScaledScene.from_dict(json.loads((args.real / "scene.json").read_text())["scaled"])
         f = discover_frames(args.real)[-1]
         p, c = read_particles(f.particles), read_contacts(f.contacts)
-        report(f"real {args.real.name}", p, c, scaled.drum_length, Liquid.from_scaled(scaled),
+        report(f"real {args.real.name}", p, c, scaled.drum.length, Liquid.from_scaled(scaled),
                f.particles.parent, f.step, False)
-        report_communities(f"real {args.real.name}", p, c, scaled.drum_length,
+        report_communities(f"real {args.real.name}", p, c, scaled.drum.length,
                            Liquid.from_scaled(scaled))
 
 

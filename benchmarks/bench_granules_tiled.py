@@ -79,7 +79,7 @@ def main() -> None:
     case = CaseFolder.open(args.case)
     facts = RunFacts.of_case(case)
     granules_numba.warm_up((facts.liquid.model,))
-    length = case.scaled.drum_length
+    length = case.scaled.drum.length
     frames = [f for f in plan_frames(case).frames if f.contacts]
 
     def load(ff):

@@ -132,7 +132,7 @@ def run_by_hand(template: CaseFolder, folder: Path, command: list[str]) -> float
         wall = time.perf_counter() - t0
     if code != 0:
         raise BenchFailed(f"by-hand run in {folder} exited {code}:\n{tail(folder / SCREEN_FILE)}")
-    problem = production_problem(folder / LOG_FILE, template.scaled.run_steps)
+    problem = production_problem(folder / LOG_FILE, template.scaled.numerics.run_steps)
     if problem:
         raise BenchFailed(f"by-hand run: {problem}\n{tail(folder / SCREEN_FILE)}")
     return wall
@@ -197,8 +197,8 @@ def main() -> None:
         engine = EngineConfig.from_site()
         command = engine.command(INPUT_NAME, args.np, extra=grid_vars(template.scaled, args.np))
         s = template.scaled
-        print(f"case {template.case_id}: {s.particle_count:,} particles, {s.total_steps:,} "
-              f"steps (settle {s.settle_steps:,}, run {s.run_steps:,}), -np {args.np}")
+        print(f"case {template.case_id}: {s.particles.count:,} particles, {s.total_steps:,} "
+              f"steps (settle {s.numerics.settle_steps:,}, run {s.numerics.run_steps:,}), -np {args.np}")
         print(f"ligwf: ligwf run {args.workflow} --np {args.np} " +
               " ".join(f"--set {x}" for x in sets))
         print(f"hand:  {' '.join(command)}")

@@ -61,19 +61,19 @@ def main() -> int:
     if man is None or man.status != DONE:
         print(f"{case.case_id} not done: {getattr(man, 'reason', 'no manifest')}")
         return 1
-    print(f"paper scale CG3: {s.particle_count:,} particles, dt {s.dt:.3g} s, "
-          f"{s.total_steps:,} steps ({s.run_steps:,} turning = {s.run_steps * s.dt:g} s, "
-          f"{s.run_steps * s.dt / s.rotation_period:.2f} revolution), {man.nprocs} rank(s); "
+    print(f"paper scale CG3: {s.particles.count:,} particles, dt {s.numerics.dt:.3g} s, "
+          f"{s.total_steps:,} steps ({s.numerics.run_steps:,} turning = {s.numerics.run_steps * s.numerics.dt:g} s, "
+          f"{s.numerics.run_steps * s.numerics.dt / s.drum.rotation_period:.2f} revolution), {man.nprocs} rank(s); "
           f"'ligwf run' wall {wall:.0f} s")
     print(f"{'phase':>10} {'steps':>8} {'wall s':>8} {'core-s':>8} {'particle-steps/core-s':>22}")
     for phase in ("fill", "settle", "production"):
         rec = man.phases.get(phase, {})
         steps, core = int(rec.get("steps", 0)), rec.get("core_seconds", float("nan"))
-        rate = s.particle_count * steps / core if core else float("nan")
+        rate = s.particles.count * steps / core if core else float("nan")
         print(f"{phase:>10} {steps:>8,} {rec.get('wall_seconds', float('nan')):>8.1f} "
               f"{core:>8.1f} {rate:>22.3e}")
     prod = man.phases["production"]
-    per_sim_s = prod["core_seconds"] / (s.run_steps * s.dt)
+    per_sim_s = prod["core_seconds"] / (s.numerics.run_steps * s.numerics.dt)
     print(f"production: {per_sim_s:.0f} core-s per simulated second "
           f"({per_sim_s / 3600:.2f} core-h)")
     cg1 = sets(["sweep.cg_levels=[1]", *ONE_CASE])

@@ -56,7 +56,7 @@ def submit_commands(out: Path, ranks: list[int], workflow: Path, cg: int, run_ti
     """One ``ligwf slurm submit`` command per rank count (pure: nothing runs)."""
     sets = [f"sweep.cg_levels=[{cg}]", "sweep.rules=[weber]", "sweep.replicas=1",
             "sweep.per_cg={}", "sweep.controls=[]", f"scene.process.run_time={run_time:g}",
-            f"scene.process.settle_time={settle_time:g}", "scene.analysis.granules=false"]
+            f"scene.process.settle_time={settle_time:g}", "scene.analysis.contact_dumps=false"]
     cmds = []
     for r in sorted(set(ranks)):
         cmd = ligwf() + ["slurm", "submit", str(workflow), "--out", str(out / f"np{r}"),
@@ -97,9 +97,9 @@ def collect(out: Path) -> list[ScalingRow]:
             print(f"{folder}: no finished production run ({exc})", file=sys.stderr)
             continue
         case = CaseFolder.open(cases[0])
-        if spread.steps != case.scaled.run_steps:
+        if spread.steps != case.scaled.numerics.run_steps:
             print(f"{folder}: the last run block has {spread.steps} steps, not the "
-                  f"production's {case.scaled.run_steps} (still running?)", file=sys.stderr)
+                  f"production's {case.scaled.numerics.run_steps} (still running?)", file=sys.stderr)
             continue
         grid = _GRID_RE.findall(text)
         rows.append(ScalingRow(spread.procs, cases[0],

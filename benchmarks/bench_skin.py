@@ -120,7 +120,7 @@ def selection(cg: int, settle: float, run: float, skin_ratio: float | None) -> l
     """``--set`` values of the one weber case at ``cg`` with ``skin_ratio`` (None: default)."""
     sets = [f"sweep.cg_levels=[{cg}]", "sweep.rules=[weber]", "sweep.replicas=1",
             "sweep.per_cg={}", f"scene.process.settle_time={settle}",
-            f"scene.process.run_time={run}", "scene.analysis.granules=true"]
+            f"scene.process.run_time={run}", "scene.analysis.contact_dumps=true"]
     if skin_ratio is not None:
         sets.append(f"scene.numerics.skin_ratio={skin_ratio}")
     return sets
@@ -204,9 +204,9 @@ def run_blocks(log_text: str) -> list[dict[str, float]]:
 def cost(case: CaseFolder) -> dict[str, float]:
     """Production-run statistics (last log block) and the manifest's wall seconds."""
     blocks = run_blocks((case.path / LOG_FILE).read_text(errors="replace"))
-    if not blocks or blocks[-1]["steps"] != case.scaled.run_steps:
+    if not blocks or blocks[-1]["steps"] != case.scaled.numerics.run_steps:
         raise BenchFailed(f"{case.path / LOG_FILE}: the last run block is not the production "
-                          f"run of {case.scaled.run_steps} steps")
+                          f"run of {case.scaled.numerics.run_steps} steps")
     row = dict(blocks[-1])
     man = case.manifest()
     row["wall_s"] = man.wall_seconds
@@ -227,7 +227,7 @@ def print_cost(cases: dict[str, CaseFolder], costs: dict[str, dict[str, float]])
           f"{'fill s':>7} {'settle s':>8} {'total s':>8}")
     for label, case in cases.items():
         s, c = case.scaled, costs[label]
-        print(f"{label:>4} {s.skin / s.d_min:>7.3f} {s.skin_fill / s.d_min:>7.3f} "
+        print(f"{label:>4} {s.numerics.skin / s.d_min:>7.3f} {s.skin_fill / s.d_min:>7.3f} "
               f"{c['loop_s']:>8.2f} {c.get('pair_s', math.nan):>8.2f} "
               f"{c.get('neigh_s', math.nan):>8.2f} {c.get('neighs_per_atom', math.nan):>11.2f} "
               f"{c.get('builds', 0):>7.0f} {c['steps'] / max(c.get('builds', 0), 1):>11.1f} "
@@ -304,13 +304,13 @@ METRICS = (
 def bond_statistics(case: CaseFolder, skip_time: float) -> tuple[list[int], dict[str, np.ndarray]]:
     """Per production frame (after ``skip_time`` s of turning): the :data:`METRICS`."""
     s = case.scaled
-    first = case.production_start_step + int(round(skip_time / s.dt))
+    first = case.production_start_step + int(round(skip_time / s.numerics.dt))
     frames = [f for f in discover_frames(case.path) if f.step >= first and f.contacts is not None]
     if len(frames) < 2:
         raise BenchFailed(f"{case.path}: {len(frames)} production contact frames, need >= 2")
     rows: dict[str, list[float]] = {key: [] for key, _, _ in METRICS}
     for f in frames:
-        pf = read_pair_forces(f.contacts, s.drum_length)
+        pf = read_pair_forces(f.contacts, s.drum.length)
         if len(pf.lo) == 0:
             raise BenchFailed(f"{f.contacts}: no bridges in a production frame")
         fn = np.linalg.norm(pf.force_normal, axis=1)
@@ -446,7 +446,7 @@ def exact_check(old_case: CaseFolder, new_skin: float, steps: int, warm_up: int,
                           "use a longer --run-time")
     restart = production[0]
     (text,) = render_resume(s, restart, [templates]).values()
-    skins = {"OLD": s.skin, "NEW": new_skin}
+    skins = {"OLD": s.numerics.skin, "NEW": new_skin}
     inputs = {label: exact_inputs(text, skin, steps, warm_up)
               for label, skin in skins.items()}
     for variant in ("switched", "restart"):
@@ -455,7 +455,7 @@ def exact_check(old_case: CaseFolder, new_skin: float, steps: int, warm_up: int,
         if len(differ) > 1:
             raise BenchFailed(f"exact inputs differ in more than the neighbor line: {differ}")
     print(f"\nExact force check from {restart.path} of OLD (step {restart.step}, "
-          f"{(restart.step - old_case.production_start_step) * s.dt:.3f} s into production), "
+          f"{(restart.step - old_case.production_start_step) * s.numerics.dt:.3f} s into production), "
           f"1 rank, ligwf's resume input, skin OLD {skins['OLD']:.4g} m vs NEW "
           f"{skins['NEW']:.4g} m, contacts dumped every step", flush=True)
     verdict = True
@@ -471,7 +471,7 @@ def exact_check(old_case: CaseFolder, new_skin: float, steps: int, warm_up: int,
         builds = {label: blocks[label].get("builds", 0) for label in skins}
         print(f"{title}; list builds in the {steps} steps: OLD {builds['OLD']:.0f}, "
               f"NEW {builds['NEW']:.0f}")
-        rows = exact_table(folders, first_step, steps, s.drum_length)
+        rows = exact_table(folders, first_step, steps, s.drum.length)
         if variant == "switched":
             verdict = all(rows[k]["only_old"] == 0 and rows[k]["only_new"] == 0
                           and rows[k]["force"] <= EXACT_TOLERANCE
@@ -524,15 +524,15 @@ def main() -> int:
     cases = {label: prepare(selection(args.cg, args.settle_time, args.run_time, r),
                             work / label.lower(), templates) for label, r in ratios.items()}
     s = cases["OLD"].scaled
-    print(f"case: {WORKFLOW.name} CG{args.cg} weber r0, {s.particle_count} particles, dt "
-          f"{s.dt:.4g} s, settle {args.settle_time:g} s + production {args.run_time:g} s "
-          f"({s.run_steps} steps), -np {args.np}, "
+    print(f"case: {WORKFLOW.name} CG{args.cg} weber r0, {s.particles.count} particles, dt "
+          f"{s.numerics.dt:.4g} s, settle {args.settle_time:g} s + production {args.run_time:g} s "
+          f"({s.numerics.run_steps} steps), -np {args.np}, "
           f"{'side by side' if args.side_by_side else 'serial'}; runs in {work}")
     for label, case in cases.items():
         c = case.scaled
         how = ("default (from the physics)" if ratios[label] is None
                else f"skin_ratio={ratios[label]}")
-        print(f"  {label}: {how}: skin {c.skin:.4g} m = {c.skin / c.d_min:.3f} d_min, "
+        print(f"  {label}: {how}: skin {c.numerics.skin:.4g} m = {c.numerics.skin / c.d_min:.3f} d_min, "
               f"fill {c.skin_fill:.4g} m = {c.skin_fill / c.d_min:.3f} d_min")
     engine = EngineConfig.from_site()
     load_line("at start")
@@ -543,7 +543,7 @@ def main() -> int:
     print_cost(cases, costs)
     stats = {label: bond_statistics(case, args.skip_time) for label, case in cases.items()}
     same = print_bonds(stats)
-    exact = exact_check(cases["OLD"], cases["NEW"].scaled.skin, args.exact_steps, args.warm_up,
+    exact = exact_check(cases["OLD"], cases["NEW"].scaled.numerics.skin, args.exact_steps, args.warm_up,
                         engine, templates, work)
     safe = all(c.get("dangerous", 1) == 0 for c in costs.values())
     ok = same and exact and safe

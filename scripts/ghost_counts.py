@@ -64,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     engine = EngineConfig.from_site()
     s = case.scaled
     bed = scene_bed(s)
-    print(f"{case.case_id}: {s.particle_count:,} particles, {s.drum_length * 1e3:g} mm slice, "
+    print(f"{case.case_id}: {s.particles.count:,} particles, {s.drum.length * 1e3:g} mm slice, "
           f"d_max {s.d_max * 1e3:g} mm, restart at step {restart.step:,}, {a.steps} steps")
     print(f"{'grid AxC':>8} {'ranks':>5} {'atoms/rank':>10} {'max/avg':>7} {'min':>6} "
           f"{'ghosts avg':>10} {'max':>6} {'ghosts/atom':>11} {'model max/avg':>13} "
@@ -89,7 +89,7 @@ def main(argv: list[str] | None = None) -> int:
         except ValueError:
             print(f"{g:>8}: engine exit {r.returncode}: {(r.stdout + r.stderr)[-400:]}")
             continue
-        model = grid_cost(s.drum_length, s.d_max, s.periodic, bed, axial, across)
+        model = grid_cost(s.drum.length, s.d_max, s.drum.periodic, bed, axial, across)
         print(f"{g:>8} {sp.procs:>5} {sp.local_avg:>10.0f} {sp.imbalance:>7.2f} "
               f"{sp.local_min:>6.0f} {sp.ghost_avg:>10.0f} {sp.ghost_max:>6.0f} "
               f"{sp.ghosts_per_local:>11.3f} {model.imbalance:>13.2f} "

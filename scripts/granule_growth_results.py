@@ -189,8 +189,9 @@ def case_table(run_dir: Path, case_ids: list[str]) -> pd.DataFrame:
     for cid in case_ids:
         case = CaseFolder.open(run_dir / cid)
         m = case.manifest()
-        rows.append({"case_id": cid, "particles": int(case.scaled.particle_count),
-                     "production_s": round(case.scaled.run_steps * case.scaled.dt, 3),
+        rows.append({"case_id": cid, "particles": int(case.scaled.particles.count),
+                     "production_s": round(case.scaled.numerics.run_steps
+                                           * case.scaled.numerics.dt, 3),
                      "frames": len(list((run_dir / cid / "post").glob("particles_[0-9]*.vtu"))),
                      "status": m.status if m is not None else "not run"})
     return pd.DataFrame(rows)

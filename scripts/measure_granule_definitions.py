@@ -65,6 +65,7 @@ from scipy.spatial import cKDTree
 
 from ligwf.analysis.frames.dumps import discover_frames, read_contacts, read_particles
 from ligwf import liquids as _liquids
+from ligwf.scene.axis import Axis
 
 
 def capillary(model, *args):
@@ -127,7 +128,7 @@ def _relative_energy(p, i, j, gap, model, gamma, theta, content):
 def load_case(path: Path, steady_fraction: float, flow_radii=(3.0,)) -> Case:
     scene = json.loads((path / "scene.json").read_text())
     s = scene["scaled"]
-    axis = "xyz".index(s.get("axis", "y"))
+    axis = Axis(s.get("axis", "y")).index
     if axis != 1:
         raise SystemExit(f"{path}: only drums along y are handled")
     length = float(s["drum_length"])

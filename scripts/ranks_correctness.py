@@ -98,7 +98,7 @@ def measure(case_dir: Path) -> dict:
     flow, _ = case_flow(case, STEADY_AFTER)
     row = {"case": case.case_id, "status": man.status, "nprocs": man.nprocs,
            "atoms_after_settle": man.atoms_after_settle, "atoms_end": man.atoms_end,
-           "wall_s": man.wall_seconds, "expected": case.scaled.particle_count}
+           "wall_s": man.wall_seconds, "expected": case.scaled.particles.count}
     # steady-window means (the flow summary names the angle's mean angle_of_repose)
     row.update({m: float(flow.summary[m if m == "angle_of_repose" else f"{m}_mean"])
                 for m in FLOW})

@@ -57,9 +57,9 @@ def main(paths: list[str]) -> None:
         for ff in plan_frames(case).frames:
             if ff.step < case.production_start_step:
                 continue
-            fr = read_particles(ff.particles, ff.step, case.scaled.dt)
+            fr = read_particles(ff.particles, ff.step, case.scaled.numerics.dt)
             rows.append((fr.time, frame_flow(fr, geo),
-                         density_surface_angle(fr, geo, case.scaled.drum_length)))
+                         density_surface_angle(fr, geo, case.scaled.drum.length)))
         fraction = steady_fraction(case, AUTO, [f for _, f, _ in rows])
         first = case.steady_start_step(fraction)
         steady = [(f.angle_of_repose, d) for _, f, d in rows if f.step >= first]

@@ -62,7 +62,7 @@ def test_planned_small_cases_run_side_by_side_longest_first(tmp_path, launches):
 def test_planned_big_case_runs_first_on_two_ranks_then_the_rest_side_by_side(tmp_path,
                                                                               launches):
     study = make_study(tmp_path, WITH_BIG)
-    assert study.cases[-1].scaled.particle_count > 6000
+    assert study.cases[-1].scaled.particles.count > 6000
     run(study, RunSettings(nprocs=None, cores=2))
     assert launches == [("mpirun", 2, "cg1-none-r0"),
                         ("ensemble", 2, 1, ("cg3-weber-r0", "cg3-bond-r0"), "phase2")]

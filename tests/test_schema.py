@@ -140,7 +140,7 @@ def test_reference_states_units_ranges_defaults_the_slice_rule_and_the_granule_s
     assert "| `scene.process.fill_fraction` | required | number | 1 | [0.01, 0.7] |" in text
     assert "| `analysis.resolution` | `0.002` |" in text
     assert "## The slice rule" in text and "below 6" in text
-    assert "## What `scene.analysis.granules` switches" in text
+    assert "## What `scene.analysis.contact_dumps` switches" in text
     assert "contact dumps" in text
 
 

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from ligwf import liquids
 from ligwf.analysis.granules.case import GranuleAnalysis, RunFacts
-from ligwf.analysis.frames.dumps import AXES, FrameFiles, read_particles
+from ligwf.analysis.frames.dumps import FrameFiles, read_particles
 from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, frame_tables,
                                           nothing_analysed, stage_granules)
@@ -34,6 +34,7 @@ from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
+from ligwf.scene.axis import Axis
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 
@@ -94,9 +95,11 @@ class ForeignRun:
             gamma = float(self.surface_tension)
             theta = applied_contact_angle_rad(self.contact_angle_deg,
                                               compensated=self.angle_convention == "scene")
-        axis = None if self.periodic_axis == "none" else self.periodic_axis
-        if axis is not None and axis not in AXES:
-            raise ConfigError(f"--periodic-axis {axis!r}: use x, y, z or none")
+        try:
+            axis = None if self.periodic_axis == "none" else Axis(self.periodic_axis)
+        except ValueError:
+            raise ConfigError(f"--periodic-axis {self.periodic_axis!r}: use x, y, z or "
+                              "none") from None
         if axis is not None and (self.box_length is None or not self.box_length > 0):
             raise ConfigError(f"--box-length: a periodic axis ({axis}) needs its length, m (> 0)")
         if not (self.dt > 0 and math.isfinite(self.dt)):
@@ -111,7 +114,7 @@ class ForeignRun:
         return RunFacts(name, float(self.cg),
                         Liquid(self.liquid, gamma, theta, content,
                                None if fraction is None else float(fraction)),
-                        None if axis is None else AXES.index(axis),
+                        axis,
                         float(self.box_length or 0.0), float(self.dt))
 
 

@@ -181,7 +181,7 @@ def stage_controls(outputs: OutputSet, cases: list, steady_from: dict[str, int],
     pairs = control_pairs(cases)
     if not pairs:
         return
-    start = {w.case_id: (steady_from[w.case_id] - w.production_start_step) * w.scaled.dt
+    start = {w.case_id: (steady_from[w.case_id] - w.production_start_step) * w.scaled.numerics.dt
              for w, _ in pairs}
     table = study_controls(cases, settings, start)
     outputs.write(layout.CONTROLS_TABLE, table.to_csv(index=False).encode())

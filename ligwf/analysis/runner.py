@@ -19,7 +19,7 @@ ids, radii, drum, contact geometry). Everything else is listed with its reason -
 cases, and missing, unexpected or refused frames -- in the analysis record and the frame
 table, which the report shows; a case left without any analysable frame is a skipped
 case. A usable case whose run holds no granule data by design (a dry scene, or
-``scene.analysis.granules: false``: no contact dumps) is not a skipped case: the record
+``scene.analysis.contact_dumps: false``: no contact dumps) is not a skipped case: the record
 lists it under ``granules_absent`` with the reason in words, and when every usable case
 is one, the record is written without granule tables (the flow stage and the report use
 those cases all the same). When nothing at all could be analysed otherwise,

@@ -13,7 +13,7 @@ a copy, so editing one never changes the next), from the file :mod:`ligwf.study.
 names for it (``TABLES``: attribute, file, the command that writes it). A table that is
 not there is one line naming the command that writes it (:class:`MissingOutput`, a
 :class:`~ligwf.errors.LigwfError`), never a traceback; granule tables of a study that has
-no granule data by design (a dry scene, ``scene.analysis.granules: false``) say why.
+no granule data by design (a dry scene, ``scene.analysis.contact_dumps: false``) say why.
 
 Dtypes, the same in every table: numbers are ``float64`` (``int64`` where a column is a
 count or an index that is never missing), flags are pandas' nullable ``boolean``, text

@@ -340,7 +340,7 @@ class StudyResults:
         """One granule-kinetics quantity per condition (``granules``, ``d50``,
         ``largest_granule``, ``granule_share``) against the time from production start,
         with its band over replicas."""
-        starts = {c.case_id: c.production_start_step * c.scaled.dt
+        starts = {c.case_id: c.production_start_step * c.scaled.numerics.dt
                   for c in self.study.usable_cases()[0]}
         return plots.kinetics(ax, self._read("kinetics_summary"), self._read("kinetics"),
                               quantity, starts)

@@ -17,6 +17,7 @@ from pathlib import Path
 from ligwf import liquids
 from ligwf.cli.analyse import print_record
 from ligwf.cli.common import folder_to_write, number_in, step_number
+from ligwf.scene.axis import Axis
 from ligwf.scene.values import MAX_LIQUID_CONTENT
 from ligwf.study import layout
 
@@ -37,7 +38,7 @@ def register(subparsers) -> None:
     p.add_argument("--angle-convention", required=True, choices=("engine", "scene"),
                    help="engine: the value written into a LIGGGHTS 3.8.0 input (which applied "
                    "0.5 theta^2); scene: the angle the engine applied (fixed engine)")
-    p.add_argument("--periodic-axis", required=True, choices=("x", "y", "z", "none"))
+    p.add_argument("--periodic-axis", required=True, choices=[*(a.value for a in Axis), "none"])
     p.add_argument("--box-length", type=number_in(1e-6, 10.0, "m"), help="m, length of the periodic box "
                    "(it spans [0, L]); required with a periodic axis")
     p.add_argument("--dt", type=number_in(1e-10, 1.0, "s"), required=True,

@@ -231,7 +231,8 @@ def case_table(prepared: Prepared, title: str) -> Table:
     for rc in prepared.rendered:
         s = rc.scaled
         table.add_row(rc.case.case_id, f"{s.cg:g}", s.rule, str(s.replica),
-                      f"{s.particle_count:,}", f"{s.dt:.3g}", f"{s.dt_rayleigh_fraction:.3g}",
+                      f"{s.particles.count:,}", f"{s.numerics.dt:.3g}",
+                      f"{s.numerics.dt_rayleigh_fraction:.3g}",
                       f"{s.total_steps:,}", f"{particle_steps(s):.3g}")
     return table
 

@@ -22,7 +22,7 @@ from ligwf.engine.resume import (FRESH, RESTART_SKIPPED, RESUME, NextAttempt, cl
                                  input_for, own_restarts, phase_steps_between, render_resume,
                                  rotate_screen)
 from ligwf.engine.thermo import parse_screen, phase_group
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.study.case import NO_DIGESTS, CaseFolder, KnownDigests
 from ligwf.study.manifest import DONE, FAILED, KILLED, RUNNING, UNSTABLE
 from ligwf.study.processes import start_time
@@ -36,12 +36,13 @@ _VERSION_RE = re.compile(r"^LIGGGHTS \((Version .*)\)\s*$")
 
 def expectation(s: ScaledScene) -> Expectation:
     """Healthy end state of a scaled scene: particle count, step counts, KE ceiling."""
-    mean_volume = sum(f * math.pi * d**3 / 6.0 for d, f in zip(s.diameters, s.number_fractions))
-    mass = s.particle_count * s.density * mean_volume
-    return Expectation(particle_count=s.particle_count,
-                       settle_end_step=s.insertion_steps + s.settle_steps,
+    p = s.particles
+    mean_volume = sum(f * math.pi * d**3 / 6.0 for d, f in zip(p.diameters, p.number_fractions))
+    mass = p.count * p.density * mean_volume
+    return Expectation(particle_count=p.count,
+                       settle_end_step=s.insertion_steps + s.numerics.settle_steps,
                        total_steps=s.total_steps,
-                       ke_ceiling=kinetic_energy_ceiling(mass, s.drum_diameter, s.omega))
+                       ke_ceiling=kinetic_energy_ceiling(mass, s.drum.diameter, s.drum.omega))
 
 
 def engine_version(lines: list[str]) -> str | None:
@@ -155,7 +156,7 @@ def record_hole(case: CaseFolder, rows: list[ThermoRow]) -> tuple[int, str] | No
     when the record is whole.
     """
     holes: list[tuple[int, str]] = []
-    every = case.scaled.thermo_every
+    every = case.scaled.numerics.thermo_every
     for a, b in zip(rows, rows[1:]):
         if not 0 < b.step - a.step <= every:
             holes.append((a.step, f"thermo rows missing or repeated between steps {a.step} "
@@ -214,7 +215,7 @@ def case_rows(case: CaseFolder, attempts: list[Attempt]) -> list[ThermoRow]:
         screen = case.path / a.screen
         if a.screen and screen.is_file():
             new = parse_screen(screen.read_text(errors="replace")).rows
-            rows = merge_rows(rows, new, a.from_step, case.scaled.dt)
+            rows = merge_rows(rows, new, a.from_step, case.scaled.numerics.dt)
         elif case.thermo.is_file():
             table = rows_from_csv(case.thermo.read_text())
             rows = [r for r in rows if r.step < a.from_step] + \

@@ -37,7 +37,7 @@ from functools import lru_cache
 import numpy as np
 
 from ligwf.errors import ConfigError
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 
 #: thinnest slab (along the axis) or column (across) one rank gets, in largest diameters
 MIN_AXIAL_SLAB = 4.0
@@ -232,7 +232,7 @@ def best_grid(ranks: int, drum_length: float, d_max: float, periodic: bool = Tru
 
 def scene_bed(scaled: ScaledScene) -> Bed:
     """The cross-section of a scaled case the decomposition plans with."""
-    return Bed(scaled.drum_diameter, scaled.fill_fraction, scaled.d_max)
+    return Bed(scaled.drum.diameter, scaled.drum.fill_fraction, scaled.d_max)
 
 
 def runner_grid(scaled: ScaledScene, ranks: int) -> tuple[int, int]:
@@ -240,8 +240,8 @@ def runner_grid(scaled: ScaledScene, ranks: int) -> tuple[int, int]:
     planner's :func:`best_grid`; a rank count no such grid fits (``--np`` by hand) keeps
     the slabs and puts the rest across, as before the 2-D planner."""
     try:
-        grid = best_grid(ranks, scaled.drum_length, scaled.d_max, scaled.periodic,
+        grid = best_grid(ranks, scaled.drum.length, scaled.d_max, scaled.drum.periodic,
                          scene_bed(scaled))
     except ConfigError:
-        grid = best_grid(ranks, scaled.drum_length, scaled.d_max, scaled.periodic, None)
+        grid = best_grid(ranks, scaled.drum.length, scaled.d_max, scaled.drum.periodic, None)
     return grid.axial, grid.across

@@ -238,7 +238,7 @@ def _run_locked(case: CaseFolder, nprocs: int, engine: EngineConfig, monitor: Mo
 
         def judge(parser: ThermoParser) -> str | None:
             return live_problem(merge_rows(before, parser.rows, attempt.from_step,
-                                           case.scaled.dt), expect)
+                                           case.scaled.numerics.dt), expect)
 
         def record(procs: list[EngineProcess]) -> None:
             manifest.engine = [p.to_dict() for p in procs]

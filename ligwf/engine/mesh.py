@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ligwf.fsio import atomic_write_text
+from ligwf.scene.axis import Axis
 from ligwf.scene.model import Drum, Scene
 from ligwf.study.layout import mesh_file
 
@@ -41,11 +42,6 @@ MIN_SEGMENTS = 96
 #: in a 144 mm slice gave 0.25 deg (measured). Past this bound the shell gets more rows, so
 #: every drum short enough for one row (0.5 deg at 72 mm there) keeps its mesh byte for byte.
 MIN_FACET_ANGLE_DEG = 0.4
-
-
-def axis_frame(axis: str) -> tuple[int, int, int]:
-    """Indices (axial, u, v) of x/y/z for a drum axis; v is 'up' (gravity along -v)."""
-    return {"x": (0, 1, 2), "y": (1, 0, 2), "z": (2, 0, 1)}[axis]
 
 
 def wall_sag(d_min_original: float) -> float:
@@ -102,8 +98,8 @@ def drum_outline(drum: Drum, sag: float) -> np.ndarray:
     return np.column_stack([arr[:, 1] * np.cos(arr[:, 0]), arr[:, 1] * np.sin(arr[:, 0])])
 
 
-def _to_xyz(u: np.ndarray, v: np.ndarray, w: np.ndarray, axis: str) -> np.ndarray:
-    ia, iu, iv = axis_frame(axis)
+def _to_xyz(u: np.ndarray, v: np.ndarray, w: np.ndarray, axis: Axis) -> np.ndarray:
+    ia, iu, iv = axis.frame
     out = np.zeros((len(u), 3))
     out[:, ia], out[:, iu], out[:, iv] = w, u, v
     return out
@@ -157,7 +153,7 @@ def shell_rows(outline: np.ndarray, length: float) -> int:
 
 def _orient_inward(tri: np.ndarray, drum: Drum) -> np.ndarray:
     """Flip triangles whose normal points away from the drum interior."""
-    ia, iu, iv = axis_frame(drum.axis)
+    ia, iu, iv = drum.axis.frame
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     centroid = tri.mean(axis=1)
     inward = np.zeros_like(centroid)

@@ -49,7 +49,7 @@ from ligwf.engine.decomposition import (Bed, GridCost, axial_slab_limit, best_gr
                                         scene_bed)
 from ligwf.engine.cores import at_least
 from ligwf.errors import ConfigError
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 
 #: Fewest particles a rank should carry (see the module docstring): 11,963 particles gain
 #: 1.76x from 2 ranks; a few hundred lose.
@@ -121,13 +121,13 @@ class CaseLoad:
 
 def particle_steps(scaled: ScaledScene) -> int:
     """Particles x total steps of a scaled case: the cost the planner packs by."""
-    return scaled.particle_count * scaled.total_steps
+    return scaled.particles.count * scaled.total_steps
 
 
 def case_load(name: str, scaled: ScaledScene) -> CaseLoad:
     """The planner's view of a scaled case."""
-    return CaseLoad(name, scaled.particle_count, scaled.total_steps, scaled.drum_length,
-                    scaled.d_max, scaled.wet, scene_bed(scaled), scaled.periodic)
+    return CaseLoad(name, scaled.particles.count, scaled.total_steps, scaled.drum.length,
+                    scaled.d_max, scaled.wet, scene_bed(scaled), scaled.drum.periodic)
 
 
 def case_grid(load: CaseLoad, ranks: int) -> GridCost:

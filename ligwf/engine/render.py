@@ -24,8 +24,7 @@ from ligwf import __version__
 from ligwf.errors import RenderError
 from ligwf.liquids.contact_angle import input_angle
 from ligwf.engine.decomposition import runner_grid
-from ligwf.engine.mesh import axis_frame
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.model import GRAVITY
 from ligwf.scene.values import unsafe_chars
 from ligwf.study.layout import INPUT_NAME, MESH_NAME
@@ -94,18 +93,19 @@ def _unit(index: int, sign: float = 1.0) -> list[float]:
 
 def template_context(s: ScaledScene) -> dict[str, Any]:
     """Everything the drum template needs, derived from the scaled scene (pure)."""
-    ia, iu, iv = axis_frame(s.axis)
-    r = 0.5 * s.drum_diameter
+    ia, iu, iv = s.drum.axis.frame
+    liquid = s.liquid_values
+    r = s.drum.radius
     half_box = 1.05 * r + s.d_max
     lo = [-half_box] * 3
     hi = [half_box] * 3
-    if s.periodic:
-        lo[ia], hi[ia] = 0.0, s.drum_length
+    if s.drum.periodic:
+        lo[ia], hi[ia] = 0.0, s.drum.length
     else:
-        pad = 0.02 * s.drum_length + s.d_max
-        lo[ia], hi[ia] = -pad, s.drum_length + pad
+        pad = 0.02 * s.drum.length + s.d_max
+        lo[ia], hi[ia] = -pad, s.drum.length + pad
     boundary = ["f", "f", "f"]
-    if s.periodic:
+    if s.drum.periodic:
         boundary[ia] = "p"
     # processor grid: never along gravity (the bed lies in the lower half: 96 % of a settled
     # bed on one of 2 ranks); ranks along the axis first, where the bed is uniform, then
@@ -115,12 +115,12 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
     grid = ["1", "1", "1"]
     grid[ia], grid[iu] = "axial", "across"
     templates = [
-        {"id": f"pts{k + 1}", "radius": 0.5 * d, "fraction": f, "seed": s.seeds[k]}
-        for k, (d, f) in enumerate(zip(s.diameters, s.number_fractions))
+        {"id": f"pts{k + 1}", "radius": 0.5 * d, "fraction": f, "seed": s.fill.seeds[k]}
+        for k, (d, f) in enumerate(zip(s.particles.diameters, s.particles.number_fractions))
     ]
     k0 = len(templates)
-    waves = [{"id": f"ins{k + 1}", "count": n, "seed": s.seeds[k0 + 1 + k]}
-             for k, n in enumerate(s.insertion_waves)]
+    waves = [{"id": f"ins{k + 1}", "count": n, "seed": s.fill.seeds[k0 + 1 + k]}
+             for k, n in enumerate(s.fill.waves)]
     return {
         "s": s,
         "version": __version__,
@@ -128,29 +128,29 @@ def template_context(s: ScaledScene) -> dict[str, Any]:
         "processor_grid": grid,
         "box_lo": lo,
         "box_hi": hi,
-        "axis": s.axis,
-        "axial_lo": 0.0 if s.periodic else 0.55 * s.d_max,
-        "axial_hi": s.drum_length if s.periodic else s.drum_length - 0.55 * s.d_max,
+        "axis": s.drum.axis.value,
+        "axial_lo": 0.0 if s.drum.periodic else 0.55 * s.d_max,
+        "axial_hi": s.drum.length if s.drum.periodic else s.drum.length - 0.55 * s.d_max,
         "axis_vector": _unit(ia),
         "gravity": GRAVITY,
         "gravity_vector": _unit(iv, -1.0),
         "templates": templates,
-        "distribution_seed": s.seeds[k0],
+        "distribution_seed": s.fill.seeds[k0],
         "waves": waves,
         "topup_margin": TOPUP_MARGIN,
-        "rolling": s.rolling_friction > 0.0,
+        "rolling": s.particles.rolling_friction > 0.0,
         "wet": s.wet,
         # the liquid block comes from the case's model (ligwf.liquids): its cohesion
         # keyword, its lines (the contact angle as LIGGGHTS 3.8.0 needs it) and dump columns
         "cohesion": s.liquid.cohesion,
         # its on/off switches (washino's modifyLbVolume, limitLiquidContent), after all
         # the models of the pair style; none at the defaults
-        "cohesion_settings": s.liquid.cohesion_settings(s),
+        "cohesion_settings": s.liquid.cohesion_settings(liquid),
         "liquid_lines": s.liquid.liggghts_lines(
-            s, input_angle(s.contact_angle_deg, s.contact_angle_compensation)),
+            liquid, input_angle(liquid.contact_angle_deg, liquid.contact_angle_compensation)),
         "liquid_dump_columns": s.liquid.dump_columns,
         "mesh_name": MESH_NAME,
-        "wet_spheres": [_xyz(ia, iu, iv, w) for w in s.wet_spheres],
+        "wet_spheres": [_xyz(ia, iu, iv, w) for w in liquid.wet_spheres],
     }
 
 

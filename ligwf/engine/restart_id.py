@@ -50,7 +50,7 @@ class CaseIdentity:
     def of(cls, case) -> "CaseIdentity":
         """The identity of a :class:`ligwf.study.case.CaseFolder`."""
         return cls(case.case_id, case.scene_hash, int(case.replica),
-                   tuple(int(s) for s in getattr(case.scaled, "seeds", ())))
+                   tuple(int(s) for s in case.scaled.fill.seeds))
 
     def to_dict(self) -> dict:
         return {"case_id": self.case_id, "scene_hash": self.scene_hash,

@@ -32,7 +32,7 @@ from pathlib import Path
 from ligwf.engine.liggghts import restart_step
 from ligwf.engine.restart_id import CaseIdentity, remove_sidecar, why_not_own
 from ligwf.engine.render import render_template, template_context
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import (ENGINE_LOG, FORCED_RESTART_RE, INPUT_NAME, MANIFEST_FILE,
                                 OUTPUT_DIRS, PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX,
@@ -165,7 +165,7 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
         return NextAttempt(FRESH, f"re-run after {status}: {m.reason}", why=Why.RERUN)
     if status == RUNNING:
         return NextAttempt(SKIP, f"running in process {m.pid} on {m.host}", why=Why.HELD)
-    limit = m.steps_done + case.scaled.thermo_every
+    limit = m.steps_done + case.scaled.numerics.thermo_every
     if m.complete_upto is not None:
         limit = min(limit, m.complete_upto)
     restarts, refused = own_restarts(case, limit)
@@ -225,9 +225,9 @@ def resume_phase(s: ScaledScene, step: int) -> tuple[str, int, bool]:
     written exactly at a wave boundary has not inserted the next wave yet.
     """
     if step < s.insertion_steps:
-        wave = step // s.wave_steps + 1
-        return "fill", wave, step % s.wave_steps != 0
-    if step < s.insertion_steps + s.settle_steps:
+        wave = step // s.fill.wave_steps + 1
+        return "fill", wave, step % s.fill.wave_steps != 0
+    if step < s.insertion_steps + s.numerics.settle_steps:
         return "settle", 0, False
     return "production", 0, False
 
@@ -236,7 +236,7 @@ def phase_steps_between(s: ScaledScene, lo: int, hi: int) -> dict[str, int]:
     """Steps ``lo+1 .. hi`` of case ``s`` per phase group (fill, settle, production): what a
     run that went from step ``lo`` to step ``hi`` spent in each (pure; empty when hi <= lo)."""
     fill_end = s.insertion_steps
-    settle_end = fill_end + s.settle_steps
+    settle_end = fill_end + s.numerics.settle_steps
     # step k belongs to the phase whose span (a, b] holds it; past the end is production
     spans = (("fill", 0, fill_end), ("settle", fill_end, settle_end),
              ("production", settle_end, max(hi, s.total_steps)))

@@ -40,7 +40,8 @@ class LiquidBlock(Protocol):
 
 
 class ScaledLiquid(Protocol):
-    """The CG-scaled liquid values (``ligwf.scene.scaling.ScaledScene``) a model renders."""
+    """The CG-scaled liquid values a model renders (a scaled scene's ``liquid_values``,
+    ``ligwf.scene.scaled.ScaledLiquidValues``)."""
 
     surface_tension: float      # N/m, CG-scaled
     viscosity: float            # Pa s, CG-scaled

@@ -28,10 +28,11 @@ from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, ato
 from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
 from ligwf.engine.plan import CaseLoad, case_load
 from ligwf.engine.render import render
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.regime import definition_warning, regime_warnings
 from ligwf.scene.stability import Preflight, check_rendered
 from ligwf.scene.window import held_window_warnings
+from ligwf.scene.renamed import renamed_setting_warnings
 from ligwf.scene.unused import unused_setting_warnings
 from ligwf.scene.workflow import Case, Workflow, comparison_warnings, load_workflow
 from ligwf.study.case import content_hash
@@ -78,14 +79,15 @@ def check_run_lengths(case: Case, scaled: ScaledScene) -> None:
     """Refuse a phase longer than one LIGGGHTS ``run`` command takes: the engine would stop
     with "Invalid run command N value" after the fill (a tiny dt with a long run)."""
     fall = "the fill's insertion wave (the fall across the drum)"
-    for field, steps in (("process.settle_time", scaled.settle_steps),
-                         ("process.run_time", scaled.run_steps), (fall, scaled.wave_steps)):
+    for field, steps in (("process.settle_time", scaled.numerics.settle_steps),
+                         ("process.run_time", scaled.numerics.run_steps),
+                         (fall, scaled.fill.wave_steps)):
         if steps > ENGINE_MAX_RUN_STEPS:
-            seconds = steps * scaled.dt
-            most = ENGINE_MAX_RUN_STEPS * scaled.dt
+            seconds = steps * scaled.numerics.dt
+            most = ENGINE_MAX_RUN_STEPS * scaled.numerics.dt
             shown = f"{field} = {seconds:g} s" if field != fall else f"{field}, {seconds:.3g} s,"
             raise ConfigError(f"case {case.case_id}: {shown} is {steps:,} steps of dt = "
-                              f"{scaled.dt:.3g} s; LIGGGHTS runs at most "
+                              f"{scaled.numerics.dt:.3g} s; LIGGGHTS runs at most "
                               f"{ENGINE_MAX_RUN_STEPS:,} steps in one run command (allowed "
                               f"range (0, {most:.3g}] s at this dt; or raise numerics.dt / "
                               "numerics.dt_rayleigh_fraction)")
@@ -123,7 +125,8 @@ def prepare(wf: Workflow, template_dirs: Iterable[str | Path] = (),
     rendered = render_workflow(wf, template_dirs)
     reports, warnings = check_rendered(rendered, allow_unstable)
     return Prepared(wf, rendered, reports,
-                    warnings + regime_warnings(rendered) + comparison_warnings(wf)
+                    renamed_setting_warnings(wf) + warnings + regime_warnings(rendered)
+                    + comparison_warnings(wf)
                     + unused_setting_warnings(wf)
                     + held_window_warnings(wf)
                     + definition_warning(wf.analysis, rendered))

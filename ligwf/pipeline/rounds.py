@@ -149,9 +149,9 @@ def apply_extensions(study: Study, rounds: Rounds) -> None:
     for case in study.cases:
         steps = target.get(case.case_id, new.get((case.group, case.cg, case.rule,
                                                   case.replica)))
-        if steps is not None and steps != case.scaled.run_steps:
-            base = case.rendered_scaled.run_steps
-            write_extension(case.path, base, max(steps, base), case.scaled.dt)
+        if steps is not None and steps != case.scaled.numerics.run_steps:
+            base = case.rendered_scaled.numerics.run_steps
+            write_extension(case.path, base, max(steps, base), case.scaled.numerics.dt)
 
 
 # ---------------------------------------------------------------- one look
@@ -207,9 +207,9 @@ def _actions(study: Study, needs: dict[tuple, list[float]]) -> tuple[list[dict],
             continue
         rate = calibration(cases)
         arm = "CG1" if cg == REFERENCE_CG else "CG-n"
-        steps_now = max(c.scaled.run_steps for c in cases)
+        steps_now = max(c.scaled.numerics.run_steps for c in cases)
         if extend > 0:
-            more = math.ceil(extend / cases[0].scaled.dt)
+            more = math.ceil(extend / cases[0].scaled.numerics.dt)
             run_steps = {c.case_id: steps_now + more for c in cases}
             actions.append({"kind": EXTEND, "arm": arm, "seconds": extend,
                             "case_ids": [c.case_id for c in cases], "run_steps": run_steps})
@@ -222,7 +222,7 @@ def _actions(study: Study, needs: dict[tuple, list[float]]) -> tuple[list[dict],
             actions.append({"kind": REPLICAS, "arm": arm, "group": group, "cg": cg,
                             "rule": rule, "replicas": reps, "each_run_steps": steps_now,
                             "condition": Condition(group, cg, rule).name})
-            scaled = dataclasses.replace(cases[0].scaled, run_steps=steps_now)
+            scaled = cases[0].scaled.with_run_steps(steps_now)
             hours += rate * add * run_costs(scaled)[0] / 3600.0
     return actions, hours
 

@@ -19,8 +19,8 @@ from matplotlib.figure import Figure
 from ligwf.analysis.records.conditions import Conditions
 from ligwf.analysis.records.field_errors import MATERIAL_SOLID, condition_mean
 from ligwf.analysis.records.fields import CaseFields, FieldGrid, fields_of
-from ligwf.engine.mesh import axis_frame
 from ligwf.report.figures import save
+from ligwf.scene.axis import Axis
 from ligwf.study import layout
 
 #: quantity -> (label, colour map) of the maps
@@ -33,10 +33,10 @@ SCALE_PERCENTILE = 99.0
 ARROWS = 15
 
 
-def rotation_sense(axis: str, omega: float) -> str:
+def rotation_sense(axis: Axis, omega: float) -> str:
     """How the drum turns on the maps (u to the right, v up): clockwise or
     counter-clockwise."""
-    ia, iu, iv = axis_frame(axis)
+    ia, iu, iv = axis.frame
     eu, ev, ea = np.eye(3)[iu], np.eye(3)[iv], np.eye(3)[ia]
     towards_viewer = float(np.dot(np.cross(eu, ev), ea))
     return "counter-clockwise" if omega * towards_viewer > 0 else "clockwise"

@@ -358,7 +358,8 @@ def fields_report(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame, o
     null = null_check(cases, fields, settings.bootstrap, settings.seed, settings.field_kernel)
     atomic_write_text(out / layout.FIELD_NULL_REPORT, null.to_csv(index=False))
     usable = study.usable_cases()[0]
-    sense = rotation_sense(usable[0].scaled.axis, usable[0].scaled.omega) if usable else "?"
+    drum = usable[0].scaled.drum if usable else None
+    sense = rotation_sense(drum.axis, drum.omega) if drum else "?"
     figures = group_figures(cases, fields, out / layout.FIGURES_DIR, sense, twin_cases(cases))
     md = fields_section(conditions, null, fields,
                         [(t, f"{layout.FIGURES_DIR}/{p.name}") for t, p in figures],

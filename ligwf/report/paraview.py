@@ -15,18 +15,17 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from ligwf.engine.mesh import axis_frame
+from ligwf.scene.axis import Axis
 from ligwf.study.layout import MESH_NAME
 from ligwf.fsio import atomic_write_text
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 
 
-def rotation_matrix(axis: str, angle: float) -> np.ndarray:
+def rotation_matrix(axis: Axis, angle: float) -> np.ndarray:
     """Right-handed rotation by ``angle`` (rad) about +axis."""
-    ia, _, _ = axis_frame(axis)
     k = np.zeros(3)
-    k[ia] = 1.0
+    k[axis.index] = 1.0
     kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
     return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
 
@@ -66,11 +65,11 @@ def case_collection(case: CaseFolder, frames, analysis_dir: Path, out_dir: Path)
     entries = []
     labelled = analysis_dir / case.case_id
     for step, dump in frames:
-        t = step * s.dt
+        t = step * s.numerics.dt
         g = labelled / layout.granule_frame(step)
         particles = g if g.is_file() else case.path / dump
         entries.append((t, 0, os.path.relpath(particles, out_dir)))
-        pts = points @ rotation_matrix(s.axis, case.drum_angle(step)).T
+        pts = points @ rotation_matrix(s.drum.axis, case.drum_angle(step)).T
         drum_file = case_out / layout.drum_frame(step)
         tmp = drum_file.with_suffix(".tmp.vtu")
         meshio.write(tmp, meshio.Mesh(pts, [("triangle", tri)]), binary=True)

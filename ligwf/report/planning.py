@@ -29,7 +29,7 @@ from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.sampling import within_variance
 from ligwf.analysis.records.statistics import MEAN, SHARE_ABOVE
 from ligwf.engine.plan import case_load, estimated_seconds
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.study.case import CaseFolder
 
 #: the columns of a noise table besides the per-criterion within-run variances
@@ -47,7 +47,7 @@ def run_costs(scaled: ScaledScene) -> tuple[float, float]:
     production) of a case on one rank, from the planner's rates."""
     load = case_load("cost", scaled)
     replica = estimated_seconds(load, 1)
-    steps_per_second = max(1, round(1.0 / scaled.dt))
+    steps_per_second = max(1, round(1.0 / scaled.numerics.dt))
     production = estimated_seconds(dataclasses.replace(load, steps=steps_per_second), 1)
     return replica, production
 

@@ -22,14 +22,15 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
 from ligwf.report.figures import save
+from ligwf.scene.axis import Axis
 
 #: colour map of speed snapshots
 SPEED_CMAP = "viridis"
 #: percentile of all snapshot speeds at the top of the shared colour scale
 SPEED_PERCENTILE = 99.0
 #: where the camera sits (seen from the focal point) and which way is up, per drum axis
-VIEW = {"x": ((1.0, 0.0, 0.0), (0.0, 0.0, 1.0)), "y": ((0.0, -1.0, 0.0), (0.0, 0.0, 1.0)),
-        "z": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0))}
+VIEW = {Axis.X: ((1.0, 0.0, 0.0), (0.0, 0.0, 1.0)), Axis.Y: ((0.0, -1.0, 0.0), (0.0, 0.0, 1.0)),
+        Axis.Z: ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0))}
 
 
 @dataclass(frozen=True)
@@ -65,21 +66,21 @@ def speed_scale(dumps: Iterable[Path]) -> SpeedScale | None:
     return SpeedScale(vmax if vmax > 0 else float(pooled.max() or 1.0), len(dumps))
 
 
-def rotation_sense(axis: str, omega: float) -> int:
+def rotation_sense(axis: Axis, omega: float) -> int:
     """+1 when the drum turns counter-clockwise in the snapshot's view, -1 clockwise (0:
     at rest). The drum turns right-handedly about +axis at ``omega`` (rad/s, signed); the
     camera looks along -view vector with screen right = direction x up (VTK's camera)."""
     if omega == 0:
         return 0
     k = np.zeros(3)
-    k["xyz".index(axis)] = 1.0
+    k[axis.index] = 1.0
     view, up = (np.asarray(v) for v in VIEW[axis])
     right = np.cross(-view, up)
     top_moves = np.sign(omega) * np.cross(k, up)   # velocity of the drum's top point
     return -1 if float(top_moves @ right) > 0 else 1
 
 
-def render_frame(particles_vtu: Path, drum_stl: Path, axis: str, drum_angle: float,
+def render_frame(particles_vtu: Path, drum_stl: Path, axis: Axis, drum_angle: float,
                  scalar: str, vmax: float | None = None) -> tuple[np.ndarray, str]:
     """(RGB image, note) of one frame along the drum axis, coloured by ``scalar``
     (``speed`` on 0..vmax, or ``granule``), with the drum turned to ``drum_angle`` (rad)."""
@@ -144,7 +145,7 @@ def snapshot_ax(ax: Axes, image: np.ndarray, title: str, sense: int = 0,
     return ax
 
 
-def snapshot(particles_vtu: Path, drum_stl: Path, axis: str, drum_angle: float, scalar: str,
+def snapshot(particles_vtu: Path, drum_stl: Path, axis: Axis, drum_angle: float, scalar: str,
              path: Path, title: str, omega: float = 0.0,
              scale: SpeedScale | None = None) -> Path:
     """One snapshot PNG: :func:`render_frame` laid out by :func:`snapshot_ax`."""

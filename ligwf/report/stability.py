@@ -37,7 +37,7 @@ from ligwf.engine import health
 from ligwf.engine.attempt import expectation
 from ligwf.engine.thermo import parse_screen
 from ligwf.errors import DumpReadError
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.stability import OVERLAP_LIMIT, REFUSED, Preflight, preflight
 from ligwf.study.case import CaseFolder
 from ligwf.study.study import studies_below
@@ -85,14 +85,14 @@ def max_overlap_in_frame(positions: np.ndarray, radii: np.ndarray, s: ScaledScen
     cylindrical shell (radius R; its polygon facets lie inside, so this never overstates)."""
     from scipy.spatial import cKDTree
 
-    ia = "xyz".index(s.axis)
+    ia = s.drum.axis.index
     pos, rad = positions, radii
-    if s.periodic:
+    if s.drum.periodic:
         reach = 2.0 * rad.max()
         ax = pos[:, ia]
-        lo, hi = ax < reach, ax > s.drum_length - reach
+        lo, hi = ax < reach, ax > s.drum.length - reach
         shift = np.zeros(3)
-        shift[ia] = s.drum_length
+        shift[ia] = s.drum.length
         pos = np.vstack([positions, positions[lo] + shift, positions[hi] - shift])
         rad = np.concatenate([radii, radii[lo], radii[hi]])
     n = len(positions)
@@ -104,7 +104,7 @@ def max_overlap_in_frame(positions: np.ndarray, radii: np.ndarray, s: ScaledScen
         dist = np.linalg.norm(pos[pairs[:, 0]] - pos[pairs[:, 1]], axis=1)
         best = float(np.max(rad[pairs[:, 0]] + rad[pairs[:, 1]] - dist))
     radial = np.delete(positions, ia, axis=1)
-    wall = np.linalg.norm(radial, axis=1) + radii - 0.5 * s.drum_diameter
+    wall = np.linalg.norm(radial, axis=1) + radii - 0.5 * s.drum.diameter
     return max(best, float(wall.max()), 0.0)
 
 

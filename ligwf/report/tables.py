@@ -86,19 +86,19 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
         s = c.scaled
         phases = man.phases or {}
         prod = phases.get("production", {})
-        production_seconds = s.run_steps * s.dt
+        production_seconds = s.numerics.run_steps * s.numerics.dt
         prod_core = prod.get("core_seconds", math.nan)
         prod_wall = prod.get("wall_seconds", math.nan)
         if not prod:   # a manifest without phase times: whole-run cost over whole-run time
             prod_core, prod_wall = man.core_seconds, man.wall_seconds
-            production_seconds = man.steps_done * s.dt
+            production_seconds = man.steps_done * s.numerics.dt
         rows.append({
             "case_id": c.case_id, "group": c.group, "group_label": group_label(c.group),
             "cg": c.cg, "rule": c.rule,
-            "replica": c.replica, "particles": s.particle_count,
-            "original_particles": s.original_particle_count, "dt": s.dt,
+            "replica": c.replica, "particles": s.particles.count,
+            "original_particles": s.particles.original_count, "dt": s.numerics.dt,
             "steps": man.steps_done,
-            "simulated_seconds": man.steps_done * s.dt,
+            "simulated_seconds": man.steps_done * s.numerics.dt,
             "production_seconds": production_seconds,
             "wall_seconds": man.wall_seconds,
             "core_seconds": man.core_seconds,
@@ -108,7 +108,7 @@ def case_rows(study: Study) -> tuple[pd.DataFrame, list[dict]]:
             # per 1,000 particles of the ORIGINAL system: slices of different length (and
             # CG levels) on one footing
             "production_core_rate_k": _per(prod_core, production_seconds)
-            / s.original_particle_count * 1000.0,
+            / s.particles.original_count * 1000.0,
             "production_wall_rate": _per(prod_wall, production_seconds),
             "nprocs": man.nprocs,
         })

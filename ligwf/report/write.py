@@ -171,7 +171,8 @@ def report_figures(study: Study, flow: FlowRecord, cases: pd.DataFrame,
             found.gsd.append(Figure("GSD overlay", figs.gsd_overlay(
                 gsd, fig_dir / layout.FIGURE_GSD_OVERLAY, study.analysis.gsd_volume,
                 size_limits(study.analysis_dir))))
-    starts = {c.case_id: c.production_start_step * c.scaled.dt for c in study.usable_cases()[0]}
+    starts = {c.case_id: c.production_start_step * c.scaled.numerics.dt
+              for c in study.usable_cases()[0]}
     found.kinetics += [Figure(t, p) for t, p in granule_figures(study.analysis_dir, fig_dir,
                                                                 starts)]
     by_id = {c.case_id: c for c in study.usable_cases()[0]}
@@ -208,10 +209,10 @@ def snapshot_figures(study: Study, shots: list, fig_dir: Path) -> list[Figure]:
     scale = speed_scale(case.path / dump for case, _, dump in shots) if shots else None
     out = []
     for case, step, dump in shots:
-        axis, mesh, omega = case.scaled.axis, case.path / MESH_NAME, case.scaled.omega
+        axis, mesh, omega = case.scaled.drum.axis, case.path / MESH_NAME, case.scaled.drum.omega
 
         def title(at: int, what: str) -> str:
-            t = (at - case.production_start_step) * case.scaled.dt
+            t = (at - case.production_start_step) * case.scaled.numerics.dt
             return f"{case.case_id}, {t:.2f} s after production start: {what}"
         out.append(Figure(f"{case.case_id}: speed", snapshot(
             case.path / dump, mesh, axis, case.drum_angle(step), "speed",

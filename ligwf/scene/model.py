@@ -17,6 +17,7 @@ from pydantic import Field, ValidationError, model_validator
 
 from ligwf import liquids
 from ligwf.errors import ConfigError
+from ligwf.scene.axis import Axis
 from ligwf.scene.liquid import Liquid
 from ligwf.scene.messages import format_validation_error
 from ligwf.scene.values import MIN_LENGTH, MIN_RESTITUTION, MIN_TIME, Frozen, SafeStr
@@ -50,7 +51,7 @@ class Drum(Frozen):
     diameter: float = Field(ge=1e-3, le=10.0, description="inner shell diameter, m")
     length: float = Field(ge=MIN_LENGTH, le=10.0,
                           description="axial length, m (the periodic length)")
-    axis: Literal["x", "y", "z"] = Field("y", description="rotation axis")
+    axis: Axis = Field(Axis.Y, description="rotation axis")
     periodic: bool = Field(True, description="periodic boundary along the axis; "
                            "otherwise the drum has end walls")
     lifters: Lifters = Field(default_factory=Lifters)
@@ -220,7 +221,26 @@ class Numerics(Frozen):
 class Analysis(Frozen):
     """Which analyses the run must prepare output for."""
 
-    granules: bool = Field(False, description="write contact dumps for granule analysis")
+    contact_dumps: bool = Field(False, description="write contact dumps (the granule "
+                                "analysis reads them; the study's analysis: block says how)")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed_granules(cls, data: Any) -> Any:
+        """``granules`` is this switch's old name (scene records written before the rename
+        hold it; a workflow that uses it gets a warning, ligwf.scene.renamed)."""
+        if isinstance(data, dict) and RENAMED_ANALYSIS_KEY in data:
+            if "contact_dumps" in data:
+                raise ValueError(f"analysis.{RENAMED_ANALYSIS_KEY} and analysis.contact_dumps "
+                                 "are both set: they are one switch (contact_dumps is its "
+                                 "name now); keep contact_dumps")
+            data = {("contact_dumps" if k == RENAMED_ANALYSIS_KEY else k): v
+                    for k, v in data.items()}
+        return data
+
+
+#: the old name of ``analysis.contact_dumps`` (still read, with a warning in workflows)
+RENAMED_ANALYSIS_KEY = "granules"
 
 
 #: most particle (+ contact) dumps and thermo lines one production run may write
@@ -241,10 +261,10 @@ class Scene(Frozen):
     analysis: Analysis = Field(default_factory=Analysis)
 
     @model_validator(mode="after")
-    def _granules_need_liquid(self) -> "Scene":
-        if self.analysis.granules and not self.liquid.wet:
+    def _contact_dumps_need_liquid(self) -> "Scene":
+        if self.analysis.contact_dumps and not self.liquid.wet:
             wet = " or ".join(n for n in liquids.names() if liquids.get(n).wet)
-            raise ValueError("analysis.granules = true: needs a liquid model (granules are "
+            raise ValueError("analysis.contact_dumps = true: needs a liquid model (granules are "
                              f"held by liquid bridges); set liquid.model to {wet}")
         return self
 

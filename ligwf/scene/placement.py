@@ -5,7 +5,7 @@ chord lies at depth c = R cos(phi / 2) below the drum axis, phi - sin(phi) = 2 p
 wet spheres are spread across the chord (at 0.6 of its half-width, equal steps), each
 half-way between the free surface and the lifter tips below it, in the middle of the slice
 along the axis. Coordinates are the drum frame's (axial, across, vertical) of
-:func:`ligwf.engine.render.axis_frame`: the renderer maps them onto x, y, z.
+:attr:`ligwf.scene.axis.Axis.frame`: the renderer maps them onto x, y, z.
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def wet_sphere_centres(radius: float, inner_radius: float, length: float, fill: 
 
 
 def wet_sphere_fields(scene, largest_diameter: float, cg: float) -> dict:
-    """The :class:`~ligwf.scene.scaling.ScaledScene` fields of placed liquid (none for a
+    """The :class:`~ligwf.scene.scaled.ScaledLiquidValues` fields of placed liquid (none for a
     uniformly wetted bed): the wet spheres (axial, across, vertical, radius) and their
     liquid content. A sphere smaller than the largest (CG-scaled) particle diameter is
     refused: it would hold no or a single particle centre, a dry bed in all but name."""

@@ -97,7 +97,7 @@ CROSS_FIELD_RULES: dict[str, tuple[str, ...]] = {
         "`numerics.dump_interval` <= `process.run_time`; `numerics.thermo_interval` <= the "
         "run time and the free fall across the drum; at most "
         f"{MAX_DUMPS:,} dumps per run.",
-        "`analysis.granules: true` needs a wet liquid model.",
+        "`analysis.contact_dumps: true` needs a wet liquid model.",
     ),
     "sweep": (
         "`cg_levels` >= 1; `per_cg` and `control_cg_levels` only name levels of `cg_levels`.",
@@ -290,7 +290,7 @@ HEAD = ["| key | required / default | type | unit | allowed range | meaning |",
 def reference_markdown() -> str:
     """``docs/workflow_reference.md``: every key of every block with required / default,
     type, unit, allowed range and meaning, the cross-field rules, the slice rule and what
-    ``scene.analysis.granules`` switches."""
+    ``scene.analysis.contact_dumps`` switches."""
     schema = workflow_schema()
     defs = schema["$defs"]
     lines = ["# Workflow reference", "",
@@ -326,7 +326,7 @@ def reference_markdown() -> str:
               "end caps (refused below). A CG level that needs a longer slice gets its own "
               "`sweep.per_cg.<n>: {drum.length: ...}`; speedups compare per original "
               "particle, so slices of different length stay on one footing.", "",
-              "## What `scene.analysis.granules` switches", "",
+              "## What `scene.analysis.contact_dumps` switches", "",
               "`true` adds contact dumps (`dump local/gran/vtk` of `compute pair/gran/local`) "
               "to the LIGGGHTS input, so it is part of the scene and of its hash, and needs a "
               "wet liquid model. With it, `ligwf analyse` runs the granule stage (granules, "
@@ -335,7 +335,9 @@ def reference_markdown() -> str:
               "no contact dumps and the study gets the flow metrics only, with a record "
               "saying why there is no granule table. How granules are defined is the "
               "study's `analysis:` block (`analysis.granules`: communities, components or "
-              "held), which changes the analysis, never the runs.", ""]
+              "held), which changes the analysis, never the runs. Its old name "
+              "`scene.analysis.granules` is still read, with a warning naming the new "
+              "one.", ""]
     return "\n".join(lines)
 
 

@@ -38,18 +38,20 @@ GRANULATING_BOND = 3.0
 
 
 def regime_numbers(s) -> dict[str, float]:
-    """St_v, Bo_g, Ca and Fr of a :class:`~ligwf.scene.scaling.ScaledScene` (its own,
+    """St_v, Bo_g, Ca and Fr of a :class:`~ligwf.scene.scaled.ScaledScene` (its own,
     scaled particles), for the number-mean radius."""
-    radius = 0.5 * sum(d * f for d, f in zip(s.diameters, s.number_fractions))
-    v = float(s.omega) * 0.5 * float(s.drum_diameter)
-    wet = s.liquid_model != "none" and s.surface_tension > 0
-    theta = math.radians(s.contact_angle_deg)
-    mu, gamma = float(s.viscosity), float(s.surface_tension)
-    stokes = 8.0 * s.density * radius * v / (9.0 * mu) if wet and mu > 0 else math.inf
-    bond = 3.0 * gamma * math.cos(theta) / (4.0 * radius ** 2 * s.density * GRAVITY) if wet else 0.0
+    p, liq = s.particles, s.liquid_values
+    radius = 0.5 * sum(d * f for d, f in zip(p.diameters, p.number_fractions))
+    v = float(s.drum.omega) * 0.5 * float(s.drum.diameter)
+    wet = liq.model != "none" and liq.surface_tension > 0
+    theta = math.radians(liq.contact_angle_deg)
+    mu, gamma = float(liq.viscosity), float(liq.surface_tension)
+    stokes = 8.0 * p.density * radius * v / (9.0 * mu) if wet and mu > 0 else math.inf
+    bond = 3.0 * gamma * math.cos(theta) / (4.0 * radius ** 2 * p.density * GRAVITY) if wet else 0.0
     capillary = mu * v / gamma if wet else 0.0
     return {"stokes_viscous": stokes, "bond_granular": bond, "capillary": capillary,
-            "froude": float(s.froude), "liquid_content": float(s.liquid_content) if wet else 0.0}
+            "froude": float(s.drum.froude),
+            "liquid_content": float(liq.liquid_content) if wet else 0.0}
 
 
 def granulation_warning(numbers: dict[str, float]) -> str:
@@ -84,7 +86,7 @@ def regime_warnings(rendered) -> list[str]:
     (contact dumps on; control twins left out: they are meant to have no granules)."""
     out: list[str] = []
     for rc in rendered:
-        if not rc.scaled.granules or any(k == "control" for k, _ in rc.case.varied):
+        if not rc.scaled.contact_dumps or any(k == "control" for k, _ in rc.case.varied):
             continue
         msg = granulation_warning(original_numbers(rc.case))
         if all(not w.endswith(msg) for w in out):
@@ -97,7 +99,7 @@ def definition_warning(settings, rendered) -> list[str]:
     cohesionless control on the regime map (every one but ``held``)."""
     if getattr(settings, "granules", "held") == "held":
         return []
-    if not any(rc.scaled.granules for rc in rendered):
+    if not any(rc.scaled.contact_dumps for rc in rendered):
         return []
     return [f"analysis.granules: {settings.granules}: its granules never beat a cohesionless "
             "control on the regime map (a CPM tiling / a bed-spanning cluster, in a twin without "

@@ -43,16 +43,16 @@ ideally n^4 cheaper.
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 from enum import Enum
 
 from ligwf import liquids
 from ligwf.errors import ConfigError
 from ligwf.scene.placement import wet_sphere_fields
-from ligwf.liquids.base import LiquidModel
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.scene.model import GRAVITY, Scene
-from ligwf.scene.neighbour import fill_skin, turning_skin
+from ligwf.scene.neighbour import turning_skin
+from ligwf.scene.scaled import (FillPlan, ScaledDrum, ScaledLiquidValues, ScaledNumerics,
+                                ScaledParticles, ScaledScene, rayleigh_time)
 from ligwf.scene.seeds import replica_seeds
 
 
@@ -80,23 +80,6 @@ def parse_rule(value: str | Rule) -> Rule:
 def liquid_factor(cg: float, rule: Rule) -> float:
     """Factor applied to surface tension and viscosity so bridge forces scale as the rule."""
     return cg ** (FORCE_EXPONENT[rule] - 1)
-
-
-def shear_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
-    """G = E / (2 (1 + nu)), Pa."""
-    return youngs_modulus / (2.0 * (1.0 + poisson_ratio))
-
-
-def rayleigh_time(radius: float, density: float, youngs_modulus: float,
-                  poisson_ratio: float) -> float:
-    """Rayleigh wave time of a sphere, s.
-
-    t_R = pi R sqrt(rho / G) / (0.1631 nu + 0.8766) -- the formula LIGGGHTS' own
-    ``fix check/timestep/gran`` uses, so ligwf's time step fraction and the engine's
-    ``f_ts[1]`` report agree.
-    """
-    g = shear_modulus(youngs_modulus, poisson_ratio)
-    return math.pi * radius * math.sqrt(density / g) / (0.1631 * poisson_ratio + 0.8766)
 
 
 def weber_number(density: float, radius: float, velocity: float, surface_tension: float,
@@ -190,131 +173,6 @@ def _every(interval: float, dt: float) -> int:
     return max(1, round(interval / dt))
 
 
-@dataclass(frozen=True)
-class ScaledScene:
-    """What one LIGGGHTS run gets: the scene after CG scaling, in SI units.
-
-    Everything a template needs is here, so rendering never recomputes physics.
-    """
-
-    name: str
-    cg: float
-    rule: str
-    replica: int
-    # drum and process (unchanged by CG)
-    drum_diameter: float
-    drum_length: float
-    axis: str
-    periodic: bool
-    lifter_count: int
-    lifter_height: float
-    lifter_width_deg: float
-    omega: float                 # rad/s
-    rotation_period: float       # s
-    rpm: float
-    froude: float
-    fill_fraction: float
-    # particles (scaled)
-    diameters: tuple[float, ...]            # largest first
-    number_fractions: tuple[float, ...]
-    particle_count: int
-    original_particle_count: int
-    density: float
-    youngs_modulus: float
-    poisson_ratio: float
-    restitution: float
-    friction: float
-    rolling_friction: float
-    wall_friction: float
-    wall_restitution: float
-    # liquid (scaled)
-    liquid_model: str
-    surface_tension: float
-    viscosity: float
-    contact_angle_deg: float
-    liquid_content: float
-    min_separation_ratio: float
-    max_separation_ratio: float
-    contact_angle_compensation: bool
-    # numerics
-    rayleigh_time: float
-    dt: float
-    dt_rayleigh_fraction: float
-    settle_steps: int
-    run_steps: int
-    dump_every: int
-    thermo_every: int
-    restart_every: int
-    skin: float
-    insertion_radius: float
-    insertion_waves: tuple[int, ...]
-    wave_steps: int              # steps between insertion waves (time to fall one diameter)
-    seeds: tuple[int, ...]       # per template, then the distribution, then per wave
-    granules: bool
-    # placed liquid (ligwf.scene.placement): wet spheres (axial, across, vertical, r), m
-    wet_spheres: tuple[tuple[float, float, float, float], ...] = ()
-    wet_sphere_content: float = 0.0
-    # washino's optional settings (None: the engine default, nothing rendered), fractions
-    # unchanged by CG; with max_liquid_content, max_separation_ratio is the engine's own
-    bridge_volume_fraction: float | None = None
-    max_liquid_content: float | None = None
-
-    @property
-    def wet(self) -> bool:
-        return self.liquid.wet
-
-    @property
-    def liquid(self) -> LiquidModel:
-        """The liquid model of this case (from :mod:`ligwf.liquids`' registry), applying
-        the case's bridge volume fraction."""
-        return liquids.get(self.liquid_model).configured(self.bridge_volume_fraction)
-
-    @property
-    def insertion_steps(self) -> int:
-        """Steps of the filling phase (all insertion waves), before ``settle_steps``."""
-        return len(self.insertion_waves) * self.wave_steps
-
-    @property
-    def total_steps(self) -> int:
-        """Insertion + settling (drum at rest) + production (drum turning)."""
-        return self.insertion_steps + self.settle_steps + self.run_steps
-
-    @property
-    def skin_fill(self) -> float:
-        """Neighbour skin of the fill phase (m): the falling particles' skin, never thinner
-        than :attr:`skin` (that of the settle and production phases)."""
-        return max(self.skin, fill_skin(self.drum_diameter, self.dt, self.d_min))
-
-    @property
-    def d_min(self) -> float:
-        return min(self.diameters)
-
-    @property
-    def d_max(self) -> float:
-        return max(self.diameters)
-
-    @classmethod
-    def from_dict(cls, data: dict) -> "ScaledScene":
-        """From :meth:`to_dict` (a case folder's stored scaled scene): lists back to tuples;
-        a missing or unknown key is a TypeError, never a default."""
-        out = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
-        out["wet_spheres"] = tuple(tuple(w) for w in out.get("wet_spheres", ()))
-        return cls(**out)
-
-    def to_dict(self) -> dict:
-        out = asdict(self)
-        out["diameters"] = list(self.diameters)
-        out["number_fractions"] = list(self.number_fractions)
-        out["seeds"] = list(self.seeds)
-        out["insertion_waves"] = list(self.insertion_waves)
-        if not self.wet_spheres:                 # records of uniform beds stay as they were
-            del out["wet_spheres"], out["wet_sphere_content"]
-        for key in ("bridge_volume_fraction", "max_liquid_content"):
-            if out[key] is None:                 # so do records at the engine's defaults
-                del out[key]
-        return out
-
-
 def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> ScaledScene:
     """Apply CG level ``cg`` under ``rule`` to ``scene``; pure.
 
@@ -353,39 +211,41 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
 
     return ScaledScene(
         name=scene.name, cg=float(cg), rule=rule.value, replica=replica,
-        drum_diameter=drum.diameter, drum_length=drum.length, axis=drum.axis,
-        periodic=drum.periodic, lifter_count=drum.lifters.count,
-        lifter_height=drum.lifters.height, lifter_width_deg=drum.lifters.width_deg,
-        omega=omega, rotation_period=2.0 * math.pi / omega, rpm=omega * 60.0 / (2.0 * math.pi),
-        froude=omega**2 * drum.radius / GRAVITY, fill_fraction=scene.process.fill_fraction,
-        diameters=diameters, number_fractions=fractions, particle_count=count,
-        original_particle_count=n1,
-        density=p.density, youngs_modulus=p.youngs_modulus, poisson_ratio=p.poisson_ratio,
-        restitution=p.restitution, friction=p.friction, rolling_friction=p.rolling_friction,
-        wall_friction=drum.wall_friction if drum.wall_friction is not None else p.friction,
-        wall_restitution=(drum.wall_restitution if drum.wall_restitution is not None
-                          else p.restitution),
-        liquid_model=liq.model,
-        surface_tension=liq.surface_tension * factor, viscosity=liq.viscosity * factor,
-        contact_angle_deg=liq.contact_angle_deg, liquid_content=liq.liquid_content,
-        min_separation_ratio=liq.min_separation_ratio,
-        max_separation_ratio=max_separation_ratio,
-        contact_angle_compensation=num.contact_angle_compensation,
-        rayleigh_time=t_r, dt=dt,
-        dt_rayleigh_fraction=num.dt_rayleigh_fraction if num.dt is None else dt / t_r,
-        settle_steps=_steps(scene.process.settle_time, dt),
-        run_steps=_steps(scene.process.run_time, dt),
-        dump_every=_every(num.dump_interval, dt),
-        thermo_every=thermo_every,
-        restart_every=max(thermo_every, _every(num.restart_interval, dt) // thermo_every
-                          * thermo_every),
-        skin=(num.skin_ratio * min(diameters) if num.skin_ratio is not None
-              else turning_skin(omega, drum.radius, dt, min(diameters))),
-        insertion_radius=r_ins, insertion_waves=waves,
-        wave_steps=max(thermo_every, _steps(fall_time, dt) // thermo_every * thermo_every),
-        seeds=replica_seeds(num.seed, replica, count=len(diameters) + 1 + len(waves)),
-        granules=scene.analysis.granules,
-        **wet_sphere_fields(scene, max(diameters), cg),
-        bridge_volume_fraction=fraction, max_liquid_content=liq.max_liquid_content,
+        drum=ScaledDrum(
+            diameter=drum.diameter, length=drum.length, axis=drum.axis,
+            periodic=drum.periodic, lifter_count=drum.lifters.count,
+            lifter_height=drum.lifters.height, lifter_width_deg=drum.lifters.width_deg,
+            omega=omega, fill_fraction=scene.process.fill_fraction,
+            wall_friction=drum.wall_friction if drum.wall_friction is not None else p.friction,
+            wall_restitution=(drum.wall_restitution if drum.wall_restitution is not None
+                              else p.restitution)),
+        particles=ScaledParticles(
+            diameters=diameters, number_fractions=fractions, count=count, original_count=n1,
+            density=p.density, youngs_modulus=p.youngs_modulus, poisson_ratio=p.poisson_ratio,
+            restitution=p.restitution, friction=p.friction,
+            rolling_friction=p.rolling_friction),
+        liquid_values=ScaledLiquidValues(
+            model=liq.model,
+            surface_tension=liq.surface_tension * factor, viscosity=liq.viscosity * factor,
+            contact_angle_deg=liq.contact_angle_deg, liquid_content=liq.liquid_content,
+            min_separation_ratio=liq.min_separation_ratio,
+            max_separation_ratio=max_separation_ratio,
+            contact_angle_compensation=num.contact_angle_compensation,
+            **wet_sphere_fields(scene, max(diameters), cg),
+            bridge_volume_fraction=fraction, max_liquid_content=liq.max_liquid_content),
+        numerics=ScaledNumerics(
+            dt=dt, dt_rayleigh_fraction=num.dt_rayleigh_fraction if num.dt is None else dt / t_r,
+            skin=(num.skin_ratio * min(diameters) if num.skin_ratio is not None
+                  else turning_skin(omega, drum.radius, dt, min(diameters))),
+            settle_steps=_steps(scene.process.settle_time, dt),
+            run_steps=_steps(scene.process.run_time, dt),
+            dump_every=_every(num.dump_interval, dt),
+            thermo_every=thermo_every,
+            restart_every=max(thermo_every, _every(num.restart_interval, dt) // thermo_every
+                              * thermo_every)),
+        fill=FillPlan(
+            radius=r_ins, waves=waves,
+            wave_steps=max(thermo_every, _steps(fall_time, dt) // thermo_every * thermo_every),
+            seeds=replica_seeds(num.seed, replica, count=len(diameters) + 1 + len(waves))),
+        contact_dumps=scene.analysis.contact_dumps,
     )
-

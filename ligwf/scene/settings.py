@@ -6,8 +6,9 @@ with the workflow, stored in the study folder, and every post-processing path (`
 study``, ``ligwf analyse`` / ``report``, the Slurm analysis job) reads them from there.
 A case folder without a study (run by hand) gets the defaults.
 
-(The scene-level ``scene.analysis.granules`` is different: it switches the contact dumps
-on in the LIGGGHTS input, so it is part of the scene and of its hash.)
+(The scene-level ``scene.analysis.contact_dumps``, once also called ``granules``, is
+different: it switches the contact dumps on in the LIGGGHTS input, so it is part of the
+scene and of its hash.)
 """
 
 from __future__ import annotations

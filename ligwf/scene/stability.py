@@ -1,6 +1,6 @@
 """Pre-flight stability checks: time scales, overlaps and flow regime of a scaled case.
 
-Pure functions of a :class:`~ligwf.scene.scaling.ScaledScene` (after CG scaling, so every length,
+Pure functions of a :class:`~ligwf.scene.scaled.ScaledScene` (after CG scaling, so every length,
 mass and liquid property is the one LIGGGHTS will see). Each check yields a
 :class:`Finding` with a verdict:
 
@@ -25,7 +25,7 @@ import math
 from dataclasses import asdict, dataclass, field
 
 from ligwf.errors import ConfigError
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.timescales import TimeScales, time_scales
 
 OK, MARGINAL, REFUSED = "ok", "marginal", "refused"
@@ -157,7 +157,7 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
     ``explicit_dt`` says the user fixed ``numerics.dt`` (so messages point at that field).
     """
     sc = time_scales(s)
-    dt, tag = s.dt, f"CG{s.cg:g}"
+    dt, tag = s.numerics.dt, f"CG{s.cg:g}"
     dt_field = _dt_field(s, explicit_dt)
     out: list[Finding] = []
 
@@ -173,11 +173,12 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
             msg += f"; use dt <= {safe * t:.2g} s{cure.format(safe=safe)}"
         out.append(Finding(check, dt_field, ratio, limit, verdict, msg))
 
-    hard = s.youngs_modulus > HARD_PARTICLE_MODULUS
+    hard = s.particles.youngs_modulus > HARD_PARTICLE_MODULUS
     timestep("dt_rayleigh", "Rayleigh time", sc.rayleigh_time,
              DT_RAYLEIGH_LIMIT_HARD if hard else DT_RAYLEIGH_LIMIT,
              " (dt_rayleigh_fraction <= {safe:.2g})",
-             f" (hard particles, E = {s.youngs_modulus:.3g} Pa > {HARD_PARTICLE_MODULUS:g}: "
+             f" (hard particles, E = {s.particles.youngs_modulus:.3g} Pa > "
+             f"{HARD_PARTICLE_MODULUS:g}: "
              "the engine crashed at 0.19 with a nan position at a wall contact, "
              "tri_mesh_I.h:109)" if hard else "")
     timestep("dt_hertz", f"Hertz contact time at {2 * sc.impact_velocity:.2g} m/s", sc.hertz_time,
@@ -185,12 +186,13 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
     if sc.capillary_time is not None and math.isfinite(sc.capillary_time):
         timestep("dt_capillary", "capillary time sqrt(m*/k_bridge)", sc.capillary_time,
                  DT_CAPILLARY_LIMIT, " or lower liquid.surface_tension (scaled "
-                 f"{s.surface_tension:.3g} N/m)")
+                 f"{s.liquid_values.surface_tension:.3g} N/m)")
 
     d = s.d_min
     ratio = sc.hertz_overlap / d
     verdict = REFUSED if ratio > OVERLAP_LIMIT else (MARGINAL if ratio > OVERLAP_WARN else OK)
-    msg = (f"particles.youngs_modulus: E = {s.youngs_modulus:.3g} Pa gives an impact overlap "
+    msg = (f"particles.youngs_modulus: E = {s.particles.youngs_modulus:.3g} Pa "
+           "gives an impact overlap "
            f"of {ratio:.2%} of the smallest {tag} diameter at {sc.impact_velocity:.2g} m/s; "
            f"warn above {OVERLAP_WARN:.0%}, limit {OVERLAP_LIMIT:.0%}")
     if verdict != OK:
@@ -204,7 +206,7 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
                                                          else OK)
         shown = "no equilibrium (the bridge pull outgrows Hertz)" if math.isinf(ratio) \
             else f"{ratio:.2%} of the smallest {tag} diameter"
-        msg = (f"liquid.surface_tension: scaled gamma = {s.surface_tension:.3g} N/m "
+        msg = (f"liquid.surface_tension: scaled gamma = {s.liquid_values.surface_tension:.3g} N/m "
                f"({s.rule} rule) gives a static capillary overlap of {shown}; warn above "
                f"{OVERLAP_WARN:.0%}, limit {OVERLAP_LIMIT:.0%}")
         if verdict != OK:
@@ -218,7 +220,8 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
         msg = (f"liquid.max_separation_ratio: bridges rupture at a gap of "
                f"{sc.rupture_distance:.2g} m; the neighbor lists reach a gap of "
                f"{sc.neighbor_cutoff:.2g} m (contact distance factor 1.1 x "
-               f"max_separation_ratio = {s.max_separation_ratio:g}) and the bridge force "
+               f"max_separation_ratio = {s.liquid_values.max_separation_ratio:g}) "
+               "and the bridge force "
                f"is cut at {sc.bridge_cutoff:.2g} m")
         if verdict != OK:
             need = (1.0 + sc.rupture_distance / d) / 1.1
@@ -230,7 +233,8 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
     if sc.rupture_distance and sc.bridge_cutoff is not None:
         ratio = sc.bridge_cutoff / sc.rupture_distance
         verdict = MARGINAL if ratio < BRIDGE_CUT_WARN else OK
-        msg = (f"liquid.max_separation_ratio = {s.max_separation_ratio:g}: the engine drops a "
+        msg = (f"liquid.max_separation_ratio = {s.liquid_values.max_separation_ratio:g}: "
+               "the engine drops a "
                f"bridge at a gap of {sc.bridge_cutoff:.2g} m, {ratio:.2g} of the force law's "
                f"own rupture gap {sc.rupture_distance:.2g} m; warn below {BRIDGE_CUT_WARN:g}")
         if verdict != OK:
@@ -247,7 +251,7 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
         verdict = MARGINAL if co >= COHESION_NO_FLOW else OK
         msg = (f"liquid.surface_tension: bed cohesion number Co = {co:.3g} (bridge force "
                f"{sc.bridge_force:.2g} N at contact, {s.rule} rule, against the weight of a "
-               f"{sc.bed_depth:.2g} m deep bed; Fr = {s.froude:.3g}); warn at "
+               f"{sc.bed_depth:.2g} m deep bed; Fr = {s.drum.froude:.3g}); warn at "
                f"{COHESION_NO_FLOW:g}")
         if verdict != OK:
             msg += (f"; the bed holds its own weight and will not flow: it turns with the "
@@ -258,21 +262,21 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
                            verdict, msg))
 
     verdict = MARGINAL if sc.regime in ("centrifuging", "slumping") else OK
-    msg = (f"process.rotation: {s.rpm:.3g} rpm, Fr = {s.froude:.3g} ({sc.regime}); "
+    msg = (f"process.rotation: {s.drum.rpm:.3g} rpm, Fr = {s.drum.froude:.3g} ({sc.regime}); "
            f"critical speed {sc.critical_rpm:.3g} rpm (Fr = 1)")
     if sc.regime == "centrifuging":
         msg += "; the bed rides with the wall: use rpm < critical for a granulation flow"
     elif sc.regime == "slumping":
         msg += "; the bed slumps intermittently: use a faster drum for a rolling flow"
-    out.append(Finding("regime", "process.rotation", s.froude, 1.0, verdict, msg))
+    out.append(Finding("regime", "process.rotation", s.drum.froude, 1.0, verdict, msg))
 
-    ratio = s.drum_length / s.d_max
-    least = SLICE_MIN if s.periodic else CLOSED_MIN
+    ratio = s.drum.length / s.d_max
+    least = SLICE_MIN if s.drum.periodic else CLOSED_MIN
     # 1e-9: a slice of exactly 6 diameters (0.018 / 0.003) is not 'below 6'
     verdict = (REFUSED if ratio < least * (1 - 1e-9) else
                (MARGINAL if ratio < SLICE_WARN * (1 - 1e-9) else OK))
-    msg = (f"drum.length: {'periodic slice' if s.periodic else 'closed drum'} "
-           f"{s.drum_length:.3g} m is {ratio:.3g} largest {tag} diameters ({s.d_max:.3g} m); "
+    msg = (f"drum.length: {'periodic slice' if s.drum.periodic else 'closed drum'} "
+           f"{s.drum.length:.3g} m is {ratio:.3g} largest {tag} diameters ({s.d_max:.3g} m); "
            f"warn below {SLICE_WARN:g}, limit {least:g}")
     if verdict != OK:
         msg += f"; use drum.length >= {SLICE_WARN * s.d_max:.3g} m or a lower CG level"

@@ -1,6 +1,6 @@
 """Time scales of a scaled case for the pre-flight: contact, capillary and flow regime.
 
-Pure formulas of a :class:`~ligwf.scene.scaling.ScaledScene` (the checks that grade them
+Pure formulas of a :class:`~ligwf.scene.scaled.ScaledScene` (the checks that grade them
 are :mod:`ligwf.scene.stability`), for the smallest scaled particle (radius r, mass
 m = 4/3 pi r^3 rho, same material):
 
@@ -44,7 +44,7 @@ from dataclasses import dataclass
 
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.scene.model import GRAVITY
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 
 #: Froude-number band edges of the regimes (Mellmann 2001).
 REGIMES = ((1e-4, "slumping"), (3e-3, "rolling"), (0.1, "cascading"), (1.0, "cataracting"),
@@ -166,36 +166,38 @@ def regime(froude: float) -> str:
 
 def time_scales(s: ScaledScene) -> TimeScales:
     """All time scales of the smallest scaled particle of a case (pure)."""
+    p, liq = s.particles, s.liquid_values
     r = 0.5 * s.d_min
-    v_imp = impact_velocity(s.omega, s.drum_diameter)
-    t_h = hertz_time(r, s.density, s.youngs_modulus, s.poisson_ratio, 2.0 * v_imp)
-    overlap = hertz_max_overlap(r, s.density, s.youngs_modulus, s.poisson_ratio, v_imp)
+    v_imp = impact_velocity(s.drum.omega, s.drum.diameter)
+    t_h = hertz_time(r, p.density, p.youngs_modulus, p.poisson_ratio, 2.0 * v_imp)
+    overlap = hertz_max_overlap(r, p.density, p.youngs_modulus, p.poisson_ratio, v_imp)
     t_c = cap_overlap = rupture = cutoff = reach = f0 = co = None
     # the bed the particles make (a particle_count may differ from the fill fraction)
-    v_mean = sum(f * math.pi * d**3 / 6.0 for d, f in zip(s.diameters, s.number_fractions))
-    fill = s.particle_count * v_mean / ((1.0 - BED_POROSITY) * math.pi
-                                        * (0.5 * s.drum_diameter) ** 2 * s.drum_length)
-    depth = bed_depth(s.drum_diameter, min(fill, 0.999))
+    v_mean = sum(f * math.pi * d**3 / 6.0 for d, f in zip(p.diameters, p.number_fractions))
+    fill = p.count * v_mean / ((1.0 - BED_POROSITY) * math.pi
+                               * (0.5 * s.drum.diameter) ** 2 * s.drum.length)
+    depth = bed_depth(s.drum.diameter, min(fill, 0.999))
     if s.wet:
         model = s.liquid
-        theta = applied_contact_angle_rad(s.contact_angle_deg, s.contact_angle_compensation)
-        f0, k_b = model.contact_force_and_stiffness(r, s.surface_tension, theta,
-                                                    s.liquid_content)
-        t_c = capillary_time(0.5 * sphere_mass(r, s.density), k_b)
-        cap_overlap = capillary_overlap(r, s.youngs_modulus, s.poisson_ratio, f0, k_b)
-        vol = model.bridge_volume(r, r, s.liquid_content, s.liquid_content)
+        theta = applied_contact_angle_rad(liq.contact_angle_deg, liq.contact_angle_compensation)
+        f0, k_b = model.contact_force_and_stiffness(r, liq.surface_tension, theta,
+                                                    liq.liquid_content)
+        t_c = capillary_time(0.5 * sphere_mass(r, p.density), k_b)
+        cap_overlap = capillary_overlap(r, p.youngs_modulus, p.poisson_ratio, f0, k_b)
+        vol = model.bridge_volume(r, r, liq.liquid_content, liq.liquid_content)
         rupture = float(model.rupture_distance(vol, theta))
-        cutoff, reach = model.engine_cutoff_gaps(r, s.max_separation_ratio) or (None, None)
+        cutoff, reach = model.engine_cutoff_gaps(r, liq.max_separation_ratio) or (None, None)
         # the bed's typical particle (number-mean diameter) holds it together
-        d_mean = sum(d * f for d, f in zip(s.diameters, s.number_fractions))
-        f0_mean, _ = model.contact_force_and_stiffness(0.5 * d_mean, s.surface_tension, theta,
-                                                       s.liquid_content)
-        co = cohesion_number(f0_mean, d_mean, s.density, depth)
-    radius = 0.5 * s.drum_diameter
+        d_mean = sum(d * f for d, f in zip(p.diameters, p.number_fractions))
+        f0_mean, _ = model.contact_force_and_stiffness(0.5 * d_mean, liq.surface_tension, theta,
+                                                       liq.liquid_content)
+        co = cohesion_number(f0_mean, d_mean, p.density, depth)
+    radius = 0.5 * s.drum.diameter
     return TimeScales(
-        rayleigh_time=s.rayleigh_time, impact_velocity=v_imp, hertz_time=t_h,
+        rayleigh_time=s.particles.rayleigh_time, impact_velocity=v_imp, hertz_time=t_h,
         hertz_overlap=overlap, capillary_time=t_c, capillary_overlap=cap_overlap,
-        rupture_distance=rupture, bridge_cutoff=cutoff, neighbor_cutoff=reach, froude=s.froude,
+        rupture_distance=rupture, bridge_cutoff=cutoff, neighbor_cutoff=reach,
+        froude=s.drum.froude,
         critical_rpm=60.0 / (2.0 * math.pi) * math.sqrt(GRAVITY / radius),
-        regime=regime(s.froude), bridge_force=f0 if f0 is None else float(f0),
+        regime=regime(s.drum.froude), bridge_force=f0 if f0 is None else float(f0),
         bed_depth=depth, cohesion_number=co)

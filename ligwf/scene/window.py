@@ -107,5 +107,5 @@ def _granule_cases(wf: Workflow):
     on, a wet liquid)."""
     for case in wf.cases:
         scene = case.scene
-        if scene.analysis.granules and scene.liquid.wet:
+        if scene.analysis.contact_dumps and scene.liquid.wet:
             yield case, 2.0 * math.pi / scene.process.rotation.omega(scene.drum.diameter / 2.0)

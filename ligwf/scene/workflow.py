@@ -34,7 +34,8 @@ from pydantic import Field, TypeAdapter, ValidationError
 from ligwf.errors import ConfigError
 from ligwf.yamlio import parse_yaml, read_yaml_mapping
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
-from ligwf.scene.scaling import Rule, ScaledScene, parse_rule, scale
+from ligwf.scene.scaled import ScaledScene
+from ligwf.scene.scaling import Rule, parse_rule, scale
 from ligwf.scene.messages import format_validation_error, short_repr
 from ligwf.scene.controls import FlowMatch, control_scene
 from ligwf.scene.model import Scene, build_scene

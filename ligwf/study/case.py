@@ -1,7 +1,7 @@
 """A case folder as one typed object: its identity, its scaled scene, its manifest.
 
 :meth:`CaseFolder.open` parses the case's scene record once (the scaled scene becomes a
-:class:`~ligwf.scene.scaling.ScaledScene`); every stage -- runner, resume, analysis, flow,
+:class:`~ligwf.scene.scaled.ScaledScene`); every stage -- runner, resume, analysis, flow,
 report, stability report -- asks the object instead of reading files. The manifest is
 read fresh on every call (the runner rewrites it while a case runs).
 
@@ -15,7 +15,6 @@ edited, copied in from another replica or added afterwards no longer matches it.
 
 from __future__ import annotations
 
-import dataclasses
 import hashlib
 import os
 import json
@@ -26,7 +25,8 @@ from typing import Any
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json
 from ligwf.scene.model import Scene
-from ligwf.scene.scaling import ScaledScene, scale
+from ligwf.scene.scaled import ScaledScene
+from ligwf.scene.scaling import scale
 from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.extension import extension_steps
 from ligwf.study.layout import (ANALYSED_DUMP_RE, DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME,
@@ -183,11 +183,11 @@ def _analysed_digest(record: Path) -> str:
 def granules_absent(scaled: ScaledScene) -> str | None:
     """Why a case's run holds no granule data, in words (None: it dumped its contacts)."""
     if not scaled.wet:
-        return (f"dry scene (liquid.model: {scaled.liquid_model}): no liquid bridges hold "
+        return (f"dry scene (liquid.model: {scaled.liquid_values.model}): no liquid bridges hold "
                 "particles together, so there are no granules to analyse")
-    if not scaled.granules:
-        return ("scene.analysis.granules: false: the runs write no contact dumps (set it to "
-                "true to analyse granules and their size distribution)")
+    if not scaled.contact_dumps:
+        return ("scene.analysis.contact_dumps: false: the runs write no contact dumps (set it "
+                "to true to analyse granules and their size distribution)")
     return None
 
 
@@ -248,7 +248,7 @@ class CaseFolder:
             scaled = ScaledScene.from_dict(rec["scaled"])
             added = extension_steps(path, scaled)
             if added:
-                scaled = dataclasses.replace(scaled, run_steps=scaled.run_steps + added)
+                scaled = scaled.with_run_steps(scaled.numerics.run_steps + added)
             return cls(path=path, case_id=rec["case_id"], index=int(rec["index"]),
                        cg=float(rec["cg"]), rule=str(rec["rule"]),
                        replica=int(rec.get("replica", 0)),
@@ -266,8 +266,7 @@ class CaseFolder:
         record and its content hash describe."""
         if not self.extension_steps:
             return self.scaled
-        return dataclasses.replace(self.scaled,
-                                   run_steps=self.scaled.run_steps - self.extension_steps)
+        return self.scaled.with_run_steps(self.scaled.numerics.run_steps - self.extension_steps)
 
     # ----------------------------------------------------------------- files of the run
     @property
@@ -316,7 +315,7 @@ class CaseFolder:
         """Steps at which the engine writes a frame up to ``end_step``: the multiples of the
         dump interval from the start of production on (the dumps are defined when the drum
         starts turning; LIGGGHTS writes on multiples of the interval only)."""
-        every = self.scaled.dump_every
+        every = self.scaled.numerics.dump_every
         first = -(-self.production_start_step // every) * every
         return list(range(first, min(end_step, self.scaled.total_steps) + 1, every))
 
@@ -333,8 +332,8 @@ class CaseFolder:
         except (OSError, ValueError, KeyError, TypeError) as exc:
             return f"{self.thermo.name} is unreadable (truncated or corrupt?): {exc}"
         last = rows[-1].step if rows else None
-        if (why := table_problem(rows, self.scaled.thermo_every,
-                                 self.scaled.particle_count)) is not None:
+        if (why := table_problem(rows, self.scaled.numerics.thermo_every,
+                                 self.scaled.particles.count)) is not None:
             return f"{self.thermo.name}: {why}"
         if last != manifest.steps_done:
             return (f"{self.thermo.name} ends at step {last}, the manifest says "
@@ -382,14 +381,14 @@ class CaseFolder:
     @property
     def production_start_step(self) -> int:
         """Step at which the drum starts turning (after the fill waves and settling)."""
-        return self.scaled.insertion_steps + self.scaled.settle_steps
+        return self.scaled.insertion_steps + self.scaled.numerics.settle_steps
 
     def steady_start_step(self, steady_after: float) -> float:
         """First step of the steady window: ``steady_after`` of the production time is the
         start-up and left out (flow metrics and GSD use the same window)."""
-        return self.production_start_step + steady_after * self.scaled.run_steps
+        return self.production_start_step + steady_after * self.scaled.numerics.run_steps
 
     def drum_angle(self, step: int) -> float:
         """Angle (rad) the drum has turned by at ``step`` (it turns during production)."""
         s = self.scaled
-        return s.omega * max(0, step - self.production_start_step) * s.dt
+        return s.drum.omega * max(0, step - self.production_start_step) * s.numerics.dt

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 from ligwf.study.layout import EXTENSION_FILE
 
 
@@ -35,7 +35,7 @@ def extension_steps(path: Path, scaled: ScaledScene) -> int:
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise ConfigError(f"{Path(path) / EXTENSION_FILE}: unreadable production extension "
                           f"({type(exc).__name__}: {exc})") from None
-    return target - base if base == scaled.run_steps and target > base else 0
+    return target - base if base == scaled.numerics.run_steps and target > base else 0
 
 
 def write_extension(path: Path, base_run_steps: int, run_steps: int, dt: float) -> None:

@@ -14,6 +14,7 @@ from ligwf.analysis.granules.case import RunFacts
 from ligwf.analysis.frames.dumps import read_contacts, read_particles
 from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.cli.main import main
+from ligwf.scene.axis import Axis
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study import layout
 from wetdump import wet_study
@@ -126,7 +127,7 @@ def test_no_silent_defaults_in_the_python_api(tmp_path):
     with pytest.raises(DumpReadError, match="no step in the file name"):
         read_contacts(bad)
     with pytest.raises(ConfigError, match="box length"):
-        RunFacts("foreign", 1.0, Liquid("washino", 0.02, 0.5, 0.02), 1, 0.0, 1e-5)
+        RunFacts("foreign", 1.0, Liquid("washino", 0.02, 0.5, 0.02), Axis.Y, 0.0, 1e-5)
     with pytest.raises(ConfigError, match="time step"):
         RunFacts("foreign", 1.0, Liquid("washino", 0.02, 0.5, 0.02), None, 0.0, 0.0)
 

@@ -33,7 +33,7 @@ STEPS = [13618, 20427, 27236]
 def run():
     """(case folder, [(particles, contacts)] of every committed frame)."""
     case = CaseFolder.open(DATA / CASE)
-    frames = [(read_particles(f.particles, dt=case.scaled.dt), read_contacts(f.contacts))
+    frames = [(read_particles(f.particles, dt=case.scaled.numerics.dt), read_contacts(f.contacts))
               for f in discover_frames(case.path)]
     return case, frames
 
@@ -41,17 +41,17 @@ def run():
 def test_the_dumps_are_the_run_of_the_committed_input(run):
     case, frames = run
     s = case.scaled
-    assert (s.cg, s.rule, s.particle_count) == (3.0, "weber", 222)
+    assert (s.cg, s.rule, s.particles.count) == (3.0, "weber", 222)
     assert [p.step for p, _ in frames] == STEPS
-    assert all(step % s.dump_every == 0 for step in STEPS)
-    radius, length = 0.5 * s.drum_diameter, s.drum_length
+    assert all(step % s.numerics.dump_every == 0 for step in STEPS)
+    radius, length = 0.5 * s.drum.diameter, s.drum.length
     for p, c in frames:
         assert np.array_equal(p.ids, np.arange(1, 223))
         np.testing.assert_allclose(p.radii, 1.5e-3, rtol=1e-6)     # 1 mm beads x 3
         x, y, z = p.positions.T
         assert np.all(np.hypot(x, z) + p.radii <= radius * (1 + 1e-3))   # inside the shell
         assert np.all((y >= 0) & (y <= length))                     # the periodic slice
-        assert np.all(p.liquid_content >= 0) and np.all(p.liquid_content <= s.liquid_content)
+        assert np.all(p.liquid_content >= 0) and np.all(p.liquid_content <= s.liquid_values.liquid_content)
         # every pair the contact dump lists: two particles whose gap is the dumped overlap
         assert len(c) > 200 and np.all(c.id1 != c.id2)
         i, j = p.index_of(c.id1), p.index_of(c.id2)

@@ -143,7 +143,7 @@ CORPUS: list[Bad] = [
         overrides=("accept={angle_deg: null, profile_error: null, rigid_share: null, "
                    "flowing_layer: null, gsd_error: null, field_error: null}",)),
     Bad("rule-sweep-dry", ("rules", "dry"),
-        overrides=("scene.liquid.model=none", "scene.analysis.granules=false",
+        overrides=("scene.liquid.model=none", "scene.analysis.contact_dumps=false",
                    "sweep.rules=[weber,bond]")),
     Bad("closed-drum-huge-particles", ("diameter",),
         overrides=("scene.drum.periodic=false", "scene.drum.length=0.02",

@@ -84,10 +84,10 @@ def test_engine_applies_the_intended_contact_angle(engine, tmp_path, model):
     r = 0.5 * s.d_min
     gap = ANGLE_GAP_RATIO * 0.5 * r
     law = liquids.get(model)
-    intended = law.capillary_force(r, r, gap, s.surface_tension,
-                                   math.radians(s.contact_angle_deg), s.liquid_content)
-    buggy = law.capillary_force(r, r, gap, s.surface_tension,
-                                engine_effective_angle_rad(s.contact_angle_deg), s.liquid_content)
+    intended = law.capillary_force(r, r, gap, s.liquid_values.surface_tension,
+                                   math.radians(s.liquid_values.contact_angle_deg), s.liquid_values.liquid_content)
+    buggy = law.capillary_force(r, r, gap, s.liquid_values.surface_tension,
+                                engine_effective_angle_rad(s.liquid_values.contact_angle_deg), s.liquid_values.liquid_content)
     assert measured == pytest.approx(intended, rel=1e-4)
     assert abs(buggy - intended) > 0.05 * intended  # the test can tell the two apart
 
@@ -99,8 +99,8 @@ def test_uncompensated_engine_applies_the_product_angle(engine, tmp_path):
     measured = measure(engine, tmp_path, s, "raw", ANGLE_GAP_RATIO)
     r = 0.5 * s.d_min
     expected = liquids.get("washino").capillary_force(
-        r, r, ANGLE_GAP_RATIO * 0.5 * r, s.surface_tension,
-        engine_effective_angle_rad(s.contact_angle_deg), s.liquid_content, s.liquid_content)
+        r, r, ANGLE_GAP_RATIO * 0.5 * r, s.liquid_values.surface_tension,
+        engine_effective_angle_rad(s.liquid_values.contact_angle_deg), s.liquid_values.liquid_content, s.liquid_values.liquid_content)
     assert measured == pytest.approx(expected, rel=1e-4)
 
 
@@ -115,21 +115,21 @@ def test_engine_applies_the_bridge_volume_fraction_and_the_cap(engine, tmp_path)
         s = scale(load_workflow(DRUM, base + extra).cases[0].scene, 1, "none")
         measured, log = probe(engine, tmp_path, s, name, ANGLE_GAP_RATIO)
         r = 0.5 * s.d_min
-        theta = math.radians(s.contact_angle_deg)
+        theta = math.radians(s.liquid_values.contact_angle_deg)
         gap = ANGLE_GAP_RATIO * 0.5 * r
         assert s.liquid.bridge_volume_fraction == 0.2
-        expected = s.liquid.capillary_force(r, r, gap, s.surface_tension, theta, s.liquid_content)
+        expected = s.liquid.capillary_force(r, r, gap, s.liquid_values.surface_tension, theta, s.liquid_values.liquid_content)
         assert measured == pytest.approx(expected, rel=1e-9)
-        default = liquids.get("washino").capillary_force(r, r, gap, s.surface_tension, theta,
-                                                         s.liquid_content)
+        default = liquids.get("washino").capillary_force(r, r, gap, s.liquid_values.surface_tension, theta,
+                                                         s.liquid_values.liquid_content)
         assert measured > 1.5 * default           # the test tells the fractions apart
         overwritten = re.findall(r"maxSeparationDistanceRatio being overwritten by (\S+) "
                                  r"\(was (\S+)\)", log)
         if extra:
             assert overwritten, log[-3000:]
             engine_ratio, written = (float(x) for x in overwritten[-1])
-            assert engine_ratio == pytest.approx(s.max_separation_ratio, rel=1e-6)
-            assert written == pytest.approx(s.max_separation_ratio, rel=1e-6)
-            assert s.max_separation_ratio > 1.3   # the law's rupture gap, not the default 1.1
+            assert engine_ratio == pytest.approx(s.liquid_values.max_separation_ratio, rel=1e-6)
+            assert written == pytest.approx(s.liquid_values.max_separation_ratio, rel=1e-6)
+            assert s.liquid_values.max_separation_ratio > 1.3   # the law's rupture gap, not the default 1.1
         else:
             assert not overwritten

@@ -38,7 +38,7 @@ def test_rendered_drum_runs_without_losing_atoms(engine, tmp_path, name):
     assert out.returncode == 0, log[-3000:]
     assert "ERROR" not in log and "Lost atoms" not in log, log[-3000:]
     atoms = [int(m.group(1)) for m in re.finditer(r"^\s+\d+\s+\S+\s+(\d+)\s", log, re.M)]
-    n = rc.scaled.particle_count
+    n = rc.scaled.particles.count
     assert 0 < n < 1000
     assert atoms[-1] == n, f"expected {n} particles at the end, thermo says {atoms[-1]}"
     # once the fill is over (the top-up trims its extra particles), the count never changes
@@ -69,6 +69,6 @@ def test_fill_reaches_the_exact_count_for_every_seed(engine, tmp_path):
         assert out.returncode == 0, out.stdout[-3000:]
         after_fill = out.stdout.split("ligwf-phase settle", 1)[1]
         atoms = [int(m.group(1)) for m in re.finditer(r"^\s+\d+\s+\S+\s+(\d+)\s", after_fill, re.M)]
-        assert atoms and set(atoms) == {rc.scaled.particle_count}, (rc.case.case_id, atoms)
+        assert atoms and set(atoms) == {rc.scaled.particles.count}, (rc.case.case_id, atoms)
         trimmed += [int(x) for x in re.findall(r"Deleted (\d+) atoms", out.stdout)]
     assert trimmed and max(trimmed) > 0, "the top-up trim never ran"

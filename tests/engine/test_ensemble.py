@@ -94,7 +94,7 @@ def test_resume_input_reissues_every_fix_of_the_drum_input(tmp_path):
     wanted = [line for line in drum if line.startswith(keep)
               and not line.startswith(("fix ins", "region domain"))]
     for step, phase in [(1, "fill"), (s.insertion_steps + 1, "settle"),
-                        (s.insertion_steps + s.settle_steps + 1, "production")]:
+                        (s.insertion_steps + s.numerics.settle_steps + 1, "production")]:
         text = render_resume(s, RestartFile("restart/restart_a.liggghts", step))[
             "resume.in.liggghts"]
         lines = text.splitlines()

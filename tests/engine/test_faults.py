@@ -356,7 +356,7 @@ def assert_pair_complete(cases: list[Path]) -> None:
         assert m.status == "done", (path.name, m.status, m.reason)
         assert m.steps_done == m.total_steps and m.atoms_end == m.atoms_after_settle == 84
         steps = [r.step for r in rows_from_csv((path / "thermo.csv").read_text())]
-        every = case.scaled.thermo_every
+        every = case.scaled.numerics.thermo_every
         assert steps[0] == 0 and steps[-1] == m.total_steps
         gaps = [(a, b) for a, b in zip(steps, steps[1:]) if not 0 < b - a <= every]
         assert not gaps, f"{path.name}: thermo gaps or duplicates: {gaps[:5]}"

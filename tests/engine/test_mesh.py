@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from ligwf.engine.mesh import (MIN_FACET_ANGLE_DEG, MIN_SEGMENTS, cached_mesh, drum_outline, drum_stl,
-                               drum_triangles, geometry_key, segment_count, shell_rows, wall_sag, axis_frame)
+                               drum_triangles, geometry_key, segment_count, shell_rows, wall_sag)
 from ligwf.scene.model import Drum
 
 
@@ -141,7 +141,7 @@ def test_no_shell_triangle_is_thinner_than_the_engine_accepts(length):
     rows = shell_rows(drum_outline(d, wall_sag(0.0015)), length)
     assert len(tri) == 2 * rows * len(drum_outline(d, wall_sag(0.0015)))
     assert (rows == 1) == (length <= 0.072)
-    ia = axis_frame(d.axis)[0]   # rows tile [0, length] without gaps
+    ia = d.axis.index              # rows tile [0, length] without gaps
     assert tri[..., ia].min() == 0.0 and tri[..., ia].max() == pytest.approx(length, abs=1e-15)
 
 

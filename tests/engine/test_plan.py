@@ -66,9 +66,9 @@ def test_ranks_keep_the_slab_rule_the_cores_and_the_particles_per_rank(particles
 def test_case_load_and_particle_steps_from_a_scaled_scene():
     scaled = load_workflow(DRUM, []).cases[0].scaled()
     lo = case_load("cg1-none-r0", scaled)
-    assert (lo.particles, lo.steps) == (scaled.particle_count, scaled.total_steps)
-    assert (lo.drum_length, lo.d_max, lo.wet) == (scaled.drum_length, scaled.d_max, scaled.wet)
-    assert lo.particle_steps == particle_steps(scaled) == scaled.particle_count * scaled.total_steps
+    assert (lo.particles, lo.steps) == (scaled.particles.count, scaled.total_steps)
+    assert (lo.drum_length, lo.d_max, lo.wet) == (scaled.drum.length, scaled.d_max, scaled.wet)
+    assert lo.particle_steps == particle_steps(scaled) == scaled.particles.count * scaled.total_steps
 
 
 def test_estimate_reproduces_the_measured_production_times():

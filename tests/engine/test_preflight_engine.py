@@ -45,7 +45,7 @@ def test_a_bed_held_by_its_bridges_is_warned_that_it_will_not_flow():
     plain = findings(["sweep.rules=[weber]"])
     assert plain["bed_flow"].verdict == OK and plain["bed_flow"].value < 0.3
     dry = findings(["sweep.rules=[none]", "scene.liquid.model=none",
-                    "scene.analysis.granules=false"])
+                    "scene.analysis.contact_dumps=false"])
     assert "bed_flow" not in dry
     assert REFUSED not in {f.verdict for f in wet.values()}
 
@@ -78,10 +78,10 @@ def test_the_bed_the_preflight_says_will_not_flow_turns_as_a_block(tmp_path):
     shares, angles = {}, {}
     for case in Study.open(out).cases:
         s = case.scaled
-        d_mean = sum(d * f for d, f in zip(s.diameters, s.number_fractions))
-        geo = DrumGeometry(radius=0.5 * s.drum_diameter, axis=s.axis, omega=s.omega,
+        d_mean = sum(d * f for d, f in zip(s.particles.diameters, s.particles.number_fractions))
+        geo = DrumGeometry(radius=0.5 * s.drum.diameter, axis=s.drum.axis, omega=s.drum.omega,
                            d_mean=d_mean)
-        spun_up = case.production_start_step + round(0.3 / s.dt)
+        spun_up = case.production_start_step + round(0.3 / s.numerics.dt)
         flows = [frame_flow(read_particles(case.path / "post" / f"particles_{step}.vtu"), geo)
                  for step in case.expected_dump_steps(s.total_steps) if step >= spun_up]
         assert len(flows) >= 8

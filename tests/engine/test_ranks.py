@@ -43,7 +43,7 @@ def test_four_ranks_keep_every_particle_on_a_two_by_two_grid(tmp_path):
     (case_dir,) = [p for p in out.iterdir() if (p / "scene.json").exists()]
     case = CaseFolder.open(case_dir)
     m = read_manifest(case_dir)
-    n = case.scaled.particle_count
+    n = case.scaled.particles.count
     assert m.status == "done", m.reason
     assert m.nprocs == 4
     assert m.atoms_after_settle == m.atoms_end == n > 500

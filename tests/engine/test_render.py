@@ -40,7 +40,7 @@ def commands(src: str) -> list[str]:
 
 
 def test_dry_scene_has_no_liquid():
-    src = text(overrides=["scene.liquid.model=none", "scene.analysis.granules=false",
+    src = text(overrides=["scene.liquid.model=none", "scene.analysis.contact_dumps=false",
                           "sweep.rules=[weber]"])
     body = "\n".join(commands(src))
     for word in ("cohesion", "surfaceTension", "fluidViscosity", "contactAngle",
@@ -65,7 +65,7 @@ def test_no_lifters_mentions_none():
 
 def test_contact_dump_only_with_granules():
     on = "\n".join(commands(text()))
-    off = "\n".join(commands(text(overrides=["scene.analysis.granules=false"])))
+    off = "\n".join(commands(text(overrides=["scene.analysis.contact_dumps=false"])))
     assert "pair/gran/local" in on and "local/gran/vtk" in on
     assert "pair/gran/local" not in off and "local/gran/vtk" not in off and "contacts" not in off
 
@@ -142,7 +142,7 @@ def test_installed_wheel_ships_templates(tmp_path):
                                         ("y", "${ligwf_pu} ${ligwf_pa} 1"),
                                         ("z", "${ligwf_pu} 1 ${ligwf_pa}")])
 def test_processor_grid_never_cuts_along_gravity(axis, grid):
-    # gravity is -z for axes x and y and -y for axis z (mesh.axis_frame); a cut along it
+    # gravity is -z for axes x and y and -y for axis z (Axis.frame); a cut along it
     # would leave the rank above the bed nearly idle
     src = text(overrides=[f"scene.drum.axis={axis}"])
     lines = commands(src)
@@ -159,7 +159,7 @@ def test_processor_grid_puts_ranks_along_the_axis_first():
 
     wf = load_workflow(DRUM, ["sweep.cg_levels=[1, 3]", "sweep.rules=[weber]"])
     cg1, cg3 = (c.scaled() for c in wf.cases)
-    slabs1 = int(cg1.drum_length / (MIN_AXIAL_SLAB * cg1.d_max))      # 9 mm / 4 mm = 2
+    slabs1 = int(cg1.drum.length / (MIN_AXIAL_SLAB * cg1.d_max))      # 9 mm / 4 mm = 2
     assert slabs1 == 2
     assert processor_grid(cg1, 1) == (1, 1)
     assert processor_grid(cg1, 2) == (1, 2)

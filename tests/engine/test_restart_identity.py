@@ -118,7 +118,7 @@ def test_a_hole_in_the_record_is_found_and_bounds_the_resume(tmp_path):
     case = CaseFolder.open(out / "cg3-weber-r0")
     s = case.scaled
     rows = [ThermoRow(step, {"step": float(step)}, "production") for step in
-            list(range(0, s.total_steps, s.thermo_every)) + [s.total_steps]]
+            list(range(0, s.total_steps, s.numerics.thermo_every)) + [s.total_steps]]
     steps = case.expected_dump_steps(s.total_steps)
     for step in steps:
         for kind in ("particles", "contacts"):

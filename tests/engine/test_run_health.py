@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from types import SimpleNamespace
 
 import pytest
 
@@ -127,8 +128,9 @@ def test_manifest_write_is_atomic(tmp_path):
 
 
 def test_resume_phase_boundaries():
-    class S:  # the four step counts resume_phase reads
-        insertion_steps, wave_steps, settle_steps = 300, 100, 50
+    # the step counts resume_phase reads
+    S = SimpleNamespace(insertion_steps=300, fill=SimpleNamespace(wave_steps=100),
+                        numerics=SimpleNamespace(settle_steps=50))
     assert resume_phase(S, 150) == ("fill", 2, True)
     assert resume_phase(S, 200) == ("fill", 3, False)  # wave 3 not inserted yet
     assert resume_phase(S, 300) == ("settle", 0, False)
@@ -146,11 +148,11 @@ def test_resume_mid_fill_keeps_the_top_up_and_its_trim():
     from helpers import DRUM
 
     s = load_workflow(DRUM, ["sweep.cg_levels=[3]", "sweep.rules=[weber]"]).cases[0].scaled()
-    n, last = s.particle_count, len(s.insertion_waves)
+    n, last = s.particles.count, len(s.fill.waves)
     fresh = render(s)["in.liggghts"]
-    ends = [f"run {k * s.wave_steps} upto" for k in range(1, last + 1)]
+    ends = [f"run {k * s.fill.wave_steps} upto" for k in range(1, last + 1)]
     assert all(e in fresh for e in ends)
-    late = list(render_resume(s, RestartFile("r", (last - 1) * s.wave_steps + 5)).values())[0]
+    late = list(render_resume(s, RestartFile("r", (last - 1) * s.fill.wave_steps + 5)).values())[0]
     assert f"fix ins{last} " not in late                     # inserted before the restart
     assert f"group ligwf_extra id > {n}" in late and "delete_atoms group ligwf_extra" in late
     assert ends[-1] in late
@@ -188,8 +190,9 @@ def test_status_table_headers_print_their_units():
 
 
 def test_steps_between_split_at_the_phase_boundaries():
-    class S:  # fill 0-300, settle 300-350, production 350-500
-        insertion_steps, settle_steps, total_steps = 300, 50, 500
+    # fill 0-300, settle 300-350, production 350-500
+    S = SimpleNamespace(insertion_steps=300, numerics=SimpleNamespace(settle_steps=50),
+                        total_steps=500)
     assert phase_steps_between(S, 290, 360) == {"fill": 10, "settle": 50, "production": 10}
     assert phase_steps_between(S, 0, 500) == {"fill": 300, "settle": 50, "production": 150}
     assert phase_steps_between(S, 300, 300) == {} and phase_steps_between(S, 400, 350) == {}
@@ -203,8 +206,8 @@ def test_a_restart_past_the_killed_attempts_last_row_is_credited_to_it():
     from ligwf.engine.attempt import credit_restart
     from ligwf.study.manifest import Attempt
 
-    class S:
-        insertion_steps, settle_steps, total_steps = 300, 50, 500
+    S = SimpleNamespace(insertion_steps=300, numerics=SimpleNamespace(settle_steps=50),
+                        total_steps=500)
     m = Manifest(case_id="c", index=0, scene_hash="h", ligwf_version="", liggghts_version="")
     m.attempts = [Attempt(number=1, started="", steps=120, from_step=0,
                           phases={"fill": {"wall_seconds": 1.0, "steps": 120}}),

@@ -17,15 +17,15 @@ def bridge_force(s, gap_ratio: float) -> float:
     """Force of the case's model between two smallest particles at a dimensionless gap."""
     r = 0.5 * s.d_min
     gap = gap_ratio * 0.5 * r
-    theta = math.radians(s.contact_angle_deg)
-    return liquids.get(s.liquid_model).capillary_force(r, r, gap, s.surface_tension, theta,
-                                                       s.liquid_content)
+    theta = math.radians(s.liquid_values.contact_angle_deg)
+    return liquids.get(s.liquid_values.model).capillary_force(r, r, gap, s.liquid_values.surface_tension, theta,
+                                                       s.liquid_values.liquid_content)
 
 
 def viscous_force(s, gap_ratio: float, speed: float = 0.1) -> float:
     r = 0.5 * s.d_min
-    return viscous_normal_force(r, r, gap_ratio * 0.5 * r, s.viscosity, speed,
-                                s.min_separation_ratio)
+    return viscous_normal_force(r, r, gap_ratio * 0.5 * r, s.liquid_values.viscosity, speed,
+                                s.liquid_values.min_separation_ratio)
 
 
 def assert_forces_scale_as_rule(scene, n: int, rule: str, power: int) -> None:

@@ -62,7 +62,7 @@ def test_non_default_settings_are_rendered_with_their_switches():
     assert "fix lq_lbvol all property/global lbVolumeFraction scalar 0.2\n" in text
     assert "fix lq_maxlc all property/global maxLiquidContent peratomtype 0.1 0.1\n" in text
     # the engine replaces maxSeparationDistanceRatio when capping: ligwf writes its value
-    assert f"maxSeparationDistanceRatio scalar {s.max_separation_ratio:.12g}\n" in text
+    assert f"maxSeparationDistanceRatio scalar {s.liquid_values.max_separation_ratio:.12g}\n" in text
 
 
 @pytest.mark.parametrize("overrides,field,value,allowed", [
@@ -94,12 +94,12 @@ def test_cap_refuses_a_separation_ratio_the_engine_would_overwrite():
 def test_fractions_unchanged_by_cg_and_forces_scale_as_the_rule(n, rule, power):
     sc = scene("scene.liquid.bridge_volume_fraction=0.2", "scene.liquid.max_liquid_content=0.1")
     s1, sn = scale(sc, 1, "none"), scale(sc, n, rule)
-    assert (sn.bridge_volume_fraction, sn.max_liquid_content) == (0.2, 0.1)
-    assert sn.max_separation_ratio == pytest.approx(s1.max_separation_ratio, rel=1e-12)
+    assert (sn.liquid_values.bridge_volume_fraction, sn.liquid_values.max_liquid_content) == (0.2, 0.1)
+    assert sn.liquid_values.max_separation_ratio == pytest.approx(s1.liquid_values.max_separation_ratio, rel=1e-12)
     theta = math.radians(sc.liquid.contact_angle_deg)
     for g in (0.0, 0.05, 0.1):
         f1, fn = (s.liquid.capillary_force(0.5 * s.d_min, 0.5 * s.d_min, g * 0.25 * s.d_min,
-                                           s.surface_tension, theta, s.liquid_content)
+                                           s.liquid_values.surface_tension, theta, s.liquid_values.liquid_content)
                   for s in (s1, sn))
         assert fn / f1 == pytest.approx(n**power, rel=1e-9)
 

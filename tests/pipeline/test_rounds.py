@@ -50,9 +50,9 @@ def test_an_undecided_extension_becomes_the_next_round(study):
                                    round_amount=0.05)), s, rounds, 1)
     assert not look.stop and look.target == "cg1.5-weber" and look.alpha == pytest.approx(0.05 / 3)
     (act,) = look.actions
-    dt = s.cases[2].scaled.dt
+    dt = s.cases[2].scaled.numerics.dt
     assert act["kind"] == EXTEND and act["case_ids"] == ["cg1.5-weber-r0", "cg1.5-weber-r1"]
-    want = s.cases[2].scaled.run_steps + math.ceil(0.05 / dt)
+    want = s.cases[2].scaled.numerics.run_steps + math.ceil(0.05 / dt)
     assert act["run_steps"] == {"cg1.5-weber-r0": want, "cg1.5-weber-r1": want}
     assert look.planned_core_hours > 0
     # applied: the case runs longer, its scene (and hash) is the rendered one
@@ -60,7 +60,8 @@ def test_an_undecided_extension_becomes_the_next_round(study):
     apply_extensions(s, rounds)
     apply_extensions(Study.open(s.path), rounds)      # again: nothing changes
     case = CaseFolder.open(s.path / "cg1.5-weber-r0")
-    assert case.scaled.run_steps == want and case.extension_steps == want - s.cases[2].scaled.run_steps
+    assert case.scaled.numerics.run_steps == want
+    assert case.extension_steps == want - s.cases[2].scaled.numerics.run_steps
     assert case.rendered_scaled == s.cases[2].scaled and case.scene_hash == s.cases[2].scene_hash
     assert case.record_problem() is None
     assert CaseFolder.open(s.path / "cg1-none-r0").extension_steps == 0
@@ -79,7 +80,7 @@ def test_replicas_are_new_cases_with_new_seeds_after_the_workflows(study, tmp_pa
     assert [rc.case.case_id for rc in new] == ["cg1.5-weber-r2", "cg1.5-weber-r3", "cg1-none-r2"]
     assert [rc.case.index for rc in new] == [4, 5, 6]
     for cg in (1.0, 1.5):                                # every replica its own seeds
-        arm = [rc.scaled.seeds for rc in more.rendered if rc.case.cg == cg]
+        arm = [rc.scaled.fill.seeds for rc in more.rendered if rc.case.cg == cg]
         assert len(set(arm)) == len(arm) == (3 if cg == 1.0 else 4)
     s2 = write(more, s.path, tmp_path / "meshes")
     assert len(s2.cases) == 7 and s2.cases[6].case_id == "cg1-none-r2"

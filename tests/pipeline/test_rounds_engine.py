@@ -45,7 +45,7 @@ def whole_record(case_dir: Path) -> None:
     assert m.status == "done", (m.status, m.reason)
     assert m.steps_done == case.scaled.total_steps == m.total_steps
     steps = [r.step for r in rows_from_csv((case_dir / "thermo.csv").read_text())]
-    every = case.scaled.thermo_every
+    every = case.scaled.numerics.thermo_every
     assert steps[0] == 0 and steps[-1] == m.total_steps
     assert not [(a, b) for a, b in zip(steps, steps[1:]) if not 0 < b - a <= every]
     frames = sorted(int(p.stem.split("_")[1]) for p in (case_dir / "post").glob("particles_*.vtu"))
@@ -62,9 +62,9 @@ def test_an_extension_continues_the_done_case_from_its_restart(tmp_path, engine)
     case_dir = out / "cg1.5-weber-r0"
     before = CaseFolder.open(case_dir)
     first = read_manifest(case_dir)
-    more = round(0.1 / before.scaled.dt)
-    write_extension(case_dir, before.scaled.run_steps, before.scaled.run_steps + more,
-                    before.scaled.dt)
+    more = round(0.1 / before.scaled.numerics.dt)
+    write_extension(case_dir, before.scaled.numerics.run_steps, before.scaled.numerics.run_steps + more,
+                    before.scaled.numerics.dt)
     r = subprocess.run(ligwf_cmd("run", str(WORKFLOW), "--out", str(out), "--set",
                                  "sweep.cg_levels=[1.5]", "--set", "sweep.replicas=1"),
                        capture_output=True, text=True, timeout=600)

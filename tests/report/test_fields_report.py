@@ -17,6 +17,7 @@ import pytest
 from ligwf.analysis.flow.fields import case_fields
 from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.report.fields import add_field_errors, fields_section, null_check, twin_cases
+from ligwf.scene.axis import Axis
 from test_fields import D1, DRUM_R, HEAD, LENGTH, OMEGA, WIDTH, geometry, lattice_frame
 
 TWIN_GROUP = json.dumps({"control": "cohesionless"})
@@ -108,7 +109,7 @@ def test_null_check_and_section(study_fields, tables, tmp_path):
     assert 0.1 < twin["field_error"] <= 0.15 and twin["field_error_lo"] > 0.05
     assert twin["field_solid_error"] == pytest.approx(0.0, abs=1e-9)
     assert twin_cases(cases) == {"{}": ["cg1-none-r0_cohesionless", "cg1-none-r1_cohesionless"]}
-    figs = group_figures(cases, fields, tmp_path, rotation_sense("y", 3.0), twin_cases(cases))
+    figs = group_figures(cases, fields, tmp_path, rotation_sense(Axis.Y, 3.0), twin_cases(cases))
     assert [p.name for _, p in figs] == ["fields_study_maps.png", "fields_study_differences.png"]
     assert all(p.stat().st_size > 10_000 for _, p in figs)
     md = fields_section(cond, null.reset_index(), fields,
@@ -128,9 +129,9 @@ def test_no_fields_no_errors(study_fields):
 
 def test_rotation_sense_on_the_maps():
     # axis y, (u, v) = (x, z): +y points away from the viewer, so omega > 0 is clockwise
-    assert rotation_sense("y", 1.0) == "clockwise"
-    assert rotation_sense("y", -1.0) == "counter-clockwise"
-    assert rotation_sense("x", 1.0) == "counter-clockwise"
+    assert rotation_sense(Axis.Y, 1.0) == "clockwise"
+    assert rotation_sense(Axis.Y, -1.0) == "counter-clockwise"
+    assert rotation_sense(Axis.X, 1.0) == "counter-clockwise"
 
 
 def test_only_the_recorded_archive_is_read(study_fields, tmp_path):

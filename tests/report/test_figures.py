@@ -18,6 +18,7 @@ from ligwf.report.figures import (equivalent_diameter_mm, error_ax, gsd_ax, pare
                                   run_cost_ax)
 from ligwf.report.granule_figures import kinetics_ax, production_origins, sensitivity_ax
 from ligwf.report.snapshots import SpeedScale, rotation_sense, snapshot_ax
+from ligwf.scene.axis import Axis
 
 
 def conditions() -> pd.DataFrame:
@@ -108,10 +109,10 @@ def test_kinetics_count_time_from_production_start():
 
 def test_rotation_sense_in_the_view_along_each_axis():
     # the camera looks along +y for a y-axis drum: +omega about +y reads clockwise
-    assert rotation_sense("y", 1.0) == -1 and rotation_sense("y", -1.0) == 1
+    assert rotation_sense(Axis.Y, 1.0) == -1 and rotation_sense(Axis.Y, -1.0) == 1
     # for x and z the axis points at the camera: +omega reads counter-clockwise
-    assert rotation_sense("x", 2.0) == 1 and rotation_sense("z", 2.0) == 1
-    assert rotation_sense("y", 0.0) == 0
+    assert rotation_sense(Axis.X, 2.0) == 1 and rotation_sense(Axis.Z, 2.0) == 1
+    assert rotation_sense(Axis.Y, 0.0) == 0
 
 
 def test_speed_snapshot_states_its_shared_scale():

@@ -3,7 +3,7 @@
 Real runs only: a tiny Bond-scaled CG3 study (tests/workflows/runner_tiny.yaml on a 12 mm
 slice, 56 particles, two replicas, 0.3 s of production with a frame every 0.02 s; ~4 s a
 case on one core) run once per module with ``ligwf run`` and analysed with ``ligwf
-analyse``; every damage works on a copy. The dry and ``granules: false`` studies are the
+analyse``; every damage works on a copy. The dry and ``contact_dumps: false`` studies are the
 same drum run through ``ligwf study``.
 """
 
@@ -33,7 +33,7 @@ BOND = ["--set", "sweep.rules=[bond]", "--set", "sweep.replicas=2",
         "--set", "scene.numerics.dump_interval=0.02"]
 R0, R1 = "cg3-bond-r0", "cg3-bond-r1"
 DRY = ["--set", "scene.liquid={model: none}", "--set", "sweep.rules=[none]",
-       "--set", "scene.analysis.granules=false"]
+       "--set", "scene.analysis.contact_dumps=false"]
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
@@ -72,8 +72,8 @@ def copy(study, tmp_path) -> Path:
 @pytest.mark.mpi
 @pytest.mark.parametrize("kind,args,words", [
     ("dry", DRY, "dry scene (liquid.model: none)"),
-    ("granules off", ["--set", "sweep.rules=[weber]", "--set", "scene.analysis.granules=false"],
-     "scene.analysis.granules: false"),
+    ("granules off", ["--set", "sweep.rules=[weber]", "--set", "scene.analysis.contact_dumps=false"],
+     "scene.analysis.contact_dumps: false"),
 ])
 def test_study_without_granule_data_ends_with_a_flow_report(engine, tmp_path, capsys, kind,
                                                             args, words):
@@ -104,7 +104,7 @@ def test_surface_fit_second_pass_too_few_strips_keeps_the_first_line(study):
     fits = []
     for p in sorted((case.path / "post").glob("particles_*.vtu")):
         step = int(p.stem.split("_")[1])
-        frame = read_particles(p, step, case.scaled.dt)
+        frame = read_particles(p, step, case.scaled.numerics.dt)
         u, v, _, _ = cross_section(frame, geo)
         fits.append(fit_surface(u, v, frame.radii, geo.radius, geo.d_mean, rising_side(geo),
                                 span=0.68))

@@ -61,7 +61,7 @@ def test_check_warns_where_the_map_expects_no_granules(capsys):
     assert "St_v = 0.349, Bo_g = 3.39 is the regime map's closest point" in out.err
     assert "closest (unproven)" in out.out
     assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.001",
-                 "--set", "scene.analysis.granules=false"]) == 0
+                 "--set", "scene.analysis.contact_dumps=false"]) == 0
     assert "granule analysis asked for" not in capsys.readouterr().err
 
 
@@ -71,10 +71,11 @@ def test_cohesionless_twin_keeps_everything_but_the_bridge_forces():
     twin = next(c for c in cases if c.case_id == "cg1-none-r0_cohesionless")
     assert dict(twin.varied)["control"] == "cohesionless"
     a, b = wet.scaled(), twin.scaled()
-    assert b.surface_tension == pytest.approx(a.surface_tension / 1000)
-    assert b.viscosity == pytest.approx(a.viscosity / 1000)
-    same = ("seeds", "particle_count", "dt", "liquid_content", "granules", "run_steps")
-    assert all(getattr(a, k) == getattr(b, k) for k in same)
+    assert b.liquid_values.surface_tension == pytest.approx(a.liquid_values.surface_tension / 1000)
+    assert b.liquid_values.viscosity == pytest.approx(a.liquid_values.viscosity / 1000)
+    assert (a.fill, a.particles, a.numerics, a.contact_dumps) == (b.fill, b.particles,
+                                                                   b.numerics, b.contact_dumps)
+    assert a.liquid_values.liquid_content == b.liquid_values.liquid_content
     # granules.yaml: 2 CG1 seeds, each with its twin; 2 seeds of each CG2 rule
     assert sum(c.cg == 1 for c in cases) == 4 and sum(c.cg == 2 for c in cases) == 4
     assert sum(CONTROL_KEY in dict(c.varied) for c in cases) == 2
@@ -83,7 +84,7 @@ def test_cohesionless_twin_keeps_everything_but_the_bridge_forces():
 def test_controls_refused_on_a_dry_scene_and_at_a_missing_level():
     with pytest.raises(ConfigError, match="dry"):
         _case(["sweep.controls=[cohesionless]", "scene.liquid.model=none",
-               "sweep.rules=[weber]", "scene.analysis.granules=false"])
+               "sweep.rules=[weber]", "scene.analysis.contact_dumps=false"])
     with pytest.raises(ConfigError, match="control_cg_levels"):
         _case(["sweep.controls=[cohesionless]", "sweep.control_cg_levels=[3]"])
     with pytest.raises(ConfigError, match="controls"):

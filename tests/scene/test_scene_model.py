@@ -139,7 +139,7 @@ def test_sweep_over_scene_field_expands_cases():
     assert wf.cases[3].scene.process.rotation.rpm == 40
     # replicas differ by their insertion seeds only
     s0, s1 = wf.cases[1].scaled(), wf.cases[2].scaled()
-    assert s0.seeds != s1.seeds and s0.dt == s1.dt
+    assert s0.fill.seeds != s1.fill.seeds and s0.numerics.dt == s1.numerics.dt
 
 
 def test_set_override_applies_and_validates():

@@ -37,7 +37,7 @@ R, RHO, E, NU = 1e-3, 2500.0, 1e7, 0.3
 
 
 def test_rayleigh_time_hand_value():
-    from ligwf.scene.scaling import rayleigh_time
+    from ligwf.scene.scaled import rayleigh_time
     assert rayleigh_time(R, RHO, E, NU) == pytest.approx(8.654e-5, rel=2e-4)
 
 
@@ -115,7 +115,7 @@ def test_refusal_message_example_shape():
     case = wf.cases[0]
     rep = st.preflight(case.scaled(), case.case_id, explicit_dt=True)
     msg = next(f.message for f in rep.findings if f.check == "dt_rayleigh")
-    t_r = case.scaled().rayleigh_time
+    t_r = case.scaled().particles.rayleigh_time
     assert msg.startswith(f"numerics.dt: dt = 0.0001 s is {1e-4 / t_r:.3g}x the Rayleigh time "
                           f"of the smallest CG3 particle ({t_r:.2g} s); limit 0.2x; "
                           f"use dt <= {0.2 * t_r:.2g} s")
@@ -126,11 +126,11 @@ def test_explicit_dt_overrides_the_fraction_and_is_reported():
                               "sweep.rules=[weber]"])
     for case in wf.cases:
         s = case.scaled()
-        assert s.dt == 2.0e-6
-        assert s.dt_rayleigh_fraction == pytest.approx(2.0e-6 / s.rayleigh_time)
+        assert s.numerics.dt == 2.0e-6
+        assert s.numerics.dt_rayleigh_fraction == pytest.approx(2.0e-6 / s.particles.rayleigh_time)
     default = load_workflow(DRUM).cases[0].scaled()
-    assert default.dt == pytest.approx(0.16 * default.rayleigh_time)
-    assert default.dt_rayleigh_fraction == 0.16
+    assert default.numerics.dt == pytest.approx(0.16 * default.particles.rayleigh_time)
+    assert default.numerics.dt_rayleigh_fraction == 0.16
 
 
 @pytest.mark.parametrize("modulus, line", [(1e10, "hard_particles yes"),
@@ -171,14 +171,14 @@ def test_cli_check_and_render_refuse_and_override(tmp_path, capsys):
 def test_suite_sweeps_every_axis_the_issue_asks_for():
     suite = load_suite(SUITE)
     scaled = {v: [c.scaled() for c in wf.cases] for v, wf in suite.items()}
-    assert max(s.youngs_modulus for s in scaled["stiffness"]) > 1e9
-    gammas = [s.surface_tension for s in scaled["surface_tension"]]
+    assert max(s.particles.youngs_modulus for s in scaled["stiffness"]) > 1e9
+    gammas = [s.liquid_values.surface_tension for s in scaled["surface_tension"]]
     assert min(gammas) == 0.0 and max(gammas) >= 100 * 0.072
-    assert max(s.froude for s in scaled["rotation"]) > 1.0
+    assert max(s.drum.froude for s in scaled["rotation"]) > 1.0
     assert {(s.cg, s.rule) for s in scaled["coarse_graining"]} >= {(4.0, "weber"), (4.0, "bond")}
-    contents = [s.liquid_content for s in scaled["liquid_content"]]
+    contents = [s.liquid_values.liquid_content for s in scaled["liquid_content"]]
     assert min(contents) <= 1e-4 and max(contents) >= 0.2
-    fractions = [s.dt_rayleigh_fraction for s in scaled["timestep"]]
+    fractions = [s.numerics.dt_rayleigh_fraction for s in scaled["timestep"]]
     assert min(fractions) <= 0.05 and max(fractions) >= 1.5
     for cases in scaled.values():
-        assert all(s.particle_count <= 300 for s in cases)
+        assert all(s.particles.count <= 300 for s in cases)

@@ -45,7 +45,7 @@ def test_other_definitions_and_dry_scenes_do_not_warn():
     assert warnings_for(2.5, granules="communities") == []
     raw = copy.deepcopy(GRANULES)
     raw["scene"]["liquid"] = {"model": "none"}
-    raw["scene"]["analysis"] = {"granules": False}
+    raw["scene"]["analysis"] = {"contact_dumps": False}
     raw["sweep"].update(controls=[], rules=["weber"])
     assert held_window_warnings(expand(raw)) == []
 

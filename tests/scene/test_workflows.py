@@ -27,20 +27,20 @@ def test_paper_scale_is_the_source_scene():
     wf = load_workflow(ROOT / "workflows" / "paper_scale.yaml")
     cases = {c.case_id: c.scaled() for c in wf.cases}
     cg1 = cases["cg1-none-r0"]
-    assert cg1.particle_count == 360_000
-    assert (cg1.drum_diameter, cg1.drum_length, cg1.periodic) == (0.2, 0.06, True)
-    assert (cg1.lifter_count, cg1.lifter_height) == (48, 0.001)
-    assert cg1.diameters == (0.001,)
-    assert cases["cg3-bond-r0"].particle_count == round(360_000 / 27)
+    assert cg1.particles.count == 360_000
+    assert (cg1.drum.diameter, cg1.drum.length, cg1.drum.periodic) == (0.2, 0.06, True)
+    assert (cg1.drum.lifter_count, cg1.drum.lifter_height) == (48, 0.001)
+    assert cg1.particles.diameters == (0.001,)
+    assert cases["cg3-bond-r0"].particles.count == round(360_000 / 27)
     assert {s.rule for s in cases.values()} == {"none", "weber", "bond"}
 
 
 def test_we_vs_bo_runs_more_revolutions_at_coarse_levels():
     wf = load_workflow(ROOT / "workflows" / "we_vs_bo.yaml")
     by_id = {c.case_id: c.scaled() for c in wf.cases}
-    rev = {cid: s.run_steps * s.dt / s.rotation_period for cid, s in by_id.items()}
+    rev = {cid: s.numerics.run_steps * s.numerics.dt / s.drum.rotation_period for cid, s in by_id.items()}
     assert rev["cg1-none-r0"] == pytest.approx(1.0, rel=1e-3)
     assert rev["cg1-none-r1"] == pytest.approx(1.0, rel=1e-3)        # the noise floor
     assert rev["cg3-bond-r2"] == pytest.approx(2.0, rel=1e-3)
-    assert by_id["cg1-none-r0"].drum_length == by_id["cg3-weber-r0"].drum_length
-    assert by_id["cg3-weber-r0"].drum_length / by_id["cg3-weber-r0"].d_max == pytest.approx(6.0)
+    assert by_id["cg1-none-r0"].drum.length == by_id["cg3-weber-r0"].drum.length
+    assert by_id["cg3-weber-r0"].drum.length / by_id["cg3-weber-r0"].d_max == pytest.approx(6.0)

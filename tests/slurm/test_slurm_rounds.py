@@ -98,7 +98,7 @@ def one_continuous_record(case_dir: Path) -> None:
     steps = [r.step for r in rows_from_csv((case_dir / "thermo.csv").read_text())]
     assert steps[0] == 0 and steps[-1] == m.total_steps
     assert not [(a, b) for a, b in zip(steps, steps[1:])
-                if not 0 < b - a <= case.scaled.thermo_every]
+                if not 0 < b - a <= case.scaled.numerics.thermo_every]
     frames = sorted(int(p.stem.split("_")[1]) for p in (case_dir / "post").glob("particles_*.vtu"))
     assert frames == case.expected_dump_steps(m.total_steps)
     assert case.why_not_usable() is None

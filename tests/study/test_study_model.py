@@ -65,10 +65,10 @@ def test_cases_in_index_order_parsed_once(rendered):
     c = study.case(1)
     assert (c.case_id, c.cg, c.rule, c.replica, c.group) == ("cg2-weber-r0", 2.0, "weber", 0, "{}")
     s = c.scaled
-    assert c.production_start_step == s.insertion_steps + s.settle_steps
-    assert c.steady_start_step(0.5) == c.production_start_step + 0.5 * s.run_steps
+    assert c.production_start_step == s.insertion_steps + s.numerics.settle_steps
+    assert c.steady_start_step(0.5) == c.production_start_step + 0.5 * s.numerics.run_steps
     assert c.drum_angle(c.production_start_step) == 0.0
-    assert c.drum_angle(c.production_start_step + 10) == pytest.approx(s.omega * 10 * s.dt)
+    assert c.drum_angle(c.production_start_step + 10) == pytest.approx(s.drum.omega * 10 * s.numerics.dt)
     with pytest.raises(ConfigError, match="case index 3"):
         study.case(3)
 

@@ -54,7 +54,7 @@ from ligwf.analysis.flow.frame import DrumGeometry
 from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.analysis.records.fields import (CRITERION_KERNELS, IN_PLANE, CaseFields, FieldGrid,
                                            WindowMeans)
-from ligwf.engine.mesh import axis_frame
+from ligwf.scene.axis import Axis
 
 #: the Gaussian is cut at this many standard deviations (and renormalised)
 KERNEL_CUTOFF = 3.0
@@ -93,9 +93,9 @@ def kernel_weights(grid: FieldGrid) -> np.ndarray:
     return g / (g.sum() * grid.spacing)
 
 
-def _in_plane(frame: ParticleFrame, axis: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _in_plane(frame: ParticleFrame, axis: Axis) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(u, v) of every particle and its velocity (u, v, axial components) in that order."""
-    ia, iu, iv = axis_frame(axis)
+    ia, iu, iv = axis.frame
     p, c = frame.positions, frame.velocities
     return p[:, iu], p[:, iv], c[:, [iu, iv, ia]]
 

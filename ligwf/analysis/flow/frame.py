@@ -39,8 +39,8 @@ import numpy as np
 from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.analysis.records.statistics import relative_l2
 from ligwf.analysis.flow.surface import fit_surface
-from ligwf.engine.mesh import axis_frame
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.axis import Axis
+from ligwf.scene.scaled import ScaledScene
 
 RIGID_FRAME_SHARE = 0.9  # a frame is rigid when more than this share co-rotates
 PROFILE_HALF_WIDTH = 0.15  # profile band half-width / drum radius (CG-independent)
@@ -52,16 +52,19 @@ class DrumGeometry:
     """What the flow metrics need to know about the drum (from the case's scaled scene)."""
 
     radius: float            # m
-    axis: str                # x | y | z
+    axis: Axis               # the drum axis (a letter is taken as its Axis)
     omega: float             # rad/s, rotation about +axis (counter-clockwise seen from +axis)
     d_mean: float            # m, a typical particle diameter (sets bins and bands)
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "axis", Axis(self.axis))
+
     @classmethod
     def from_scaled(cls, scaled: ScaledScene) -> "DrumGeometry":
-        d = np.asarray(scaled.diameters, float)
-        f = np.asarray(scaled.number_fractions, float)
-        return cls(radius=0.5 * scaled.drum_diameter, axis=scaled.axis,
-                   omega=scaled.omega, d_mean=float(np.sum(d * f)))
+        d = np.asarray(scaled.particles.diameters, float)
+        f = np.asarray(scaled.particles.number_fractions, float)
+        return cls(radius=0.5 * scaled.drum.diameter, axis=scaled.drum.axis,
+                   omega=scaled.drum.omega, d_mean=float(np.sum(d * f)))
 
 
 @dataclass(frozen=True)
@@ -83,7 +86,7 @@ class FrameFlow:
 
 def cross_section(frame: ParticleFrame, geo: DrumGeometry) -> tuple[np.ndarray, ...]:
     """(u, v, vel_u, vel_v) of every particle in the drum cross-section."""
-    _, iu, iv = axis_frame(geo.axis)
+    _, iu, iv = geo.axis.frame
     p, vel = frame.positions, frame.velocities
     return p[:, iu], p[:, iv], vel[:, iu], vel[:, iv]
 
@@ -94,7 +97,7 @@ def rigid_rotation_velocity(frame: ParticleFrame, geo: DrumGeometry) -> tuple[np
     Computed in 3-D: for axis y the (u, v) = (x, z) plane is left-handed about +y, so a
     2-D formula would get the sense of rotation wrong.
     """
-    ia, iu, iv = axis_frame(geo.axis)
+    ia, iu, iv = geo.axis.frame
     w = np.zeros(3)
     w[ia] = geo.omega
     rigid = np.cross(w, frame.positions)
@@ -103,7 +106,7 @@ def rigid_rotation_velocity(frame: ParticleFrame, geo: DrumGeometry) -> tuple[np
 
 def rising_side(geo: DrumGeometry) -> float:
     """+1 when the drum wall at +u moves up (rigid rotation at (u, v) = (R, 0)), else -1."""
-    ia, iu, iv = axis_frame(geo.axis)
+    ia, iu, iv = geo.axis.frame
     w, p = np.zeros(3), np.zeros(3)
     w[ia], p[iu] = geo.omega, geo.radius
     return 1.0 if np.cross(w, p)[iv] >= 0 else -1.0

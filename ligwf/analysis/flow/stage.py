@@ -51,11 +51,11 @@ def steady_fraction(case: CaseFolder, steady_after, flows: list) -> float:
     production frames' :class:`~ligwf.analysis.flow.frame.FrameFlow`)."""
     if not is_auto(steady_after):
         return float(steady_after)
-    dt = case.scaled.dt
+    dt = case.scaled.numerics.dt
     return auto_fraction(np.array([f.time for f in flows]),
                          [np.array([f.angle_of_repose for f in flows]),
                           np.array([f.kinetic_energy for f in flows])],
-                         case.production_start_step * dt, case.scaled.run_steps * dt)
+                         case.production_start_step * dt, case.scaled.numerics.run_steps * dt)
 
 
 @dataclass
@@ -82,7 +82,7 @@ class FlowFrames(FrameAnalysis):
     def _single_frame(self, ff):
         try:
             self.plan.check_record(ff)
-            frame = read_particles(ff.particles, ff.step, self.case.scaled.dt)
+            frame = read_particles(ff.particles, ff.step, self.case.scaled.numerics.dt)
             check_particles(self.case, frame)
         except DumpReadError as exc:
             self.problems.append({"step": ff.step, "reason": str(exc)})
@@ -141,7 +141,7 @@ def case_flow(case: CaseFolder, steady_after, field_kernel: float = FIELD_KERNEL
     geo = DrumGeometry.from_scaled(case.scaled)
     steady_frames = [frames[k][0] for k in steady]
     fields = case_fields(steady_frames, geo, kernel_width(geo, case.cg, field_kernel),
-                         case.scaled.drum_length,
+                         case.scaled.drum.length,
                          {k: head[k] for k in ("case_id", "cg", "rule", "replica", "group")},
                          tuple(sorted({*CRITERION_KERNELS, float(field_kernel)})))
     return measured_flow(head, steady_frames, all_flows, all_series, steady, geo,

@@ -43,7 +43,7 @@ from typing import Callable, Iterator
 
 import numpy as np
 
-from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame, dump_files,
+from ligwf.analysis.frames.dumps import (ContactFrame, FrameFiles, ParticleFrame, dump_files,
                                          read_particles)
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.study.case import CaseFolder, DumpRecord, file_digest
@@ -147,7 +147,7 @@ def plan_frames(case: CaseFolder) -> ExpectedFrames:
     last = end_step(case)
     expected = case.expected_dump_steps(last)
     parts, contacts = dump_files(case.path)
-    plan = f"every {s.dump_every} steps from {case.production_start_step} to {last}"
+    plan = f"every {s.numerics.dump_every} steps from {case.production_start_step} to {last}"
     frames, problems = [], []
 
     def refuse(step: int, reason: str, kind: str = "missing") -> None:
@@ -161,7 +161,7 @@ def plan_frames(case: CaseFolder) -> ExpectedFrames:
         elif part is None:
             refuse(step, f"missing frame: no particle dump for step {step}"
                    + (f" (its contact dump {contact.name} is left)" if contact else ""))
-        elif s.granules and contact is None:
+        elif s.contact_dumps and contact is None:
             refuse(step, f"missing frame: no contact dump for step {step} "
                    f"(its particle dump {part.name} is left)")
         elif (copy := _copy_of(frames[-1] if frames else None, part, record)) is not None:
@@ -203,32 +203,32 @@ def check_particles(case: CaseFolder, p: ParticleFrame) -> None:
 
 def _check_particles(case: CaseFolder, p: ParticleFrame) -> None:
     s = case.scaled
-    n = s.particle_count
+    n = s.particles.count
     if len(p) != n:
         _fail(p, f"{len(p)} particles, the run has {n}")
     if p.ids[0] != 1 or p.ids[-1] != n:
         _fail(p, f"particle ids {p.ids[0]}..{p.ids[-1]}, the run numbers them 1..{n}")
     if np.any(p.types < 1):
         _fail(p, "particle type below 1")
-    radii = 0.5 * np.asarray(s.diameters, dtype=float)
+    radii = 0.5 * np.asarray(s.particles.diameters, dtype=float)
     near = np.min(np.abs(p.radii[:, None] - radii[None, :]) / radii[None, :], axis=1)
     if np.any(near > 1e-6):
         _fail(p, f"radius {p.radii[near.argmax()]:.6g} m is none of the scene's size classes")
-    ia = AXES.index(s.axis)
+    ia = s.drum.axis.index
     across = np.delete(p.positions, ia, axis=1)
-    reach = 0.5 * s.drum_diameter * (1 + GEOMETRY_SLACK)
+    reach = 0.5 * s.drum.diameter * (1 + GEOMETRY_SLACK)
     if np.any(np.hypot(across[:, 0], across[:, 1]) > reach):
         _fail(p, "a particle centre lies outside the drum")
     along = p.positions[:, ia]
-    slack = GEOMETRY_SLACK * s.drum_length
-    if np.any(along < -slack) or np.any(along > s.drum_length + slack):
-        _fail(p, f"a particle centre lies outside the drum length [0, {s.drum_length:g}] m")
-    limit = SPEED_FACTOR * (s.omega * 0.5 * s.drum_diameter + np.sqrt(2 * 9.81 * s.drum_diameter))
+    slack = GEOMETRY_SLACK * s.drum.length
+    if np.any(along < -slack) or np.any(along > s.drum.length + slack):
+        _fail(p, f"a particle centre lies outside the drum length [0, {s.drum.length:g}] m")
+    limit = SPEED_FACTOR * (s.drum.omega * s.drum.radius + np.sqrt(2 * 9.81 * s.drum.diameter))
     if np.any(np.linalg.norm(p.velocities, axis=1) > limit):
         _fail(p, f"a particle speed above {limit:.3g} m/s (not physical in this drum)")
     if p.liquid_content is not None and np.any((p.liquid_content < 0) | (p.liquid_content > 1)):
         _fail(p, "liquid content outside [0, 1]")
-    before = p.step - s.dump_every
+    before = p.step - s.numerics.dump_every
     if before >= case.production_start_step and \
             _positions_digest(Path(p.path).with_name(_step_name(p, before)), case) == \
             _positions_digest(Path(p.path), case, p):
@@ -258,7 +258,7 @@ def _positions_digest(path: Path, case: CaseFolder, frame: ParticleFrame | None 
     if _POSITIONS is not None and key in _POSITIONS:
         return _POSITIONS[key]
     try:
-        frame = frame or read_particles(path, None, case.scaled.dt)
+        frame = frame or read_particles(path, None, case.scaled.numerics.dt)
     except (DumpReadError, OSError, ValueError):
         return None
     digest = hashlib.sha256(np.ascontiguousarray(frame.positions).tobytes()).hexdigest()
@@ -270,8 +270,8 @@ def _positions_digest(path: Path, case: CaseFolder, frame: ParticleFrame | None 
 def check_contacts(p: ParticleFrame, c: ContactFrame, periodic_axis: int | None,
                    box_length: float) -> None:
     """DumpReadError unless every pair's overlap matches the two particles' centres and
-    radii in ``p`` (nearest image along the periodic axis): the contact dump then belongs
-    to the same particles at the same step."""
+    radii in ``p`` (nearest image along the periodic axis, its column ``periodic_axis``):
+    the contact dump then belongs to the same particles at the same step."""
     if len(c) == 0:
         return
     i, j = p.index_of(c.id1), p.index_of(c.id2)

@@ -38,8 +38,6 @@ from ligwf.study.layout import CONTACT_DUMP_RE, PARTICLE_DUMP_RE, POST_DIR
 PARTICLE_ARRAYS = ("id", "type", "v", "radius")
 CONTACT_ARRAYS = ("id1", "id2", "delta")
 _CONTACT_WANTED = frozenset(CONTACT_ARRAYS)     # contact geometry (Points) is not used
-#: the axis letters in the order of a position's columns (``AXES.index("y") == 1``)
-AXES = "xyz"
 
 
 

@@ -16,7 +16,7 @@ from ligwf import liquids
 from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.liquids.base import LiquidModel
-from ligwf.scene.scaling import ScaledScene
+from ligwf.scene.scaled import ScaledScene
 
 
 @dataclass(frozen=True)
@@ -43,12 +43,12 @@ class Liquid:
     def from_scaled(cls, scaled: ScaledScene, engine_product_bug: bool = True) -> "Liquid":
         """The law of a scaled case. ligwf writes a compensated input angle so the 3.8.0
         engine applies the scene angle; without compensation it applied 0.5 a^2."""
-        liquids.get(scaled.liquid_model)          # an unknown model is an error here
-        theta = applied_contact_angle_rad(scaled.contact_angle_deg,
-                                          scaled.contact_angle_compensation, engine_product_bug)
-        return cls(scaled.liquid_model, float(scaled.surface_tension), theta,
-                   float(scaled.liquid_content), scaled.bridge_volume_fraction,
-                   scaled.max_liquid_content)
+        liq = scaled.liquid_values
+        liquids.get(liq.model)          # an unknown model is an error here
+        theta = applied_contact_angle_rad(liq.contact_angle_deg, liq.contact_angle_compensation,
+                                          engine_product_bug)
+        return cls(liq.model, float(liq.surface_tension), theta, float(liq.liquid_content),
+                   liq.bridge_volume_fraction, liq.max_liquid_content)
 
 
 def content_of(particles: ParticleFrame, liquid: Liquid) -> np.ndarray:

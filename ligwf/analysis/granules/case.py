@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.frames.dumps import (AXES, ContactFrame, FrameFiles, ParticleFrame,
+from ligwf.analysis.frames.dumps import (ContactFrame, FrameFiles, ParticleFrame,
                                          read_contacts, read_particles)
 from ligwf.analysis.granules.persistent import Frame, bridge_keys, persistent_labels, presence_run
 from ligwf.analysis.frames.checks import ExpectedFrames, check_contacts, check_particles, plan_frames
@@ -30,6 +30,7 @@ from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.analysis.granules.communities import louvain_labels
 from ligwf.errors import ConfigError, DumpReadError
 from ligwf.fsio import atomic_write_bytes
+from ligwf.scene.axis import Axis
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -42,13 +43,13 @@ class RunFacts:
     case_id: str
     cg: float
     liquid: Liquid
-    periodic_axis: int | None      # 0, 1, 2 for x, y, z; None: no periodic axis
+    periodic_axis: Axis | None     # None: no periodic axis
     box_length: float              # m, periodic length (the box spans [0, L] on that axis)
     dt: float                      # s per step
     case: CaseFolder | None = None     # a ligwf case: frames checked against its run
     plan: ExpectedFrames | None = None      # ... and its dump record
     omega: float | None = None         # rad/s about +rotation_axis (None: unknown)
-    rotation_axis: int = 1             # the drum axis through the origin (0, 1, 2)
+    rotation_axis: Axis = Axis.Y       # the drum axis through the origin
 
     def __post_init__(self) -> None:
         if self.periodic_axis is not None and not self.box_length > 0:
@@ -62,8 +63,13 @@ class RunFacts:
     def of_case(cls, case: CaseFolder, plan: ExpectedFrames | None = None) -> "RunFacts":
         """The facts of a ligwf case (the drum axis spans [0, L], see templates/drum.in.j2)."""
         s = case.scaled
-        return cls(case.case_id, case.cg, case_liquid(case), periodic_axis(case),
-                   s.drum_length, s.dt, case, plan, float(s.omega), AXES.index(s.axis))
+        return cls(case.case_id, case.cg, case_liquid(case), s.drum.periodic_axis,
+                   s.drum.length, s.numerics.dt, case, plan, float(s.drum.omega), s.drum.axis)
+
+    @property
+    def periodic_column(self) -> int | None:
+        """Column of the periodic axis in a position (None: none), for the array kernels."""
+        return None if self.periodic_axis is None else self.periodic_axis.index
 
     @property
     def motion(self) -> Motion:
@@ -74,11 +80,6 @@ class RunFacts:
 def case_liquid(case: CaseFolder) -> Liquid:
     """The liquid-bridge law the engine applied in the case."""
     return Liquid.from_scaled(case.scaled)
-
-
-def periodic_axis(case: CaseFolder) -> int | None:
-    """0, 1, 2 for a periodic drum axis x, y, z; None for a closed drum."""
-    return AXES.index(case.scaled.axis) if case.scaled.periodic else None
 
 
 @dataclass
@@ -143,7 +144,7 @@ class GranuleAnalysis(FrameAnalysis):
         try:
             if ff.contacts is None:
                 raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
-                                    "(was the case rendered with analysis.granules: true?)")
+                                    "(was the case rendered with analysis.contact_dumps: true?)")
             particles, contacts = self._read(ff)
             if self.definition.granules == "held":
                 ident = self._held(ff, particles, contacts)
@@ -158,7 +159,7 @@ class GranuleAnalysis(FrameAnalysis):
             return res
         labels = ident.labels
         # the periodic axis spans [0, L] (the box, see templates/drum.in.j2)
-        table = granule_table(particles, labels, f.cg, ident.unwrapped_axis, f.periodic_axis,
+        table = granule_table(particles, labels, f.cg, ident.unwrapped_axis, f.periodic_column,
                               0.0, f.box_length, ident.percolating)
         res.table, res.particles, res.contacts = table, len(particles), len(contacts)
         res.bonds = len(ident.i)
@@ -178,14 +179,14 @@ class GranuleAnalysis(FrameAnalysis):
         f = self._facts
         if ff.contacts is None:
             raise DumpReadError(f"{ff.particles}: no contact dump for step {ff.step} "
-                                "(was the case rendered with analysis.granules: true?)")
+                                "(was the case rendered with analysis.contact_dumps: true?)")
         if f.plan is not None:
             f.plan.check_record(ff)
         particles = read_particles(ff.particles, ff.step, f.dt)
         contacts = read_contacts(ff.contacts, ff.step)
         if f.case is not None:
             check_particles(f.case, particles)
-        check_contacts(particles, contacts, f.periodic_axis, f.box_length)
+        check_contacts(particles, contacts, f.periodic_column, f.box_length)
         return particles, contacts
 
     def _held(self, ff: FrameFiles, particles: ParticleFrame, contacts: ContactFrame):

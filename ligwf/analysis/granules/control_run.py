@@ -88,7 +88,7 @@ def load_series(case_dir: Path) -> Series:
     start = case.production_start_step
     times = (np.asarray(steps) - start) * facts.dt
     s = case.scaled
-    return Series(facts, tuple(frames), times, float(s.omega) * 0.5 * float(s.drum_diameter),
+    return Series(facts, tuple(frames), times, float(s.drum.omega) * 0.5 * float(s.drum.diameter),
                   float(2.0 * np.mean(frames[0].particles.radii)))
 
 
@@ -161,7 +161,7 @@ def control_rows(series: Series, candidates=DEFAULT_CANDIDATES, steady_from: flo
     starts = [k for k in range(len(series.frames)) if series.times[k] >= steady_from - 1e-9]
     starts = starts[::series.frames_in(stride)]
     volumes = series.frames[0].particles.volumes
-    axis, length = facts.periodic_axis, facts.box_length
+    axis, length = facts.periodic_column, facts.box_length
     rows = []
     shared_keys: dict[tuple[int, bool], np.ndarray] = {}
     for name, kind, param in candidates:

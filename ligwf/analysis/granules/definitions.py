@@ -46,6 +46,7 @@ from ligwf.analysis.granules.communities import cpm_labels, cpm_labels_reference
 from ligwf.analysis.frames.dumps import ContactFrame, ParticleFrame
 from ligwf.analysis.granules.bonds import (BondCriterion, Identification, bonded_contacts,
                                      bonded_contacts_reference, components, identify)
+from ligwf.scene.axis import Axis
 from ligwf.scene.settings import AnalysisSettings
 
 #: the factors the sensitivity table moves each threshold by
@@ -108,10 +109,15 @@ def variants(definition: AnalysisSettings) -> list[tuple[str, AnalysisSettings]]
 class Motion:
     """What the velocity frames need of a run: the drum's rotation and its periodic axis."""
 
-    rotation_axis: int          # 0, 1, 2: the drum axis (x, y, z) through the origin
+    rotation_axis: Axis         # the drum axis through the origin
     omega: float | None         # rad/s, positive about +axis; None: unknown (drum frame refused)
-    periodic_axis: int | None
+    periodic_axis: Axis | None
     length: float               # m, periodic length along periodic_axis
+
+    @property
+    def periodic_column(self) -> int | None:
+        """Column of the periodic axis in a position (None: none), for the array kernels."""
+        return None if self.periodic_axis is None else self.periodic_axis.index
 
 
 def drum_frame_velocities(particles: ParticleFrame, motion: Motion) -> np.ndarray:
@@ -119,7 +125,7 @@ def drum_frame_velocities(particles: ParticleFrame, motion: Motion) -> np.ndarra
     if motion.omega is None:
         raise ValueError("velocity_frame drum needs the drum's angular velocity")
     w = np.zeros(3)
-    w[motion.rotation_axis] = motion.omega
+    w[motion.rotation_axis.index] = motion.omega
     return particles.velocities - np.cross(w, particles.positions)
 
 
@@ -137,7 +143,7 @@ def flow_frame_velocities(particles: ParticleFrame, motion: Motion, radius_diame
         for a in range(n):
             d = pos - pos[a]
             if periodic:
-                ax = motion.periodic_axis
+                ax = motion.periodic_column
                 d[:, ax] -= motion.length * np.round(d[:, ax] / motion.length)
             near = np.einsum("ij,ij->i", d, d) <= radius * radius
             near[a] = False
@@ -150,7 +156,7 @@ def flow_frame_velocities(particles: ParticleFrame, motion: Motion, radius_diame
     pts = pos - lo
     box = pts.max(axis=0) + 2.0 * radius + 1.0       # non-periodic sides never wrap
     if periodic:
-        ax = motion.periodic_axis
+        ax = motion.periodic_column
         pts[:, ax] = np.mod(pos[:, ax], motion.length)
         box[ax] = motion.length
     pairs = cKDTree(pts, boxsize=box).query_pairs(radius, output_type="ndarray")
@@ -188,7 +194,7 @@ def identify_granules(particles: ParticleFrame, contacts: ContactFrame, liquid: 
     if definition.max_velocity_angle < 180.0 and definition.velocity_frame != "lab":
         particles = replace(particles, velocities=frame_velocities(
             particles, definition, motion, implementation))
-    axis, length = motion.periodic_axis, motion.length
+    axis, length = motion.periodic_column, motion.length
     if definition.granules == "components" and definition.min_relative_force == 0.0:
         return identify(particles, contacts, liquid, crit, axis, length, implementation)
     bonds = bonded_contacts if implementation == "fast" else bonded_contacts_reference

@@ -201,13 +201,13 @@ def growth_rows(series: Series, settings: GrowthSettings = GrowthSettings(),
             cm = comovement(big_labels(labels, settings.min_particles),
                             series.frames[k0].particles.positions,
                             series.frames[k1].particles.positions, series.diameter,
-                            facts.periodic_axis, facts.box_length)
+                            facts.periodic_column, facts.box_length)
             row["comove_ratio"] = cm.ratio
         else:
             row["comove_ratio"] = np.nan
         if radius is not None:
             row["wall_share"], row["bed_wall_share"] = wall_shares(
-                series.frames[k].particles.positions, volumes, labels, facts.rotation_axis,
+                series.frames[k].particles.positions, volumes, labels, facts.rotation_axis.index,
                 radius, settings.wall_band * d_cg1, settings.min_particles)
         events = (track(previous.labels, labels, settings.min_particles)
                   if previous is not None else None)

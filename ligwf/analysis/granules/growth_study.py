@@ -50,7 +50,7 @@ def measure_case(case_dir: Path, settings: GrowthSettings = GrowthSettings(),
     """(growth rows, share_10 per start frame at each window cadence, flow per frame)."""
     case = CaseFolder.open(case_dir)
     series = load_series(case_dir)
-    radius = 0.5 * float(case.scaled.drum_diameter)
+    radius = 0.5 * float(case.scaled.drum.diameter)
     rows = growth_rows(series, settings, radius)
     volumes = series.frames[0].particles.volumes
     stride = frames_spanning(series, settings.stride)

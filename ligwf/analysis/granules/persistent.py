@@ -108,4 +108,4 @@ def persistent_labels(frames: list[Frame], keys: list[np.ndarray], motion: Motio
         passed = passed_flowing_layer(frames, motion, passage_speed)
         keep = passed[i] | passed[j]
         i, j = i[keep], j[keep]
-    return components(first.positions, i, j, None, motion.periodic_axis, motion.length)
+    return components(first.positions, i, j, None, motion.periodic_column, motion.length)

@@ -55,7 +55,6 @@ from ligwf.analysis.records.fields import (CRITERION_KERNELS, EMPTY_SOLID, IN_PL
 from ligwf.analysis.records.intervals import (Interval, block_indices, block_length,
                                               interval_from_draws)
 from ligwf.analysis.records.metrics import POSITIVE
-from ligwf.engine.mesh import axis_frame
 
 #: a node where the CG1 solid fraction reaches this holds material (the field criterion's
 #: support: the bed and its smoothed edge, not the dilute spray above it)
@@ -212,7 +211,7 @@ def rotation_velocity(grid: FieldGrid, omega: float) -> tuple[np.ndarray, np.nda
     """(u, v) components of the rigid rotation omega x r at the grid's nodes ((n, n) each,
     rows v, columns u), computed in 3-D as the rigid-block share does (the (u, v) plane
     of axis y is left-handed about +y)."""
-    ia, iu, iv = axis_frame(grid.axis)
+    ia, iu, iv = grid.axis.frame
     e = np.eye(3)
     w = omega * e[ia]
     du, dv = np.cross(w, e[iu]), np.cross(w, e[iv])    # omega x r is linear in (u, v)

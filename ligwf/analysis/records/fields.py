@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ligwf.engine.mesh import axis_frame
+from ligwf.scene.axis import Axis
 
 #: per-frame kernel sums on the grid, in this order (axis 1 of ``CaseFields.moments``)
 MOMENTS = ("solid_fraction", "flux_u", "flux_v", "flux_axial", "fluctuation")
@@ -60,14 +60,17 @@ class FieldGrid:
     nodes: int         # nodes per axis
     width: float       # m, kernel standard deviation (a physical length, CG-independent)
     length: float      # m, periodic length the fields are averaged over
-    axis: str          # x | y | z, the drum axis (u, v: ligwf.engine.mesh.axis_frame)
+    axis: Axis         # the drum axis (u, v: Axis.frame); read back from its letter
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "axis", Axis(self.axis))
 
     def coordinates(self) -> np.ndarray:
         """(nodes,) node coordinates, m (the same for u and v)."""
         return self.origin + self.spacing * np.arange(self.nodes)
 
     def to_json(self) -> dict:
-        return dict(self.__dict__)
+        return {**self.__dict__, "axis": self.axis.value}
 
 
 @dataclass(frozen=True)
@@ -198,7 +201,7 @@ def image_text(case: CaseFields) -> str:
     drum's own coordinates (the in-plane velocity as a 3-vector with zero axial part)."""
     g = case.grid
     f = fields_of(case.mean())
-    ia, iu, iv = axis_frame(g.axis)
+    ia, iu, iv = g.axis.frame
     origin, spacing, extent = [0.0] * 3, [g.spacing] * 3, [0] * 6
     origin[iu] = origin[iv] = g.origin
     extent[2 * iu + 1] = extent[2 * iv + 1] = g.nodes - 1

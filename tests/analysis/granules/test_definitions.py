@@ -145,8 +145,8 @@ def test_communities_gsd_is_invariant_to_tiling(real):
     1x / 2x / 4x / 8x / 16x). That is the slice, not the definition's scale, so the base
     frame here is the real frame tiled 4x (12 diameters), tiled again 2x and 4x."""
     scaled, liquid, motion, frames = real
-    L = 4 * scaled.drum_length
-    frames = [tiled(p, c, 4, scaled.drum_length) for p, c in frames]
+    L = 4 * scaled.drum.length
+    frames = [tiled(p, c, 4, scaled.drum.length) for p, c in frames]
 
     def hists(tiles, seeds):
         out = []

@@ -37,7 +37,7 @@ def real(engine, tmp_path_factory):
 def test_reference_equals_fast_on_real_dumps(real, angle):
     scaled, frames = real
     liquid = Liquid.from_scaled(scaled)
-    counts, L = [], scaled.drum_length
+    counts, L = [], scaled.drum.length
     for p, c in frames:
         crit = BondCriterion(0.0, angle)
         ref = identify_reference(p, c, liquid, crit, 1, L)
@@ -178,8 +178,8 @@ def test_bond_criterion_matches_scalar_evaluation(real):
     for a, b, delta in zip(c.id1.tolist(), c.id2.tolist(), c.delta.tolist()):
         ia, ib = int(np.searchsorted(p.ids, a)), int(np.searchsorted(p.ids, b))
         f = liquids.get("washino").capillary_force(p.radii[ia], p.radii[ib], -delta,
-                                                   scaled.surface_tension,
-                                                   math.radians(scaled.contact_angle_deg),
+                                                   scaled.liquid_values.surface_tension,
+                                                   math.radians(scaled.liquid_values.contact_angle_deg),
                                                    p.liquid_content[ia], p.liquid_content[ib])
         va, vb = p.velocities[ia], p.velocities[ib]
         cosang = float(va @ vb) / (float(np.linalg.norm(va)) * float(np.linalg.norm(vb)))

@@ -57,7 +57,7 @@ def real(engine, tmp_path_factory):
 def test_louvain_with_stay_proofs_equals_reference_on_tiled_real_frames(real):
     scaled, facts, frames = real
     for p, c in frames[-3:]:
-        pt, ct = tiled(p, c, 4, scaled.drum_length)
+        pt, ct = tiled(p, c, 4, scaled.drum.length)
         i, j, w, nw = cpm_weights(pt, ct, facts.liquid, scaled.cg)
         for gamma in (0.001, 0.002, 0.004):
             np.testing.assert_array_equal(cpm_labels(len(pt), i, j, w, nw, gamma, seed=1),
@@ -69,7 +69,7 @@ def test_louvain_with_stay_proofs_equals_reference_on_tiled_real_frames(real):
 def test_rupture_work_table_returns_the_bits_of_each_pair_alone(real):
     """Tiled 4x, every touching pair of a copy has equals in the other copies."""
     scaled, facts, frames = real
-    p, c = tiled(*frames[-1], 4, scaled.drum_length)
+    p, c = tiled(*frames[-1], 4, scaled.drum.length)
     i, j, _, rows = bonded_contacts(p, c, facts.liquid, BondCriterion(0.0, 180.0),
                                     with_rows=True)
     gap = -c.delta[rows]
