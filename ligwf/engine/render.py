@@ -13,6 +13,7 @@ LIGGGHTS command (the engine has ``shell``).
 from __future__ import annotations
 
 import math
+import re
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
@@ -24,7 +25,7 @@ from ligwf import __version__
 from ligwf.errors import RenderError
 from ligwf.liquids.contact_angle import input_angle
 from ligwf.engine.decomposition import runner_grid
-from ligwf.scene.scaled import ScaledScene
+from ligwf.scene.scaled import ScaledScene, nested_name
 from ligwf.scene.model import GRAVITY
 from ligwf.scene.values import unsafe_chars
 from ligwf.study.layout import INPUT_NAME, MESH_NAME
@@ -184,11 +185,20 @@ def render_template(name: str, context: dict[str, Any],
     try:
         return env.get_template(name).render(**context)
     except jinja2.TemplateError as exc:
-        raise RenderError(f"cannot render {name}: {exc}") from exc
+        raise RenderError(f"cannot render {name}: {exc}{flat_name_hint(str(exc))}") from exc
     except UnicodeDecodeError as exc:   # a user's template saved in another encoding
         raise RenderError(f"template {name} (searched in {', '.join(map(str, template_dirs))} "
                           f"before ligwf's own) is not UTF-8 text (byte {exc.object[exc.start]:#04x} "
                           f"at offset {exc.start}); save it as UTF-8") from None
+
+
+def flat_name_hint(message: str) -> str:
+    """For a user's template that asks the scaled scene for a name of its flat record
+    (``s.dt``, ``s.youngs_modulus``, as templates did before the record was nested): where
+    that value is now, so the error says how to mend the template."""
+    found = re.search(r"ScaledScene object' has no attribute '(\w+)'", message)
+    where = nested_name(found.group(1)) if found else None
+    return f" (the scaled scene is nested: s.{found.group(1)} is s.{where})" if where else ""
 
 
 def render(scaled: ScaledScene, template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:

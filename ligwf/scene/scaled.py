@@ -332,6 +332,21 @@ DERIVED_KEYS = {
     "rayleigh_time": lambda s: s.particles.rayleigh_time,
 }
 
+#: the sub-record whose property each derived key is
+DERIVED_PLACES = {"rotation_period": "drum", "rpm": "drum", "froude": "drum",
+                  "rayleigh_time": "particles"}
+
+
+def nested_name(flat_key: str) -> str | None:
+    """Where a flat record key lives on the nested scene (``"dt"`` -> ``"numerics.dt"``,
+    ``"rpm"`` -> ``"drum.rpm"``); None for a name the record never had."""
+    if flat_key in DERIVED_PLACES:
+        return f"{DERIVED_PLACES[flat_key]}.{flat_key}"
+    if flat_key not in FLAT_KEYS:
+        return None
+    return ".".join(part for part in FLAT_KEYS[flat_key] if part)
+
+
 #: where the derived keys sat in the record's historical key order (after which stored key)
 DERIVED_AFTER = {"omega": ("rotation_period", "rpm", "froude"),
                  "contact_angle_compensation": ("rayleigh_time",)}

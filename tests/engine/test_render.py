@@ -120,6 +120,23 @@ def test_user_template_folder_overrides_and_strict_undefined(tmp_path):
         render(scaled, [tmp_path / "."])
 
 
+@pytest.mark.parametrize(("flat", "nested"), [
+    ("youngs_modulus", "particles.youngs_modulus"), ("dt", "numerics.dt"),
+    ("rpm", "drum.rpm"), ("rayleigh_time", "particles.rayleigh_time"),
+    ("granules", "contact_dumps"), ("insertion_radius", "fill.radius")])
+def test_a_flat_record_name_in_a_user_template_says_where_it_is_now(tmp_path, flat, nested):
+    scaled = load_workflow(DRUM).cases[0].scaled()
+    assert str(eval(f"s.{nested}", {}, {"s": scaled})) != ""    # the named place exists
+    (tmp_path / "_header.j2").write_text(f"# {{{{ s.{flat} }}}}\natom_style granular\n")
+    with pytest.raises(RenderError) as err:
+        render(scaled, [tmp_path])
+    assert str(err.value).endswith(f"(the scaled scene is nested: s.{flat} is s.{nested})")
+    (tmp_path / "_header.j2").write_text("# {{ s.no_such_field }}\n")
+    with pytest.raises(RenderError) as err:
+        render(scaled, [tmp_path])
+    assert "nested" not in str(err.value)
+
+
 def test_render_is_pure(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     files = render(load_workflow(DRUM).cases[1].scaled())
