@@ -43,6 +43,25 @@ from ligwf.study.study import Study
 
 #: Seconds between looks at cases another runner holds.
 WAIT_SECONDS = 1.0
+#: set in the environment of a local analysis share: the pid of the ligwf that started it
+#: (the share ends when that process does: :func:`end_with_parent`)
+SHARE_PARENT_ENV = "LIGWF_SHARE_PARENT"
+#: prctl option: a signal this process gets when its parent ends (linux/prctl.h)
+_PR_SET_PDEATHSIG = 1
+
+
+def end_with_parent() -> None:
+    """In a local analysis share (``SHARE_PARENT_ENV`` set): have the kernel send this
+    process SIGTERM when the ligwf that started it ends, however it ends (a SIGKILLed
+    ``ligwf analyse --tasks N`` leaves no share computing for nobody); a parent already
+    gone ends it now. Nothing outside a share."""
+    parent = os.environ.get(SHARE_PARENT_ENV)
+    if parent is None:
+        return
+    import ctypes
+    ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGTERM, 0, 0, 0)
+    if str(os.getppid()) != parent:
+        os.kill(os.getpid(), signal.SIGTERM)
 
 
 @dataclass(frozen=True)
@@ -240,20 +259,24 @@ class LocalExecutor:
         logs = study.path / layout.ANALYSIS_SHARE_LOG_DIR
         logs.mkdir(parents=True, exist_ok=True)
         procs = []
-        for index in range(tasks):
-            with open(logs / layout.analysis_share_log(token, index), "wb") as log:
-                procs.append(subprocess.Popen(
-                    [sys.executable, "-m", "ligwf", "analyse", str(study.path), "--part",
-                     f"{index}/{tasks}", "--token", token],
-                    stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL))
-        while any(p.poll() is None for p in procs):
-            if stop.wait(WAIT_SECONDS):
-                for p in procs:
-                    if p.poll() is None:
-                        p.terminate()
-                for p in procs:
-                    p.wait()
-                return None
+        env = {**os.environ, SHARE_PARENT_ENV: str(os.getpid())}
+        try:
+            for index in range(tasks):
+                with open(logs / layout.analysis_share_log(token, index), "wb") as log:
+                    procs.append(subprocess.Popen(
+                        [sys.executable, "-m", "ligwf", "analyse", str(study.path), "--part",
+                         f"{index}/{tasks}", "--token", token],
+                        stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                        env=env))
+            while any(p.poll() is None for p in procs):
+                if stop.wait(WAIT_SECONDS):
+                    return None
+        finally:            # stopped, or an error here: no share computes on for nobody
+            for p in procs:
+                if p.poll() is None:
+                    p.terminate()
+            for p in procs:
+                p.wait()
         return merge_parts(study.path, token, tasks, None, AnalysisOptions(),
                            rerun=f"{sys.executable} -m ligwf analyse {study.path} "
                                  f"--part {{index}}/{tasks} --token {token}")

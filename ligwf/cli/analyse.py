@@ -92,6 +92,7 @@ def cmd_split(args: argparse.Namespace, options) -> int:
     """``--slurm N`` (submit), ``--part K/N`` (one array task), ``--merge N``."""
     from ligwf.analysis import parts
     from ligwf.analysis.runner import analyse_part, merge_parts
+    from ligwf.local import end_with_parent
     from ligwf.study.study import Study
 
     if args.slurm is not None:
@@ -105,6 +106,7 @@ def cmd_split(args: argparse.Namespace, options) -> int:
                           "`ligwf analyse --slurm` printed)")
     token = parts.check_token(args.token)
     if args.part is not None:
+        end_with_parent()               # a share of a local analysis ends with its ligwf
         index, count = parts.parse_part(args.part)
         path = analyse_part(args.run_dir, token, index, count, args.out, options)
         print(f"analysis task {index} of {count}: partial output {path}")

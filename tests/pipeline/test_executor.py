@@ -140,3 +140,47 @@ def test_a_local_analysis_stopped_mid_way_merges_nothing(tmp_path):
     stop.set()
     assert LocalExecutor().analyse(study, 2, stop) is None
     assert not (study.analysis_dir / layout.ANALYSIS_RECORD).exists()
+
+
+def _shares_of(study: Path) -> list[int]:
+    """Pids of the analysis shares (``ligwf analyse STUDY --part``) running on ``study``."""
+    pids = []
+    for proc in Path("/proc").iterdir():
+        try:
+            argv = (proc / "cmdline").read_bytes().split(b"\0")
+        except OSError:
+            continue
+        if b"--part" in argv and str(study).encode() in argv:
+            pids.append(int(proc.name))
+    return pids
+
+
+def test_shares_end_with_a_sigkilled_ligwf_and_leave_no_part(tmp_path):
+    """kill -9 of the process running LocalExecutor.analyse(study, 2): its shares end with
+    it (the kernel's parent-death signal) instead of computing on for nobody: no share
+    process is left and none wrote its part. Without the signal they finish their shares
+    (a few seconds of work after their imports) and write both parts."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    study = write(prepare_workflow(DRUM, SCENE), tmp_path / "study", tmp_path / "meshes")
+    assert run_study(study, study.cases, ReplayExecutor())
+    parent = subprocess.Popen(
+        [sys.executable, "-c", "import sys; from ligwf.local import LocalExecutor; "
+         "from ligwf.study.study import Study; "
+         "LocalExecutor().analyse(Study.open(sys.argv[1]), 2)", str(study.path)])
+    deadline = time.monotonic() + 60
+    while len(_shares_of(study.path)) < 2:
+        assert parent.poll() is None and time.monotonic() < deadline, "no shares started"
+        time.sleep(0.05)
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+    deadline = time.monotonic() + 30
+    while _shares_of(study.path):
+        assert time.monotonic() < deadline, "the shares outlived their ligwf"
+        time.sleep(0.1)
+    assert not list(study.analysis_dir.parent.rglob("part-*")), "a share finished its part"
+    assert not (study.analysis_dir / layout.ANALYSIS_RECORD).exists()
