@@ -101,7 +101,7 @@ def angle_of(case_dir: Path) -> dict[str, float]:
     finished case, with its friction values."""
     case = CaseFolder.open(case_dir)
     flow, _ = case_flow(case, SPIN_UP)
-    p = case.scaled
+    p = case.scaled.particles
     return {"case_id": case.case_id, "friction": float(p.friction),
             "rolling_friction": float(p.rolling_friction),
             "angle_deg": float(flow.values.get("angle_of_repose", math.nan)),
