@@ -1,14 +1,15 @@
 """Constant Potts model communities by compiled Louvain (numba): the fast path of the
 default granule definition.
 
-CPM quality of a partition: Q = sum over communities c of W_in(c) - gamma N_c^2 / 2, with
+CPM quality of a partition: Q = sum over communities c of W_in(c) - resolution N_c^2 / 2, with
 W_in the edge weight inside c and N_c its node weight (:func:`ligwf.analysis.granules.communities.
 cpm_quality` computes it in numpy). Louvain (Blondel et al. 2008) with the CPM gain:
 
 1. *local moving*: nodes in order (on the particle graph: id order from a seeded start,
-   for cache locality; on aggregated graphs: a seeded random order); each leaves its community and joins
-   the neighbouring community c with the largest gain w(v, c) - gamma n_v N_c (or a
-   community of its own, gain 0); passes repeat until no node moves;
+   for cache locality; on aggregated graphs: a seeded random order); each leaves its
+   community and joins the neighbouring community c with the largest gain
+   w(v, c) - resolution n_v N_c (or a community of its own, gain 0); passes repeat until
+   no node moves;
 2. *aggregation*: each community becomes a node (weight N_c, edges summed), and 1. runs
    on that graph; until a level moves nothing.
 
@@ -59,7 +60,7 @@ PROOF_SLACK = 1e-9
 
 
 @cached_jit()
-def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, init):
+def _local_moving(indptr, indices, weights, node_w, resolution, order, max_passes, init):
     """Louvain local moving from the partition ``init`` (ids < n); returns (community per
     node, moves made). A node moves only for a strictly larger gain (relative tolerance
     1e-12), so every move raises the quality and the passes end.
@@ -69,8 +70,8 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
     nodes): a node that stayed at its last visit by a margin M (its stay gain over the best
     alternative, and over being alone) stays again while none of its neighbours moved (so
     its sums ``acc`` are bit-identical) and the weights of its own and its neighbours'
-    communities changed in total by less than (M - slack) / (gamma n_v): each gain moves
-    by gamma n_v times its community's weight change. ``drift`` is that total per community
+    communities changed in total by less than (M - slack) / (resolution n_v): each gain moves
+    by resolution n_v times its community's weight change. ``drift`` is that total per community
     (it only grows), summed at the visit over the communities the node touches; the node's
     own community weight is still taken out and put back, as the full visit does, so every
     floating-point sum stays the same."""
@@ -125,7 +126,7 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
                 for t in range(indptr[v], indptr[v] + n_seen[v]):
                     now += drift[seen[t]]
                 comm_w[cv] += nv
-                if alone == was_alone[v] and gamma * nv * (now - drift_at[v]) < margin[v]:
+                if alone == was_alone[v] and resolution * nv * (now - drift_at[v]) < margin[v]:
                     continue               # proven: the full visit would stay too
             visit += 1                     # (not v: a node's next visit must not reuse
             k = 0                          # the sums of its previous one)
@@ -140,14 +141,14 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
                 acc[c] += weights[e]
                 spread += abs(weights[e])
             comm_w[cv] -= nv
-            stay = (acc[cv] if stamp[cv] == visit else 0.0) - gamma * nv * comm_w[cv]
+            stay = (acc[cv] if stamp[cv] == visit else 0.0) - resolution * nv * comm_w[cv]
             best, best_gain = cv, stay
             rival = -np.inf                # the best alternative's gain
             for t in range(k):
                 c = touched[t]
                 if c == cv:
                     continue
-                gain = acc[c] - gamma * nv * comm_w[c]
+                gain = acc[c] - resolution * nv * comm_w[c]
                 if gain > rival:
                     rival = gain
                 if gain > best_gain + 1e-12 * (abs(best_gain) + abs(gain)):
@@ -181,7 +182,7 @@ def _local_moving(indptr, indices, weights, node_w, gamma, order, max_passes, in
             m = stay - rival
             if not alone and stay < m:
                 m = stay
-            m -= PROOF_SLACK * (spread + gamma * nv * total_w)
+            m -= PROOF_SLACK * (spread + resolution * nv * total_w)
             margin[v] = m
             was_alone[v] = alone
             now = drift[cv]
@@ -305,7 +306,7 @@ def level_order(size, level_no):
 
 
 @cached_jit()
-def _levels(n, graph, node_w, gamma, start, max_passes, max_levels):
+def _levels(n, graph, node_w, resolution, start, max_passes, max_levels):
     """One Louvain run: local moving on the graph (``graph``: its CSR, :func:`_csr`) from
     partition ``start``, then on the aggregated graphs from singletons, until a level
     moves nothing."""
@@ -319,7 +320,7 @@ def _levels(n, graph, node_w, gamma, start, max_passes, max_levels):
         if level_no > 0:
             indptr, indices, weights = _csr(size, ci, cj, cw)
         order = level_order(size, level_no)
-        comm, moves = _local_moving(indptr, indices, weights, cnw, gamma, order, max_passes,
+        comm, moves = _local_moving(indptr, indices, weights, cnw, resolution, order, max_passes,
                                     init)
         level, k = _renumber(comm)
         for v in range(n):
@@ -333,9 +334,9 @@ def _levels(n, graph, node_w, gamma, start, max_passes, max_levels):
 
 
 @cached_jit()
-def louvain_cpm(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50, max_levels=20):
+def louvain_cpm(n, i, j, w, node_w, resolution, seed, iterations=2, max_passes=50, max_levels=20):
     """Community per node (0..K-1 in order of first appearance) maximising CPM with
-    resolution ``gamma`` by Louvain; node orders drawn from ``seed``. ``iterations``: the
+    resolution by Louvain; node orders drawn from ``seed``. ``iterations``: the
     first run starts from singletons, each further run from the previous partition (as
     igraph's Leiden iterations do), which on real bond graphs recovers most of the quality
     Louvain's first run leaves to Leiden."""
@@ -345,13 +346,13 @@ def louvain_cpm(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50, ma
     labels = np.arange(n)
     graph = _csr(n, ci, cj, cw)            # the particle graph: built once for every run
     for _ in range(iterations):
-        labels = _levels(n, graph, cnw, gamma, labels, max_passes, max_levels)
+        labels = _levels(n, graph, cnw, resolution, labels, max_passes, max_levels)
     return labels
 
 
 @cached_jit()
-def cpm_quality_compiled(labels, i, j, w, node_w, gamma):
-    """CPM quality of a partition, sum of W_in(c) - gamma N_c^2 / 2, in one compiled loop
+def cpm_quality_compiled(labels, i, j, w, node_w, resolution):
+    """CPM quality of a partition, sum of W_in(c) - resolution N_c^2 / 2, in one compiled loop
     (the value the fast path reports; the numpy version in ligwf.analysis.granules.communities is
     the independent check)."""
     k = 0
@@ -368,4 +369,4 @@ def cpm_quality_compiled(labels, i, j, w, node_w, gamma):
     penalty = 0.0
     for c in range(k):
         penalty += size[c] * size[c]
-    return inside - gamma * 0.5 * penalty
+    return inside - resolution * 0.5 * penalty

@@ -215,7 +215,7 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("variant", "text", "variant", "the definition's setting moved x0.8 / x1.25 (first: as set)"),
     ("method", "text", "method", "analysis.granules of the variant"),
     ("velocity_frame", "text", "velocity frame", "analysis.velocity_frame of the variant"),
-    ("resolution", "1", "resolution", "analysis.resolution (CPM gamma) of the variant"),
+    ("resolution", "1", "resolution", "analysis.resolution (the CPM resolution) of the variant"),
     ("max_velocity_angle", "deg", "max velocity angle", "analysis.max_velocity_angle of the "
      "variant"),
     ("min_relative_force", "1", "min relative force", "analysis.min_relative_force of the "

@@ -74,7 +74,7 @@ class AnalysisSettings(Frozen):
         3.0, ge=0.1, le=50.0, description="radius of the local mean flow of velocity_frame "
         "flow, in mean particle diameters of the case")
     resolution: float = Field(
-        0.002, ge=1e-9, le=100.0, allow_inf_nan=False, description="CPM resolution gamma of "
+        0.002, ge=1e-9, le=100.0, allow_inf_nan=False, description="CPM resolution of "
         "the communities (edge weight w n^2, node weight n^3 at CG level n; the default "
         "0.002 is for the energy weight, the force weight's scale is ~3-5x larger: 0.01-0.02)")
     community_weight: Literal["energy", "force"] = Field(

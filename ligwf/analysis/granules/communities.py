@@ -60,7 +60,7 @@ def cpm_quality(labels: np.ndarray, i: np.ndarray, j: np.ndarray, weight: np.nda
     (edge weight inside c) - resolution * (node weight of c)^2 / 2.
 
     The independent check of both Leiden implementations (igraph reports
-    (2 W_in - gamma sum N_c^2) / (2 W), leidenalg 2 (W_in - gamma sum N_c (N_c - 1) / 2);
+    (2 W_in - resolution sum N_c^2) / (2 W), leidenalg 2 (W_in - resolution sum N_c (N_c - 1) / 2);
     all three differ only by constants of the graph, so they rank partitions alike).
     """
     inside = labels[i] == labels[j]
@@ -94,7 +94,7 @@ def cpm_labels(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarray,
     return labels
 
 
-def _moves_reference(adj, node_w, gamma, order, max_passes, init):
+def _moves_reference(adj, node_w, resolution, order, max_passes, init):
     """Plain-Python local moving of :func:`ligwf.analysis.cpm_numba._local_moving` (dicts
     and lists, the same visiting order, sums and tie rule)."""
     n = len(node_w)
@@ -113,11 +113,11 @@ def _moves_reference(adj, node_w, gamma, order, max_passes, init):
             for u, x in adj[v]:
                 acc[comm[u]] = acc.get(comm[u], 0.0) + x
             comm_w[cv] -= nv
-            best, best_gain = cv, acc.get(cv, 0.0) - gamma * nv * comm_w[cv]
+            best, best_gain = cv, acc.get(cv, 0.0) - resolution * nv * comm_w[cv]
             for c, a in acc.items():                # insertion order = first touch
                 if c == cv:
                     continue
-                gain = a - gamma * nv * comm_w[c]
+                gain = a - resolution * nv * comm_w[c]
                 if gain > best_gain + 1e-12 * (abs(best_gain) + abs(gain)):
                     best, best_gain = c, gain
             if best_gain < 0.0 and comm_w[cv] > 0.0:
@@ -142,7 +142,7 @@ def _first_appearance(comm):
     return [new.setdefault(c, len(new)) for c in comm]
 
 
-def louvain_cpm_reference(n, i, j, w, node_w, gamma, seed, iterations=2, max_passes=50,
+def louvain_cpm_reference(n, i, j, w, node_w, resolution, seed, iterations=2, max_passes=50,
                           max_levels=20) -> np.ndarray:
     """The reference of the compiled Louvain (:func:`ligwf.analysis.cpm_numba.louvain_cpm`):
     the same algorithm written again in plain Python (adjacency lists in edge order, dict
@@ -164,7 +164,7 @@ def louvain_cpm_reference(n, i, j, w, node_w, gamma, seed, iterations=2, max_pas
                     adj[a].append((b, x))
                     adj[b].append((a, x))
             order = level_order(size, level_no).tolist()
-            comm, moves = _moves_reference(adj, nw, gamma, order, max_passes, init)
+            comm, moves = _moves_reference(adj, nw, resolution, order, max_passes, init)
             level = _first_appearance(comm)
             k = max(level) + 1 if level else 0
             out = [level[c] for c in out]
@@ -239,12 +239,12 @@ def cpm_labels_leidenalg(n: int, i: np.ndarray, j: np.ndarray, weight: np.ndarra
     if n == 0:
         return np.zeros(0, np.int64)
     graph = ig.Graph(n=n, edges=list(zip(i.tolist(), j.tolist())))
-    sizes, gamma = node_weight.tolist(), resolution
+    sizes = node_weight.tolist()
     if np.all(node_weight == node_weight[0]):
-        # leidenalg takes integer node sizes: equal weights w become 1 with gamma w^2,
+        # leidenalg takes integer node sizes: equal weights w become 1 with resolution w^2,
         # the same objective (every community term scales by w^2)
-        sizes, gamma = [1] * n, resolution * float(node_weight[0]) ** 2
+        sizes, resolution = [1] * n, resolution * float(node_weight[0]) ** 2
     part = leidenalg.find_partition(graph, leidenalg.CPMVertexPartition,
                                     weights=weight.tolist(), node_sizes=sizes,
-                                    resolution_parameter=gamma, n_iterations=-1, seed=seed)
+                                    resolution_parameter=resolution, n_iterations=-1, seed=seed)
     return canonical_labels(np.asarray(part.membership, dtype=np.int64))

@@ -14,7 +14,7 @@ applied to one frame by :func:`identify_granules`:
    mean particle diameters, periodic along the drum axis).
 2. **Partition** -- ``components``: connected components of the bonds (the source study;
    in a dense wet bed one cluster spans the bed); ``communities`` (the default):
-   communities maximising the constant Potts model with resolution gamma, edge weight
+   communities maximising the constant Potts model at ``resolution``, edge weight
    w n^2 and node weight n^3 at CG level n, where w is the bridge's relative rupture work
    e_rel = W / (F_0 R*) (``weight: energy``, the default: the energy needed to pull the
    pair apart, which grows with the bridge volume) or its relative force f_rel
@@ -22,7 +22,7 @@ applied to one frame by :func:`identify_granules`:
    liquid volume, so the partition barely responds to the liquid content). A CG-n contact
    stands for ~n^2 primary contacts across the same interface and a CG-n node for n^3
    primaries, so the CPM balance gives the same granule volume at every n (measured CG2/CG1
-   d50 = 0.98-1.02). Why CPM, rupture work and gamma = 0.002 by default:
+   d50 = 0.98-1.02). Why CPM, rupture work and a resolution of 0.002 by default:
    docs/results/granule_definitions.md.
 3. **Granules** -- connected components of the bonds inside one partition class (for
    connected communities these are the communities; Louvain can leave one disconnected,
