@@ -1,11 +1,15 @@
 #!/usr/bin/env python3
-"""docs/results/ladder/: the committed tables of the ladder study and the README whose every
-number is read from them.
+"""docs/results/ladder/: the committed tables of the ladder studies and the READMEs whose
+every number is read from them. Two studies: the continuation (amendments 2 and 3 of
+criterion.md, in docs/results/ladder/) and the run under the 80-min cap on a quiet machine
+(amendment 4, in docs/results/ladder/cap_80min/).
 
     ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided --max-looks 3 --max-core-hours 2.7
     ligwf study runs/ladder --out runs/ladder --no-snapshots --until-decided --every-level --max-looks 3 --max-core-hours 6.2
     .venv/bin/python scripts/ladder_results.py runs/ladder          # copies tables, writes README
-    .venv/bin/python scripts/ladder_results.py --check               # README == text from tables
+    /usr/bin/time -v -o runs/ladder80.time ligwf study workflows/ladder.yaml --out runs/ladder80 --no-snapshots --until-decided --max-looks 3 --max-core-hours 2.7
+    .venv/bin/python scripts/ladder_results.py runs/ladder80 --ladder cap_80min
+    .venv/bin/python scripts/ladder_results.py --check               # READMEs == text from tables
 
 ``--check`` (what tests/report/test_committed_ladder.py runs) rebuilds the README from the
 committed tables and fails when the committed README differs: a sentence cannot drift
@@ -14,7 +18,9 @@ from its table.
 
 from __future__ import annotations
 
+import re
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -40,6 +46,49 @@ COMMANDS = ("ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots 
             "machine's measured rates")
 #: look 1 as amendment 2's run first took it (stuck), before the continuation re-took it
 FIRST_LOOK = "rounds_look1_first.json"
+#: the wall time of the 80-min run, the line of /usr/bin/time -v that gives it
+WALL = "wall.txt"
+
+TIMING_CONTINUATION = (
+    "Timings: the first 14 runs (look 1) shared the machine with the developer's "
+    "tests (niced; CG1 r1 took 6,645 core-s against r0's 3,070); the continuation's "
+    "runs had the 2 cores to themselves. The CG1 runs used 2 ranks, the CG-n runs 1: "
+    "the speedups (production core-seconds per simulated second, CG1 over CG-n) are "
+    "indicative, not a benchmark (benchmarks/bench_cg_speedup.py is). The design was "
+    "amended to two CG1 seeds before any result was analysed (criterion.md); "
+    "amendment 2 registered the sequential run (`--until-decided`) before it started, "
+    "amendment 3 its continuation (`--every-level`, look 1 re-taken on the same data "
+    f"at the same level; look 1 as first taken: `{FIRST_LOOK}`). The same study under "
+    "the registered 80-min cap on a quiet machine: [cap_80min/](cap_80min/README.md).")
+TIMING_80MIN = (
+    "Amendment 4 of [criterion.md](../criterion.md): amendment 2's command again, from "
+    "scratch, on a quiet machine (no tests, helpers or benchmarks ran beside it; the "
+    "developer only edited files), cap 2.7 core-h = 80 min of the 2 cores, default choice of "
+    "what to extend (the cheapest level that can still pass). The CG1 runs used the "
+    "planner's ranks; speedups are indicative (benchmarks/bench_cg_speedup.py is the "
+    "benchmark). The continuation with a larger cap: [../README.md](../README.md).")
+
+
+@dataclass(frozen=True)
+class Ladder:
+    """One committed ladder study: where its tables go and how it was made."""
+
+    out: Path
+    study: str                      # its run folder, as the commands name it
+    commands: tuple[str, ...]
+    timing: str                     # the paragraph on timings and amendments
+    title: str = "The ladder: which CG level and rule keeps the flow of the we_vs_bo drum"
+
+
+LADDERS = {
+    "continuation": Ladder(OUT, "runs/ladder", COMMANDS, TIMING_CONTINUATION),
+    "cap_80min": Ladder(
+        OUT / "cap_80min", "runs/ladder80",
+        ("/usr/bin/time -v -o runs/ladder80.time ligwf study workflows/ladder.yaml --out "
+         "runs/ladder80 --no-snapshots --until-decided --max-looks 3 --max-core-hours 2.7",),
+        TIMING_80MIN,
+        "The ladder under its 80-min cap, on a quiet machine (criterion.md, amendment 4)"),
+}
 
 
 def rounds_lines(rounds) -> list[str]:
@@ -58,30 +107,44 @@ def rounds_lines(rounds) -> list[str]:
     return lines
 
 
-def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None) -> str:
-    """The README text, every number from ``verdict`` (verdict.csv), ``cases`` and the
-    rounds record."""
-    lines = ["# The ladder: which CG level and rule keeps the flow of the we_vs_bo drum",
+def wall_minutes(text: str) -> float:
+    """Minutes of wall time in a ``/usr/bin/time -v`` report (its ``Elapsed`` line)."""
+    found = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): ([\d:.]+)", text)
+    if found is None:
+        raise ValueError("no 'Elapsed (wall clock) time' line")
+    seconds = 0.0
+    for part in found.group(1).split(":"):
+        seconds = seconds * 60 + float(part)
+    return seconds / 60
+
+
+def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
+           ladder: Ladder = LADDERS["continuation"], wall: str | None = None,
+           repeated: pd.DataFrame | None = None) -> str:
+    """The README text, every number from ``verdict`` (verdict.csv), ``cases``, the
+    rounds record, (``wall``) the run's ``/usr/bin/time -v`` report and (``repeated``) the
+    cases.csv of the continuation whose seeds this study ran again."""
+    name = [k for k, v in LADDERS.items() if v == ladder][0]
+    remake = f".venv/bin/python scripts/ladder_results.py {ladder.study}" + (
+        f" --ladder {name}" if name != "continuation" else "")
+    criterion = "criterion.md" if ladder.out == OUT else "../criterion.md"
+    lines = [f"# {ladder.title}",
              "",
              "Pre-registration (budget, statistics, looks, cap), committed before the runs: "
-             "[criterion.md](criterion.md). Made by:",
+             f"[criterion.md]({criterion}). Made by:",
              "",
-             "```", *COMMANDS, ".venv/bin/python scripts/ladder_results.py runs/ladder", "```",
+             "```", *ladder.commands, remake, "```",
              "",
              "Tables: `verdict.csv` (one row per CG level, rule and criterion), `cases.csv` "
              "(one row per run), `conditions.csv`, the report's `summary.md`. This README is "
              "written from them by `scripts/ladder_results.py` and checked against them by "
              "`tests/report/test_committed_ladder.py`.",
              "",
-             "Timings: the first 14 runs (look 1) shared the machine with the developer's "
-             "tests (niced; CG1 r1 took 6,645 core-s against r0's 3,070); the continuation's "
-             "runs had the 2 cores to themselves. The CG1 runs used 2 ranks, the CG-n runs 1: "
-             "the speedups (production core-seconds per simulated second, CG1 over CG-n) are "
-             "indicative, not a benchmark (benchmarks/bench_cg_speedup.py is). The design was "
-             "amended to two CG1 seeds before any result was analysed (criterion.md); "
-             "amendment 2 registered the sequential run (`--until-decided`) before it started, "
-             "amendment 3 its continuation (`--every-level`, look 1 re-taken on the same data "
-             f"at the same level; look 1 as first taken: `{FIRST_LOOK}`).",
+             ladder.timing,
+             *([] if wall is None else [
+                 "", f"Wall time of the command (`{WALL}`, from `/usr/bin/time -v`): "
+                     f"{wall_minutes(wall):.1f} min; runs in all: "
+                     f"{cases['core_seconds'].sum() / 3600:.2f} core-h."]),
              "", "## Looks (`rounds.json`)", "", *rounds_lines(rounds if rounds is not None
                                                              else read_rounds(OUT / "none")),
              "", "## Runs", ""]
@@ -133,24 +196,65 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None) -> str:
     open_ = flow[flow["state"] == "undecided"]
     for _, r in open_.iterrows():
         lines.append(f"- Undecided: {r['condition']} {r['label']}: {r['note']}.")
+    if repeated is not None:
+        lines += repeat_lines(cases, repeated)
     return "\n".join(lines) + "\n"
+
+
+def repeat_lines(cases: pd.DataFrame, repeated: pd.DataFrame) -> list[str]:
+    """How many runs of the same seed (CG level, rule, replica) in both studies give the
+    same angle of repose (exactly, as cases.csv stores it), and which do not."""
+    both = cases.merge(repeated, on=["cg", "rule", "replica"], suffixes=("", "_then"))
+    same = both["angle_of_repose"] == both["angle_of_repose_then"]
+    differ = "; ".join(f"cg{r['cg']:g}-{r['rule']} r{int(r['replica'])} "
+                       f"({r['angle_of_repose']:.2f} deg here, "
+                       f"{r['angle_of_repose_then']:.2f} in the continuation)"
+                       for _, r in both[~same].iterrows())
+    return [f"- The same seeds as the continuation (the engine is deterministic): {int(same.sum())} "
+            f"of {len(both)} runs that both studies have give the same angle of repose to "
+            "every digit of cases.csv" + (f"; not: {differ}." if differ else ".")]
 
 
 def main(argv=None) -> int:
     ap = parser(__doc__, "ladder")
+    ap.add_argument("--ladder", choices=sorted(LADDERS), default="continuation",
+                    help="which committed ladder the study folder is (default continuation)")
     args = ap.parse_args(argv)
-    if not args.check:
-        if args.study is None:
-            ap.error("give the study folder (or --check)")
-        copy_files(args.study / "report", OUT, TABLES)
-        copy_files(args.study, OUT, [ROUNDS])
-        first = args.study.parent / "ladder_rounds_look1_amendment2.json"
-        if first.is_file():
-            copy_files(first.parent, OUT, [first.name])
-            (OUT / first.name).rename(OUT / FIRST_LOOK)
-    return write_or_check(OUT, lambda: readme(pd.read_csv(OUT / "verdict.csv"),
-                                              pd.read_csv(OUT / "cases.csv"), read_rounds(OUT)),
-                          args.check, "scripts/ladder_results.py runs/ladder")
+    if args.check:
+        return max(check(ladder) for ladder in LADDERS.values()
+                   if (ladder.out / "verdict.csv").exists())
+    if args.study is None:
+        ap.error("give the study folder (or --check)")
+    ladder = LADDERS[args.ladder]
+    ladder.out.mkdir(parents=True, exist_ok=True)
+    copy_files(args.study / "report", ladder.out, TABLES)
+    copy_files(args.study, ladder.out, [ROUNDS])
+    first = args.study.parent / "ladder_rounds_look1_amendment2.json"
+    if ladder.out == OUT and first.is_file():
+        copy_files(first.parent, ladder.out, [first.name])
+        (ladder.out / first.name).rename(ladder.out / FIRST_LOOK)
+    timed = args.study.parent / f"{args.study.name}.time"
+    if ladder.out != OUT and timed.is_file():
+        (ladder.out / WALL).write_text(next(line.strip() + "\n" for line in
+                                            timed.read_text().splitlines()
+                                            if "Elapsed (wall clock)" in line))
+    return write_or_check(ladder.out, lambda: text(ladder), False, "")
+
+
+def text(ladder: Ladder) -> str:
+    """The README of ``ladder`` from its committed tables."""
+    wall = ladder.out / WALL
+    return readme(pd.read_csv(ladder.out / "verdict.csv"), pd.read_csv(ladder.out / "cases.csv"),
+                  read_rounds(ladder.out), ladder,
+                  wall.read_text() if wall.is_file() else None,
+                  None if ladder.out == OUT else pd.read_csv(OUT / "cases.csv"))
+
+
+def check(ladder: Ladder) -> int:
+    """0 when the committed README of ``ladder`` is what its tables give."""
+    name = [k for k, v in LADDERS.items() if v == ladder][0]
+    return write_or_check(ladder.out, lambda: text(ladder), True,
+                          f"scripts/ladder_results.py {ladder.study} --ladder {name}")
 
 
 if __name__ == "__main__":
