@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 
 import pandas as pd
+import pytest
 
 from tests.helpers import ROOT
 
@@ -29,12 +30,13 @@ def test_readme_counts_are_the_tables():
         assert list(sub["within_30_percent"]) == [abs(r - 1) <= 0.3 for r in ratios]
 
 
-def test_ladder_counts_are_its_table():
-    """The ladder's rows (registered in the README before the check ran): counts over the
-    rows with a ratio (a statistic without an interval has none)."""
-    table = pd.read_csv(HERE / "ladder.csv")
+@pytest.mark.parametrize("name, prefix", [("ladder", "Ladder"), ("ladder80", "Ladder80")])
+def test_ladder_counts_are_its_table(name, prefix):
+    """A ladder's rows (each registered in the README before its check ran): counts over
+    the rows with a ratio (a statistic without an interval has none)."""
+    table = pd.read_csv(HERE / f"{name}.csv")
     text = (HERE / "README.md").read_text()
-    for kind, label in (("replicas", "Ladder replicas"), ("extension", "Ladder extension")):
+    for kind, label in (("replicas", f"{prefix} replicas"), ("extension", f"{prefix} extension")):
         sub = table[table["kind"] == kind]
         ratios = sub["measured_over_predicted"].dropna()
         ok = int(sub["within_30_percent"].sum())
