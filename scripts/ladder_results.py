@@ -73,6 +73,7 @@ TIMING_80MIN = (
 class Ladder:
     """One committed ladder study: where its tables go and how it was made."""
 
+    name: str                       # its --ladder name
     out: Path
     study: str                      # its run folder, as the commands name it
     commands: tuple[str, ...]
@@ -81,9 +82,9 @@ class Ladder:
 
 
 LADDERS = {
-    "continuation": Ladder(OUT, "runs/ladder", COMMANDS, TIMING_CONTINUATION),
+    "continuation": Ladder("continuation", OUT, "runs/ladder", COMMANDS, TIMING_CONTINUATION),
     "cap_80min": Ladder(
-        OUT / "cap_80min", "runs/ladder80",
+        "cap_80min", OUT / "cap_80min", "runs/ladder80",
         ("/usr/bin/time -v -o runs/ladder80.time ligwf study workflows/ladder.yaml --out "
          "runs/ladder80 --no-snapshots --until-decided --max-looks 3 --max-core-hours 2.7",),
         TIMING_80MIN,
@@ -124,9 +125,8 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
     """The README text, every number from ``verdict`` (verdict.csv), ``cases``, the
     rounds record, (``wall``) the run's ``/usr/bin/time -v`` report and (``repeated``) the
     cases.csv of the continuation whose seeds this study ran again."""
-    name = [k for k, v in LADDERS.items() if v == ladder][0]
     remake = f".venv/bin/python scripts/ladder_results.py {ladder.study}" + (
-        f" --ladder {name}" if name != "continuation" else "")
+        f" --ladder {ladder.name}" if ladder.name != "continuation" else "")
     criterion = "criterion.md" if ladder.out == OUT else "../criterion.md"
     lines = [f"# {ladder.title}",
              "",
@@ -210,8 +210,8 @@ def repeat_lines(cases: pd.DataFrame, repeated: pd.DataFrame) -> list[str]:
                        f"({r['angle_of_repose']:.2f} deg here, "
                        f"{r['angle_of_repose_then']:.2f} in the continuation)"
                        for _, r in both[~same].iterrows())
-    return [f"- The same seeds as the continuation (the engine is deterministic): {int(same.sum())} "
-            f"of {len(both)} runs that both studies have give the same angle of repose to "
+    return [f"- The same seeds as the continuation (the engine is deterministic): "
+            f"{int(same.sum())} of {len(both)} runs that both studies have give the same angle of repose to "
             "every digit of cases.csv" + (f"; not: {differ}." if differ else ".")]
 
 
@@ -252,9 +252,8 @@ def text(ladder: Ladder) -> str:
 
 def check(ladder: Ladder) -> int:
     """0 when the committed README of ``ladder`` is what its tables give."""
-    name = [k for k, v in LADDERS.items() if v == ladder][0]
     return write_or_check(ladder.out, lambda: text(ladder), True,
-                          f"scripts/ladder_results.py {ladder.study} --ladder {name}")
+                          f"scripts/ladder_results.py {ladder.study} --ladder {ladder.name}")
 
 
 if __name__ == "__main__":
