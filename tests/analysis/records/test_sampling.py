@@ -93,6 +93,28 @@ def test_predicted_half_width_after_an_extension_matches_the_measured_one():
     assert np.mean((ratios > 0.5) & (ratios < 2.0)) >= 0.8
 
 
+def test_the_within_part_never_exceeds_the_scatter_of_the_run_means():
+    """An oscillating frame series over-states each run's own variance (the ladder's angle:
+    1.53 against a run-mean variance of 1.05): the within part is bounded by the sample
+    variance, the between part is then 0, and extending every run cannot predict a wider
+    interval than the present one (unbounded, it predicted 0.93 against 0.50 there)."""
+    values = [38.63, 38.01, 38.57]                  # the ladder's 3 CG1 half-window means
+    over = sp.arm(values, within=[1.24, 0.38, 0.56], window=[0.58, 0.5, 0.58],
+                  steady_share=1.0)
+    within, between = sp.components(over)
+    assert within == pytest.approx(np.var(values, ddof=1)) and between == 0.0
+    # each run keeps its share of the within part; doubling every window halves it
+    assert sp.run_variance(over, 0.55) == pytest.approx(
+        np.mean(np.array([1.24, 0.38, 0.56]) * within / np.mean([1.24, 0.38, 0.56])
+                * np.array([0.58, 0.5, 0.58]) / (np.array([0.58, 0.5, 0.58]) + 0.55)))
+    cg3 = sp.arm([41.2, 41.87, 41.17, 41.61, 42.2, 43.82], within=[0.95, 0.78, 1.2, 0.8, 1.8, 1.5],
+                 window=[1.0] * 6, steady_share=1.0)
+    assert sp.half_width(cg3, over, extend=(1.0, 0.55)) < sp.half_width(cg3, over)
+    # below the bound nothing changes
+    under = sp.arm(values, within=[0.01] * 3, window=[0.5] * 3)
+    assert sp.components(under) == pytest.approx((0.01, np.var(values, ddof=1) - 0.01))
+
+
 def test_hsu_degrees_of_freedom_are_the_smaller_arm_less_one():
     """A sequential study's looks (ligwf.study.rounds) use Hsu's min(R1, R2) - 1: never
     more than Welch's, so their intervals are never narrower."""
