@@ -3,6 +3,7 @@ half-width within +-30 % of the planner's prediction) are those of the committed
 
 from __future__ import annotations
 
+import math
 import re
 
 import pandas as pd
@@ -13,10 +14,13 @@ from tests.helpers import ROOT
 HERE = ROOT / "docs" / "results" / "prediction_check"
 
 
-def test_readme_counts_are_the_tables():
-    table = pd.read_csv(HERE / "demo.csv")
+@pytest.mark.parametrize("name, prefix", [("demo_unbounded", ""), ("demo", "Bounded demo ")])
+def test_readme_counts_are_the_tables(name, prefix):
+    """The demo's rows under the unbounded and the bounded within-run part."""
+    table = pd.read_csv(HERE / f"{name}.csv")
     text = (HERE / "README.md").read_text()
-    for kind, label in (("replicas", "Replicas"), ("extension", "Extension")):
+    for kind, label in (("replicas", f"{prefix}Replicas"), ("extension", f"{prefix}Extension")):
+        label = label[0] + label[1:].lower() if prefix else label
         sub = table[table["kind"] == kind]
         ok = int(sub["within_30_percent"].sum())
         ratios = sub["measured_over_predicted"]
@@ -30,7 +34,8 @@ def test_readme_counts_are_the_tables():
         assert list(sub["within_30_percent"]) == [abs(r - 1) <= 0.3 for r in ratios]
 
 
-@pytest.mark.parametrize("name, prefix", [("ladder", "Ladder"), ("ladder80", "Ladder80")])
+@pytest.mark.parametrize("name, prefix", [("ladder", "Ladder"), ("ladder80", "Ladder80"),
+                                          ("ladder80_bounded", "Bounded ladder80")])
 def test_ladder_counts_are_its_table(name, prefix):
     """A ladder's rows (each registered in the README before its check ran): counts over
     the rows with a ratio (a statistic without an interval has none)."""
@@ -50,24 +55,26 @@ def test_ladder_counts_are_its_table(name, prefix):
     assert "Every miss is\n  on the same side" in text and (ext[(ext - 1).abs() > 0.3] < 1).all()
 
 
-def _bench_rows() -> list[dict]:
-    """The cells of the committed bench_prediction.txt."""
-    lines = (HERE / "bench_prediction.txt").read_text().splitlines()
-    assert lines[0].startswith("# .venv/bin/python benchmarks/bench_prediction.py")
+def _bench_rows(name: str = "bench_prediction_unbounded.txt") -> list[dict]:
+    """The cells of a committed bench_prediction run (``startup`` inf: a periodic cell)."""
+    lines = (HERE / name).read_text().splitlines()
+    assert lines[0].startswith("# ") and "bench_prediction" in lines[0]   # the command
     rows = []
     for line in lines:
-        m = re.match(r"^\s*(0\.\d)\s+(\d+)\s+([\d.]+)\s+(\d)\s+([\d.]+) \|\s+([\d.]+)\s+[\d.]+"
-                     r"\s+([\d.]+)\s+[\d.]+ \|\s+(\S+)", line)
+        m = re.match(r"^\s*(0\.\d)\s+(\d+)\s+([\d.]+)\s+(\d)\s+([\d.]+|sine) \|\s+([\d.]+)"
+                     r"\s+[\d.]+\s+([\d.]+)\s+([\d.]+) \|\s+(\S+)", line)
         if m:
-            rows.append({"offset": float(m.group(3)), "startup": float(m.group(5)),
+            rows.append({"offset": float(m.group(3)),
+                         "startup": math.inf if m.group(5) == "sine" else float(m.group(5)),
                          "share": float(m.group(6)), "median": float(m.group(7)),
-                         "oracle": float(m.group(8)) if m.group(8) != "-" else None})
-    assert len(rows) == 72
+                         "q90": float(m.group(8)),
+                         "oracle": float(m.group(9)) if m.group(9) != "-" else None})
     return rows
 
 
 def test_bench_prediction_numbers_in_the_readme_are_the_file():
     rows = _bench_rows()
+    assert len(rows) == 72
     text = " ".join((HERE / "README.md").read_text().split())
     still = [r for r in rows if r["startup"] == 0]
     lone = [r for r in still if r["offset"] == 0]
@@ -84,7 +91,49 @@ def test_bench_prediction_numbers_in_the_readme_are_the_file():
     # H3: the start-up transient, without and with seed offsets
     for sub in ([r for r in moving if r["offset"] == 0], [r for r in moving if r["offset"] > 0]):
         assert f"{min(r['median'] for r in sub):.2f}-{max(r['median'] for r in sub):.2f}" in text
-    verdicts = (HERE / "bench_prediction.txt").read_text()
+    verdicts = (HERE / "bench_prediction_unbounded.txt").read_text()
     for h, word in (("H1", "holds"), ("H2", "does not hold"), ("H3", "holds")):
         assert re.search(rf"^{h} .*: {word}$", verdicts, re.M), h
         assert f"{h} {word}" in text
+
+
+def test_the_bounded_bench_numbers_in_the_readme_are_its_files():
+    """The bounded planner's bench (periodic cells added, H4 registered before its first
+    run) and the same cells under the unbounded rule: the README's result paragraph."""
+    rows = _bench_rows("bench_prediction.txt")
+    assert len(rows) == 108
+    sine = [r for r in rows if r["startup"] == math.inf]
+    lone = [r for r in sine if r["offset"] == 0]
+    own = [r for r in sine if r["offset"] > 0]
+    text = " ".join((HERE / "README.md").read_text().split("## Registered before the change")[1]
+                    .split())
+
+    def span(sub, key):
+        return f"{min(r[key] for r in sub):.2f}-{max(r[key] for r in sub):.2f}"
+
+    assert f"median ratio is {span(sine, 'median')}" in text
+    assert all(0.75 <= r["median"] <= 1.25 for r in sine)
+    gap = max(r["oracle"] - r["share"] for r in lone)
+    below = sum(r["oracle"] - r["share"] > 0.05 + 1e-9 for r in lone)
+    assert (f"its +-30 % share is {span(lone, 'share')}, up to {gap:.2f} below the oracle's "
+            f"({below} of {len(lone)} such cells more than 0.05 below)") in text
+    assert f"offset of one frame sd it is {span(own, 'share')}" in text
+    old = [r for r in _bench_rows("bench_prediction_sine_unbounded.txt")
+           if r["startup"] == math.inf]
+    old_lone = [r for r in old if r["offset"] == 0]
+    assert len(old) == 36
+    assert (f"gave medians {span(old_lone, 'median')} and shares {span(old_lone, 'share')}, up to "
+            f"{max(r['oracle'] - r['share'] for r in old_lone):.2f} below") in text
+    # the stationary cells without offsets, unbounded (the earlier file) and bounded
+    still = [r for r in rows if r["startup"] == 0 and r["offset"] == 0]
+    before = [r for r in _bench_rows() if r["startup"] == 0 and r["offset"] == 0]
+    assert (f"median from {span(before, 'median')} to {span(still, 'median')}") in text
+    assert (f"q90 up to {max(r['q90'] for r in still):.2f} from "
+            f"{max(r['q90'] for r in before):.2f}") in text
+    assert (f"share up to {max(r['oracle'] - r['share'] for r in still):.2f} below the "
+            f"oracle's") in text
+    verdicts = (HERE / "bench_prediction.txt").read_text()
+    for h, word in (("H1", "holds"), ("H2", "does not hold"), ("H3", "holds"),
+                    ("H4", "does not hold")):
+        assert re.search(rf"^{h} .*: {word}$", verdicts, re.M), h
+    assert "**H4 does not hold.**" in text and "H1 and H3 hold as before" in text
