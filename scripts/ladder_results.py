@@ -9,6 +9,8 @@ criterion.md, in docs/results/ladder/) and the run under the 80-min cap on a qui
     .venv/bin/python scripts/ladder_results.py runs/ladder          # copies tables, writes README
     /usr/bin/time -v -o runs/ladder80.time ligwf study workflows/ladder.yaml --out runs/ladder80 --no-snapshots --until-decided --max-looks 3 --max-core-hours 2.7
     .venv/bin/python scripts/ladder_results.py runs/ladder80 --ladder cap_80min
+    ligwf report runs/ladder80 --out runs/ladder80_replanned --no-snapshots   # after 5c72b39
+    .venv/bin/python scripts/ladder_results.py runs/ladder80 --ladder cap_80min --replanned runs/ladder80_replanned
     .venv/bin/python scripts/ladder_results.py --check               # READMEs == text from tables
 
 ``--check`` (what tests/report/test_committed_ladder.py runs) rebuilds the README from the
@@ -19,6 +21,7 @@ from its table.
 from __future__ import annotations
 
 import re
+import shutil
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -48,6 +51,9 @@ COMMANDS = ("ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots 
 FIRST_LOOK = "rounds_look1_first.json"
 #: the wall time of the 80-min run, the line of /usr/bin/time -v that gives it
 WALL = "wall.txt"
+#: the verdict of the same stored analysis re-reported with the plans' within-run part
+#: bounded by the run-mean variance (5c72b39): the states are the run's, the plans today's
+REPLANNED = "verdict_bounded_plans.csv"
 
 TIMING_CONTINUATION = (
     "Timings: the first 14 runs (look 1) shared the machine with the developer's "
@@ -121,10 +127,11 @@ def wall_minutes(text: str) -> float:
 
 def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
            ladder: Ladder = LADDERS["continuation"], wall: str | None = None,
-           repeated: pd.DataFrame | None = None) -> str:
+           repeated: pd.DataFrame | None = None, replanned: pd.DataFrame | None = None) -> str:
     """The README text, every number from ``verdict`` (verdict.csv), ``cases``, the
-    rounds record, (``wall``) the run's ``/usr/bin/time -v`` report and (``repeated``) the
-    cases.csv of the continuation whose seeds this study ran again."""
+    rounds record, (``wall``) the run's ``/usr/bin/time -v`` report, (``repeated``) the
+    cases.csv of the continuation whose seeds this study ran again and (``replanned``) the
+    verdict of the same analysis under today's plans."""
     remake = f".venv/bin/python scripts/ladder_results.py {ladder.study}" + (
         f" --ladder {ladder.name}" if ladder.name != "continuation" else "")
     criterion = "criterion.md" if ladder.out == OUT else "../criterion.md"
@@ -198,7 +205,27 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
         lines.append(f"- Undecided: {r['condition']} {r['label']}: {r['note']}.")
     if repeated is not None:
         lines += repeat_lines(cases, repeated)
+    if replanned is not None:
+        lines += replanned_lines(verdict, replanned)
     return "\n".join(lines) + "\n"
+
+
+def replanned_lines(verdict: pd.DataFrame, replanned: pd.DataFrame) -> list[str]:
+    """What the same stored analysis says under the plans of 5c72b39 (the within-run part
+    bounded by the run-mean variance): the states, and each plan that changed."""
+    key = ["condition", "criterion"]
+    both = verdict.merge(replanned, on=key, suffixes=("", "_new"))
+    same = int((both["state"] == both["state_new"]).sum())
+    lines = ["", f"## Plans re-made with the bounded within-run part (`{REPLANNED}`)", "",
+             "The same stored analysis re-reported after 5c72b39 bounded the within-run part "
+             "of each arm's variance by the run-mean variance "
+             "([../../prediction_check/README.md](../../prediction_check/README.md)): "
+             f"{same} of {len(both)} rows keep their state (the intervals do not use the "
+             "bound); the looks above were planned before it. Plans that change:", ""]
+    changed = both[both["note"].fillna("") != both["note_new"].fillna("")]
+    lines += [f"- {r['condition']} {r['label']}: {r['note_new']} (was: {r['note']})."
+              for _, r in changed.iterrows()] or ["- none."]
+    return lines
 
 
 def repeat_lines(cases: pd.DataFrame, repeated: pd.DataFrame) -> list[str]:
@@ -219,6 +246,9 @@ def main(argv=None) -> int:
     ap = parser(__doc__, "ladder")
     ap.add_argument("--ladder", choices=sorted(LADDERS), default="continuation",
                     help="which committed ladder the study folder is (default continuation)")
+    ap.add_argument("--replanned", type=Path, metavar="REPORT",
+                    help="a report folder of the same study made by today's planner "
+                         f"(ligwf report STUDY --out REPORT): its verdict.csv -> {REPLANNED}")
     args = ap.parse_args(argv)
     if args.check:
         return max(check(ladder) for ladder in LADDERS.values()
@@ -227,6 +257,8 @@ def main(argv=None) -> int:
         ap.error("give the study folder (or --check)")
     ladder = LADDERS[args.ladder]
     ladder.out.mkdir(parents=True, exist_ok=True)
+    if args.replanned is not None:
+        shutil.copyfile(args.replanned / "verdict.csv", ladder.out / REPLANNED)
     copy_files(args.study / "report", ladder.out, TABLES)
     copy_files(args.study, ladder.out, [ROUNDS])
     first = args.study.parent / "ladder_rounds_look1_amendment2.json"
@@ -244,10 +276,12 @@ def main(argv=None) -> int:
 def text(ladder: Ladder) -> str:
     """The README of ``ladder`` from its committed tables."""
     wall = ladder.out / WALL
+    replanned = ladder.out / REPLANNED
     return readme(pd.read_csv(ladder.out / "verdict.csv"), pd.read_csv(ladder.out / "cases.csv"),
                   read_rounds(ladder.out), ladder,
                   wall.read_text() if wall.is_file() else None,
-                  None if ladder.out == OUT else pd.read_csv(OUT / "cases.csv"))
+                  None if ladder.out == OUT else pd.read_csv(OUT / "cases.csv"),
+                  pd.read_csv(replanned) if replanned.is_file() else None)
 
 
 def check(ladder: Ladder) -> int:
