@@ -137,3 +137,26 @@ def test_the_bounded_bench_numbers_in_the_readme_are_its_files():
                     ("H4", "does not hold")):
         assert re.search(rf"^{h} .*: {word}$", verdicts, re.M), h
     assert "**H4 does not hold.**" in text and "H1 and H3 hold as before" in text
+
+
+def test_the_long_check_is_read_from_its_table_against_its_registered_criterion():
+    """workflows/prediction_check.yaml (8 runs an arm), registered before it ran: extension
+    holds in >= 2/3 of the rows with a ratio and their median ratio lies in [0.75, 1.25];
+    replicas in >= 2/3. The README's counts, ratios and 'met' / 'not met' are the table's."""
+    table = pd.read_csv(HERE / "long.csv")
+    text = " ".join((HERE / "README.md").read_text().split())
+    met = {}
+    for kind in ("extension", "replicas"):
+        sub = table[table["kind"] == kind]
+        ratios = sub["measured_over_predicted"].dropna()
+        ok = int(sub["within_30_percent"].sum())
+        assert list(sub["within_30_percent"]) == [bool(abs(r - 1) <= 0.3) if math.isfinite(r)
+                                                  else False
+                                                  for r in sub["measured_over_predicted"]]
+        line = (f"Long {kind}: the prediction holds in {ok} of {len(ratios)} rows with a ratio "
+                f"(measured / predicted {ratios.min():.2f}-{ratios.max():.2f}, median "
+                f"{ratios.median():.2f})")
+        assert line in text, line
+        met[kind] = 3 * ok >= 2 * len(ratios) and (
+            kind == "replicas" or 0.75 <= ratios.median() <= 1.25)
+        assert f"Long {kind} criterion {'met' if met[kind] else 'not met'}" in text
