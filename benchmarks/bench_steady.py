@@ -1,0 +1,141 @@
+#!/usr/bin/env python3
+"""Where does ``steady_after: auto`` start the steady window, and should it? (issue 30)
+
+The long prediction check (docs/results/prediction_check, ``workflows/prediction_check.yaml``,
+6.4 s of production) had its automatic window start at the 50 % cap in 5 of 8 CG1 runs and
+13 of 16 CG2 runs. The rule (:func:`ligwf.analysis.flow.steady.auto_fraction`) takes the last
+frame whose 3-frame running mean leaves a band of 2 steady sds around the second half's level,
+over the whole run, the reference half included. With correlated frames a chance crossing
+somewhere is likely, and the more frames, the likelier. This measures it on synthetic runs
+and beside it a standard truncation rule, MSER-5 (White 1997; batch means of 5 frames, the
+truncation d minimising the remaining batch means' variance / (m - d)^2, d at most half the
+run; the later of the two signals, as the current rule does).
+
+Per cell: frames of production (40, 80, 160: 1.6, 3.2, 6.4 s at the demo's 0.04 s), AR(1)
+phi of both signals (0.5, 0.8), an oscillation (none, or amplitude 1 sd with a period of 4
+frames: the demo drum's 12 lifters at 30 rpm), and a start-up (none, or each signal starting
+5 sds off and relaxing with a time constant of 4 frames: settled to 0.1 sd by frame 16).
+Printed per rule: the share of runs whose window starts at the cap (>= 45 % of production),
+the median start (fraction of production), and the bias of the window mean from the true
+level in standard errors of that mean (mean over trials of (window mean - level) / se, se
+from the true AR(1) variance of the window mean; 0 for a window free of start-up).
+
+Registered before the first run (2026-12-06 03:30 UTC):
+
+* H1: without a start-up, the current rule starts the window at the cap in >= 25 % of runs
+  at 160 frames in every (phi, oscillation) cell, and that share grows from 40 to 160 frames.
+* H2: MSER-5 starts it at the cap in <= 10 % of runs in every cell without a start-up, and
+  with a start-up the bias of its window mean lies within +-0.5 standard errors in every cell.
+
+    .venv/bin/python benchmarks/bench_steady.py            # ~1 min
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import math
+import sys
+
+import numpy as np
+
+from ligwf.analysis.flow.steady import auto_fraction
+
+CAP_SHARE = 0.45        # a start at or after this fraction of production counts as capped
+BATCH = 5               # MSER-5
+STARTUP_SDS, STARTUP_TAU = 5.0, 4.0
+PERIOD = 4.0
+
+
+def signal(rng, frames: int, phi: float, oscillation: float, startup: bool) -> np.ndarray:
+    """One signal of unit stationary AR(1) sd around level 0, with an oscillation of random
+    phase and a relaxing start-up offset (of random sign)."""
+    x = np.empty(frames)
+    x[0] = rng.standard_normal()
+    e = rng.standard_normal(frames) * math.sqrt(1.0 - phi * phi)
+    for t in range(1, frames):
+        x[t] = phi * x[t - 1] + e[t]
+    t = np.arange(frames)
+    if oscillation:
+        x += oscillation * np.sin(2.0 * math.pi * t / PERIOD + rng.uniform(0, 2 * math.pi))
+    if startup:
+        x += rng.choice((-1.0, 1.0)) * STARTUP_SDS * np.exp(-t / STARTUP_TAU)
+    return x
+
+
+def mser(x: np.ndarray, batch: int = BATCH) -> int:
+    """MSER-``batch`` truncation point (frames) of ``x``, at most half the run."""
+    m = len(x) // batch
+    if m < 4:
+        return 0
+    b = x[: m * batch].reshape(m, batch).mean(axis=1)
+    best, arg = math.inf, 0
+    for d in range(0, m // 2 + 1):
+        rest = b[d:]
+        stat = float(np.sum((rest - rest.mean()) ** 2)) / (len(rest) ** 2)
+        if stat < best:
+            best, arg = stat, d
+    return arg * batch
+
+
+def window_se(frames_in_window: int, phi: float, oscillation: float) -> float:
+    """Standard error of the mean of a stationary window (AR(1) part, oscillation ignored:
+    it averages out over whole periods)."""
+    n = frames_in_window
+    k = np.arange(1, n)
+    return math.sqrt((1.0 + 2.0 * np.sum((1.0 - k / n) * phi**k)) / n)
+
+
+def cell(rng, trials: int, frames: int, phi: float, oscillation: float, startup: bool):
+    t = np.arange(frames, dtype=float)
+    out = {"current": ([], []), "mser5": ([], [])}
+    for _ in range(trials):
+        sig = [signal(rng, frames, phi, oscillation, startup) for _ in range(2)]
+        current = auto_fraction(t, sig, 0.0, float(frames))
+        k_cur = int(math.ceil(current * frames - 1e-6))
+        k_mser = max(mser(s) for s in sig)
+        for name, k in (("current", k_cur), ("mser5", k_mser)):
+            window = sig[0][k:]
+            out[name][0].append(k / frames)
+            out[name][1].append(window.mean() / window_se(len(window), phi, oscillation))
+    return {name: (np.asarray(f), np.asarray(b)) for name, (f, b) in out.items()}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--trials", type=int, default=400)
+    ap.add_argument("--seed", type=int, default=20261206)
+    args = ap.parse_args(argv)
+    rng = np.random.default_rng(args.seed)
+    print(f"steady-window start: {args.trials} trials a cell; capped = start >= "
+          f"{CAP_SHARE:.0%} of production; bias = mean (window mean - level) / se")
+    print(f"{'frames':>6} {'phi':>4} {'osc':>4} {'start-up':>8} | {'current':>7} {'median':>6} "
+          f"{'bias':>6} | {'mser5':>7} {'median':>6} {'bias':>6}")
+    h1 = h2 = True
+    capped = {}
+    for phi, osc, startup, frames in itertools.product((0.5, 0.8), (0.0, 1.0), (False, True),
+                                                       (40, 80, 160)):
+        c = cell(rng, args.trials, frames, phi, osc, startup)
+        row = []
+        for name in ("current", "mser5"):
+            f, b = c[name]
+            share = float(np.mean(f >= CAP_SHARE))
+            row.append((share, float(np.median(f)), float(np.mean(b))))
+            if name == "current" and not startup:
+                capped[(phi, osc, frames)] = share
+            if name == "mser5":
+                h2 = h2 and (share <= 0.10 if not startup else abs(float(np.mean(b))) <= 0.5)
+        print(f"{frames:6d} {phi:4.1f} {osc:4.1f} {'yes' if startup else 'no':>8} | "
+              + " | ".join(f"{s:7.2f} {m:6.2f} {b:6.2f}" for s, m, b in row), flush=True)
+    for phi, osc in itertools.product((0.5, 0.8), (0.0, 1.0)):
+        at = [capped[(phi, osc, n)] for n in (40, 80, 160)]
+        h1 = h1 and at[2] >= 0.25 and at[2] > at[0]
+    print(f"H1 (current rule, no start-up: capped in >= 25 % at 160 frames, growing with "
+          f"length): {'holds' if h1 else 'does not hold'}")
+    print(f"H2 (MSER-5: capped in <= 10 % without a start-up, |bias| <= 0.5 se with one): "
+          f"{'holds' if h2 else 'does not hold'}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
