@@ -51,3 +51,45 @@ def test_readme_numbers_are_the_benchmark():
             assert cell[2]["current"] > cell[0]["current"]
     low = [r["current"] for r in still if r["frames"] == 160 and r["current"] < 0.25]
     assert len(low) == 1 and f"caps {low[0]:.2f} at 160 frames" in text
+
+
+def test_the_new_rule_and_the_long_check_numbers_are_their_files():
+    import pandas as pd
+
+    lines = (HERE / "bench_steady_hybrid.txt").read_text().splitlines()
+    assert "--seed 20261207" in lines[0]
+    rows = []
+    for line in lines:
+        m = re.match(r"^\s*(\d+)\s+[\d.]+\s+[\d.]+\s+(yes|no) \|\s+([\d.]+)\s+[\d.]+\s+"
+                     r"(-?[\d.]+) \|", line)
+        if m:
+            rows.append((int(m.group(1)), m.group(2) == "yes", float(m.group(3)),
+                         float(m.group(4))))
+    assert len(rows) == 24
+    text = " ".join((HERE / "README.md").read_text().split())
+    still = [r for r in rows if not r[1] and r[0] >= 80]
+    worst, bias = max(r[2] for r in still), max(abs(r[3]) for r in rows)
+    met = worst <= 0.20 and bias <= 0.25
+
+    def span(frames):
+        sub = [r[2] for r in still if r[0] == frames]
+        return f"{min(sub):.2f}-{max(sub):.2f}"
+
+    assert (f"caps at most {worst:.2f} of runs in the cells of 80 and 160 frames "
+            f"({span(80)} at 80, {span(160)} at 160)") in text
+    assert f"at most {bias:.2f} standard errors in every cell" in text
+    assert f"**the registered criterion is {'met' if met else 'not met'}.**" in text
+    capped = [int((pd.read_csv(HERE / f"long_cases_{k}.csv")["steady_fraction"] >= 0.45).sum())
+              for k in ("band", "mser")]
+    assert f"in {capped[0]} of 24 runs with the band and in {capped[1]} of 24" in text
+    decided = []
+    for k in ("band", "mser"):
+        v = pd.read_csv(HERE / f"long_verdict_{k}.csv")
+        v = v[v["state"] != "not assessed"]
+        decided.append((int(v["state"].isin(["pass", "fail"]).sum()), len(v)))
+    assert (f"decides {decided[0][0]} of {decided[0][1]} assessed criteria with the band and "
+            f"{decided[1][0]} of {decided[1][1]} with the new rule") in text
+    check = pd.read_csv(HERE / "long_prediction_check_mser.csv")
+    ext = check[check["kind"] == "extension"]
+    assert (f"holds in {int(ext['within_30_percent'].sum())} of "
+            f"{int(ext['measured_over_predicted'].notna().sum())} rows with a ratio") in text
