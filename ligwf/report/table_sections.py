@@ -12,7 +12,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.flow.steady import MSER_BATCH, MSER_MIN_BATCHES
 from ligwf.analysis.records.conditions import REFERENCE_CG
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.metrics import CASE_TABLE, CONDITION_TABLE, GRANULE_METRICS
@@ -193,9 +192,8 @@ def steady_line(flow: FlowRecord, cases: pd.DataFrame) -> str:
     fr = cases.get("steady_fraction", pd.Series(dtype=float)).dropna()
     if flow.steady_auto:
         span = (f"{100 * fr.min():.0f}-{100 * fr.max():.0f} %" if len(fr) else "–")
-        return (f"`steady_after: auto` (the spin-up of the flow angle and kinetic energy: "
-                f"a running-mean band below {MSER_BATCH * MSER_MIN_BATCHES} frames, MSER-5 "
-                f"from there on, ligwf.analysis.flow.steady): {span} of production left out")
+        return (f"`steady_after: auto` (the measured spin-up of the flow angle and kinetic "
+                f"energy, ligwf.analysis.flow.steady): {span} of production left out")
     return f"`steady_after: {setting}`: the first {100 * float(setting):.0f} % of production left out"
 
 
