@@ -11,6 +11,8 @@ criterion.md, in docs/results/ladder/) and the run under the 80-min cap on a qui
     .venv/bin/python scripts/ladder_results.py runs/ladder80 --ladder cap_80min
     ligwf report runs/ladder80 --out runs/ladder80_replanned --no-snapshots   # after 5c72b39
     .venv/bin/python scripts/ladder_results.py runs/ladder80 --ladder cap_80min --replanned runs/ladder80_replanned
+    cp -a runs/ladder80 runs/ladder80_mser && ligwf analyse runs/ladder80_mser --no-vtu && ligwf report runs/ladder80_mser --no-snapshots   # after a1377ba
+    .venv/bin/python scripts/ladder_results.py runs/ladder80 --ladder cap_80min --replanned runs/ladder80_replanned --reanalysed runs/ladder80_mser/report
     .venv/bin/python scripts/ladder_results.py --check               # READMEs == text from tables
 
 ``--check`` (what tests/report/test_committed_ladder.py runs) rebuilds the README from the
@@ -54,6 +56,9 @@ WALL = "wall.txt"
 #: the verdict of the same stored analysis re-reported with the plans' within-run part
 #: bounded by the run-mean variance (5c72b39): the states are the run's, the plans today's
 REPLANNED = "verdict_bounded_plans.csv"
+#: the same runs re-analysed with the steady window of a1377ba (MSER-5 from 80 frames on):
+#: their report's verdict and cases tables
+REANALYSED = ("verdict_mser_windows.csv", "cases_mser_windows.csv")
 
 TIMING_CONTINUATION = (
     "Timings: the first 14 runs (look 1) shared the machine with the developer's "
@@ -127,11 +132,13 @@ def wall_minutes(text: str) -> float:
 
 def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
            ladder: Ladder = LADDERS["continuation"], wall: str | None = None,
-           repeated: pd.DataFrame | None = None, replanned: pd.DataFrame | None = None) -> str:
+           repeated: pd.DataFrame | None = None, replanned: pd.DataFrame | None = None,
+           reanalysed: tuple[pd.DataFrame, pd.DataFrame] | None = None) -> str:
     """The README text, every number from ``verdict`` (verdict.csv), ``cases``, the
     rounds record, (``wall``) the run's ``/usr/bin/time -v`` report, (``repeated``) the
-    cases.csv of the continuation whose seeds this study ran again and (``replanned``) the
-    verdict of the same analysis under today's plans."""
+    cases.csv of the continuation whose seeds this study ran again, (``replanned``) the
+    verdict of the same analysis under today's plans and (``reanalysed``) the verdict and
+    cases of the same runs re-analysed with today's steady window."""
     remake = f".venv/bin/python scripts/ladder_results.py {ladder.study}" + (
         f" --ladder {ladder.name}" if ladder.name != "continuation" else "")
     criterion = "criterion.md" if ladder.out == OUT else "../criterion.md"
@@ -207,7 +214,42 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
         lines += repeat_lines(cases, repeated)
     if replanned is not None:
         lines += replanned_lines(verdict, replanned)
+    if reanalysed is not None:
+        lines += reanalysed_lines(verdict, cases, *reanalysed)
     return "\n".join(lines) + "\n"
+
+
+#: a steady window that starts at or after this fraction of production is at the 50 % cap
+AT_CAP = 0.45
+
+
+def reanalysed_lines(verdict: pd.DataFrame, cases: pd.DataFrame, verdict_again: pd.DataFrame,
+                     cases_again: pd.DataFrame) -> list[str]:
+    """The same runs re-analysed with the steady window of a1377ba (MSER-5 from 80 frames
+    on): windows at the cap, flow criteria decided, and each state that changed."""
+    flow = ["angle_deg", "rigid_share", "flowing_layer", "profile_error"]
+
+    def decided(v):
+        f = v[v["criterion"].isin(flow)]
+        return int(f["state"].isin(["pass", "fail"]).sum()), len(f)
+
+    both = verdict.merge(verdict_again, on=["condition", "criterion"], suffixes=("", "_new"))
+    changed = both[both["state"] != both["state_new"]]
+    (d0, n0), (d1, n1) = decided(verdict), decided(verdict_again)
+    lines = ["", f"## The same runs re-analysed with today's steady window (`{REANALYSED[0]}`, "
+             f"`{REANALYSED[1]}`)", "",
+             "A copy of the run folder analysed and reported again after a1377ba changed "
+             "`steady_after: auto` to MSER-5 from 80 production frames on "
+             "([../../steady/README.md](../../steady/README.md)); not the registered analysis "
+             "of this ladder, whose tables are above. Windows starting at the 50 % cap: "
+             f"{int((cases['steady_fraction'] >= AT_CAP).sum())} of {len(cases)} runs before, "
+             f"{int((cases_again['steady_fraction'] >= AT_CAP).sum())} of {len(cases_again)} "
+             f"now. Flow criteria decided: {d0} of {n0} before, {d1} of {n1} now. States that "
+             "change:", ""]
+    lines += [f"- {r['condition']} {r['label']}: {r['state']} -> {r['state_new']} "
+              f"({_n(r['value_new'])} [{_n(r['lo_new'])}, {_n(r['hi_new'])}], budget "
+              f"{_n(r['budget_new'])})." for _, r in changed.iterrows()] or ["- none."]
+    return lines
 
 
 def replanned_lines(verdict: pd.DataFrame, replanned: pd.DataFrame) -> list[str]:
@@ -249,6 +291,9 @@ def main(argv=None) -> int:
     ap.add_argument("--replanned", type=Path, metavar="REPORT",
                     help="a report folder of the same study made by today's planner "
                          f"(ligwf report STUDY --out REPORT): its verdict.csv -> {REPLANNED}")
+    ap.add_argument("--reanalysed", type=Path, metavar="REPORT",
+                    help="the report folder of a copy of the study re-analysed with today's "
+                         f"steady window: its verdict.csv and cases.csv -> {', '.join(REANALYSED)}")
     args = ap.parse_args(argv)
     if args.check:
         return max(check(ladder) for ladder in LADDERS.values()
@@ -259,6 +304,9 @@ def main(argv=None) -> int:
     ladder.out.mkdir(parents=True, exist_ok=True)
     if args.replanned is not None:
         shutil.copyfile(args.replanned / "verdict.csv", ladder.out / REPLANNED)
+    if args.reanalysed is not None:
+        for name, target in zip(("verdict.csv", "cases.csv"), REANALYSED):
+            shutil.copyfile(args.reanalysed / name, ladder.out / target)
     copy_files(args.study / "report", ladder.out, TABLES)
     copy_files(args.study, ladder.out, [ROUNDS])
     first = args.study.parent / "ladder_rounds_look1_amendment2.json"
@@ -277,11 +325,14 @@ def text(ladder: Ladder) -> str:
     """The README of ``ladder`` from its committed tables."""
     wall = ladder.out / WALL
     replanned = ladder.out / REPLANNED
+    again = [ladder.out / name for name in REANALYSED]
     return readme(pd.read_csv(ladder.out / "verdict.csv"), pd.read_csv(ladder.out / "cases.csv"),
                   read_rounds(ladder.out), ladder,
                   wall.read_text() if wall.is_file() else None,
                   None if ladder.out == OUT else pd.read_csv(OUT / "cases.csv"),
-                  pd.read_csv(replanned) if replanned.is_file() else None)
+                  pd.read_csv(replanned) if replanned.is_file() else None,
+                  tuple(pd.read_csv(f) for f in again) if all(f.is_file() for f in again)
+                  else None)
 
 
 def check(ladder: Ladder) -> int:
