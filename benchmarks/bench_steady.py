@@ -9,7 +9,8 @@ over the whole run, the reference half included. With correlated frames a chance
 somewhere is likely, and the more frames, the likelier. This measures it on synthetic runs
 and beside it a standard truncation rule, MSER-5 (White 1997; batch means of 5 frames, the
 truncation d minimising the remaining batch means' variance / (m - d)^2, d at most half the
-run; the later of the two signals, as the current rule does).
+run: :func:`ligwf.analysis.flow.steady.mser_index`; the later of the two signals, as the
+current rule does).
 
 Per cell: frames of production (40, 80, 160: 1.6, 3.2, 6.4 s at the demo's 0.04 s), AR(1)
 phi of both signals (0.5, 0.8), an oscillation (none, or amplitude 1 sd with a period of 4
@@ -39,10 +40,10 @@ import sys
 
 import numpy as np
 
-from ligwf.analysis.flow.steady import auto_fraction
+from benchmarks.bench_prediction import ar1_mean_variance
+from ligwf.analysis.flow.steady import auto_fraction, mser_index
 
 CAP_SHARE = 0.45        # a start at or after this fraction of production counts as capped
-BATCH = 5               # MSER-5
 STARTUP_SDS, STARTUP_TAU = 5.0, 4.0
 PERIOD = 4.0
 
@@ -63,29 +64,6 @@ def signal(rng, frames: int, phi: float, oscillation: float, startup: bool) -> n
     return x
 
 
-def mser(x: np.ndarray, batch: int = BATCH) -> int:
-    """MSER-``batch`` truncation point (frames) of ``x``, at most half the run."""
-    m = len(x) // batch
-    if m < 4:
-        return 0
-    b = x[: m * batch].reshape(m, batch).mean(axis=1)
-    best, arg = math.inf, 0
-    for d in range(0, m // 2 + 1):
-        rest = b[d:]
-        stat = float(np.sum((rest - rest.mean()) ** 2)) / (len(rest) ** 2)
-        if stat < best:
-            best, arg = stat, d
-    return arg * batch
-
-
-def window_se(frames_in_window: int, phi: float, oscillation: float) -> float:
-    """Standard error of the mean of a stationary window (AR(1) part, oscillation ignored:
-    it averages out over whole periods)."""
-    n = frames_in_window
-    k = np.arange(1, n)
-    return math.sqrt((1.0 + 2.0 * np.sum((1.0 - k / n) * phi**k)) / n)
-
-
 def cell(rng, trials: int, frames: int, phi: float, oscillation: float, startup: bool):
     t = np.arange(frames, dtype=float)
     out = {"current": ([], []), "mser5": ([], [])}
@@ -93,11 +71,12 @@ def cell(rng, trials: int, frames: int, phi: float, oscillation: float, startup:
         sig = [signal(rng, frames, phi, oscillation, startup) for _ in range(2)]
         current = auto_fraction(t, sig, 0.0, float(frames))
         k_cur = int(math.ceil(current * frames - 1e-6))
-        k_mser = max(mser(s) for s in sig)
+        k_mser = max(mser_index(s) for s in sig)
         for name, k in (("current", k_cur), ("mser5", k_mser)):
             window = sig[0][k:]
             out[name][0].append(k / frames)
-            out[name][1].append(window.mean() / window_se(len(window), phi, oscillation))
+            # se of a stationary window's mean: its AR(1) part (an oscillation averages out)
+            out[name][1].append(window.mean() / math.sqrt(ar1_mean_variance(len(window), phi)))
     return {name: (np.asarray(f), np.asarray(b)) for name, (f, b) in out.items()}
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks.bench_coverage import ar1_runs
 from ligwf.analysis.flow.steady import (FALLBACK_FRACTION, MSER_BATCH, auto_fraction,
                                         mser_index, settled_index)
 
@@ -51,14 +52,7 @@ def test_a_long_steady_correlated_run_keeps_its_window_where_the_band_throws_hal
     0.89); MSER-5, the rule from 80 frames on, in few."""
     rng = np.random.default_rng(7)
     band = mser = 0
-    for _ in range(100):
-        sig = []
-        for _ in range(2):
-            x = np.empty(160)
-            x[0] = rng.standard_normal()
-            for t in range(1, 160):
-                x[t] = 0.8 * x[t - 1] + 0.6 * rng.standard_normal()
-            sig.append(x)
+    for sig in ar1_runs(rng, 100, 2, 160, 0.8, 0.0):
         band += max(settled_index(s) for s in sig) >= 72
         mser += auto_fraction(np.arange(160.0), sig, 0.0, 160.0) >= 0.45
         assert max(mser_index(s) for s in sig) <= 80
