@@ -219,6 +219,12 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
     return "\n".join(lines) + "\n"
 
 
+def beside(verdict: pd.DataFrame, other: pd.DataFrame) -> pd.DataFrame:
+    """``verdict``'s rows with the same condition and criterion of ``other`` beside them
+    (its columns suffixed ``_new``)."""
+    return verdict.merge(other, on=["condition", "criterion"], suffixes=("", "_new"))
+
+
 #: a steady window that starts at or after this fraction of production is at the 50 % cap
 AT_CAP = 0.45
 
@@ -233,7 +239,7 @@ def reanalysed_lines(verdict: pd.DataFrame, cases: pd.DataFrame, verdict_again: 
         f = v[v["criterion"].isin(flow)]
         return int(f["state"].isin(["pass", "fail"]).sum()), len(f)
 
-    both = verdict.merge(verdict_again, on=["condition", "criterion"], suffixes=("", "_new"))
+    both = beside(verdict, verdict_again)
     changed = both[both["state"] != both["state_new"]]
     (d0, n0), (d1, n1) = decided(verdict), decided(verdict_again)
     lines = ["", f"## The same runs re-analysed with today's steady window (`{REANALYSED[0]}`, "
@@ -255,8 +261,7 @@ def reanalysed_lines(verdict: pd.DataFrame, cases: pd.DataFrame, verdict_again: 
 def replanned_lines(verdict: pd.DataFrame, replanned: pd.DataFrame) -> list[str]:
     """What the same stored analysis says under the plans of 5c72b39 (the within-run part
     bounded by the run-mean variance): the states, and each plan that changed."""
-    key = ["condition", "criterion"]
-    both = verdict.merge(replanned, on=key, suffixes=("", "_new"))
+    both = beside(verdict, replanned)
     same = int((both["state"] == both["state_new"]).sum())
     lines = ["", f"## Plans re-made with the bounded within-run part (`{REPLANNED}`)", "",
              "The same stored analysis re-reported after 5c72b39 bounded the within-run part "

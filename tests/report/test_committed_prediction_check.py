@@ -19,8 +19,8 @@ def test_readme_counts_are_the_tables(name, prefix):
     """The demo's rows under the unbounded and the bounded within-run part."""
     table = pd.read_csv(HERE / f"{name}.csv")
     text = (HERE / "README.md").read_text()
-    for kind, label in (("replicas", f"{prefix}Replicas"), ("extension", f"{prefix}Extension")):
-        label = label[0] + label[1:].lower() if prefix else label
+    for kind in ("replicas", "extension"):
+        label = f"{prefix}{kind}" if prefix else kind.capitalize()
         sub = table[table["kind"] == kind]
         ok = int(sub["within_30_percent"].sum())
         ratios = sub["measured_over_predicted"]
