@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks.bench_prediction import halves_within_variance
 from ligwf.analysis.records import sampling
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.statistics import MEAN, SHARE_ABOVE
@@ -48,13 +49,19 @@ def run_value(x: np.ndarray, spec) -> np.ndarray:
     return x
 
 
-def arm(series: list[np.ndarray], seconds: list[float]) -> sampling.Arm:
+#: the within-run estimates a check can use: the planner's own, or the two-half batch means
+#: of benchmarks/bench_prediction.py (a record of the alternative H5 tested, not the planner)
+WITHIN = {"planner": sampling.within_variance,
+          "halves": lambda s: halves_within_variance(s[np.isfinite(s)])}
+
+
+def arm(series: list[np.ndarray], seconds: list[float], within=sampling.within_variance
+        ) -> sampling.Arm:
     values = [float(np.nanmean(s)) for s in series]
-    within = [sampling.within_variance(s) for s in series]
-    return sampling.arm(values, within, seconds, steady_share=1.0)
+    return sampling.arm(values, [within(s) for s in series], seconds, steady_share=1.0)
 
 
-def check(study: Path) -> pd.DataFrame:
+def check(study: Path, within=sampling.within_variance) -> pd.DataFrame:
     flow = FlowRecord.read(study / layout.ANALYSIS_DIR / layout.FLOW_PROFILES)
     cases = pd.read_csv(study / layout.REPORT_DIR / layout.CASES_REPORT)
     rows = []
@@ -88,8 +95,8 @@ def check(study: Path) -> pd.DataFrame:
 
             xs, xh, xsh, xsf = halves(ids)
             ys, yh, ysh, ysf = halves(ref)
-            x_full, y_full = arm(xs, xsf), arm(ys, ysf)
-            x_half, y_half = arm(xh, xsh), arm(yh, ysh)
+            x_full, y_full = arm(xs, xsf, within), arm(ys, ysf, within)
+            x_half, y_half = arm(xh, xsh, within), arm(yh, ysh, within)
             measured = sampling.half_width(x_full, y_full, ALPHA)
             added = (float(np.mean(np.subtract(xsf, xsh))), float(np.mean(np.subtract(ysf, ysh))))
             predicted = sampling.half_width(x_half, y_half, ALPHA, extend=added)
@@ -97,7 +104,7 @@ def check(study: Path) -> pd.DataFrame:
                              f"+{added[1]:.3g} s CG1 on every run",
                              sampling.half_width(x_half, y_half, ALPHA), predicted, measured))
             k = len(ids) // 2
-            x_few = arm(xs[:k], xsf[:k])
+            x_few = arm(xs[:k], xsf[:k], within)
             predicted = sampling.half_width(x_few, y_full, ALPHA, add=(len(ids) - k, 0))
             rows.append(_row(cond, column, "replicas", f"{k} -> {len(ids)} CG-n seeds",
                              sampling.half_width(x_few, y_full, ALPHA), predicted, measured))
@@ -117,8 +124,10 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("study", type=Path)
     ap.add_argument("out", type=Path)
+    ap.add_argument("--within", choices=sorted(WITHIN), default="planner",
+                    help="within-run estimate of a run mean (default: the planner's own)")
     args = ap.parse_args(argv)
-    table = check(args.study)
+    table = check(args.study, WITHIN[args.within])
     table.to_csv(args.out, index=False)
     print(table.to_string(index=False))
     return 0

@@ -2,12 +2,12 @@
 of the run means and the half-width they predict after more sampling.
 
 A run's steady-window mean varies from seed to seed for two reasons: the run's own
-correlated frames (its **within-run** variance, which falls as the window grows;
-estimated from the difference of the run's two half-window means, :func:`within_variance`)
-and the seed's offset (the **between-run** variance, which no run length removes). The
-sample variance of an arm's run means holds both; its within part is the mean of the
-runs' own within-run variances, bounded by the sample variance; the rest is the between
-part (:func:`components`).
+correlated frames (its **within-run** variance, ``s_frames^2 x 2 tau / n_frames``, which
+falls as the window grows) and the seed's offset (the **between-run** variance, which no
+run length removes). The sample variance of an arm's run means holds both; its within part
+is the mean of the runs' own within-run variances (:func:`within_variance` of each run's
+frame series), bounded by the sample variance; the rest is the between part
+(:func:`components`).
 
 Two ways to narrow Welch's interval of CG-n - CG1:
 
@@ -35,6 +35,7 @@ import numpy as np
 
 from ligwf.analysis.records.equivalence import (ALPHA, WELCH, finite_values, t_quantile,
                                                 welch_df)
+from ligwf.analysis.records.intervals import autocorrelation_time
 
 #: the kinds of option
 EXTEND, REPLICAS = "extend", "replicas"
@@ -44,26 +45,13 @@ MOST_EXTENSION = 200.0
 
 
 def within_variance(series) -> float:
-    """Variance of one run's mean from its own frames: the batch-means estimate with two
-    batches, (mean of the first half - mean of the second half)^2 / 4 (nan with fewer than
-    two finite frames; 0 for a constant series).
-
-    Why two halves and not s^2 x 2 tau / n: a seed's own offset is common to both halves
-    and cancels in their difference, so across an arm's runs the mean of this estimate
-    is the within part and the sample variance of the run means less it is the
-    covariance of the half-window means, i.e. the part a longer window keeps (the between
-    part). It needs no model of the frames' correlation: the angle of repose oscillates
-    (a period of ~16 frames on the ladder's drum) and Sokal's window stops after the first
-    positive lobe; a start-up transient and a rigid block's bursts decay faster than
-    1 / window. One degree of freedom a run; the arm's mean over its runs is what the
-    planning uses (:func:`components`). Chosen on benchmarks/bench_prediction.py
-    (docs/results/prediction_check/README.md)."""
+    """Variance of one run's mean from its own frames: s^2 x 2 tau / n (nan with fewer
+    than two finite frames; 0 for a constant series)."""
     x = np.asarray(series, float)
     x = x[np.isfinite(x)]
     if len(x) < 2:
         return math.nan
-    half = len(x) // 2
-    return float((x[:half].mean() - x[len(x) - half:].mean()) ** 2 / 4.0)
+    return float(np.var(x, ddof=1) * 2.0 * autocorrelation_time(x) / len(x))
 
 
 @dataclass(frozen=True)
@@ -110,10 +98,11 @@ def components(a: Arm) -> tuple[float, float]:
     then between runs: extension cannot help).
 
     Why the bound: the within part of a run value's variance cannot exceed the variance
-    itself, and an estimate from few runs can (the former frame-based estimate did on
-    every arm of the 80-min ladder, docs/results/prediction_check/README.md); unbounded, a
-    plan shrinks an over-stated within part and predicts an extension to widen the
-    interval."""
+    itself, and the frame-based estimate does on real drums: the angle of repose oscillates
+    (a period of ~16 frames on the ladder's drum) and the self-consistent window stops
+    after the first positive lobe of the autocorrelation, missing the negative lobes that
+    average out in a run mean (docs/results/prediction_check/README.md). Unbounded, a plan
+    shrank an over-stated within part and predicted an extension to widen the interval."""
     within = finite_values(a.within)
     w = float(within.mean()) if len(within) == a.n and a.n else 0.0
     total = a.variance

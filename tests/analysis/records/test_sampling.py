@@ -14,7 +14,6 @@ import pytest
 from scipy import stats
 
 from benchmarks.bench_coverage import ar1_runs
-from benchmarks.bench_prediction import ar1_mean_variance
 from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records import sampling as sp
 
@@ -128,25 +127,3 @@ def test_hsu_degrees_of_freedom_are_the_smaller_arm_less_one():
     a, b = sp.arm(x), sp.arm(y)
     assert sp.half_width(a, b, 0.05 / 3, df_rule=eq.HSU) == pytest.approx(
         0.5 * (hsu.hi - hsu.lo), rel=1e-3)
-
-
-def test_the_within_run_part_comes_from_the_two_half_window_means():
-    """The estimate is (first-half mean - second-half mean)^2 / 4: a seed's offset cancels,
-    a constant run has none, an odd frame out is left out of neither half's count."""
-    assert sp.within_variance([1.0, 1.0, 3.0, 3.0]) == pytest.approx(1.0)
-    assert sp.within_variance([5.0, 5.0, 7.0, 7.0]) == pytest.approx(1.0)    # offset: same
-    assert sp.within_variance([2.0] * 9) == 0.0
-    assert sp.within_variance([0.0, 9.0, 4.0]) == pytest.approx((0.0 - 4.0) ** 2 / 4.0)
-    assert sp.within_variance([1.0, np.nan, 3.0]) == pytest.approx(1.0)
-    assert math.isnan(sp.within_variance([1.0, np.nan]))
-    # an oscillation of 16 frames averages out over each half of 64 frames: no within part,
-    # where s^2 x 2 tau / n reports one (its window stops after the first positive lobe)
-    t = np.arange(128)
-    wave = np.sin(2.0 * np.pi * t / 16.0)
-    assert sp.within_variance(wave) == pytest.approx(0.0, abs=1e-20)
-    # on stationary AR(1) runs its mean over many runs is the variance of a run's mean
-    # (analytic: 0.0198 at phi 0.6, 200 frames), less the two halves' small covariance
-    rng = np.random.default_rng(11)
-    runs = ar1_runs(rng, 1, 4000, 200, 0.6, 0.0)[0]
-    estimate = np.mean([sp.within_variance(r) for r in runs])
-    assert estimate == pytest.approx(ar1_mean_variance(200, 0.6), rel=0.06)
