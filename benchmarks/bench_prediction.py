@@ -112,6 +112,8 @@ def halves_within_variance(series: np.ndarray) -> float:
     (first-half mean - second-half mean)^2 / 4: a seed's offset cancels, so over an arm's
     runs the rest of the run-mean variance is the covariance of the half-window means."""
     half = len(series) // 2
+    if half < 1:
+        return math.nan
     return float((series[:half].mean() - series[len(series) - half:].mean()) ** 2 / 4.0)
 
 

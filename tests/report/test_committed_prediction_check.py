@@ -180,3 +180,16 @@ def test_the_two_long_checks_pooled_are_the_tables():
     assert (f"the planner's extension prediction held in {e[0]} of {e[1]} rows with a ratio"
             in text)
     assert f"the replica prediction in {r[0]} of {r[1]};" in text
+
+
+def test_the_two_half_estimate_is_what_the_readme_says():
+    """H5's alternative: (first-half mean - second-half mean)^2 / 4; a seed's offset
+    cancels, a middle frame of an odd run is in neither half, one frame gives nan."""
+    import numpy as np
+
+    from benchmarks.bench_prediction import halves_within_variance
+    assert halves_within_variance(np.array([1.0, 1.0, 3.0, 3.0])) == pytest.approx(1.0)
+    assert halves_within_variance(np.array([6.0, 6.0, 8.0, 8.0])) == pytest.approx(1.0)
+    assert halves_within_variance(np.array([0.0, 9.0, 4.0])) == pytest.approx(4.0)
+    assert halves_within_variance(np.full(7, 2.5)) == 0.0
+    assert math.isnan(halves_within_variance(np.array([1.0])))
