@@ -24,13 +24,13 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-#: the fit of docs/results/extrapolation/size_relation.csv (every committed Weber row):
-#: excess angle (deg) = SLOPE x (n - 1) d / D, its 95 % interval, and the D / (n d) the rows
-#: spanned (tests/inference/test_size_relation.py recomputes them from the table)
-SLOPE_DEG = 122.0
-SLOPE_DEG_LO = 73.0
-SLOPE_DEG_HI = 171.0
-FITTED_D_OVER_ND = (8.9, 25.0)
+#: the fit of docs/results/extrapolation/size_fit.csv (every committed Weber row, 5 rows
+#: of 4 studies): excess angle (deg) = SLOPE x (n - 1) d / D, its 95 % interval, and the
+#: D / (n d) the rows spanned (tests/inference/test_size_relation.py recomputes them)
+SLOPE_DEG = 99.1
+SLOPE_DEG_LO = 89.0
+SLOPE_DEG_HI = 109.3
+FITTED_D_OVER_ND = (12.5, 25.0)
 #: the rows' columns
 COLUMNS = ("study", "rule", "cg", "d_over_D", "x", "excess_deg", "excess_se", "replicas",
            "cg1_replicas")
