@@ -81,12 +81,25 @@ _StrictLoader.add_implicit_resolver("tag:yaml.org,2002:float", _FLOAT,
                                     list("-+0123456789."))
 
 
+#: stands for a node whose size is being counted (met again below itself: an alias cycle)
+_COUNTING = -1
+
+
 def _expanded_size(node, memo: dict[int, int]) -> int:
-    """Nodes of the document with every alias expanded (aliases share node objects)."""
+    """Nodes of the document with every alias expanded (aliases share node objects);
+    ConfigError on an alias that refers to a node holding it (``d: &d [*d]``: a value
+    containing itself, which no workflow field can hold and JSON cannot write)."""
     key = id(node)
+    if memo.get(key) == _COUNTING:
+        mark = node.start_mark
+        raise ConfigError(f"an alias refers to the value that holds it (a value containing "
+                          f"itself, from line {mark.line + 1}, column {mark.column + 1}); "
+                          "write the value out")
     if key not in memo:
-        memo[key] = 1   # a recursive alias counts once: it cannot grow the composition
-        if isinstance(node, yaml.SequenceNode):
+        memo[key] = _COUNTING
+        if not isinstance(node, (yaml.SequenceNode, yaml.MappingNode)):
+            memo[key] = 1
+        elif isinstance(node, yaml.SequenceNode):
             memo[key] = 1 + sum(_expanded_size(n, memo) for n in node.value)
         elif isinstance(node, yaml.MappingNode):
             memo[key] = 1 + sum(_expanded_size(k, memo) + _expanded_size(v, memo)
@@ -140,6 +153,22 @@ def parse_yaml(text: str, source: str) -> Any:
                           "[ or {)") from None
     finally:
         loader.dispose()
+
+
+#: characters a one-line value (``--set KEY=VALUE``) may not hold: C0 controls but the tab,
+#: and DEL (YAML folds a line break into a space: ``name=a<LF>shell x`` became "a shell x")
+_LINE_BREAKS = re.compile("[\x00-\x08\x0a-\x1f\x7f]")
+
+
+def line_break_problem(text: str) -> str | None:
+    """Where a value given on one line (a ``--set``) holds a line break or another control
+    character, in words (None: it holds none)."""
+    if m := _LINE_BREAKS.search(text):
+        what = {"\n": "a line break (\\n)", "\r": "a carriage return (\\r)"}.get(
+            m.group(), f"the control character U+{ord(m.group()):04X}")
+        return (f"holds {what} at character {m.start() + 1}; a value given on the command "
+                "line is one line (YAML would fold it into a space)")
+    return None
 
 
 def read_yaml_file(path: str | Path, what: str) -> Any:

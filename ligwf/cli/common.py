@@ -23,6 +23,7 @@ from ligwf.engine.plan import MAX_RANKS, RankPlan, Schedule, particle_steps
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import Prepared, prepare_workflow
 from ligwf.study.layout import STUDY_FILE
+from ligwf.study.paths import path_text_problem, resolved, shown
 
 console = Console(width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True, soft_wrap=True)
@@ -99,14 +100,23 @@ def folder_to_write(text: str) -> Path:
     if not text.strip():
         raise argparse.ArgumentTypeError(f"{text!r} is an empty path (it would write into the "
                                          "current folder); name the folder")
+    if (why := path_text_problem(text)) is not None:
+        raise argparse.ArgumentTypeError(f"{shown(text)}: {why}")
     path = Path(text)
-    if path.exists() and not path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text} is a file, not a folder")
-    probe = path
-    while not probe.exists():
-        if probe.parent == probe:
-            break
-        probe = probe.parent
+    try:
+        resolved(path)                   # a symbolic link loop on the way: one line
+        if path.exists() and not path.is_dir():
+            raise argparse.ArgumentTypeError(f"{text} is a file, not a folder")
+        probe = path
+        while not probe.exists():
+            if probe.parent == probe:
+                break
+            probe = probe.parent
+    except ConfigError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    except OSError as exc:               # too long a name, no permission on the way, ...
+        raise argparse.ArgumentTypeError(f"{shown(text)}: cannot be used as a folder "
+                                         f"({exc.strerror or exc})") from None
     if not probe.is_dir():
         raise argparse.ArgumentTypeError(f"{text}: {probe} is a file, so no folder can be "
                                          "made below it")

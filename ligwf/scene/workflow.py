@@ -32,7 +32,7 @@ from typing import Any, Literal
 from pydantic import Field, TypeAdapter, ValidationError
 
 from ligwf.errors import ConfigError
-from ligwf.yamlio import parse_yaml, read_yaml_mapping
+from ligwf.yamlio import line_break_problem, parse_yaml, read_yaml_mapping
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.scaling import Rule, parse_rule, scale
@@ -118,6 +118,8 @@ def parse_override(text: str) -> tuple[str, Any]:
     key = key.strip()
     if not key:
         raise ConfigError(f"--set {text!r}: empty key")
+    if (why := line_break_problem(text)) is not None:
+        raise ConfigError(f"--set {text!r}: {why}")
     parsed = parse_yaml(value, f"--set {key}: value {value!r}") if value.strip() else ""
     return key, parsed
 
@@ -208,11 +210,12 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
         if not 1 <= n <= MAX_REPLICAS:
             raise ConfigError(f"{where} = {n}: allowed range [1, {MAX_REPLICAS}] "
                               "replicas per CG level")
-    stray = sorted(set(sweep.per_cg) - set(sweep.cg_levels))
-    if stray:
-        raise ConfigError(f"sweep.per_cg: CG level {stray[0]:g} is not in sweep.cg_levels "
-                          f"{[float(c) for c in sweep.cg_levels]} (its settings would never "
-                          "be used)")
+    for what, levels in (("per_cg", sweep.per_cg), ("replicas", sweep.replicas
+                                                       if isinstance(sweep.replicas, dict) else {})):
+        if stray := sorted(set(levels) - set(sweep.cg_levels)):
+            raise ConfigError(f"sweep.{what}: CG level {stray[0]:g} is not in sweep.cg_levels "
+                              f"{[float(c) for c in sweep.cg_levels]} (its settings would "
+                              "never be used)")
     count = math.prod(len(v) for _, v in varied) * sum(
         (1 if cg == 1 else len(set(sweep.rules))) * sweep.replicas_for(cg)
         for cg in set(sweep.cg_levels))

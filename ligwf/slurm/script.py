@@ -17,6 +17,7 @@ Design notes
 
 from __future__ import annotations
 
+import re
 import shlex
 from dataclasses import dataclass
 from pathlib import PurePosixPath
@@ -25,18 +26,56 @@ from typing import Iterable, Sequence
 from ligwf.errors import ConfigError
 from ligwf.slurm.site import SlurmSite
 from ligwf.study.layout import STUDY_FILE, SLURM_LOG_DIR
+from ligwf.study.paths import control_character, path_text_problem, shown
 
 #: squeue columns ligwf reads: job id, array job id, array task id, state, reason.
 SQUEUE_FORMAT = "%i|%F|%K|%T|%r"
 
 
+#: a Slurm job name ligwf writes (:func:`ligwf.slurm.jobs.job_name` keeps to these)
+_JOB_NAME = re.compile(r"^[A-Za-z0-9_.-]+$")
+#: a staging token of a split analysis (``ligwf.analysis.parts``)
+_TOKEN = re.compile(r"^[A-Za-z0-9_-]+$")
+#: characters of a study path Slurm reads differently from a shell in ``#SBATCH
+#: --output=``: ``%`` starts a file name pattern (``%x`` is the job name), ``\`` escapes
+#: even inside quotes (and ``\\`` switches every pattern off)
+_SLURM_SPECIAL = {"%": "a percent sign (Slurm's file name patterns: %j, %x, ...)",
+                  "\\": "a backslash (an escape in Slurm's #SBATCH parser)"}
+
+
+def study_path_problem(study_dir: PurePosixPath | str) -> str | None:
+    """Why ``study_dir`` cannot go into a batch script (None: it can): not absolute (a
+    task's working folder is not the submitting one; a leading ``-`` would read as an
+    option), not one line of text, or holding a character Slurm reads otherwise."""
+    text = str(study_dir)
+    if (why := path_text_problem(text)) is not None:
+        return why
+    if not text.startswith("/"):
+        return "not an absolute path"
+    for ch, what in _SLURM_SPECIAL.items():
+        if ch in text:
+            return f"holds {what}; rename the folder or use another --out"
+    return None
+
+
 @dataclass(frozen=True)
 class ScriptContext:
-    """What a script needs besides the site settings (all paths absolute)."""
+    """What a script needs besides the site settings (all paths absolute). Refuses (one
+    line, :class:`ConfigError`) a study path or job name that could become script text
+    other than the one value it stands for."""
 
     study_dir: PurePosixPath
     job_name: str
     ligwf_version: str
+
+    def __post_init__(self) -> None:
+        why = study_path_problem(self.study_dir)
+        if why is not None:
+            raise ConfigError(f"study folder {shown(str(self.study_dir))}: {why}; a Slurm "
+                              "script names it on its #SBATCH and command lines")
+        if not _JOB_NAME.match(self.job_name):
+            raise ConfigError(f"job name {self.job_name!r}: allowed characters are letters, "
+                              "digits and _ . -")
 
 
 def array_spec(indices: Iterable[int], max_concurrent: int | None = None) -> str:
@@ -84,9 +123,25 @@ def _directives(site: SlurmSite, job_name: str, output: str, time: str | None,
         lines.append(f"#SBATCH --partition={site.partition}")
     if site.account:
         lines.append(f"#SBATCH --account={site.account}")
-    lines.append(f"#SBATCH --output={output}")
+    lines.append(f"#SBATCH --output={_q(output)}")
     lines += [f"#SBATCH {arg}" for arg in site.sbatch_args]
     return lines
+
+
+def _checked_steps(steps: Sequence[str]) -> Sequence[str]:
+    """The ligwf steps of a follow-up job (``report``, or a shell-quoted ``slurm
+    next-round --templates DIR ...``): each one line of text."""
+    for step in steps:
+        if (ch := control_character(step)) is not None:
+            raise ConfigError(f"ligwf step {shown(step)}: holds {ch}; a step is one line")
+    return steps
+
+
+def _checked_token(token: str) -> str:
+    if not _TOKEN.match(token):
+        raise ConfigError(f"staging token {shown(token)}: allowed characters are letters, "
+                          "digits, _ and -")
+    return token
 
 
 def _environment(site: SlurmSite) -> list[str]:
@@ -152,6 +207,7 @@ def analysis_script(ctx: ScriptContext, site: SlurmSite, steps: Sequence[str]) -
     """
     if not steps:
         raise ConfigError("the analysis job needs at least one ligwf step")
+    _checked_steps(steps)
     study = ctx.study_dir
     log = f"{study}/{SLURM_LOG_DIR}/{ctx.job_name}_%j.out"
     lines = ["#!/bin/bash",
@@ -169,6 +225,7 @@ def analysis_script(ctx: ScriptContext, site: SlurmSite, steps: Sequence[str]) -
 def analysis_array_script(ctx: ScriptContext, site: SlurmSite, count: int, token: str) -> str:
     """The array of a split analysis: task K of ``count`` runs ``ligwf analyse STUDY
     --part K/count --token TOKEN`` (one partial output each, :mod:`ligwf.analysis.parts`)."""
+    _checked_token(token)
     study = ctx.study_dir
     log = f"{study}/{SLURM_LOG_DIR}/{ctx.job_name}_%A_%a.out"
     lines = ["#!/bin/bash",
@@ -190,6 +247,8 @@ def analysis_merge_script(ctx: ScriptContext, site: SlurmSite, count: int, token
     """The job after a split analysis' array (``afterany``): ``ligwf analyse STUDY --merge
     count --token TOKEN`` (it names any task that left no part and fails), then ``ligwf
     <step> STUDY`` for each of ``steps`` (e.g. ``report``)."""
+    _checked_token(token)
+    _checked_steps(steps)
     study = ctx.study_dir
     log = f"{study}/{SLURM_LOG_DIR}/{ctx.job_name}_%j.out"
     lines = ["#!/bin/bash",
