@@ -75,7 +75,7 @@ def pair_verdicts(summary: pd.DataFrame) -> pd.DataFrame:
             continue
         checks = criteria(w.to_dict(), t.to_dict())
         rows.append({"point": point, "twin": TWIN_OF[point], "definition": d,
-                     "St_v": w["stokes_viscous"], "Bo_g": w["bond_granular"],
+                     "St_v": w["stokes_viscous_ennis"], "Bo_g": w["bond_granular"],
                      "share_10": w["share_10"], "twin_share_10": t["share_10"],
                      "persist_quarter": w["persist_quarter"],
                      "twin_persist_quarter": t["persist_quarter"],
@@ -138,7 +138,7 @@ def figure(summary: pd.DataFrame, rows: pd.DataFrame, path: Path,
             twin = "twin" in r["point"]
             placed = r["point"].startswith("placed")
             # a twin is drawn at its wet partner's St_v (its own is 1000x larger)
-            st = r["stokes_viscous"] / (1000.0 if twin else 1.0)
+            st = r["stokes_viscous_ennis"] / (1000.0 if twin else 1.0)
             kw = dict(marker="s" if placed else "o", color=colours[d], ms=7,
                       mfc="none" if twin else colours[d], ls="none")
             axes[0].plot(st, r["share_10"], **kw)

@@ -17,7 +17,7 @@ import re
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any, Iterable, Sequence
 
 import jinja2
 
@@ -207,13 +207,21 @@ def render(scaled: ScaledScene, template_dirs: Iterable[str | Path] = ()) -> dic
 
 
 def render_bridge_probe(scaled: ScaledScene, gap_ratio: float, model_approach: bool,
-                        template_dirs: Iterable[str | Path] = ()) -> dict[str, str]:
+                        template_dirs: Iterable[str | Path] = (),
+                        velocity: tuple[float, float, float] = (0.0, 0.0, 0.0),
+                        path: Sequence[float] = ()) -> dict[str, str]:
     """Input of a two-particle probe: two smallest particles of ``scaled`` held (no
     integrator) at surface gap ``gap_ratio * r_eff``; the thermo prints the force on
     particle 2 (``v_fx2``). With ``model_approach`` the pair touches first and is then
-    separated, which the easo model needs to form its bridge.
+    separated, which the easo model needs to form its bridge. ``velocity`` (m/s) is given
+    to particle 2 (particle 1 rests; positions stay put, but the engine's viscous force
+    reads the velocities). ``path``: gap ratios particle 2 is then set to one after the
+    other, one step each (a bridge's formation and rupture along a prescribed approach
+    and separation).
     """
     ctx = template_context(scaled)
     radius = 0.5 * scaled.d_min
-    ctx.update(probe_radius=radius, probe_gap=gap_ratio * 0.5 * radius, approach=model_approach)
+    ctx.update(probe_radius=radius, probe_gap=gap_ratio * 0.5 * radius, approach=model_approach,
+               probe_velocity=tuple(float(v) for v in velocity),
+               probe_path=[2 * radius + g * 0.5 * radius for g in path])
     return {INPUT_NAME: render_template("bridge_probe.in.j2", ctx, template_dirs)}

@@ -4,16 +4,25 @@ Both ``cohesion washino/capillary/viscous`` and ``cohesion easo/capillary/viscou
 same six ``fix property/global`` entries, break a bridge at Lian et al.'s rupture distance
 (1 + theta/2) V^(1/3) in their force law, cut it at ``maxSeparationDistanceRatio`` x
 (r_i + r_j), enlarge the contact distance factor of the neighbour lists to 1.1 x that
-ratio, add the same lubrication force, and create the per-atom ``surfaceLiquidContent``.
-The models differ in their force law and bridge volume only (:mod:`ligwf.liquids.washino`,
-:mod:`ligwf.liquids.easo`).
+ratio, add the same viscous force, and create the per-atom ``surfaceLiquidContent``.
+The models differ in their force law, bridge volume and when a bridge forms
+(:mod:`ligwf.liquids.washino`: on approach, at the rupture gap; :mod:`ligwf.liquids.easo`:
+only once the pair has touched) -- measured on the engine in
+tests/engine/test_engine_bridge_dynamics.py.
+
+The viscous force (Nase et al. as cited by Shi and McCarthy, Powder Technol. 184 (2008)
+eqs. 40-41) is regularised by ``minSeparationDistanceRatio`` s_min: a GAP OVER R* =
+r_i r_j / (r_i + r_j) below which the force stops growing (in contact it is the value at
+s_min). Bridges end at a gap of at most ~0.4-0.6 R*, so s_min >= 1 turns lubrication off
+(Stokes drag / s_min at every bridged gap); s_min of a few 1e-2 gives lubrication that
+grows as R*/h down to h = s_min R*; s_min = 0 makes the engine divide by zero (nan).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ligwf.liquids.base import InputAngle, Line, LiquidBlock, LiquidModel, ScaledLiquid, \
+from ligwf.liquids.base import InputAngle, Line, LiquidModel, ScaledLiquid, \
     comment
 from ligwf.numba_cache import cached_jit
 
@@ -43,13 +52,50 @@ def within_rupture(gap, vol, theta):
     return gap < (1.0 + 0.5 * theta) * np.cbrt(vol)
 
 
-def viscous_normal_force(r_i, r_j, gap, viscosity, normal_speed, min_separation_ratio):
-    """Normal lubrication force magnitude, N: 6 pi mu R* v_n / max(s_min, gap / R*)
-    (Nase et al. as cited by Shi and McCarthy, Powder Technol. 184 (2008) eq. 40)."""
+def lubrication_gap(r_i, r_j, gap, min_separation_ratio):
+    """max(s_min, gap / R*): the dimensionless gap the engine's viscous force is evaluated
+    at (``MathExtraLiggghts::max(minSeparationDistanceRatio, dist/rEff)``; a touching pair,
+    gap <= 0, gets s_min)."""
     r_i, r_j, gap = (np.asarray(a, float) for a in (r_i, r_j, gap))
+    return np.maximum(min_separation_ratio, gap * (r_i + r_j) / (r_i * r_j))
+
+
+def viscous_normal_force(r_i, r_j, gap, viscosity, normal_speed, min_separation_ratio):
+    """Normal viscous force magnitude, N: 6 pi mu R* v_n / max(s_min, gap / R*)
+    (Nase et al. as cited by Shi and McCarthy, Powder Technol. 184 (2008) eq. 40), opposing
+    the normal relative velocity v_n (m/s): lubrication ~ 1/gap above s_min R*, constant
+    below; with s_min >= 1, Stokes drag / s_min at every bridged gap."""
+    r_i, r_j = np.asarray(r_i, float), np.asarray(r_j, float)
     r_eff = r_i * r_j / (r_i + r_j)
-    out = 6 * np.pi * viscosity * r_eff * np.abs(normal_speed) / np.maximum(
-        min_separation_ratio, gap / r_eff)
+    out = 6 * np.pi * viscosity * r_eff * np.abs(normal_speed) / lubrication_gap(
+        r_i, r_j, gap, min_separation_ratio)
+    return out if out.ndim else float(out)
+
+
+def viscous_tangential_force(r_i, r_j, gap, viscosity, tangential_speed,
+                             min_separation_ratio):
+    """Tangential viscous force magnitude, N: (8/15 ln(1 / max(s_min, gap / R*)) + 0.9588)
+    6 pi mu R* v_t (Shi and McCarthy eq. 41 as coded in LIGGGHTS, 8/15 written 0.5333333),
+    opposing the tangential relative velocity v_t (m/s) of the surfaces."""
+    r_i, r_j = np.asarray(r_i, float), np.asarray(r_j, float)
+    r_eff = r_i * r_j / (r_i + r_j)
+    factor = 0.5333333 * np.log(1.0 / lubrication_gap(r_i, r_j, gap, min_separation_ratio)) \
+        + 0.9588
+    out = factor * 6 * np.pi * viscosity * r_eff * np.abs(tangential_speed)
+    return out if out.ndim else float(out)
+
+
+def viscous_path_integral(bridge_gap_ratio, min_separation_ratio):
+    """J = integral of dx / max(s_min, x) over x = gap / R* from contact (0) to the bridge's
+    end ``bridge_gap_ratio``: the normal viscous impulse of one traverse of the bridge at
+    relative speed v is 6 pi mu R*^2 v J (N s) while the speed changes little. With
+    s_min < x_end: 1 + ln(x_end / s_min) (Ennis's ln(h_0 / h_a), the engine's s_min in the
+    place of the asperity height); with s_min >= x_end: x_end / s_min (Stokes drag)."""
+    x_end = np.asarray(bridge_gap_ratio, float)
+    s = float(min_separation_ratio)
+    if s <= 0:
+        raise ValueError(f"min_separation_ratio = {s:g}: the engine divides by it (allowed > 0)")
+    out = np.where(x_end > s, 1.0 + np.log(np.maximum(x_end, s) / s), np.maximum(x_end, 0.0) / s)
     return out if out.ndim else float(out)
 
 
@@ -58,13 +104,6 @@ class CapillaryModel(LiquidModel):
 
     properties = CAPILLARY_PROPERTIES
     dump_columns = ("f_surfaceLiquidContent",)
-
-    def validate(self, liquid: LiquidBlock) -> list[str]:
-        problems = super().validate(liquid)
-        if liquid.max_separation_ratio < liquid.min_separation_ratio:
-            problems.append(f"max_separation_ratio = {liquid.max_separation_ratio:g} must "
-                            f"be >= min_separation_ratio = {liquid.min_separation_ratio:g}")
-        return problems
 
     def liggghts_lines(self, s: ScaledLiquid, angle: InputAngle) -> tuple[Line, ...]:
         # LIGGGHTS reads surfaceLiquidContentInitial as a FRACTION of the particle volume

@@ -57,11 +57,19 @@ class Liquid(Frozen):
     liquid_content: float = Field(
         0.02, ge=1e-5, le=MAX_LIQUID_CONTENT, description="liquid volume / solid volume",
         json_schema_extra={"bound_reason": PENDULAR_REASON})
-    min_separation_ratio: float = Field(1.01, ge=1.0, le=10.0,
-                                        description="minSeparationDistanceRatio (distance "
-                                        "over the sum of radii: >= 1, outside contact)")
+    min_separation_ratio: float = Field(
+        1.01, gt=0.0, le=10.0, description="minSeparationDistanceRatio: the surface gap over "
+        "R* = r_i r_j / (r_i + r_j) below which the engine's viscous force stops growing "
+        "(normal 6 pi mu R* v_n / max(s, gap / R*)); >= 1: Stokes drag / s at every bridged "
+        "gap, lubrication off (the default); a few 1e-2: lubrication (Shi & McCarthy 2008); "
+        "0: the engine divides by zero. Unchanged by CG scaling",
+        json_schema_extra={"bound_reason": "the engine divides the viscous force by it (0 "
+                           "gives nan, then an internal error); above 10 it is Stokes drag "
+                           "divided by more than 10, a viscous force switched off"})
     max_separation_ratio: float = Field(1.1, ge=1.0, le=10.0,
-                                        description="maxSeparationDistanceRatio")
+                                        description="maxSeparationDistanceRatio: centre "
+                                        "distance over r_i + r_j at which the engine cuts a "
+                                        "bridge")
     placement: Literal["uniform", "granules"] = Field(
         "uniform", description="uniform: every particle starts with liquid_content; "
         "granules: a dry bed with pre-formed wet granules (wet_granules)")

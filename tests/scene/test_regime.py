@@ -26,7 +26,13 @@ def test_numbers_by_hand_and_under_both_rules():
     cg1 = next(c for c in cases if c.cg == 1)
     n = regime_numbers(cg1.scaled())
     r, v = 0.75e-3, 2 * math.pi * 30 / 60 * 0.02      # 1.5 mm beads, 40 mm drum at 30 rpm
-    assert n["stokes_viscous"] == pytest.approx(8 * 2500 * r * v / (9 * 1e-3), rel=1e-9)
+    ennis = 8 * 2500 * r * v / (9 * 1e-3)
+    assert n["stokes_viscous_ennis"] == pytest.approx(ennis, rel=1e-9)
+    # bridges cut at 1.1 x (r_i + r_j): x_0 = 0.1 * 2r / (r / 2) = 0.4 R*; lubrication off
+    # (s_min 1.01): the engine's viscous impulse is Stokes drag over 0.4 R*, J = 0.4 / 1.01
+    assert n["bridge_gap_ratio"] == pytest.approx(0.4, rel=1e-9)
+    assert n["viscous_path_integral"] == pytest.approx(0.4 / 1.01, rel=1e-9)
+    assert n["stokes_viscous"] == pytest.approx(ennis * 1.01 / 0.4, rel=1e-9)
     assert n["bond_granular"] == pytest.approx(
         3 * 0.024 * math.cos(math.radians(30)) / (4 * r * r * 2500 * 9.81), rel=1e-9)
     we = regime_numbers(next(c for c in cases if c.rule.value == "weber").scaled())
@@ -47,18 +53,21 @@ def test_check_warns_where_the_map_expects_no_granules(capsys):
     assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.001",
                  "--set", "scene.liquid.surface_tension=0.024"]) == 0
     out = capsys.readouterr()
-    assert "granule analysis asked for, but St_v = 105, Bo_g = 1.13: no granule definition" in out.err
+    # the engine's St_v: Ennis's 105 over J = 0.4 / 1.01 (lubrication off)
+    assert "granule analysis asked for, but St_v = 264, Bo_g = 1.13: no granule definition" in out.err
     row = next(line for line in out.out.splitlines() if line.startswith("│ cg1-none-r0 ")
-               and "105" in line)
+               and "264" in line)
     assert row.rstrip().endswith("no │")
     assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.3",
                  "--set", "scene.liquid.surface_tension=0.024"]) == 0
-    assert "St_v = 0.349, Bo_g = 1.13: no granule definition" in capsys.readouterr().err
-    assert GRANULATING_BOND <= 3.39 and GRANULATING_ST_V >= 0.349
+    assert "St_v = 0.881, Bo_g = 1.13: no granule definition" in capsys.readouterr().err
+    assert GRANULATING_BOND <= 3.39 and GRANULATING_ST_V >= 0.881
+    assert GRANULATING_ST_V < 2.64   # the map's next point (mu 0.1) stays outside
     assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.3",
                  "--set", "scene.liquid.surface_tension=0.072"]) == 0
     out = capsys.readouterr()
-    assert "St_v = 0.349, Bo_g = 3.39 is the regime map's closest point" in out.err
+    assert "St_v = 0.881, Bo_g = 3.39 is the regime map's closest point" in out.err
+    assert "extrapolation" not in out.err
     assert "closest (unproven)" in out.out
     assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.001",
                  "--set", "scene.analysis.contact_dumps=false"]) == 0
@@ -96,3 +105,68 @@ def test_check_warns_when_the_definition_never_beat_the_control(capsys):
     assert "analysis.granules: communities: its granules never beat" in capsys.readouterr().err
     assert main(["check", str(GRANULES)]) == 0                     # granules.yaml: held
     assert "never beat" not in capsys.readouterr().err
+
+
+def numbers(*overrides: str) -> dict[str, float]:
+    case = next(c for c in _case(list(overrides)) if c.cg == 1)
+    return regime_numbers(case.scaled())
+
+
+@pytest.mark.parametrize("s_min", [0.02, 0.05, 0.3])
+def test_engine_stokes_number_follows_the_lubrication_the_engine_applies(s_min):
+    """Below the bridge's end (x_0 = 0.4 here) the engine's law is lubrication cut at
+    s_min: J = 1 + ln(0.4 / s_min), so St_v = St_v,Ennis / J, smaller than with the
+    default 1.01 by J(s_min) / J(1.01); Ennis's number does not move."""
+    off, on = numbers(), numbers(f"scene.liquid.min_separation_ratio={s_min}")
+    j = 1 + math.log(0.4 / s_min)
+    assert on["viscous_path_integral"] == pytest.approx(j, rel=1e-9)
+    assert on["stokes_viscous"] == pytest.approx(on["stokes_viscous_ennis"] / j, rel=1e-9)
+    assert on["stokes_viscous_ennis"] == off["stokes_viscous_ennis"]
+    assert on["stokes_viscous"] / off["stokes_viscous"] == pytest.approx(
+        (0.4 / 1.01) / j, rel=1e-9)
+
+
+def test_bridge_end_is_the_laws_rupture_when_the_cut_is_farther():
+    """max_separation_ratio 1.3 puts the cut at 1.2 R*, beyond washino's rupture gap
+    (1 + theta/2) V^(1/3), V = 0.05 x both particles' liquid: x_0 is the rupture gap."""
+    n = numbers("scene.liquid.max_separation_ratio=1.3", "scene.liquid.min_separation_ratio=0.02")
+    r, theta = 0.75e-3, math.radians(30)
+    volume = 0.05 * 2 * 0.02 * 4 / 3 * math.pi * r**3
+    x_0 = (1 + theta / 2) * volume ** (1 / 3) / (r / 2)
+    assert 0.4 < x_0 < 1.2
+    assert n["bridge_gap_ratio"] == pytest.approx(x_0, rel=1e-9)
+    assert n["viscous_path_integral"] == pytest.approx(1 + math.log(x_0 / 0.02), rel=1e-9)
+
+
+def test_engine_stokes_number_keeps_the_cg_rules():
+    """x_0 and J are gap ratios, unchanged by CG: the engine's St_v is Weber-invariant and
+    falls as 1/n under Bond scaling, as Ennis's does."""
+    cases = _case(["sweep.cg_levels=[1, 2]", "scene.liquid.min_separation_ratio=0.02"])
+    n1 = regime_numbers(next(c for c in cases if c.cg == 1).scaled())
+    we = regime_numbers(next(c for c in cases if c.rule.value == "weber").scaled())
+    bo = regime_numbers(next(c for c in cases if c.rule.value == "bond").scaled())
+    assert we["viscous_path_integral"] == pytest.approx(n1["viscous_path_integral"], rel=1e-9)
+    assert we["stokes_viscous"] == pytest.approx(n1["stokes_viscous"], rel=1e-9)
+    assert bo["stokes_viscous"] == pytest.approx(n1["stokes_viscous"] / 2, rel=1e-9)
+
+
+def test_warning_says_the_map_had_lubrication_off(capsys):
+    """With lubrication on, mu 0.1 (St_v,Ennis 1.05, the map's 'no' point) falls to the
+    engine's St_v 0.26, inside the closest region: the warning grades it so, and says the
+    map never ran with lubrication on."""
+    assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.1",
+                 "--set", "scene.liquid.surface_tension=0.072",
+                 "--set", "scene.liquid.min_separation_ratio=0.02"]) == 0
+    err = capsys.readouterr().err
+    assert "St_v = 0.262, Bo_g = 3.39 is the regime map's closest point" in err
+    assert "min_separation_ratio = 0.02 switches the engine's lubrication on" in err
+    assert "extrapolation" in err
+
+
+def test_dry_bed_has_no_bridge_numbers():
+    from helpers import DRUM
+    case = load_workflow(DRUM, ["scene.liquid.model=none", "scene.analysis.contact_dumps=false",
+                                "sweep.rules=[weber]"]).cases[0]
+    n = regime_numbers(case.scaled())
+    assert n["stokes_viscous"] == math.inf and n["bond_granular"] == 0.0
+    assert n["viscous_path_integral"] == 0.0

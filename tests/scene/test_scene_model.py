@@ -224,8 +224,8 @@ def test_signed_zero_sweep_is_refused_not_collapsed():
 
 
 def test_model_level_errors_name_the_field_not_the_block():
-    msg = expect_error(with_value("scene.liquid.max_separation_ratio", 1.005),
-                       "scene.liquid.max_separation_ratio = 1.005", "min_separation_ratio")
+    msg = expect_error(with_value("scene.liquid.max_liquid_content", 0.01),
+                       "scene.liquid.max_liquid_content = 0.01", "liquid content")
     assert "{" not in msg
     msg = expect_error(with_value("scene.process.rotation", {"rpm": 30, "froude": 0.1}),
                        "scene.process.rotation: give exactly one")
