@@ -7,6 +7,7 @@ production, a particle and a contact .vtu every 0.05 s) is rendered and run on 2
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 from pathlib import Path
@@ -14,6 +15,8 @@ from pathlib import Path
 from helpers import DRUM, run_liggghts
 from ligwf.pipeline.prepare import render_workflow, write_study
 from ligwf.scene.workflow import load_workflow
+from ligwf.study.made_from import sealed
+from ligwf.study.study_record import CaseEntry, StudyRecord
 
 _CACHE: dict[str, Path] = {}
 
@@ -45,12 +48,11 @@ def wet_study(engine, tmp_path_factory) -> Path:
     shutil.copytree(case, rep)
     scene = json.loads((rep / "scene.json").read_text())
     scene["case_id"], scene["replica"] = "cg3-weber-r1", 1
-    (rep / "scene.json").write_text(json.dumps(scene))
+    (rep / "scene.json").write_text(json.dumps(sealed(scene)))    # as if ligwf wrote it
     write_manifest(rep)
-    study = json.loads((out / "study.json").read_text())
-    study["cases"].append({"case_id": "cg3-weber-r1", "cg": 3.0, "rule": "weber", "replica": 1,
-                           "index": 2, "scene_hash": scene["scene_hash"]})
-    (out / "study.json").write_text(json.dumps(study))
+    study = StudyRecord.read(out)
+    replica = CaseEntry(2, "cg3-weber-r1", 3.0, "weber", 1, scene["scene_hash"])
+    dataclasses.replace(study, cases=study.cases + (replica,)).write(out)
     _CACHE["study"] = out
     return out
 

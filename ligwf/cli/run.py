@@ -98,6 +98,9 @@ def cmd_run_case(args: argparse.Namespace) -> int:
 def cmd_status(args: argparse.Namespace) -> int:
     study = Study.open(args.study)
     console.print(summary_table(study.cases, f"{args.study}: {len(study.cases)} case(s)"))
+    for case in study.cases:             # an edited record: its results are not used
+        if (why := case.record_problem(check_hash=False)) is not None:
+            print_warning(f"{case.case_id}: {why}")
     held = [c for c in LocalExecutor().status(args.study).cases if c.queued]
     for runner in sorted({c.job for c in held}):
         names = [c.case_id for c in held if c.job == runner]

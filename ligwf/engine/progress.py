@@ -16,7 +16,7 @@ from rich.markup import escape
 from rich.table import Table
 
 from ligwf.engine.resume import NextAttempt
-from ligwf.engine.thermo import ThermoParser
+from ligwf.engine.thermo import ThermoParser, parse_screen
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import (DONE, FAILED, KILLED, MISSING, RUNNING, UNSTABLE, Manifest,
                                   effective_status)
@@ -93,12 +93,41 @@ def summary_table(cases: Iterable[CaseFolder], title: str = "cases") -> Table:
         status = effective_status(m)
         style = _STATUS_STYLE.get(status, "")
         phases = m.phases
+        steps, reason = live_state(case, m, status)
         table.add_row(
-            m.case_id, f"[{style}]{status}[/]", f"{m.steps_done:,}/{m.total_steps:,}",
+            m.case_id, f"[{style}]{status}[/]", steps,
             f"{m.atoms_start if m.atoms_start is not None else '-'}->"
             f"{m.atoms_end if m.atoms_end is not None else '-'}",
             f"{m.wall_seconds:.1f}", f"{m.core_seconds:.1f}",
             f"{phases.get('settle', {}).get('wall_seconds', 0.0):.1f}",
             f"{phases.get('production', {}).get('wall_seconds', 0.0):.1f}",
-            escape(shown_reason(status, m.reason)[:80]))
+            escape(reason[:80]))
     return table
+
+
+def live_step(case: CaseFolder) -> int | None:
+    """The last thermo step the case's current screen shows (None: none yet)."""
+    try:
+        text = case.screen.read_text(errors="replace")
+    except OSError:
+        return None
+    row = parse_screen(text).last_row
+    return row.step if row is not None else None
+
+
+def live_state(case: CaseFolder, m: Manifest, status: str) -> tuple[str, str]:
+    """The steps and reason a status table shows for a case: a manifest records the steps
+    of finished attempts only, so a case whose attempt is under way (alone or inside an
+    ensemble) or was cut off by a dead runner shows the step its screen reached."""
+    steps, reason = f"{m.steps_done:,}/{m.total_steps:,}", shown_reason(status, m.reason)
+    if m.status != RUNNING:
+        return steps, reason
+    live = live_step(case)
+    if live is None:
+        return steps, ("starting (no thermo row on its screen yet)" if status == RUNNING
+                       else "killed: its runner is gone before the engine's first thermo row")
+    steps = f"{live:,}/{m.total_steps:,}"
+    if status == RUNNING:
+        return steps, f"running: step {live:,} of {m.total_steps:,} (live, {case.screen.name})"
+    return steps, (f"killed: its runner is gone; the screen reached step {live:,} (the same "
+                   "run command resumes it)")

@@ -37,6 +37,7 @@ from ligwf.scene.unused import unused_setting_warnings
 from ligwf.scene.workflow import Case, Workflow, comparison_warnings, load_workflow
 from ligwf.study.case import content_hash
 from ligwf.study.layout import MESH_CACHE_DIR, MESH_NAME, OUTPUT_DIRS, SCENE_FILE
+from ligwf.study.made_from import sealed
 from ligwf.study.study import Study
 from ligwf.study.study_record import CaseEntry, StudyRecord
 
@@ -57,7 +58,8 @@ class RenderedCase:
     scene_hash: str
 
     def scene_record(self) -> dict:
-        return {
+        """The case's scene record, sealed (:func:`ligwf.study.made_from.sealed`)."""
+        return sealed({
             "ligwf_version": __version__,
             "case_id": self.case.case_id,
             "index": self.case.index,
@@ -68,7 +70,7 @@ class RenderedCase:
             "scene": self.case.scene.model_dump(mode="json"),
             "scaled": self.scaled.to_dict(),
             "scene_hash": self.scene_hash,
-        }
+        })
 
 
 #: most steps LIGGGHTS runs in one ``run`` command ("Invalid run command N value" above)

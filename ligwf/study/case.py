@@ -31,7 +31,9 @@ from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.extension import extension_steps
 from ligwf.study.layout import (ANALYSED_DUMP_RE, DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME,
                                 POST_DIR, SCENE_FILE, SCREEN_FILE, THERMO_FILE)
+from ligwf.study.made_from import edit_summary, record_edits
 from ligwf.study.manifest import DONE, Manifest, read_manifest, write_manifest
+from ligwf.study.paths import check_case_id
 from ligwf.study.thermo_table import rows_from_csv, table_problem
 
 
@@ -167,8 +169,6 @@ def folder_fingerprint(path: Path) -> dict:
     return {"scene_hash": scene, "dump_record": _analysed_digest(record) if record.is_file() else None}
 
 
-
-
 def _analysed_digest(record: Path) -> str:
     """SHA-256 over the record's entries of the dumps an analysis reads (the whole file's
     digest when it is unreadable, so a damaged record still differs)."""
@@ -245,6 +245,7 @@ class CaseFolder:
         path = Path(path)
         try:
             rec = json.loads((path / SCENE_FILE).read_text())
+            check_case_id(rec["case_id"], str(path / SCENE_FILE))
             scaled = ScaledScene.from_dict(rec["scaled"])
             added = extension_steps(path, scaled)
             if added:
@@ -351,7 +352,9 @@ class CaseFolder:
             rec = json.loads((self.path / SCENE_FILE).read_text())
         except (OSError, ValueError) as exc:
             return f"{SCENE_FILE} unreadable: {exc}"
-        why = scene_record_problem(self.path, rec, self.rendered_scaled, check_hash)
+        edited = record_edits(rec)
+        why = (f"edited after ligwf wrote it ({edit_summary(edited)})" if edited else
+               scene_record_problem(self.path, rec, self.rendered_scaled, check_hash))
         return (None if why is None else f"{SCENE_FILE}: {why}; the record no longer describes "
                 "the run (edited after rendering?): render and run the case again")
 

@@ -2,8 +2,10 @@
 
 Written once per rendering (:func:`ligwf.pipeline.prepare.write_study`): the ligwf version,
 the study's name and description, the workflow as validated (``--set`` overrides applied),
-its analysis settings and error budget as dumped by their models, and one entry per case
-(index, id, CG level, rule, replica, scene hash). :class:`~ligwf.study.study.Study`, the
+its analysis settings and error budget as dumped by their models, one entry per case
+(index, id, CG level, rule, replica, scene hash) and the seal of what the runs are made
+from (:mod:`ligwf.study.made_from`): a record edited by hand is refused on read, naming
+the field; a case id that is no plain folder name too (``../victim``). :class:`~ligwf.study.study.Study`, the
 rounds of a sequential study and the API read it through :meth:`StudyRecord.read`.
 """
 
@@ -16,6 +18,8 @@ from pathlib import Path
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json
 from ligwf.study.layout import STUDY_FILE
+from ligwf.study.made_from import SEAL_KEY, edit_summary, edited_fields, seal
+from ligwf.study.paths import check_case_id
 
 #: the sweep's maps keyed by CG level (JSON stores their keys as text)
 CG_KEYED = ("replicas", "per_cg")
@@ -52,12 +56,14 @@ class StudyRecord:
         return tuple(c.case_id for c in sorted(self.cases, key=lambda c: c.index))
 
     def write(self, folder: Path) -> None:
-        """Write the record into the study folder ``folder`` atomically."""
+        """Write the record into the study folder ``folder`` atomically, sealed
+        (:func:`sealed_content`)."""
+        cases = [asdict(c) for c in self.cases]
         atomic_write_json(Path(folder) / STUDY_FILE, {
             "ligwf_version": self.ligwf_version, "name": self.name,
             "description": self.description, "workflow": self.workflow,
-            "analysis": self.analysis, "accept": self.accept,
-            "cases": [asdict(c) for c in self.cases]})
+            "analysis": self.analysis, "accept": self.accept, "cases": cases,
+            SEAL_KEY: seal(sealed_content(self.name, self.workflow, cases))})
 
     @classmethod
     def read(cls, folder: Path) -> "StudyRecord":
@@ -78,12 +84,34 @@ class StudyRecord:
         if twice:
             raise ConfigError(f"{path}: lists case {', '.join(twice)} more than once (edited "
                               "or merged by hand?): render the study again")
+        for case_id in ids:
+            check_case_id(case_id, str(path))
+        edited = edited_fields(sealed_content(rec.get("name"), rec.get("workflow"),
+                                              rec["cases"]), rec.get(SEAL_KEY))
+        if edited:
+            raise ConfigError(f"{path}: edited after ligwf wrote it ({edit_summary(edited)}); "
+                              "ligwf runs, analyses and reports only the study it wrote: undo "
+                              "the edit, or render the workflow you mean into the folder "
+                              "(--replace)")
         workflow = rec.get("workflow")
         workflow = numeric_cg_keys(workflow) if isinstance(workflow, dict) else {}
         accept = rec["accept"] if "accept" in rec else workflow.get("accept")
         return cls(str(rec.get("name", Path(folder).name)), workflow, rec.get("analysis"),
                    accept, cases, str(rec.get("description") or ""),
                    str(rec.get("ligwf_version", "")))
+
+
+#: keys of the stored workflow the seal leaves out: the settings of the later stages and
+#: prose (the analysis and the report record the settings they used themselves)
+UNSEALED_WORKFLOW_KEYS = ("analysis", "accept", "description")
+
+
+def sealed_content(name, workflow, cases) -> dict:
+    """What the study record's seal covers: the name, the workflow without
+    :data:`UNSEALED_WORKFLOW_KEYS` and the case list (what the runs are made from)."""
+    kept = ({k: v for k, v in workflow.items() if k not in UNSEALED_WORKFLOW_KEYS}
+            if isinstance(workflow, dict) else workflow)
+    return {"name": name, "workflow": kept, "cases": cases}
 
 
 def _number(key):

@@ -4,6 +4,7 @@ what is not used as ``ligwf report`` (case folders the study record leaves out i
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import shutil
 
@@ -19,6 +20,7 @@ from ligwf.report.digests import DIGEST_RECORD, damaged_report_files, record_dig
 from ligwf.report.problems import study_problems
 from ligwf.study import layout
 from ligwf.study.study import Study
+from ligwf.study.study_record import StudyRecord
 
 TINY = ROOT / "tests" / "workflows" / "runner_tiny.yaml"
 
@@ -54,9 +56,9 @@ def test_a_damaged_analysis_record_is_a_missing_output_not_a_traceback(rendered,
 def test_a_case_folder_the_record_leaves_out_is_named(rendered, tmp_path):
     study = tmp_path / "s"
     shutil.copytree(rendered, study)
-    record = json.loads((study / layout.STUDY_FILE).read_text())
-    dropped = record["cases"].pop()["case_id"]
-    (study / layout.STUDY_FILE).write_text(json.dumps(record))
+    record = StudyRecord.read(study)          # a record ligwf wrote without that case
+    dropped = record.cases[-1].case_id
+    dataclasses.replace(record, cases=record.cases[:-1]).write(study)
     cases = dict(study_problems(Study.open(study)).cases)
     assert f"not listed in {layout.STUDY_FILE}" in cases[dropped]
 

@@ -29,7 +29,26 @@ def test_run_case_refuses_a_case_whose_original_scene_no_longer_gives_its_scaled
     capsys.readouterr()
     assert main(["run-case", str(study), "--index", str(case.index)]) == 2
     (line,) = capsys.readouterr().err.strip().splitlines()
-    assert "not run" in line and "original scene block no longer gives" in line, line
-    assert "scaled.surface_tension" in line
+    # the record's seal names the edited field itself (issue 46 item 3)
+    assert "not run" in line and "edited after ligwf wrote it" in line, line
+    assert "scene.liquid.surface_tension = 0.24" in line
     assert not (case.path / layout.MANIFEST_FILE).exists()
-    assert "scaled.surface_tension" in dict(study_problems(Study.open(study)).cases)[case.case_id]
+    assert "scene.liquid.surface_tension = 0.24" in dict(
+        study_problems(Study.open(study)).cases)[case.case_id]
+
+
+def test_an_unsealed_record_is_still_checked_by_scaling_it_again(tmp_path, capsys):
+    """A scene record written before records were sealed (no ``made_from``): the edit is
+    still caught by scaling its original block again, as before."""
+    study = tmp_path / "s"
+    assert main(["render", str(TINY), "--out", str(study), "--mesh-cache",
+                 str(tmp_path / "meshes")]) == 0
+    case = Study.open(study).cases[0]
+    record = json.loads((case.path / layout.SCENE_FILE).read_text())
+    del record["made_from"]
+    record["scene"]["liquid"]["surface_tension"] *= 10
+    (case.path / layout.SCENE_FILE).write_text(json.dumps(record))
+    capsys.readouterr()
+    assert main(["run-case", str(study), "--index", str(case.index)]) == 2
+    (line,) = capsys.readouterr().err.strip().splitlines()
+    assert "original scene block no longer gives" in line and "scaled.surface_tension" in line
