@@ -6,7 +6,8 @@ relative to CG1) are the difference of run means CG-n - CG1 with Welch's interva
 by two one-sided tests against +-budget; the velocity profile is the noise-corrected
 distance of the mean profiles with noncentral-F bounds; the GSD and field errors keep the
 analysis' intervals against the tolerance (the field criterion's at the verdict's alpha,
-with the replicas that would decide it from its noise pieces). Holm's step-down over a level's fail tests
+with the replicas that would decide it from its noise pieces). Holm's step-down over the fail
+tests of every tested criterion of a level (each with its own p-value, decided or not)
 decides which fails stand. The statistics: :mod:`ligwf.analysis.records.equivalence`.
 """
 
@@ -18,10 +19,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+from scipy import stats
 
 from ligwf.analysis.records import equivalence as eq
-from ligwf.analysis.records import sampling
+from ligwf.analysis.records import sampling, shares
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
 from ligwf.report import planning
 from ligwf.report.deciding import decide_text, field_plan, profile_plan, signed_plan
 from ligwf.scene.accept import AcceptSettings
@@ -43,13 +46,15 @@ class CriterionSpec:
     column: str         # the case-table (signed) or condition-table (error) column it reads
     kind: str           # SIGNED | RELATIVE (to the CG1 mean) | PROFILE | ERROR
     gated: bool = False    # only where the granules beat their control
+    share: bool = False    # a share in [0, 1] per run: an all-zero arm gets a bound over runs
 
 
 #: The budget's criteria, in the order "fails first" refers to.
 CRITERIA = (
     CriterionSpec("angle_deg", "angle of repose", "deg", "angle_of_repose", SIGNED),
     CriterionSpec("profile_error", "velocity profile", "", "profile_error", PROFILE),
-    CriterionSpec("rigid_share", "rigid-block frames", "", "rigid_frame_share", SIGNED),
+    CriterionSpec("rigid_share", "rigid-block frames", "", "rigid_frame_share", SIGNED,
+                  share=True),
     CriterionSpec("flowing_layer", "flowing layer", "", "flowing_layer_thickness_mean", RELATIVE),
     CriterionSpec("gsd_error", "GSD", "", "gsd_error_all", ERROR, gated=True),
     CriterionSpec("field_error", "continuum fields", "", "field_error", ERROR),
@@ -173,6 +178,9 @@ def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.
     if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED,
                                note=f"not measured: no {spec.column} value"), math.nan
+    zero = shares.share_test(x.values, y.values, tolerance, alpha) if spec.share else None
+    if zero is not None:
+        return _all_zero(base, spec, zero, x, y, tolerance, alpha)
     test = eq.equivalence(e, tolerance, alpha)
     noise = eq.difference_estimate(x.values, y.values, alpha / 2, df_rule)
     vs_noise = ("" if not noise.has_interval else
@@ -186,6 +194,27 @@ def _signed(spec: CriterionSpec, tolerance: float, x: sampling.Arm, y: sampling.
     bound = max(abs(e.lo), abs(e.hi)) if e.has_interval else math.nan
     return CriterionResult(**base, state=test.state, value=e.value, lo=e.lo, hi=e.hi,
                            bound=bound, note=note, **decide), test.p_fail
+
+
+def _all_zero(base: dict, spec: CriterionSpec, zero: tuple[eq.Estimate, eq.Test],
+              x: sampling.Arm, y: sampling.Arm, tolerance: float, alpha: float
+              ) -> tuple[CriterionResult, float]:
+    """A share whose runs all read 0 in an arm (:func:`shares.share_test`): the zero arm's mean
+    is bounded over its runs (rule of three), never by a variance of 0."""
+    e, test = zero
+    arms = [f"{name} ({n} runs) <= {shares.zero_arm_bound(n, alpha):.3g}"
+            for name, v, n in (("CG-n", x.values, x.n), ("CG1", y.values, y.n))
+            if n and np.all(np.asarray(v)[np.isfinite(v)] == 0)]
+    need = math.ceil(math.log(alpha) / math.log(1.0 - tolerance)) if 0 < tolerance < 1 else 0
+    note = (f"every run of {' and '.join(a.split(' (')[0] for a in arms)} reads 0: its mean "
+            f"share is bounded over runs, not frames (rule of three, one-sided "
+            f"{100 * (1 - alpha):.3g} %: {'; '.join(arms)})")
+    if test.state == UNDECIDED and need:
+        note += (f"; {need} all-zero runs of an arm would bound it within the budget "
+                 f"{tolerance:g}")
+    bound = max(abs(e.lo), abs(e.hi))
+    return CriterionResult(**base, state=test.state, value=e.value, lo=e.lo, hi=e.hi,
+                           bound=bound, note=note), test.p_fail
 
 
 def _holm_replan(r: CriterionResult, x: sampling.Arm, y: sampling.Arm, alpha: float,
@@ -262,7 +291,8 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
                        ) -> tuple[CriterionResult, ...]:
     """Every criterion of the budget for one CG-n condition (``row`` of the condition table,
     ``runs`` its cases, ``ref_runs`` its group's CG1 cases), with Holm's step-down over the
-    level's fail tests: a criterion fails only if its fail test survives Holm."""
+    fail tests of every criterion tested (an interval or bounds): a criterion fails only if
+    its fail test survives Holm."""
     out, p_fail = [], []
     arms: dict[int, tuple[sampling.Arm, sampling.Arm]] = {}   # signed criteria: their arms
     for spec in CRITERIA:
@@ -290,9 +320,10 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
                 xa = ya = np.array([])
             costs = (_replica_cost(runs, noise), _replica_cost(ref_runs, noise))
             out.append(_norm(spec, tol, xa, ya, alpha, costs))
-            # a fail by its bounds has no p-value: it enters Holm's family as decided
-            # (p = 0), which only makes the signed fails beside it harder to keep
-            p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
+            # its own fail test's p-value, decided or not: the family is every tested
+            # criterion, so its size does not depend on the outcome
+            p_fail.append(eq.norm_fail_p(xa, ya, tol) if out[-1].assessed
+                          and math.isfinite(out[-1].lo) else math.nan)
         elif spec.column not in row.index:
             out.append(CriterionResult(**base, state=NOT_MEASURED,
                                        note=f"not measured: the study has no {spec.column}"))
@@ -300,13 +331,31 @@ def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs
         else:
             costs = (_replica_cost(runs, noise), _replica_cost(ref_runs, noise))
             out.append(_analysis_interval(spec, tol, row, alpha, costs))
-            p_fail.append(0.0 if out[-1].state == FAIL else math.nan)
+            p_fail.append(error_fail_p(spec, tol, row, out[-1]))
     rejected = eq.holm_rejects(p_fail, alpha)
     family = sum(math.isfinite(p) for p in p_fail)
     out = [_holm_replan(r, *arms[i], alpha / family, df_rule)
            if r.state == FAIL and not ok and i in arms else r
            for i, (r, ok) in enumerate(zip(out, rejected))]
     return tuple(_after_holm(r, ok, family) for r, ok in zip(out, rejected))
+
+
+def error_fail_p(spec: CriterionSpec, tolerance: float, row, r: CriterionResult) -> float:
+    """The fail test's p-value of an analysis error (nan: not tested). The field criterion
+    from its noise pieces (:meth:`LayerNoise.fail_p`, the test its bounds make); the GSD
+    error from its 95 % bootstrap interval read as a normal one (se = width / 2 z_0.975),
+    an approximation: the bootstrap gives no p-value."""
+    if not (r.assessed and math.isfinite(r.lo) and math.isfinite(r.hi)):
+        return math.nan
+    if spec.name == "field_error":
+        values = [row_value(row, c) for c in FIELD_NOISE_COLUMNS]
+        if all(math.isfinite(v) for v in values):
+            return LayerNoise(values[0], values[1], values[2], int(values[3]),
+                              int(values[4])).fail_p(tolerance)
+    se = (r.hi - r.lo) / (2.0 * 1.959963984540054)
+    if not se > 0:
+        return 0.0 if r.value > tolerance else 1.0
+    return float(stats.norm.sf((r.value - tolerance) / se))
 
 
 _NO_DECIDE = dict(decide_by="", decide_arm="", decide_amount=math.nan, decide_amount_cg1=math.nan,

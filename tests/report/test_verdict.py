@@ -39,9 +39,10 @@ PROFILE = np.array([0.10, 0.08, 0.05, 0.02])   # m/s, a downhill velocity profil
 
 def runs(cg: float, rule: str, angles, rigid=None, layer=None, group: str = GROUP,
          profile_shift: float = 0.0) -> list[dict]:
-    """One case row per angle (deg); rigid shares and flowing layers default to CG1's."""
+    """One case row per angle (deg); rigid shares and flowing layers default to CG1's (a
+    share that is not 0 in every run: an all-zero arm is bounded over its runs only)."""
     n = len(angles)
-    rigid = rigid if rigid is not None else [0.0] * n
+    rigid = rigid if rigid is not None else [0.010 + 0.001 * k for k in range(n)]
     layer = layer if layer is not None else [0.0100 + 0.0001 * k for k in range(n)]
     return [{"case_id": f"cg{cg:g}-{rule}-r{k}-{group}", "group": group, "cg": float(cg),
              "rule": rule, "replica": k, "angle_of_repose": angles[k],

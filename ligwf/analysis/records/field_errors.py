@@ -256,6 +256,21 @@ class LayerNoise:
             stats.norm.ppf(1.0 - alpha / 2.0))
         return t * math.sqrt(noise)
 
+    def fail_p(self, tolerance: float) -> float:
+        """The p-value of the criterion's fail test (H0: true distance <= ``tolerance``):
+        the lower bound D - t sqrt(S) exceeds the tolerance at level alpha exactly when
+        2 P(T >= (D - tolerance) / sqrt(S)) <= alpha (t is the 1 - alpha / 2 quantile);
+        nan without the noise of both arms."""
+        noise, df = self.noise()
+        if not (math.isfinite(noise) and math.isfinite(tolerance)) or self.runs < 2 \
+                or self.reference_runs < 2:
+            return math.nan
+        if noise <= 0:
+            return 0.0 if self.distance > tolerance else 1.0
+        z = (self.distance - tolerance) / math.sqrt(noise)
+        tail = float(stats.t.sf(z, df)) if math.isfinite(df) else float(stats.norm.sf(z))
+        return min(1.0, 2.0 * tail)
+
     def estimate(self, alpha: float = ALPHA) -> NormEstimate:
         """The noise-corrected distance and its bounds (module docstring)."""
         noise, _ = self.noise()

@@ -33,8 +33,8 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ligwf.analysis.records.equivalence import (ALPHA, WELCH, finite_values, t_quantile,
-                                                welch_df)
+from ligwf.analysis.records.equivalence import (ALPHA, WELCH, degrees_of_freedom,
+                                                finite_values, t_quantile)
 from ligwf.analysis.records.intervals import autocorrelation_time
 
 #: the kinds of option
@@ -141,7 +141,7 @@ def half_width(x: Arm, y: Arm, alpha: float = ALPHA, add: tuple[int, int] = (0, 
         return 0.0
     # the variances are still estimated from the runs there are: their degrees of freedom
     # grow with added replicas, not with a longer window
-    df = welch_df(vx, nx, vy, ny) if df_rule == WELCH else float(min(nx, ny) - 1)
+    df = degrees_of_freedom(vx, nx, vy, ny, df_rule)
     return _t_planned(float(f"{df:.3g}") if math.isfinite(df) else df, alpha) * se
 
 

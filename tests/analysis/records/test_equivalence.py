@@ -41,7 +41,11 @@ def test_two_one_sided_tests_at_their_edges():
     assert eq.equivalence(e, 1.3).state == eq.PASS
     assert eq.equivalence(eq.Estimate(-2.0, -2.5, -1.5, 0.2, 10.0), 1.0).state == eq.FAIL
     t = eq.equivalence(eq.Estimate(2.0, 1.5, 2.5, 0.2, 10.0), 1.0)
-    assert t.state == eq.FAIL and t.p_fail == pytest.approx(1 - stats.t.cdf(5.0, 10))
+    # the fail test's p covers both tails of |delta| <= 1 (at delta = +1 and at -1)
+    assert t.state == eq.FAIL and t.p_fail == pytest.approx(
+        1 - stats.t.cdf(5.0, 10) + stats.t.cdf(-15.0, 10))
+    assert eq.equivalence(eq.Estimate(2.0, 1.5, 2.5, 0.2, 10.0), 1.0, fail_sides=1
+                          ).p_fail == pytest.approx(1 - stats.t.cdf(5.0, 10))
     # pass <=> the larger one-sided p is below alpha (the interval is the 90 % one)
     se, df = 0.3, 6.0
     half = stats.t.ppf(0.95, df) * se
