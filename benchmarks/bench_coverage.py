@@ -26,6 +26,11 @@ run value is its steady-window mean, exactly as the report takes it. For every c
   and of final fails when it sits on the budget or at 0 (each must be <= 0.05).
 
 Every coverage cell must lie in [0.92, 0.99]; the summary line says how many do.
+
+``--designs`` measures instead the designs users run under the verdict's single-look rules
+(unequal arms, all-zero shares, a level's family of criteria, the cheapest of several
+levels: :mod:`benchmarks.verdict_designs`, registered in docs/results/verdict_rates/); the
+default run keeps the rules coverage.txt was made with, so it reproduces that file.
 The previous interval (frame bootstrap over replicas, ``intervals.frame_metric_interval``)
 is measured on the R = 2 / 3 cells with ``--old`` (slow).
 
@@ -189,7 +194,9 @@ def sequential_study(rng, R: int, frames: int, phi: float, offset: float, delta:
     for look in range(1, looks + 1):
         x, y = _synth_arm(arms[0], 1.0), _synth_arm(arms[1], CG1_PRICE)
         e = difference_estimate(x.values, y.values, alpha, HSU)
-        state = equivalence(e, budget, alpha).state
+        # the rule coverage.txt was registered with: a fail when the interval lies wholly
+        # outside (one-sided fail p); the two-sided rule is measured by --designs
+        state = equivalence(e, budget, alpha, fail_sides=1).state
         if state != "undecided" or look == looks:
             return state
         # the round's rule (ligwf.pipeline.rounds): the cheapest way to halve the half-width
@@ -246,11 +253,19 @@ def main(argv=None) -> int:
     ap.add_argument("--looks", type=int, default=3, help="looks of the sequential procedure")
     ap.add_argument("--sequential-only", action="store_true",
                     help="only the sequential procedure (skip the interval cells)")
+    ap.add_argument("--designs", action="store_true",
+                    help="only the designs users run (docs/results/verdict_rates)")
+    ap.add_argument("--level-trials", type=int, default=2000,
+                    help="studies a cell of the family and levels designs (--designs)")
     ap.add_argument("--recheck", type=int, default=0, metavar="N",
                     help="re-measure the wrong-pass share of every cell above 0.05 on N "
                     "fresh null studies (Welch's and Hsu's df)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
+    if args.designs:
+        from benchmarks.verdict_designs import report
+        report(rng, args.trials, args.level_trials)
+        return 0
     rows, inside, total = [], 0, 0
     print(f"trials per cell: {args.trials}; coverage cells must lie in [{LOW}, {HIGH}]")
     head = (f"{'R':>2} {'frames':>6} {'phi':>4} {'offset':>6} | {'value':>6} {'diff':>6} "
