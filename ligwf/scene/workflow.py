@@ -210,12 +210,11 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
         if not 1 <= n <= MAX_REPLICAS:
             raise ConfigError(f"{where} = {n}: allowed range [1, {MAX_REPLICAS}] "
                               "replicas per CG level")
-    for what, levels in (("per_cg", sweep.per_cg), ("replicas", sweep.replicas
-                                                       if isinstance(sweep.replicas, dict) else {})):
-        if stray := sorted(set(levels) - set(sweep.cg_levels)):
-            raise ConfigError(f"sweep.{what}: CG level {stray[0]:g} is not in sweep.cg_levels "
-                              f"{[float(c) for c in sweep.cg_levels]} (its settings would "
-                              "never be used)")
+    stray = sorted(set(sweep.per_cg) - set(sweep.cg_levels))
+    if stray:
+        raise ConfigError(f"sweep.per_cg: CG level {stray[0]:g} is not in sweep.cg_levels "
+                          f"{[float(c) for c in sweep.cg_levels]} (its settings would never "
+                          "be used)")
     count = math.prod(len(v) for _, v in varied) * sum(
         (1 if cg == 1 else len(set(sweep.rules))) * sweep.replicas_for(cg)
         for cg in set(sweep.cg_levels))
