@@ -242,17 +242,19 @@ VERDICT = (
      "profile_error, rigid_share, flowing_layer, gsd_error, field_error)"),
     ("label", "text", "criterion label", "the criterion as the report names it"),
     ("unit", "text", "unit", "unit of value, lo, hi and budget (empty: a ratio)"),
-    ("state", "text", "verdict", "pass (signed criteria: the 90 % interval of CG-n - CG1 "
-     "inside +-budget, two one-sided tests; norms: the upper bound within the budget), fail "
-     "(wholly outside, surviving Holm over the level's criteria), undecided, or not "
-     "assessed (with a note)"),
+    ("state", "text", "verdict", "pass (signed criteria: the (1 - 2 alpha) interval of "
+     "CG-n - CG1 inside +-budget, two one-sided tests; norms: the upper bound within the "
+     "budget), fail (its fail test rejects, surviving Holm over the level's tested "
+     "criteria), undecided, or not assessed (with a note); alpha, the degrees-of-freedom "
+     "rule and the family rule: the verdict record's statistics"),
     ("value", "unit", "value", "the criterion's measured value (in the row's unit): the "
      "signed difference CG-n - CG1, or the noise-corrected distance"),
-    ("lo", "unit", "lo", "lower bound of its interval (90 % for signed criteria)"),
+    ("lo", "unit", "lo", "lower bound of its interval (signed criteria: the (1 - 2 alpha) "
+     "interval, alpha in the verdict record's statistics)"),
     ("hi", "unit", "hi", "upper bound of its interval"),
     ("budget", "unit", "budget", "the tolerance it is held to: the accept: value"),
-    ("shown_within", "unit", "shown within", "the largest |error| its interval allows: the "
-     "error this level is shown to stay within"),
+    ("shown_within", "unit", "shown within", "the largest |error| its interval allows (a "
+     "one-sided (1 - alpha) bound): the error this level is shown to stay within"),
     ("budget_source", "text", "budget from", "where the budget came from (the accept: block)"),
     ("decide_by", "text", "decide by", "undecided only: the cheapest way to decide it "
      "(extend: more production on the existing runs, continued from their restarts; "

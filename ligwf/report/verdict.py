@@ -41,6 +41,7 @@ from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.report.criteria import CriterionResult, Gate, band, condition_criteria
+from ligwf.report.verdict_statistics import statistics_record
 from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.workflow import CONTROL_KEY
 
@@ -86,6 +87,9 @@ class GroupVerdict:
 class Verdict:
     groups: tuple[GroupVerdict, ...]
     accept: dict = field(default_factory=dict)   # the tolerances it was decided with
+    #: alpha, interval level, df rule, fail test and family rule it was decided with
+    #: (:func:`ligwf.report.verdict_statistics.statistics_record`; {} in older records)
+    statistics: dict = field(default_factory=dict)
 
 
 def is_control_group(group: str) -> bool:
@@ -189,7 +193,7 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
     gates, profiles = gates or {}, profiles or {}
     groups = []
     if conditions.empty:
-        return Verdict((), accept.model_dump(mode="json"))
+        return Verdict((), accept.model_dump(mode="json"), statistics_record(alpha, df_rule))
     if cases is None:
         cases = pd.DataFrame(columns=["case_id", "group", "cg", "rule"])
     for group, sub in conditions.groupby("group", sort=True):
@@ -214,4 +218,5 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
                                         results))
         sentence, cheapest = group_sentence(out)
         groups.append(GroupVerdict(group, tuple(out), sentence, cheapest))
-    return Verdict(tuple(groups), accept.model_dump(mode="json"))
+    return Verdict(tuple(groups), accept.model_dump(mode="json"),
+                   statistics_record(alpha, df_rule))

@@ -56,7 +56,7 @@ def verdict_rows(verdict: Verdict) -> pd.DataFrame:
 
 def write_verdict(verdict: Verdict, out: Path) -> None:
     """``verdict.csv`` and ``verdict.json`` into the report folder ``out`` (atomically)."""
-    record = {"accept": verdict.accept, "groups": [
+    record = {"accept": verdict.accept, "statistics": _clean(verdict.statistics), "groups": [
         {**_clean(asdict(g)), "conditions": [{**_clean(asdict(c)), "state": c.state,
                                               "name": c.name} for c in g.conditions]}
         for g in verdict.groups]}
@@ -89,7 +89,7 @@ def read_verdict(out: Path) -> Verdict | None:
                                               int(c["replicas"]), _nan(c["speedup"]),
                                               _nan(c["speedup_lo"]), _nan(c["speedup_hi"]), crit))
             groups.append(GroupVerdict(g["group"], tuple(conds), g["sentence"], g["cheapest"]))
-        return Verdict(tuple(groups), rec.get("accept", {}))
+        return Verdict(tuple(groups), rec.get("accept", {}), rec.get("statistics") or {})
     except (OSError, ValueError, KeyError, TypeError):
         return None
 

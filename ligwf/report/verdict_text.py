@@ -4,8 +4,10 @@ terminal lines ``ligwf study`` and ``ligwf report`` end with (rich).
 
 All three show the same facts: per sweep group its sentence (the cheapest level that meets
 the budget, or that none does and why), then per CG level and rule the speedup with its
-interval and each criterion's state with its value, 95 % interval and budget; undecided
-criteria say what would decide them, unassessed ones why.
+interval and each criterion's state with its value, interval and budget; undecided
+criteria say what would decide them, unassessed ones why. Every sentence about the statistics
+(interval level, alpha, degrees of freedom, family) is written from the verdict's record
+(:mod:`ligwf.report.verdict_statistics`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ from rich.text import Text
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.report.criteria import CRITERIA, RELATIVE, SIGNED, CriterionResult
 from ligwf.report.verdict import FAILS, MEETS, ConditionVerdict, GroupVerdict, Verdict, band_text
+from ligwf.report.verdict_statistics import (cheapest_disclosure, method_text,
+                                             shown_within_heading)
 
 TITLE = "Verdict"
 #: criteria judged on a signed difference (their budget is +-tolerance)
@@ -98,9 +102,15 @@ def _columns(g: GroupVerdict) -> list[str]:
     return heads
 
 
-def group_markdown(g: GroupVerdict, several: bool) -> list[str]:
+def sentence(g: GroupVerdict, stats: dict) -> str:
+    """The group's sentence, with what naming the cheapest of its levels costs."""
+    note = cheapest_disclosure(stats, len(g.conditions)) if g.cheapest else ""
+    return f"{g.sentence} {note}" if note else g.sentence
+
+
+def group_markdown(g: GroupVerdict, several: bool, stats: dict | None = None) -> list[str]:
     lines = ([f"### {group_title(g.group)}", ""] if several else [])
-    lines += [f"**{g.sentence}**", ""]
+    lines += [f"**{sentence(g, stats or {})}**", ""]
     if not g.conditions:
         return lines
     cols = _columns(g)
@@ -110,8 +120,7 @@ def group_markdown(g: GroupVerdict, several: bool) -> list[str]:
         lines.append(f"| {c.name} | {c.replicas} | "
                      f"{band_text(c.speedup, c.speedup_lo, c.speedup_hi)} | {c.state} | "
                      + " | ".join(cell(r) for r in c.criteria) + " |")
-    lines += ["", "Shown to stay within (the largest error each interval allows, speedup "
-              "beside):", ""]
+    lines += ["", shown_within_heading(stats or {}), ""]
     lines += [f"- **{c.name}** (speedup {_num(c.speedup)}): {shown_within(c)}"
               for c in g.conditions]
     notes = _notes(g)
@@ -124,20 +133,15 @@ def verdict_section(verdict: Verdict) -> str:
     """The verdict as the report's first markdown section."""
     lines = [f"## {TITLE}", "",
              f"Budget (`accept:` block): {budget_line(verdict.accept)}. The unit is the run "
-             "(its steady-window mean). Signed criteria (angle, rigid-block share, flowing "
-             "layer) are the difference of run means CG-n - CG1 with Welch's 90 % interval: "
-             "they pass when it lies inside +-budget and fail when it lies wholly outside "
-             "(two one-sided tests, 5 % each); the velocity profile is the distance of the "
-             "mean profiles less the noise of both arms, with noncentral-F bounds. A level meets "
-             "the budget when every criterion it was assessed on passes, and fails when one "
-             "fails after Holm's step-down over its criteria; coverage measured by "
-             "`benchmarks/bench_coverage.py`. Control twins are not candidates.", ""]
+             f"(its steady-window mean). {method_text(verdict.statistics)} Coverage and error "
+             "rates measured by `benchmarks/bench_coverage.py`. Control twins are not "
+             "candidates.", ""]
     if not verdict.groups:
         return "\n".join(lines + ["No sweep group with a CG1 reference and a CG level to "
                                   "judge.", ""])
     several = len(verdict.groups) > 1
     for g in verdict.groups:
-        lines += group_markdown(g, several)
+        lines += group_markdown(g, several, verdict.statistics)
     return "\n".join(lines)
 
 
@@ -146,7 +150,8 @@ def verdict_renderables(verdict: Verdict) -> list:
     out: list = [Text(f"{TITLE} ({budget_line(verdict.accept)})", style="bold")]
     for g in verdict.groups:
         title = group_title(g.group)
-        out.append(Text(f"{title}: {g.sentence}" if len(verdict.groups) > 1 else g.sentence,
+        said = sentence(g, verdict.statistics)
+        out.append(Text(f"{title}: {said}" if len(verdict.groups) > 1 else said,
                         style="bold green" if g.cheapest else "bold"))
         if not g.conditions:
             continue
