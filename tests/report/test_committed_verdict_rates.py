@@ -1,0 +1,99 @@
+"""docs/results/verdict_rates: the designs users run (bench_coverage.py --designs), registered
+before the run. The README's numbers are those of the committed rates.txt, its checks say
+what the file's check lines say (a failed registered check stays failed), and the file's
+cells give its check lines."""
+
+from __future__ import annotations
+
+import re
+
+from scipy import stats
+
+from tests.helpers import ROOT
+
+HERE = ROOT / "docs" / "results" / "verdict_rates"
+TEXT = (HERE / "rates.txt").read_text()
+README = " ".join((HERE / "README.md").read_text().split())
+
+
+def _lower(rate: float, trials: int) -> float:
+    k = round(rate * trials)
+    return 0.0 if k == 0 else float(stats.beta.ppf(0.05, k, trials - k + 1))
+
+
+def _section(title: str) -> str:
+    return TEXT.split(title, 1)[1].split("\ncheck", 1)[0]
+
+
+def _rows(title: str) -> list[list[float]]:
+    """The cells of a design: [CG-n runs, CG1 runs, *the line's numbers]."""
+    return [[float(v) for v in re.findall(r"-?\d+(?:\.\d+)?", line)]
+            for line in _section(title).splitlines() if "|" in line and re.search(r"\d", line)]
+
+
+def test_made_by_the_registered_command_after_its_registration():
+    first = TEXT.splitlines()[0]
+    registered = re.search(r"^    (nice -n 19 .*) > docs/results/verdict_rates/rates.txt$",
+                           (HERE / "README.md").read_text(), re.M).group(1)
+    assert first.startswith("# " + registered.replace(" > docs", ""))
+    assert "4000 studies a cell (2000 for the family and levels cells)" in TEXT
+    # the registration precedes the result section in the README
+    assert README.index("Registered before the run") < README.index("## Result")
+
+
+def test_check_lines_recompute_from_the_cells():
+    trials, level_trials = 4000, 2000
+    unequal = _rows("budget in frame sd)")
+    assert len(unequal) == 36
+    cover = [v for r in unequal for v in r[5:7]]
+    inside = sum(0.92 <= v <= 0.99 for v in cover)
+    assert (f"check unequal intervals: {inside} of 72 cells in [0.92, 0.99] "
+            f"({min(cover):.3f}-{max(cover):.3f}): FAILS") in TEXT
+    rates = [v for r in unequal for v in r[7:9]]
+    assert f"check unequal rates: at most {max(rates):.4f}; 0 of 72" in TEXT
+    assert all(_lower(v, trials) <= 0.05 for v in rates)
+    zero = _rows("the budget 0.05)")
+    above = [r for r in zero if _lower(r[4], trials) > 0.05]
+    assert len(zero) == 8 and len(above) == 1
+    assert (f"at most {max(r[4] for r in zero):.4f} (registered rule: up to "
+            f"{max(r[5] for r in zero):.4f}); 1 of 8 shown above 0.05: FAILS") in TEXT
+    fam = _rows("each on its budget")
+    assert len(fam) == 6 and all(_lower(r[5], level_trials) <= 0.05 for r in fam)
+    lev = _rows("each with a criterion on the budget")
+    assert len(lev) == 6 and all(_lower(r[3], level_trials) <= 0.2 for r in lev)
+    assert "summary: 2 of 4 registered checks hold" in TEXT
+
+
+def test_readme_numbers_are_the_file():
+    assert "**2 of 4 registered checks hold.**" in README
+    unequal = _rows("budget in frame sd)")
+    cover = [v for r in unequal for v in r[5:7]]
+    outside = [v for v in cover if not 0.92 <= v <= 0.99]
+    assert all(v > 0.99 for v in outside)
+    assert (f"{72 - len(outside)} of 72 interval cells of the unequal designs lie in "
+            f"[0.92, 0.99]; all {len(outside)} outside lie above 0.99 "
+            f"({min(cover):.3f}-{max(cover):.3f} in all)") in README
+    six = [v for r in unequal if r[0] == 6.0 for v in r[5:7]]
+    assert f"{sum(v > 0.99 for v in six)} of the {len(six)} cells of 6 vs 2 are above 0.99" \
+        in README
+    wide = [r[5] for r in unequal if r[0] == 24.0 and r[2] == 2.0]
+    assert all(v > 0.99 for v in wide) and len(outside) == sum(v > 0.99 for v in six) + len(wide)
+    assert f"so are the {len(wide)} cells of the 95 % interval of 24 vs 3" in README
+    rates = [v for r in unequal for v in r[7:9]]
+    assert f"wrong pass and wrong fail at most {max(rates):.4f}" in README
+    zero = _rows("the budget 0.05)")
+    worst = max(zero, key=lambda r: r[4])
+    assert worst[:3] == [60.0, 60.0, 0.2]
+    assert f"passes wrongly in {worst[4]:.4f} of studies" in README
+    rule3 = next(r for r in zero if r[0] == 60.0 and r[2] == 1.0)
+    assert f"reads 1 in 5 % of runs: {rule3[4]:.4f}" in README
+    assert all(r[4] == 0.0 for r in zero if r[1] <= 3.0)                # 2- and 3-run arms
+    assert f"passed wrongly in up to {max(r[5] for r in zero):.4f}" in README
+    fam = _rows("each on its budget")
+    assert (f"decided in at most {max(r[5] for r in fam):.4f} of studies (the registered "
+            f"rule: {min(r[6] for r in fam):.4f}-{max(r[6] for r in fam):.4f})") in README
+    lev = _rows("each with a criterion on the budget")
+    assert f"meets in at most {max(r[3] for r in lev):.4f} of studies" in README
+    assert f"it would be at most {max(r[5] for r in lev):.4f}" in README
+    for n, state in ((1, "fails"), (2, "fails"), (3, "holds"), (4, "holds")):
+        assert re.search(rf"{n}\. [^:]+: \*\*{state}\*\*", README), n
