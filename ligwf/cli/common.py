@@ -147,6 +147,12 @@ def add_workflow_args(p: argparse.ArgumentParser) -> None:
                    help="run/write cases the pre-flight stability check refuses (experts)")
 
 
+def add_replace_arg(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--replace", action="store_true",
+                   help="write over another study in --out (refused without it: another "
+                   "name or other workflow values); cases it does not change keep their runs")
+
+
 def add_mesh_cache(p: argparse.ArgumentParser) -> None:
     p.add_argument("--mesh-cache", type=folder_to_write, default=None,
                    help="mesh cache folder (default $LIGWF_MESH_CACHE or ./meshes)")

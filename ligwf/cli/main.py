@@ -15,7 +15,8 @@ from pathlib import Path
 from ligwf import __version__
 from ligwf.cli import (analyse, analyse_dumps, calibrate, report, run, schema, slurm,
                        stability, study)
-from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_workflow_args,
+from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_replace_arg,
+                              add_workflow_args,
                               case_table, console, err_console, folder_to_write, plan_table,
                               prepare_from_args)
 from ligwf.errors import LigwfError
@@ -94,7 +95,7 @@ def analysis_lines(prepared) -> list[str]:
 
 def cmd_render(args: argparse.Namespace) -> int:
     prepared = prepare_from_args(args)
-    write(prepared, args.out, args.mesh_cache)
+    write(prepared, args.out, args.mesh_cache, args.replace)
     wf = prepared.workflow
     console.print(case_table(prepared, f"{wf.name}: {len(prepared.rendered)} case(s) -> {args.out}"))
     return 0
@@ -116,6 +117,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_workflow_args(p)
     p.add_argument("--out", type=folder_to_write, required=True, help="study folder to write")
     add_mesh_cache(p)
+    add_replace_arg(p)
     p.set_defaults(func=cmd_render)
 
     for module in COMMAND_MODULES:

@@ -20,7 +20,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, console,
+from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
+                              add_workflow_args, console,
                               folder_to_write, plan_table, prepare_from_args,
                               print_warning, rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
@@ -35,7 +36,7 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     prepared = prepare_from_args(args)
     settings = run_settings(args.np, args.ensemble, args.cores, args.retry_unstable,
                             args.templates)
-    run = start_run(prepared, args.out, settings, args.mesh_cache)
+    run = start_run(prepared, args.out, settings, args.mesh_cache, args.replace)
     title = (f"rank plan for {settings.cores} core(s) ({settings.cores_source})"
              if settings.planned else "ranks as asked (--np / --ensemble)")
     console.print(plan_table(run.schedule, title))
@@ -136,6 +137,7 @@ def add_run_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--retry-unstable", action="store_true",
                    help="also re-run cases found unstable before")
     add_mesh_cache(p)
+    add_replace_arg(p)
 
 
 def register(subparsers) -> None:

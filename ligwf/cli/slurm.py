@@ -40,7 +40,8 @@ from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
-from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_workflow_args, case_table,
+from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
+                              add_workflow_args, case_table,
                               console, duration, err_console, folder_to_write, positive_int,
                               prepare_from_args, print_warning, rank_count)
 from ligwf.cli.slurm_rounds import (add_next_round_parser, add_until_decided_args,
@@ -49,6 +50,7 @@ from ligwf.cli.slurm_rounds import (add_next_round_parser, add_until_decided_arg
 from ligwf.engine.plan import RankPlan
 from ligwf.engine.progress import shown_reason
 from ligwf.engine.site import EngineConfig
+from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import prepared_loads
 from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_submit
 from ligwf.slurm.assumptions import site_assumptions
@@ -58,6 +60,7 @@ from ligwf.pipeline.submit_rounds import is_sequential
 from ligwf.slurm.jobs import PlannedJob, read_record, recorded_site, study_status
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
+from ligwf.study.ownership import other_study
 
 
 def add_site_args(p: argparse.ArgumentParser) -> None:
@@ -170,6 +173,8 @@ def cmd_submit(args: argparse.Namespace) -> int:
     limit = slurm_time_seconds(site.time)
     over_time = [over_time_warning(row, site.time) for row in rows if row.exceeds(limit)]
     if args.dry_run:
+        if not args.replace and (why := other_study(submission.out, wf.name, wf.raw)):
+            raise ConfigError(why)          # what the submission would refuse
         console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) (dry run)"))
         console.print(plan_view)
         _warn(over_time)
@@ -180,7 +185,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
         if rounds:
             print(dry_run_note(args, submission.out))
         return 0
-    write_for_submit(prepared, submission, scheduler, args.mesh_cache)
+    write_for_submit(prepared, submission, scheduler, args.mesh_cache, args.replace)
     console.print(case_table(prepared, f"{wf.name}: {len(rendered)} case(s) -> {submission.out}"))
     console.print(plan_view)
     _warn(over_time)
@@ -285,6 +290,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_workflow_args(p)
     p.add_argument("--out", type=folder_to_write, required=True, help="study folder to write")
     add_mesh_cache(p)
+    add_replace_arg(p)
     add_site_args(p)
     add_until_decided_args(p)
     p.set_defaults(func=cmd_submit)

@@ -91,7 +91,8 @@ def cmd_until_decided(args: argparse.Namespace) -> int:
     rounds = until_decided(prepared, args.out, LocalExecutor(settings),
                            RoundPlan(args.max_looks, args.max_core_hours, args.every_level),
                            run_round,
-                           show_look, args.mesh_cache, snapshots=not args.no_snapshots)
+                           show_look, args.mesh_cache, snapshots=not args.no_snapshots,
+                           replace=args.replace)
     if not rounds.stopped:
         console.print("some cases did not finish (see the table): the same command resumes "
                       "them and goes on with the rounds")

@@ -24,12 +24,14 @@ re-issues every fix with the same ID and runs the remaining phases with ``run N 
 from __future__ import annotations
 
 import dataclasses
+import os
 import shutil
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
 
 from ligwf.engine.liggghts import restart_step
+from ligwf.errors import ConfigError
 from ligwf.engine.restart_id import CaseIdentity, remove_sidecar, why_not_own
 from ligwf.engine.render import render_template, template_context
 from ligwf.scene.scaled import ScaledScene
@@ -206,6 +208,11 @@ def _extension_plan(case: CaseFolder, steps_done: int) -> NextAttempt:
 def clean_outputs(case_dir: Path) -> None:
     """Remove the outputs of earlier attempts before a fresh run (inputs stay)."""
     case_dir = Path(case_dir)
+    for sub in OUTPUT_DIRS:              # nothing removed through a link (checked first)
+        if (case_dir / sub).is_symlink():
+            raise ConfigError(f"{case_dir / sub} is a symbolic link (to "
+                              f"{os.readlink(case_dir / sub)}): ligwf removes a case's "
+                              "earlier outputs only inside its folder; remove the link")
     for sub in OUTPUT_DIRS:
         d = case_dir / sub
         if d.is_dir():

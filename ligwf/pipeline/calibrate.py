@@ -148,7 +148,9 @@ class Calibration:
 def _run(raw: dict[str, Any], out: Path, settings: RunSettings, monitor, stop,
          allow_unstable: bool) -> list[Path]:
     prepared = prepare(expand(raw), settings.template_dirs, allow_unstable)
-    run = start_run(prepared, out, settings)
+    # the calibration folder's two studies are its own: another grid or workflow replaces
+    # them (cases it does not change keep their runs), as a calibration run again expects
+    run = start_run(prepared, out, settings, replace=True)
     if not run.run(monitor, stop):
         bad = [c.case_id for c in run.study.cases
                if (m := c.manifest()) is None or m.status != "done"]

@@ -38,6 +38,7 @@ from ligwf.scene.workflow import Case, Workflow, comparison_warnings, load_workf
 from ligwf.study.case import content_hash
 from ligwf.study.layout import MESH_CACHE_DIR, MESH_NAME, OUTPUT_DIRS, SCENE_FILE
 from ligwf.study.made_from import sealed
+from ligwf.study.ownership import check_own_folder
 from ligwf.study.study import Study
 from ligwf.study.study_record import CaseEntry, StudyRecord
 
@@ -151,10 +152,16 @@ def write_case(rc: RenderedCase, out_dir: Path, mesh_cache: Path | None = None) 
 
 
 def write_study(wf: Workflow, rendered: list[RenderedCase], out_dir: Path,
-                mesh_cache: Path | None = None) -> Study:
+                mesh_cache: Path | None = None, replace: bool = False) -> Study:
     """Write every case folder, then the study record; returns the written study.
-    FolderNotWritable (one line naming the folder) on a full or read-only file system."""
+    First, before anything is written (:func:`ligwf.study.ownership.check_own_folder`):
+    ConfigError when ``out_dir`` holds another study (unless ``replace``) or a path to
+    write is a symbolic link or resolves outside ``out_dir``. FolderNotWritable (one line
+    naming the folder) on a full or read-only file system."""
     out_dir = Path(out_dir)
+    files = {MESH_NAME, *(name for rc in rendered for name in rc.files)}
+    check_own_folder(out_dir, wf.name, wf.raw, [rc.case.case_id for rc in rendered], files,
+                     replace)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
         for rc in rendered:
@@ -179,10 +186,11 @@ def prepare_workflow(workflow: Path, overrides: Sequence[str] = (),
                    allow_unstable)
 
 
-def write(prepared: Prepared, out: Path, mesh_cache: Path | None = None) -> Study:
+def write(prepared: Prepared, out: Path, mesh_cache: Path | None = None,
+          replace: bool = False) -> Study:
     """Write the prepared study folder (identical cases are rewritten byte for byte, so
-    their outputs stay and a re-run resumes)."""
-    return write_study(prepared.workflow, prepared.rendered, out, mesh_cache)
+    their outputs stay and a re-run resumes); ``replace``: also over another study."""
+    return write_study(prepared.workflow, prepared.rendered, out, mesh_cache, replace)
 
 
 def prepared_loads(prepared: Prepared) -> list[CaseLoad]:

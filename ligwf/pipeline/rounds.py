@@ -50,6 +50,7 @@ from ligwf.scheduler import Executor
 from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
 from ligwf.study.case import CaseFolder, group_of
 from ligwf.study.extension import write_extension
+from ligwf.study.ownership import check_own_folder
 from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Look,
                                 Rounds, read_rounds, write_rounds)
 from ligwf.study.study import Study
@@ -280,15 +281,19 @@ def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Lo
 # ---------------------------------------------------------------- the loop
 def until_decided(prepared: Prepared, out: Path, executor: LocalExecutor, plan: RoundPlan,
                   run_round: Callable[[StudyRun], bool], show: Callable[[Look, Rounds], None],
-                  mesh_cache: Path | None = None, snapshots: bool = True) -> Rounds:
+                  mesh_cache: Path | None = None, snapshots: bool = True,
+                  replace: bool = False) -> Rounds:
     """Run, analyse and judge the study in rounds until it decides (module docstring), its
     cases and analysis on ``executor``; ``run_round`` runs a scheduled round (the CLI's
     progress display), ``show`` prints a look. Returns the rounds record; stops early (no
-    look recorded) when a case did not finish (the same command resumes it)."""
+    look recorded) when a case did not finish (the same command resumes it). Another study
+    in ``out`` is refused before the rounds record is touched, unless ``replace``."""
+    check_own_folder(out, prepared.workflow.name, prepared.workflow.raw,
+                     [rc.case.case_id for rc in prepared.rendered], (), replace)
     rounds = start_rounds(out, plan)
     while not rounds.stopped:
         _, identity = site_engine()             # refused before anything is written
-        study = write_round(prepared, out, rounds, mesh_cache)
+        study = write_round(prepared, out, rounds, mesh_cache, replace)
         run = scheduled(study, executor, identity)
         if not run_round(run):
             return rounds
@@ -300,14 +305,14 @@ def until_decided(prepared: Prepared, out: Path, executor: LocalExecutor, plan: 
 
 # ---------------------------------------------------------------- the steps of a round
 def write_round(prepared: Prepared, out: Path, rounds: Rounds,
-                mesh_cache: Path | None = None) -> Study:
+                mesh_cache: Path | None = None, replace: bool = False) -> Study:
     """Write the study as its looks left it: the workflow's cases and the replicas the
     rounds added (:func:`added_cases`), then the production extensions
     (:func:`apply_extensions`). Idempotent (an unchanged case is rewritten byte for byte,
     an extension only where it differs); the study read afresh (its cases rescheduled).
     The local loop and a scheduler's follow-up job (:mod:`ligwf.pipeline.submit_rounds`)
     both write a round this way."""
-    study = write(added_cases(prepared, rounds), out, mesh_cache)
+    study = write(added_cases(prepared, rounds), out, mesh_cache, replace)
     apply_extensions(study, rounds)
     return Study.open(out)
 

@@ -29,6 +29,8 @@ from ligwf.local import LocalExecutor, RunSettings, cases_to_run, study_schedule
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.scheduler import Executor
 from ligwf.study.case import CaseFolder
+from ligwf.study.layout import OUTPUT_DIRS
+from ligwf.study.paths import check_inside
 from ligwf.study.study import Study
 
 
@@ -52,7 +54,12 @@ def run_study(study: Study, cases: Sequence[CaseFolder], executor: Executor,
 
     A stop on request (``stop`` set; the CLI's signal handler records the signal as
     ``stop.signum``) ends the engines with forced restarts and raises
-    :class:`Interrupted`, so nothing after the run stage (analysis, report) runs."""
+    :class:`Interrupted`, so nothing after the run stage (analysis, report) runs.
+    ConfigError, before any case is touched, when a case folder or its output folders are
+    symbolic links or lead outside the study (the runner writes and cleans there)."""
+    for case in cases:
+        inside = [case.path] if case.path != study.path else []
+        check_inside(study.path, inside + [case.path / sub for sub in OUTPUT_DIRS])
     stop = stop or threading.Event()
     done = executor.run_cases(study, cases, monitor, stop)
     if stop.is_set():
@@ -77,13 +84,13 @@ class StudyRun:
 
 
 def start_run(prepared: Prepared, out: Path, settings: RunSettings,
-              mesh_cache: Path | None = None) -> StudyRun:
+              mesh_cache: Path | None = None, replace: bool = False) -> StudyRun:
     """Write a prepared study (the pre-flight is behind it) and schedule the cases that
     are not finished. The site's engine is found first (executable, its library, version,
     the MPI launcher): one that is missing or cannot be loaded is refused before anything
     is written."""
     engine, identity = site_engine()
-    study = write(prepared, out, mesh_cache)
+    study = write(prepared, out, mesh_cache, replace)    # refuses another study's folder
     return scheduled(study, LocalExecutor(settings, engine), identity)
 
 

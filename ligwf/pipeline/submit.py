@@ -82,7 +82,7 @@ def _token(analysis_tasks: int) -> str | None:
 
 
 def write_for_submit(prepared: Prepared, submission: Submission, scheduler: Scheduler,
-                     mesh_cache: Path | None = None) -> Study:
+                     mesh_cache: Path | None = None, replace: bool = False) -> Study:
     """Check the scheduler's commands, refuse while an earlier submission of the study
     still runs, then write the study folder (:meth:`Submission.submit` submits it)."""
     scheduler.require()
@@ -93,7 +93,7 @@ def write_for_submit(prepared: Prepared, submission: Submission, scheduler: Sche
             raise SubmitError(f"{out} still has {len(busy)} queued or running case(s) "
                               f"({', '.join(c.job or '?' for c in busy[:5])}); wait, scancel "
                               f"them, or use 'ligwf {scheduler.name} resubmit'")
-    return write(prepared, out, mesh_cache)
+    return write(prepared, out, mesh_cache, replace)
 
 
 @dataclass(frozen=True)
