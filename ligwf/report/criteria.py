@@ -2,8 +2,11 @@
 (:mod:`ligwf.report.verdict` combines them into the study's answer).
 
 Signed criteria (angle of repose in deg, rigid-block share, flowing-layer thickness
-relative to CG1) are the difference of run means CG-n - CG1 with Welch's interval, decided
-by two one-sided tests against +-budget; the velocity profile is the noise-corrected
+relative to CG1) are the difference of run means CG-n - CG1 with its (1 - 2 alpha) t
+interval (the df rule the caller passes: Welch's for equal arms, Hsu's for unequal ones or
+sequential looks), passed by two one-sided tests against +-budget and failed by a two-sided
+fail test; a share whose runs all read 0 in an arm is bounded over runs
+(:mod:`ligwf.analysis.records.shares`); the velocity profile is the noise-corrected
 distance of the mean profiles with noncentral-F bounds; the GSD and field errors keep the
 analysis' intervals against the tolerance (the field criterion's at the verdict's alpha,
 with the replicas that would decide it from its noise pieces). Holm's step-down over the fail

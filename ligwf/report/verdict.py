@@ -8,10 +8,10 @@ verdicts (:func:`granule_gates`). The statistics are
 :mod:`ligwf.analysis.records.equivalence` (their coverage: ``benchmarks/bench_coverage.py``):
 
 - **signed criteria** (angle of repose in deg, rigid-block share, flowing-layer thickness
-  relative to CG1) are the difference of run means CG-n - CG1 with Welch's interval, decided
-  by two one-sided tests against +-budget: ``pass`` when the 90 % interval lies inside,
-  ``fail`` when it lies wholly outside, else ``undecided`` (saying which arm's replicas
-  would decide it);
+  relative to CG1) are the difference of run means CG-n - CG1 with its (1 - 2 alpha)
+  interval (``df_rule``'s degrees of freedom), decided by two one-sided tests against
+  +-budget: ``pass`` when the interval lies inside, ``fail`` when the two-sided fail test
+  rejects, else ``undecided`` (saying which arm's replicas would decide it);
 - the **velocity profile** is the relative L2 distance of the mean profiles, less the noise
   of both arms, with one-sided bounds from the noncentral F distribution: ``pass`` when the
   upper bound is within the budget, ``fail`` when the lower bound exceeds it;
@@ -22,8 +22,9 @@ verdicts (:func:`granule_gates`). The statistics are
 The CG1 noise floor no longer widens a budget: each signed criterion says whether its
 difference is distinguishable from CG1 seed noise at the replicas run. Family rule: a
 level meets the budget when every assessed criterion passes (an intersection-union test,
-each at alpha); it fails when a criterion fails after Holm's step-down over the level's
-criteria. Every criterion also carries ``bound``: the largest error its interval allows
+each at alpha); it fails when a criterion fails after Holm's step-down over every criterion
+the level was tested on (each with its own p-value). The alpha, levels and rules travel with
+the verdict (``Verdict.statistics``). Every criterion also carries ``bound``: the largest error its interval allows
 (the error the level is shown to stay within), so a user with another budget reads the
 answer without a rerun. Written by :mod:`ligwf.report.verdict_records`, shown by
 :mod:`ligwf.report.verdict_text`.
