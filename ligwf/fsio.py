@@ -95,6 +95,20 @@ def not_writable(exc: OSError, folder: Path) -> FolderNotWritable:
     return FolderNotWritable(f"cannot write in {where}: {exc.strerror or exc}")
 
 
+@contextmanager
+def writing_in(folder: Path) -> Iterator[None]:
+    """Inside the block, an ``OSError`` saying a folder cannot take a file (full, read-only,
+    no permission) becomes :class:`FolderNotWritable` naming the file's folder, else
+    ``folder``: an error of ``write()`` carries no file name, and the current folder is not
+    where a stage writes (a full disk during analysis named it)."""
+    try:
+        yield
+    except OSError as exc:
+        if exc.errno in NOT_WRITABLE:
+            raise not_writable(exc, folder) from exc
+        raise
+
+
 def atomic_write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` via a temporary file in the same folder and a rename
     (a per-process unique temporary name: concurrent writers never collide), with the

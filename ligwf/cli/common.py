@@ -21,7 +21,7 @@ from rich.text import Text
 
 from ligwf.engine.plan import MAX_RANKS, RankPlan, Schedule, particle_steps
 from ligwf.errors import ConfigError
-from ligwf.pipeline.prepare import Prepared, prepare_workflow
+from ligwf.pipeline.prepare import Prepared, mesh_cache_lines, prepare_workflow
 from ligwf.study.layout import STUDY_FILE
 from ligwf.study.paths import path_text_problem, resolved, shown
 
@@ -172,6 +172,9 @@ def prepare_from_args(args: argparse.Namespace) -> Prepared:
     case_ids = [rc.case.case_id for rc in prepared.rendered]
     for line in grouped_warnings(prepared.warnings, case_ids):
         print_warning(line)
+    if out is not None and hasattr(args, "mesh_cache"):     # commands that write meshes
+        for line in mesh_cache_lines(prepared, args.mesh_cache):
+            print_warning(line)
     return prepared
 
 

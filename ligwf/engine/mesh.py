@@ -202,6 +202,26 @@ def mesh_file_name(drum: Drum, sag: float) -> str:
     return mesh_file(geometry_key(drum, sag))
 
 
+def cache_problem(drum: Drum, sag: float, cache_dir: Path) -> str | None:
+    """Why the drum's STL in ``cache_dir`` cannot be used as it is (None: absent, so it
+    is generated, or the very mesh): :func:`cached_mesh` writes it again, and the command
+    line says so before anything is written."""
+    path = Path(cache_dir) / mesh_file_name(drum, sag)
+    want = drum_stl(drum, sag).encode()
+    try:
+        have = path.read_bytes()
+    except (FileNotFoundError, IsADirectoryError, NotADirectoryError):
+        return None
+    if have == want:
+        return None
+    if len(have) < len(want) and want.startswith(have):
+        return (f"mesh cache: {path} is truncated ({len(have):,} of {len(want):,} bytes; a "
+                "copy or write cut short): written again before a case uses it")
+    return (f"mesh cache: {path} is not the mesh its name stands for ({len(have):,} bytes, "
+            f"the mesh has {len(want):,}: edited, damaged or another mesh version): written "
+            "again before a case uses it")
+
+
 def cached_mesh(drum: Drum, sag: float, cache_dir: Path) -> Path:
     """Path of the drum's STL in ``cache_dir``, generated on first use. A cached file is
     checked against the mesh it must hold (generating the text is pure and quick) before

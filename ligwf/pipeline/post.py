@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ligwf.errors import ConfigError
+from ligwf.fsio import writing_in
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.workflow import apply_override, parse_override
 from ligwf.scheduler import Executor
@@ -36,7 +37,8 @@ def analyse_study(path: Path, out: Path | None = None,
     rank 0 (None on other MPI ranks)."""
     from ligwf.analysis.runner import AnalysisOptions, analyse
 
-    return analyse(path, out, options or AnalysisOptions(), comm)
+    with writing_in(Path(out) if out is not None else Path(path)):
+        return analyse(path, out, options or AnalysisOptions(), comm)
 
 
 def report_study(path: Path, out: Path | None = None, snapshots: bool = True,
@@ -51,8 +53,9 @@ def report_study(path: Path, out: Path | None = None, snapshots: bool = True,
     if accept_overrides:
         study = dataclasses.replace(study, accept=overridden_accept(study.accept,
                                                                     accept_overrides))
-    folder = write_report(study, out, snapshots=snapshots)
-    record_digests(folder)      # what the API's check() holds the tables against
+    with writing_in(Path(out) if out is not None else study.report_dir):
+        folder = write_report(study, out, snapshots=snapshots)
+        record_digests(folder)      # what the API's check() holds the tables against
     return folder
 
 

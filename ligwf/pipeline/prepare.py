@@ -25,7 +25,7 @@ from ligwf import __version__
 from ligwf.errors import ConfigError
 from ligwf.fsio import (NOT_WRITABLE, atomic_write_bytes, atomic_write_json, atomic_write_text,
                         not_writable)
-from ligwf.engine.mesh import cached_mesh, drum_stl, scene_sag
+from ligwf.engine.mesh import cache_problem, cached_mesh, drum_stl, scene_sag
 from ligwf.engine.plan import CaseLoad, case_load
 from ligwf.engine.render import render
 from ligwf.scene.scaled import ScaledScene
@@ -191,6 +191,14 @@ def write(prepared: Prepared, out: Path, mesh_cache: Path | None = None,
     """Write the prepared study folder (identical cases are rewritten byte for byte, so
     their outputs stay and a re-run resumes); ``replace``: also over another study."""
     return write_study(prepared.workflow, prepared.rendered, out, mesh_cache, replace)
+
+
+def mesh_cache_lines(prepared: Prepared, mesh_cache: Path | None = None) -> list[str]:
+    """A line for each damaged drum mesh in the mesh cache the prepared cases will use
+    (:func:`ligwf.engine.mesh.cache_problem`; writing repairs it). Reads only."""
+    cache = mesh_cache or default_mesh_cache()
+    geometries = {(rc.case.scene.drum, scene_sag(rc.case.scene)) for rc in prepared.rendered}
+    return [why for drum, sag in geometries if (why := cache_problem(drum, sag, cache))]
 
 
 def prepared_loads(prepared: Prepared) -> list[CaseLoad]:

@@ -37,7 +37,7 @@ class Bad:
     options: tuple[str, ...] = ()
     setup: str = ""     # "out-file", "out-under-file", "cache-file", "study-listed-twice",
     #                     "out-empty", "out-workflow-folder", "workflow-symlink-loop",
-    #                     "template-not-utf8"
+    #                     "template-not-utf8", "out-symlink-loop"; extra["out"]: --out
     warns: bool = False                   # a documented warning (check exits 0), not a refusal
     seconds: float = 5.0                  # time allowed before the refusal
     extra: dict = field(default_factory=dict)
@@ -333,6 +333,33 @@ CORPUS: list[Bad] = [
     Bad("analyse-dumps-seed-huge", ("analysis.community_seed", "[0, 4294967295]"),
         command="analyse-dumps", overrides=("community_seed=99999999999999999999",),
         options=FOREIGN),
+    # --- issue 46: nothing injected, no traceback ---
+    Bad("alias-cycle-description", ("alias refers to the value that holds it", "line 3"),
+        text=BASE.replace("description: Small", "description: &d [*d]\nx_was: Small", 1)),
+    Bad("alias-cycle-scene", ("alias refers to the value that holds it",),
+        text=BASE.replace("scene:\n", "scene: &s\n  self: *s\n", 1)),
+    Bad("alias-cycle-sweep", ("alias refers to the value that holds it",),
+        text=BASE.split("sweep:")[0] + "sweep: &w {cg_levels: [1], again: *w}\n"),
+    Bad("alias-cycle-accept", ("alias refers to the value that holds it",),
+        text=BASE + "accept: &a [*a]\n"),
+    Bad("alias-bomb-scene", ("alias",), text=LAUGHS.replace("scene: *j", "scene: {x: *j}")),
+    Bad("alias-bomb-sweep", ("alias",), text=LAUGHS.replace("scene: *j", "sweep: *j")),
+    Bad("alias-bomb-accept", ("alias",), text=LAUGHS.replace("scene: *j", "accept: {a: *j}")),
+    Bad("out-newline-render", ("--out", "line break", "one line"),
+        extra={"out": "s\ntouch PWNED\n#"}),
+    Bad("out-newline-run", ("--out", "line break"), command="run",
+        extra={"out": "s\ntouch PWNED\n#"}),
+    Bad("out-newline-slurm", ("--out", "line break"), command="slurm submit",
+        options=("--dry-run",), extra={"out": "runs/s\ntouch PWNED\n#"}),
+    Bad("out-carriage-return", ("--out", "carriage return"), extra={"out": "s\rx"}),
+    Bad("out-escape", ("--out", "U+001B"), command="study", extra={"out": "s\x1b[2Jx"}),
+    Bad("out-symlink-loop", ("--out", "symbolic link loop"), setup="out-symlink-loop"),
+    Bad("out-over-4096", ("--out", "allowed at most 4,095", "PATH_MAX"),
+        extra={"out": "a/" * 2100}),
+    Bad("out-name-over-255", ("--out", "NAME_MAX"), command="run", extra={"out": "n" * 300}),
+    Bad("set-newline", ("--set", "line break", "one line"),
+        overrides=("scene.name=a\nshell x",)),
+    Bad("set-carriage-return", ("--set", "carriage return"), overrides=("name=a\rb",)),
 ]
 CORPUS += [Bad(f"{path}={raw}", (path.rpartition(".")[2], shown), overrides=(f"{path}={raw}",))
            for path in NUMERIC_FIELDS for raw, shown in NOT_A_NUMBER.items()]
@@ -367,6 +394,13 @@ def test_bad_input_ends_in_one_clear_error(bad: Bad, tmp_path, monkeypatch, caps
     elif bad.setup == "workflow-symlink-loop":
         workflow = tmp_path / "loop.yaml"
         workflow.symlink_to(workflow)
+    elif bad.setup == "out-symlink-loop":             # loop/a -> b, loop/b -> a
+        (tmp_path / "loop").mkdir()
+        (tmp_path / "loop" / "a").symlink_to("b")
+        (tmp_path / "loop" / "b").symlink_to("a")
+        out = tmp_path / "loop" / "a" / "x"
+    if "out" in bad.extra:
+        out = tmp_path / bad.extra["out"]
     options = list(bad.options)
     if bad.setup == "cache-file":
         (tmp_path / "cachefile").write_text("x")

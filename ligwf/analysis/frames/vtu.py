@@ -191,10 +191,12 @@ def _decode_vtu(path: Path, raw, wanted: frozenset[str] | None) -> VtuData | Non
                 raw_data = raw_data[header.itemsize:]
             data = np.frombuffer(raw_data, np.uint8)
         expected = rows * comps * dtype.itemsize
-        if nbytes != expected or len(data) < expected:
+        if nbytes != expected or len(data) < expected:     # each count said, both sides
+            what = (f"its byte count says {nbytes} bytes, the piece's {rows} x {comps} "
+                    f"values of {dtype.itemsize} bytes are {expected}" if nbytes != expected
+                    else f"decodes to {len(data)} bytes, expected {expected}")
             raise DumpReadError(f"{path}: not a readable VTU file (truncated or corrupt?): "
-                                f"array {name or 'Points'} decodes to {len(data)} bytes, "
-                                f"expected {expected}")
+                                f"array {name or 'Points'} {what}")
         arr = data[:expected].view(dtype)
         arr = arr.reshape(rows, comps) if comps > 1 else arr
         _check_range(path, name or "Points", attrs, arr)
