@@ -87,6 +87,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("folder model", ("ligwf.study",)),
     ("engine", ("ligwf.engine",)),
     ("analysis", ("ligwf.analysis",)),
+    ("inference", ("ligwf.inference",)),
     ("report", ("ligwf.report",)),
     ("executors", ("ligwf.scheduler", "ligwf.local", "ligwf.slurm")),
     ("pipeline", ("ligwf.pipeline",)),

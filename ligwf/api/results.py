@@ -158,6 +158,8 @@ class StudyResults:
                                 f"run `{REPORT} {self.path}`")
         return found
 
+    extrapolation = property(lambda s: s.table("extrapolation"), doc="CG1 from CG-n levels")
+
     @property
     def noise_floor(self) -> pd.DataFrame:
         """Per sweep group and metric the CG1 value and its CG1-vs-CG1 scatter."""

@@ -47,6 +47,10 @@ TABLES: tuple[TableSpec, ...] = (
     TableSpec("verdict", layout.REPORT_DIR, layout.VERDICT_TABLE, REPORT, False,
               "one row per (sweep group, CG level, rule, criterion): pass / fail / undecided "
               "with the value, its 95 % interval and the budget, the speedup"),
+    TableSpec("extrapolation", layout.REPORT_DIR, layout.EXTRAPOLATION_REPORT, REPORT, False,
+              "one row per (sweep group, rule, signed criterion) with two or more CG-n "
+              "levels: the CG1 value extrapolated from them (95 % interval, model term, "
+              "lack-of-fit check, observed order) beside the measured CG1 mean"),
     TableSpec("noise_floor", layout.REPORT_DIR, layout.NOISE_FLOOR_REPORT, REPORT, False,
               "one row per (sweep group, metric): the CG1 value and CG1-vs-CG1 scatter"),
     TableSpec("field_null_check", layout.REPORT_DIR, layout.FIELD_NULL_REPORT, REPORT, False,

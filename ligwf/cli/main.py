@@ -46,6 +46,8 @@ def cmd_check(args: argparse.Namespace) -> int:
                              f"({settings.cores_source}): what "
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     console.print(regime_table(prepared))
+    for line in size_relation_lines(prepared):
+        console.print(line, highlight=False, soft_wrap=True)
     try:
         console.print(site_engine()[1].describe(), highlight=False, soft_wrap=True)
     except LigwfError as exc:   # check writes nothing: the run would refuse, say so here
@@ -70,6 +72,28 @@ def regime_table(prepared) -> Table:
                                          ("stokes_viscous", "bond_granular", "capillary", "froude")),
                       f"{cg1['stokes_viscous']:.3g}", f"{cg1['bond_granular']:.3g}", verdict)
     return table
+
+
+def size_relation_lines(prepared) -> list[str]:
+    """What the size relation (:mod:`ligwf.inference.size_relation`) expects of each Weber
+    level's angle of repose on this drum, before a core-hour is spent."""
+    from ligwf.inference.reference import size_ratio
+    from ligwf.inference.size_relation import SLOPE_DEG, expected_excess
+
+    levels = sorted({(rc.case.cg, str(rc.case.rule.value)) for rc in prepared.rendered
+                     if rc.case.cg > 1.0})
+    if not levels:
+        return []
+    ratio = size_ratio(prepared.rendered[0].case.scene.model_dump(mode="json"))
+    lines = [f"size relation (angle of repose, Weber: {SLOPE_DEG:g} deg x (n - 1) d / D, "
+             f"docs/results/extrapolation; d / D = {ratio:.3g} here):"]
+    for cg in sorted({n for n, rule in levels if rule == "weber"}):
+        lines.append(f"  {expected_excess(cg, ratio).text}")
+    if any(rule == "bond" for _, rule in levels):
+        lines.append("  Bond: no size relation (its cohesion grows with n: on the committed "
+                     "flow beds, the we_vs_bo drum and the demo, its CG2 lies 7.6-7.9 deg "
+                     "above CG1: docs/results/extrapolation/size_relation.csv)")
+    return lines
 
 
 def analysis_lines(prepared) -> list[str]:

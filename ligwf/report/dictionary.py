@@ -189,6 +189,12 @@ TABLES: dict[str, Table] = {
         "lo", "hi", "budget", "shown_within", "budget_source", "decide_by", "decide_arm",
         "decide_amount", "decide_amount_cg1", "decide_core_hours", "decide_half_width",
         "note", "cheapest")),
+    layout.EXTRAPOLATION_REPORT: Table(layout.REPORT_DIR, "sweep group, rule and signed "
+                                       "criterion with two or more CG-n levels", (
+        "group", "rule", "column", "levels", "replicas", "extrapolated", "lo", "hi",
+        "half_width", "noise_se", "model_term", "df", "form", "lack_of_fit_p",
+        "observed_order", "slope_per_level", "cg1_measured", "cg1_se", "cg1_replicas",
+        "cg1_inside")),
     layout.FIELD_NULL_REPORT: Table(layout.REPORT_DIR, "null check: per sweep group CG1 "
                                     "against CG1, per cohesionless-twin condition the twins "
                                     "against the wet CG1 cases", (

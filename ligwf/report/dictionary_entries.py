@@ -274,6 +274,32 @@ VERDICT = (
 )
 
 #: table file -> (name, unit, label, meaning[, shown]) that differ there from COMMON
+#: the extrapolated CG1 reference's columns (ligwf.inference.reference)
+EXTRAPOLATION = (
+    ("column", "text", "metric", "the case-table column extrapolated (a signed criterion's)"),
+    ("levels", "text", "CG levels", "the CG-n levels of the rule the line was fitted on"),
+    ("replicas", "text", "runs a level", "runs at each of those levels, in their order"),
+    ("extrapolated", "metric", "extrapolated CG1", "the line through the level means at n = 1 "
+     "(weber - bond rows: the two rules' difference)"),
+    ("lo", "metric", "lo", "lower bound of its 95 % interval (noise and model term)"),
+    ("hi", "metric", "hi", "upper bound of its 95 % interval"),
+    ("half_width", "metric", "half-width", "half the interval's width"),
+    ("noise_se", "metric", "noise se", "standard error from the levels' run-to-run noise"),
+    ("model_term", "metric", "model term", "standard uncertainty of the line's bias under the "
+     "curvature prior (ligwf.inference.extrapolation.CURVATURE_PRIOR)"),
+    ("df", "1", "df", "effective degrees of freedom of noise and model term"),
+    ("form", "text", "form", "checked (three or more levels, no lack of fit), unchecked (two "
+     "levels) or rejected (the rule does not extrapolate)"),
+    ("lack_of_fit_p", "1", "lack of fit p", "p of the test that the level means lie on a line"),
+    ("observed_order", "1", "observed order", "p of theta_1 + b (n - 1)^p through three "
+     "levels (printed, not a gate)"),
+    ("slope_per_level", "metric", "slope", "the fitted change per CG level"),
+    ("cg1_measured", "metric", "measured CG1", "the mean of the group's CG1 runs, if any"),
+    ("cg1_se", "metric", "CG1 se", "its standard error"),
+    ("cg1_replicas", "count", "CG1 runs", "CG1 runs of the group"),
+    ("cg1_inside", "flag", "inside", "the measured CG1 mean lies in the 95 % interval"),
+)
+
 OVERRIDES: dict[str, tuple[tuple[str, ...], ...]] = {
     layout.GSD_TABLE: (
         ("frames", "count", "frames", "frames pooled over the condition's replicas"),
@@ -328,4 +354,5 @@ OVERRIDES: dict[str, tuple[tuple[str, ...], ...]] = {
         ("frames", "count", "frames", "checked production frames of the steady window"),
     ),
     layout.VERDICT_TABLE: VERDICT,
+    layout.EXTRAPOLATION_REPORT: EXTRAPOLATION,
 }

@@ -42,6 +42,7 @@ from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.report.criteria import CriterionResult, Gate, band, condition_criteria
+from ligwf.report.extrapolated import extrapolated_criteria
 from ligwf.report.verdict_statistics import statistics_record
 from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.workflow import CONTROL_KEY
@@ -181,16 +182,45 @@ def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[st
     return gates
 
 
+def extrapolated_group(group: str, sub: pd.DataFrame, in_group: pd.DataFrame,
+                       accept: AcceptSettings, alpha: float, size_ratio: float,
+                       speedups: dict) -> GroupVerdict:
+    """The verdict of a group without CG1: every CG-n level of a rule with two or more
+    levels judged against that rule's extrapolated CG1."""
+    out = []
+    for _, row in sub.sort_values(["cg", "rule"]).iterrows():
+        rule = str(row["rule"])
+        runs = in_group[in_group["rule"].astype(str) == rule]
+        if runs["cg"].nunique() < 2:
+            continue
+        results = extrapolated_criteria(accept, runs, float(row["cg"]), size_ratio, alpha)
+        speedup = speedups.get((group, float(row["cg"]), rule), math.nan)
+        out.append(ConditionVerdict(group, float(row["cg"]), rule, int(row["replicas"]),
+                                    speedup, math.nan, math.nan, results))
+    if not out:
+        return GroupVerdict(group, (), "No CG1 case in this group and no rule with two CG "
+                                       "levels to extrapolate CG1 from: nothing to compare "
+                                       "the CG levels with.")
+    sentence, cheapest = group_sentence(out)
+    return GroupVerdict(group, tuple(out), "No CG1 ran: every level is judged against the "
+                        "CG1 value extrapolated from its rule's CG levels (speedups: the "
+                        "planner's CG1 cost). " + sentence, cheapest)
+
+
 def decide(conditions: pd.DataFrame, accept: AcceptSettings,
            gates: dict[str, Gate] | None = None, cases: pd.DataFrame | None = None,
            profiles: dict | None = None, alpha: float = eq.ALPHA,
-           noise: pd.DataFrame | None = None, df_rule: str = eq.WELCH) -> Verdict:
+           noise: pd.DataFrame | None = None, df_rule: str = eq.WELCH,
+           size_ratio: float = math.nan, speedups: dict | None = None) -> Verdict:
     """The verdict of every sweep group of a condition table (control groups left out);
     ``cases`` (one row per run) and ``profiles`` (case id -> mean velocity profile) hold
     the run values the signed and profile criteria are decided on; ``noise`` (by case id,
     :func:`ligwf.report.planning.noise_table`) what would decide an undecided one and its
     cost; ``alpha`` each test's level and ``df_rule`` its degrees of freedom (a sequential
-    study's per-look level, Hsu's conservative df)."""
+    study's per-look level, Hsu's conservative df). A group without CG1 is judged against
+    the CG1 value extrapolated from its CG-n levels (:mod:`ligwf.report.extrapolated`;
+    ``size_ratio``: the drum's d / D, the model term's scale; ``speedups``: (group, cg,
+    rule) -> the planner's CG1 cost over the level's, the speedup it reports)."""
     gates, profiles = gates or {}, profiles or {}
     groups = []
     if conditions.empty:
@@ -201,11 +231,11 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
         group = str(group)
         if is_control_group(group):
             continue
-        if sub[sub["cg"] == REFERENCE_CG].empty:
-            groups.append(GroupVerdict(group, (), "No CG1 case in this group: nothing to "
-                                                  "compare the CG levels with."))
-            continue
         in_group = cases[cases["group"].astype(str) == group]
+        if sub[sub["cg"] == REFERENCE_CG].empty:
+            groups.append(extrapolated_group(group, sub, in_group, accept, alpha, size_ratio,
+                                             speedups or {}))
+            continue
         ref_runs = in_group[in_group["cg"] == REFERENCE_CG]
         gate = gates.get(group, Gate(None, "no cohesionless control ran"))
         out = []

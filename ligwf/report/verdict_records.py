@@ -97,11 +97,13 @@ def read_verdict(out: Path) -> Verdict | None:
 def study_verdict(cases: pd.DataFrame, conditions: pd.DataFrame, accept: AcceptSettings,
                   analysis_dir: Path, profiles: dict | None = None,
                   noise: pd.DataFrame | None = None, alpha: float = ALPHA,
-                  df_rule: str = WELCH) -> Verdict:
+                  df_rule: str = WELCH, size_ratio: float = math.nan,
+                  speedups: dict | None = None) -> Verdict:
     """The verdict of a study's report tables, with its granule control verdicts read from
     the analysis folder (``noise``: the runs' noise and prices, what would decide;
-    ``alpha``: each test's level)."""
+    ``alpha``: each test's level; ``size_ratio`` and ``speedups``: a sweep without CG1,
+    :func:`ligwf.report.verdict.decide`)."""
     if cases.empty or conditions.empty:
         return Verdict((), accept.model_dump(mode="json"))
     return decide(conditions, accept, granule_gates(cases, read_controls(analysis_dir)),
-                  cases, profiles, alpha, noise, df_rule)
+                  cases, profiles, alpha, noise, df_rule, size_ratio, speedups)

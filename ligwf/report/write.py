@@ -39,6 +39,8 @@ from ligwf.report.table_sections import (markdown_tables, noise_markdown, paravi
                                          pooling_markdown, stability_markdown, steady_line)
 from ligwf.report.tables import build_tables
 from ligwf.report.criteria import SIGNED_COLUMNS
+from ligwf.report.extrapolation_report import extrapolation_inputs, extrapolation_section
+from ligwf.inference.reference import extrapolation_rows
 from ligwf.report.planning import noise_table
 from ligwf.report.rounds import rounds_sections
 from ligwf.report.verdict import Verdict
@@ -83,14 +85,19 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
+    ratio, speedups = extrapolation_inputs(study)
     verdict = study_verdict(cases, conditions, study.accept, study.analysis_dir,
                             {cid: c.profile_v_mean for cid, c in flow.cases.items()},
                             noise_table(study.usable_cases()[0], flow, SIGNED_COLUMNS),
-                            *sequential_level(read_rounds(study.path)))
+                            *sequential_level(read_rounds(study.path)), size_ratio=ratio,
+                            speedups=speedups)
     write_verdict(verdict, out)
+    extrapolated = extrapolation_rows(cases, SIGNED_COLUMNS, ratio)
+    atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
     figures = report_figures(study, flow, cases, conditions, out, snapshots)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
-                               verdict, flow_field_sections(study, cases, conditions, out))
+                               verdict, [*extrapolation_section(extrapolated, ratio),
+                                         *flow_field_sections(study, cases, conditions, out)])
     title = f"{study.name}: error against run time"
     preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "
                 "relative to the CG1 cases of the same sweep group; speedup is CG1 production "

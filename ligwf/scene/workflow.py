@@ -272,9 +272,17 @@ def comparison_warnings(wf: Workflow) -> list[str]:
     levels = sorted({c.cg for c in wf.cases})
     if levels and 1.0 not in levels:
         shown = "[" + ", ".join(f"{c:g}" for c in levels) + "]"
-        return [f"sweep.cg_levels = {shown}: no CG1 case, so no CG-n "
-                "result can be compared with the original size (errors, size limit and "
-                "CG-n/CG1 ratios stay empty); add 1 to sweep.cg_levels to compare"]
+        if len(levels) < 2:
+            return [f"sweep.cg_levels = {shown}: no CG1 case and one CG level, so no CG-n "
+                    "result can be compared with the original size (errors, size limit and "
+                    "CG-n/CG1 ratios stay empty); add 1, or a second CG level to extrapolate "
+                    "CG1 from, to sweep.cg_levels"]
+        check = ("two levels cannot check the line: a third one tests it" if len(levels) < 3
+                 else "the line is checked for lack of fit")
+        return [f"sweep.cg_levels = {shown}: no CG1 case: each level is judged against the "
+                f"CG1 value extrapolated from its rule's levels ({check}); the velocity "
+                "profile, the continuum fields and the GSD are judged only against a real "
+                "CG1 and stay not assessed"]
     cg1 = [c.replica for c in wf.cases
            if c.cg == 1.0 and CONTROL_KEY not in dict(c.varied)]   # twins are not replicas
     reps = 1 + max(cg1) if cg1 else 0

@@ -259,6 +259,9 @@ NOISE_FLOOR_REPORT = "noise_floor.csv"
 #: the verdict per sweep group, CG level, rule and criterion (ligwf.report.verdict)
 VERDICT_TABLE = "verdict.csv"
 VERDICT_RECORD = "verdict.json"
+#: the CG1 value extrapolated from the CG-n levels of each rule, beside the measured one
+#: (ligwf.inference.reference)
+EXTRAPOLATION_REPORT = "extrapolation.csv"
 #: the cohesionless twins' field errors against the wet CG1 cases (ligwf.report.fields)
 FIELD_NULL_REPORT = "fields_null_check.csv"
 SUMMARY_REPORT = "summary.md"
