@@ -18,8 +18,8 @@ from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.records.fields import CaseFields, read_fields
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.api import fields, plots
-from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec, read_table,
-                              typed)
+from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec,
+                              column_problem, read_table, typed)
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.report import dictionary
 from ligwf.report.digests import damaged_report_files
@@ -386,6 +386,9 @@ class StudyResults:
             except (OSError, ValueError) as exc:
                 raise MissingOutput(f"{path}: unreadable ({type(exc).__name__}: {exc}); run "
                                     f"`{spec.command} {self.path}` again") from None
+            if (why := column_problem(cache[name], spec)) is not None:
+                del cache[name]
+                raise MissingOutput(f"{path}: {why}; run `{spec.command} {self.path}` again")
         return cache[name]
 
     def _why_no_granules(self) -> str | None:

@@ -15,6 +15,7 @@ import pandas as pd
 
 from ligwf.analysis.records.renamed import current_names
 from ligwf.errors import LigwfError
+from ligwf.report import dictionary
 from ligwf.study import layout
 
 ANALYSE, REPORT = "ligwf analyse", "ligwf report"
@@ -124,6 +125,33 @@ def _is_flags(s: pd.Series) -> bool:
         return False
     values = set(s.dropna().astype(str).unique())
     return bool(values) and values <= {"True", "False"}
+
+
+#: columns that name a row: a table whose dictionary entry lists one always writes it
+KEY_COLUMNS = frozenset({"case_id", "condition", "group", "cg", "rule", "replica",
+                         "criterion", "variant", "definition", "twin_id", "metric", "column",
+                         "comparison", "control", "step", "time", "k", "pool"})
+
+
+def column_problem(table: pd.DataFrame, spec: TableSpec) -> str | None:
+    """Why ``table`` (read from ``spec``'s file) is not the table ligwf writes, naming the
+    table and the column (None: it is, or it is empty): a column that names its rows is
+    missing, or a column is none the data dictionary documents for it (renamed or added
+    by hand). The CLI's stages never read such a table either: one rule for both."""
+    if not len(table.columns):
+        return None
+    documented = dictionary.TABLES.get(spec.file)
+    if documented is None:
+        return None
+    for name in documented.columns:
+        if name in KEY_COLUMNS and name not in table.columns:
+            return (f"the {spec.attribute} table has no column {name!r} (each of its rows "
+                    "is named by it: renamed or removed since ligwf wrote it?)")
+    for name in table.columns:
+        if not dictionary.documented(spec.file, str(name)):
+            return (f"column {str(name)!r} is none of the {spec.attribute} table's (see "
+                    "describe(); renamed or added by hand?)")
+    return None
 
 
 def read_table(path: Path) -> pd.DataFrame:
