@@ -97,3 +97,25 @@ def test_readme_numbers_are_the_file():
     assert f"it would be at most {max(r[5] for r in lev):.4f}" in README
     for n, state in ((1, "fails"), (2, "fails"), (3, "holds"), (4, "holds")):
         assert re.search(rf"{n}\. [^:]+: \*\*{state}\*\*", README), n
+
+
+def test_second_run_numbers_are_its_file():
+    text = (HERE / "rates_2.txt").read_text()
+    assert "--seed 20261208" in text.splitlines()[0]
+    assert "summary: 3 of 4 registered checks hold" in text
+    assert "**3 of 4 registered checks hold.** Check 2 now holds" in README
+    unequal = re.search(r"check unequal intervals: (\d+) of 72 cells in \[0.92, 0.99\] "
+                        r"\(([\d.]+-[\d.]+)\): FAILS", text)
+    assert (f"{unequal.group(1)} of 72 interval cells in [0.92, 0.99] ({unequal.group(2)})"
+            in README)
+    for label, quoted in (("check unequal rates: at most ([\\d.]+)", "are at most {}"),
+                          ("check all-zero wrong pass: at most ([\\d.]+)",
+                           "passes wrongly in at most {} of studies"),
+                          ("check family-wise wrong decision: at most ([\\d.]+)",
+                           "family-wise at most {}"),
+                          ("check cheapest level disclosed: at most ([\\d.]+)",
+                           "meets in at most {} of studies")):
+        value = re.search(label, text).group(1)
+        assert quoted.format(value) in README, label
+    zero = re.findall(r"^60 vs 60 +([\d.]+) +[\d.]+ \| +([\d.]+)", text, re.M)
+    assert dict(zero) == {"1.0": "0.0495", "0.2": "0.0000"}
