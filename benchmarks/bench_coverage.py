@@ -255,6 +255,10 @@ def main(argv=None) -> int:
                     help="only the sequential procedure (skip the interval cells)")
     ap.add_argument("--designs", action="store_true",
                     help="only the designs users run (docs/results/verdict_rates)")
+    ap.add_argument("--df-rule", default="welch if equal arms, else hsu",
+                    choices=("welch if equal arms, else hsu",
+                             "welch if equal arms, else behrens-fisher"),
+                    help="the single-look df rule the designs are decided with (--designs)")
     ap.add_argument("--level-trials", type=int, default=2000,
                     help="studies a cell of the family and levels designs (--designs)")
     ap.add_argument("--recheck", type=int, default=0, metavar="N",
@@ -264,7 +268,7 @@ def main(argv=None) -> int:
     rng = np.random.default_rng(args.seed)
     if args.designs:
         from benchmarks.verdict_designs import report
-        report(rng, args.trials, args.level_trials)
+        report(rng, args.trials, args.level_trials, args.df_rule)
         return 0
     rows, inside, total = [], 0, 0
     print(f"trials per cell: {args.trials}; coverage cells must lie in [{LOW}, {HIGH}]")

@@ -6,7 +6,8 @@ Runs are AR(1) frame series plus a replica offset, as in the coverage cells
 (:func:`bench_coverage.ar1_runs`); a run's value is its window mean. Each design is decided
 with the verdict's own functions (:mod:`ligwf.analysis.records.equivalence`,
 :mod:`ligwf.analysis.records.shares`, Holm's step-down) under the single-look rules:
-alpha 0.05, Welch's df for equal arms and Hsu's for unequal ones, two-sided fail tests.
+alpha 0.05, Welch's df for equal arms and Hsu's for unequal ones (``--df-rule``: or the
+Behrens-Fisher distribution for unequal ones), two-sided fail tests.
 
 * ``unequal``: CG-n / CG1 arms of 6 / 2 (the demo) and 24 / 3 (the ladder) runs, the CG-n
   seed offset 0.5, 1 or 2 times CG1's: the 95 % interval of CG-n - CG1 and the one-sided
@@ -54,7 +55,7 @@ def _means(rng, trials: int, runs: int, offset: float) -> np.ndarray:
     return ar1_runs(rng, trials, runs, FRAMES, PHI, offset).mean(axis=2)
 
 
-def unequal_cells(rng, trials: int) -> list[dict]:
+def unequal_cells(rng, trials: int, rule: str = eq.WELCH_EQUAL) -> list[dict]:
     out = []
     for (nx, ny), scale, offset, budget in itertools.product(
             ((6, 2), (24, 3)), (0.5, 1.0, 2.0), (0.0, 1.0), (0.5, 1.0, 3.0)):
@@ -63,12 +64,12 @@ def unequal_cells(rng, trials: int) -> list[dict]:
         y = _means(rng, trials, ny, offset)
         diff = tost = wp = wf_on = wf_zero = 0
         for i in range(trials):
-            d95 = eq.difference_estimate(x0[i], y[i], 0.025, eq.WELCH_EQUAL)
+            d95 = eq.difference_estimate(x0[i], y[i], 0.025, rule)
             diff += d95.lo <= 0.0 <= d95.hi
-            d90 = eq.difference_estimate(x0[i], y[i], ALPHA, eq.WELCH_EQUAL)
+            d90 = eq.difference_estimate(x0[i], y[i], ALPHA, rule)
             tost += d90.lo <= 0.0
             wf_zero += eq.equivalence(d90, budget).state == eq.FAIL
-            on = eq.difference_estimate(x0[i] + budget, y[i], ALPHA, eq.WELCH_EQUAL)
+            on = eq.difference_estimate(x0[i] + budget, y[i], ALPHA, rule)
             state = eq.equivalence(on, budget).state
             wp += state == eq.PASS
             wf_on += state == eq.FAIL
@@ -79,7 +80,8 @@ def unequal_cells(rng, trials: int) -> list[dict]:
     return out
 
 
-def all_zero_cells(rng, trials: int, budget: float = 0.05) -> list[dict]:
+def all_zero_cells(rng, trials: int, budget: float = 0.05, rule: str = eq.WELCH_EQUAL
+                   ) -> list[dict]:
     out = []
     for (nx, ny), s in itertools.product(((3, 3), (6, 2), (24, 3), (60, 60)), (1.0, 0.2)):
         q = budget / s
@@ -91,7 +93,7 @@ def all_zero_cells(rng, trials: int, budget: float = 0.05) -> list[dict]:
             if zero is not None:
                 new += zero[1].state == eq.PASS
             else:
-                e = eq.difference_estimate(x[i], y[i], ALPHA, eq.WELCH_EQUAL)
+                e = eq.difference_estimate(x[i], y[i], ALPHA, rule)
                 new += eq.equivalence(e, budget).state == eq.PASS
             old += eq.equivalence(eq.difference_estimate(x[i], y[i], ALPHA),
                                   budget).state == eq.PASS
@@ -105,7 +107,7 @@ def _profiles(rng, trials: int, runs: int, offset: float, shift: np.ndarray) -> 
 
 
 def level_states(rng, trials: int, nx: int, ny: int, offset: float, alpha: float,
-                 registered: bool = False) -> list[str]:
+                 registered: bool = False, rule: str = eq.WELCH_EQUAL) -> list[str]:
     """The state of ``trials`` levels whose four criteria (three signed, the profile) sit
     exactly on their budgets (signed: 1 frame sd; profile: its true distance)."""
     shift = np.zeros(BINS)
@@ -115,7 +117,6 @@ def level_states(rng, trials: int, nx: int, ny: int, offset: float, alpha: float
               for _ in range(3)]
     px, py = (_profiles(rng, trials, nx, offset, shift),
               _profiles(rng, trials, ny, offset, np.zeros(BINS)))
-    rule = eq.HSU if registered and nx != ny else eq.WELCH_EQUAL
     states = []
     for i in range(trials):
         tests, p = [], []
@@ -137,10 +138,10 @@ def level_states(rng, trials: int, nx: int, ny: int, offset: float, alpha: float
     return states
 
 
-def family_cells(rng, trials: int) -> list[dict]:
+def family_cells(rng, trials: int, rule: str = eq.WELCH_EQUAL) -> list[dict]:
     out = []
     for (nx, ny), offset in itertools.product(((3, 3), (6, 2), (24, 3)), (0.0, 1.0)):
-        new = level_states(rng, trials, nx, ny, offset, ALPHA)
+        new = level_states(rng, trials, nx, ny, offset, ALPHA, rule=rule)
         old = level_states(rng, trials, nx, ny, offset, ALPHA, registered=True)
         out.append({"design": f"{nx} vs {ny}", "offset": offset,
                     "meets": new.count("meets") / trials, "fails": new.count("fails") / trials,
@@ -149,13 +150,13 @@ def family_cells(rng, trials: int) -> list[dict]:
     return out
 
 
-def levels_cells(rng, trials: int, levels: int = 4) -> list[dict]:
+def levels_cells(rng, trials: int, levels: int = 4, rule: str = eq.WELCH_EQUAL
+                 ) -> list[dict]:
     """Some level of ``levels`` meets, each level with one signed criterion exactly on its
     budget (1 frame sd; the others far inside it, so the one decides the level): the worst
     case of the cheapest-level sentence, which names a level when any meets."""
     out = []
     for (nx, ny), offset in itertools.product(((3, 3), (6, 2), (24, 3)), (0.0, 1.0)):
-        rule = eq.WELCH_EQUAL
         some = some_b = 0
         for i in range(trials):
             y = _means(rng, 1, ny, offset)[0]          # the levels share their CG1 runs
@@ -174,16 +175,17 @@ def levels_cells(rng, trials: int, levels: int = 4) -> list[dict]:
     return out
 
 
-def report(rng, trials: int, level_trials: int) -> int:
+def report(rng, trials: int, level_trials: int, rule: str = eq.WELCH_EQUAL) -> int:
     """Print every design's table and the registered checks; the number of failed checks."""
     failed = 0
     print(f"designs: {trials} studies a cell ({level_trials} for the family and levels "
           f"cells); AR(1) phi {PHI}, {FRAMES} frames a run; alpha {ALPHA}; a rate cell fails "
-          f"when the lower 95 % Clopper-Pearson bound of its share is above its alpha")
+          f"when the lower 95 % Clopper-Pearson bound of its share is above its alpha"
+          + ("" if rule == eq.WELCH_EQUAL else f"; df rule: {rule}"))
     print("unequal arms (CG-n vs CG1; scale: CG-n seed offset / CG1's; budget in frame sd)")
     print(f"{'design':>8} {'scale':>5} {'offset':>6} {'budget':>6} | {'diff':>6} {'tost':>6} | "
           f"{'wrong pass':>10} {'wrong fail':>10}")
-    cells = unequal_cells(rng, trials)
+    cells = unequal_cells(rng, trials, rule)
     for c in cells:
         print(f"{c['design']:>8} {c['scale']:5.1f} {c['offset']:6.1f} {c['budget']:6.1f} | "
               f"{c['diff']:6.3f} {c['tost']:6.3f} | {c['wrong pass']:10.4f} "
@@ -202,7 +204,7 @@ def report(rng, trials: int, level_trials: int) -> int:
     print("all-zero arms (CG1 reads 0; a CG-n run reads `share` with probability q, mean on "
           "the budget 0.05)")
     print(f"{'design':>8} {'share':>5} {'q':>6} | {'wrong pass':>10} {'registered rule':>15}")
-    zero = all_zero_cells(rng, trials)
+    zero = all_zero_cells(rng, trials, rule=rule)
     for c in zero:
         print(f"{c['design']:>8} {c['share']:5.1f} {c['q']:6.3f} | {c['wrong pass']:10.4f} "
               f"{c['registered rule']:15.4f}", flush=True)
@@ -215,7 +217,7 @@ def report(rng, trials: int, level_trials: int) -> int:
     print("a level's family: three signed criteria and the profile, each on its budget")
     print(f"{'design':>8} {'offset':>6} | {'meets':>6} {'fails':>6} {'wrong decision':>14} | "
           f"{'registered rule':>15}")
-    fam = family_cells(rng, level_trials)
+    fam = family_cells(rng, level_trials, rule)
     for c in fam:
         print(f"{c['design']:>8} {c['offset']:6.1f} | {c['meets']:6.4f} {c['fails']:6.4f} "
               f"{c['wrong decision']:14.4f} | {c['registered rule']:15.4f}", flush=True)
@@ -228,7 +230,7 @@ def report(rng, trials: int, level_trials: int) -> int:
     print("the cheapest level that meets: four levels, each with a criterion on the budget")
     print(f"{'design':>8} {'offset':>6} | {'some level meets':>16} {'disclosed bound':>15} | "
           f"{'at alpha / levels':>17}")
-    lev = levels_cells(rng, level_trials)
+    lev = levels_cells(rng, level_trials, rule=rule)
     for c in lev:
         print(f"{c['design']:>8} {c['offset']:6.1f} | {c['some level meets']:16.4f} "
               f"{c['disclosed bound']:15.2f} | {c['at alpha / levels']:17.4f}", flush=True)

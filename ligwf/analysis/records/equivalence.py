@@ -27,6 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, special, stats
 
+from ligwf.analysis.records import behrens_fisher
+
 #: a decision's error rate per side (the two one-sided tests each at ALPHA: a 90 % interval)
 ALPHA = 0.05
 PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
@@ -37,11 +39,16 @@ PASS, FAIL, UNDECIDED = "pass", "fail", "undecided"
 #: 0.060-0.078 of single-look studies of 2 vs 6 and 3 vs 24 runs (issue 45), where the few
 #: runs of the small arm carry a variance that Satterthwaite's df trusts too much
 WELCH, HSU, WELCH_EQUAL = "welch", "hsu", "welch if equal arms, else hsu"
+#: Welch for equal arms, the Behrens-Fisher distribution for unequal ones (Hsu's df there
+#: covers 0.999-1.000 at 6 vs 2: docs/results/verdict_rates; :mod:`.behrens_fisher`)
+WELCH_BF = "welch if equal arms, else behrens-fisher"
 #: the rule's words for a reader (the verdict's sentences are written from these)
 DF_RULE_TEXT = {WELCH: "Welch-Satterthwaite degrees of freedom",
                 HSU: "Hsu's degrees of freedom min(R1, R2) - 1",
                 WELCH_EQUAL: "Welch-Satterthwaite degrees of freedom for arms of equal "
-                             "size, Hsu's min(R1, R2) - 1 for unequal arms"}
+                             "size, Hsu's min(R1, R2) - 1 for unequal arms",
+                WELCH_BF: "Welch-Satterthwaite degrees of freedom for arms of equal size, "
+                          "the Behrens-Fisher distribution for unequal arms"}
 
 
 @dataclass(frozen=True)
@@ -54,6 +61,9 @@ class Estimate:
     hi: float
     se: float
     df: float
+    #: (theta, df1, df2) when the interval is Behrens-Fisher's (its tests use that
+    #: distribution, :mod:`.behrens_fisher`; ``df`` is then Welch's, for display and plans)
+    fiducial: tuple[float, float, float] | None = None
 
     @property
     def has_interval(self) -> bool:
@@ -100,8 +110,8 @@ def welch_df(v1: float, n1: int, v2: float, n2: int) -> float:
 def degrees_of_freedom(v1: float, n1: int, v2: float, n2: int, df_rule: str = WELCH
                        ) -> float:
     """The degrees of freedom of s1^2/n1 + s2^2/n2 under ``df_rule``."""
-    if df_rule == WELCH or (df_rule == WELCH_EQUAL and n1 == n2):
-        return welch_df(v1, n1, v2, n2)
+    if df_rule in (WELCH, WELCH_BF) or (df_rule == WELCH_EQUAL and n1 == n2):
+        return welch_df(v1, n1, v2, n2)     # (WELCH_BF unequal: only plans read this df)
     return float(min(n1, n2) - 1)
 
 
@@ -118,13 +128,19 @@ def difference_estimate(runs, reference, alpha: float = ALPHA, df_rule: str = WE
     vx, vy = float(x.var(ddof=1)), float(y.var(ddof=1))
     se = math.sqrt(vx / len(x) + vy / len(y))
     df = degrees_of_freedom(vx, len(x), vy, len(y), df_rule)
+    if df_rule == WELCH_BF and len(x) != len(y) and se > 0:
+        shape = (math.atan2(math.sqrt(vy / len(y)), math.sqrt(vx / len(x))),
+                 float(len(x) - 1), float(len(y) - 1))
+        half = behrens_fisher.quantile(1.0 - alpha, *shape) * se
+        return Estimate(d, d - half, d + half, se, df, shape)
     half = t_quantile(df, alpha) * se
     return Estimate(d, d - half, d + half, se, df)
 
 
 def scaled(e: Estimate, factor: float) -> Estimate:
     """The estimate in another unit (a positive factor: relative to a reference value)."""
-    return Estimate(e.value * factor, e.lo * factor, e.hi * factor, e.se * factor, e.df)
+    return Estimate(e.value * factor, e.lo * factor, e.hi * factor, e.se * factor, e.df,
+                    e.fiducial)
 
 
 @dataclass(frozen=True)
@@ -160,8 +176,9 @@ def equivalence(e: Estimate, budget: float, alpha: float = ALPHA,
     if e.se == 0:
         inside = abs(e.value) <= budget
         return Test(PASS if inside else FAIL, 0.0 if inside else 1.0, 1.0 if inside else 0.0)
-    cdf = lambda z: float(stats.t.cdf(z, e.df)) if math.isfinite(e.df) else float(
-        stats.norm.cdf(z))
+    cdf = (lambda z: behrens_fisher.cdf(float(z), *e.fiducial)) if e.fiducial else (
+        lambda z: float(stats.t.cdf(z, e.df)) if math.isfinite(e.df) else float(
+            stats.norm.cdf(z)))
     p_pass = max(1.0 - cdf((e.value + budget) / e.se), cdf((e.value - budget) / e.se))
     p_fail = 1.0 - cdf((abs(e.value) - budget) / e.se)
     if fail_sides == 2:
