@@ -352,9 +352,9 @@ class CaseFolder:
             rec = json.loads((self.path / SCENE_FILE).read_text())
         except (OSError, ValueError) as exc:
             return f"{SCENE_FILE} unreadable: {exc}"
-        edited = record_edits(rec)
-        why = (f"edited after ligwf wrote it ({edit_summary(edited)})" if edited else
-               scene_record_problem(self.path, rec, self.rendered_scaled, check_hash))
+        why = scene_record_problem(self.path, rec, self.rendered_scaled, check_hash)
+        if edited := record_edits(rec):       # the seal names the field edited by hand
+            why = f"edited after ligwf wrote it ({edit_summary(edited)})" + (f"; {why}" if why else "")
         return (None if why is None else f"{SCENE_FILE}: {why}; the record no longer describes "
                 "the run (edited after rendering?): render and run the case again")
 
