@@ -18,7 +18,7 @@ import pandas as pd
 
 from ligwf import __version__
 from ligwf.analysis.records.conditions import REFERENCE_CG
-from ligwf.analysis.records.equivalence import HSU, WELCH_EQUAL
+from ligwf.analysis.records.equivalence import HSU, WELCH_BF
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import LOWER_LIMIT
 from ligwf.analysis.records.analysis_record import AnalysisRecord
@@ -144,8 +144,9 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
 def sequential_level(rounds) -> tuple[float, str]:
     """(alpha, df rule) of each test: a sequential study's looks test at alpha / looks with
     Hsu's conservative degrees of freedom (:mod:`ligwf.study.rounds`); a single look Welch's
-    for equal arms and Hsu's for unequal ones (Welch is liberal there: bench_coverage.py)."""
-    return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH_EQUAL)
+    for equal arms and the Behrens-Fisher distribution for unequal ones (Welch is liberal
+    there, Hsu's far too wide: docs/results/verdict_rates)."""
+    return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH_BF)
 
 
 def verdict_sections(verdict: Verdict | None) -> list[Section]:

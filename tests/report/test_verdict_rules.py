@@ -14,13 +14,15 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pandas as pd
 import pytest
-from scipy import stats
+from scipy import integrate, stats
 
+from ligwf.analysis.records import behrens_fisher
 from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
 from ligwf.analysis.records.shares import share_bounds, share_test
@@ -136,26 +138,55 @@ def test_a_mostly_zero_arm_gets_a_binomial_bound_not_a_t_bound():
         stats.beta.ppf(0.95, 3.0 + 1, 60 - 3.0))
 
 
-def test_unequal_arms_take_hsu_df_where_welch_passes_wrongly():
+def test_unequal_arms_leave_welch_where_it_passes_wrongly():
     """6 CG-n runs (sd 0.5) against 2 CG1 runs (sd 1), the truth on the budget (3): Welch
-    passes in ~0.077 of studies (issue 45: 0.060-0.078), Hsu's df in ~0.01."""
+    passes in ~0.077 of studies (issue 45: 0.060-0.078), Hsu's df in ~0.01, the
+    Behrens-Fisher interval (the single-look rule for unequal arms) at most alpha."""
     rng = np.random.default_rng(2)
     trials, budget = 4000, 3.0
     x = 0.5 * rng.standard_normal((trials, 6)) + budget
     y = rng.standard_normal((trials, 2))
     rate = {}
-    for rule in (eq.WELCH, eq.WELCH_EQUAL):
+    for rule in (eq.WELCH, eq.WELCH_EQUAL, eq.WELCH_BF):
         rate[rule] = sum(eq.equivalence(eq.difference_estimate(a, b, df_rule=rule),
                                         budget).state == eq.PASS
                          for a, b in zip(x, y)) / trials
     assert rate[eq.WELCH] > 0.06
     assert rate[eq.WELCH_EQUAL] <= 0.05
+    assert rate[eq.WELCH_EQUAL] < rate[eq.WELCH_BF] <= 0.05 + 3 * math.sqrt(0.05 * 0.95 / trials)
     # equal arms keep Welch (the coverage benchmark's cells), unequal ones Hsu
     assert eq.degrees_of_freedom(1.0, 3, 2.0, 3, eq.WELCH_EQUAL) == eq.welch_df(1.0, 3, 2.0, 3)
     assert eq.degrees_of_freedom(1.0, 24, 2.0, 3, eq.WELCH_EQUAL) == 2.0
 
 
-def test_a_single_look_report_decides_with_hsu_for_unequal_arms():
+def test_a_single_look_report_decides_with_behrens_fisher_for_unequal_arms():
     class OneLook:
         alpha_per_look, max_looks = 0.05, 1
-    assert sequential_level(OneLook()) == (0.05, eq.WELCH_EQUAL)
+    assert sequential_level(OneLook()) == (0.05, eq.WELCH_BF)
+
+
+def test_behrens_fisher_is_its_distribution():
+    """The quadrature against scipy's quad and a Monte Carlo draw; its edges are Student's
+    t; an interval of unequal arms carries its shape into the tests, equal arms keep
+    Welch's."""
+    rng = np.random.default_rng(7)
+    theta, d1, d2 = 0.7, 5.0, 1.0
+    q = behrens_fisher.quantile(0.95, theta, d1, d2)
+    draws = math.cos(theta) * rng.standard_t(d1, 400_000) - math.sin(theta) * rng.standard_t(
+        d2, 400_000)
+    assert float(np.mean(draws <= q)) == pytest.approx(0.95, abs=0.002)
+    c, s = math.cos(0.9), math.sin(0.9)
+    ref = integrate.quad(lambda t: stats.t.pdf(t, 2.0) * stats.t.cdf((-3.0 + s * t) / c, 23.0),
+                         -np.inf, np.inf, epsabs=1e-13, limit=400)[0]
+    assert behrens_fisher.cdf(-3.0, 0.9, 23.0, 2.0) == pytest.approx(ref, rel=1e-8)
+    assert behrens_fisher.quantile(0.95, 0.0, d1, d2) == pytest.approx(stats.t.ppf(0.95, d1))
+    x, y = [1.0, 1.3, 0.8, 1.1, 0.9, 1.2], [0.2, 0.9]
+    e = eq.difference_estimate(x, y, 0.05, eq.WELCH_BF)
+    assert e.fiducial is not None and e.fiducial[1:] == (5.0, 1.0)
+    hsu = eq.difference_estimate(x, y, 0.05, eq.HSU)
+    welch = eq.difference_estimate(x, y, 0.05, eq.WELCH)
+    assert welch.hi < e.hi < hsu.hi
+    edge = dataclasses.replace(e, value=10.0 - (e.hi - e.value))  # upper bound on 10
+    assert eq.equivalence(edge, 10.0).p_pass == pytest.approx(0.05, abs=1e-6)
+    assert eq.difference_estimate(x[:2], y, 0.05, eq.WELCH_BF) == eq.difference_estimate(
+        x[:2], y, 0.05, eq.WELCH)
