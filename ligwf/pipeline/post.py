@@ -20,6 +20,7 @@ from ligwf.fsio import writing_in
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.workflow import apply_override, parse_override
 from ligwf.scheduler import Executor
+from ligwf.study.paths import check_inside
 from ligwf.study.study import Study
 
 if TYPE_CHECKING:  # the analysis and report stages load numba / matplotlib: imported on use
@@ -37,6 +38,9 @@ def analyse_study(path: Path, out: Path | None = None,
     rank 0 (None on other MPI ranks)."""
     from ligwf.analysis.runner import AnalysisOptions, analyse
 
+    if out is None:         # the study's own analysis folder: no link leading out of it
+        study = Study.open(path)
+        check_inside(study.path, [study.analysis_dir])
     with writing_in(Path(out) if out is not None else Path(path)):
         return analyse(path, out, options or AnalysisOptions(), comm)
 
@@ -53,6 +57,8 @@ def report_study(path: Path, out: Path | None = None, snapshots: bool = True,
     if accept_overrides:
         study = dataclasses.replace(study, accept=overridden_accept(study.accept,
                                                                     accept_overrides))
+    if out is None:         # the study's own report folder: no link leading out of it
+        check_inside(study.path, [study.report_dir])
     with writing_in(Path(out) if out is not None else study.report_dir):
         folder = write_report(study, out, snapshots=snapshots)
         record_digests(folder)      # what the API's check() holds the tables against

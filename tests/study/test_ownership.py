@@ -133,3 +133,17 @@ def test_a_case_folder_leading_outside_through_a_parent_link_is_refused(study, t
     (case / layout.RESTART_DIR).symlink_to(target / layout.RESTART_DIR)
     assert main(["render", str(TINY), "--out", str(study)]) == 2
     assert "is a symbolic link" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("folder,argv", [
+    (layout.ANALYSIS_DIR, ["analyse"]), (layout.REPORT_DIR, ["report", "--no-snapshots"])])
+def test_a_symlinked_output_folder_of_the_study_is_refused(study, tmp_path, capsys, folder,
+                                                           argv):
+    target = tmp_path / "outside"
+    target.mkdir()
+    (study / folder).symlink_to(target)
+    capsys.readouterr()
+    assert main([argv[0], str(study), *argv[1:]]) == 2
+    line = _error(capsys.readouterr().err)
+    assert f"{study / folder} is a symbolic link" in line, line
+    assert list(target.iterdir()) == []
