@@ -53,9 +53,9 @@ STUDIES = (Study("ladder", ROOT / "docs" / "results" / "ladder"),
 
 def levels(folder: Path) -> tuple[float, str]:
     """(alpha, df rule) under the new rules: a sequential study's looks keep alpha / looks
-    and Hsu's df; a single look Welch's df for equal arms, Hsu's for unequal ones."""
+    and Hsu's df; a single look Welch's df for equal arms, Behrens-Fisher for unequal ones."""
     rounds = read_rounds(folder)
-    return (rounds.alpha_per_look, eq.HSU) if rounds.looks else (eq.ALPHA, eq.WELCH_EQUAL)
+    return (rounds.alpha_per_look, eq.HSU) if rounds.looks else (eq.ALPHA, eq.WELCH_BF)
 
 
 def _signed(x, y, name: str, budget: float, alpha: float, df_rule: str
@@ -78,6 +78,8 @@ def _signed(x, y, name: str, budget: float, alpha: float, df_rule: str
     why = [what for what, (rule, sides) in (
         (f"degrees of freedom: {eq.DF_RULE_TEXT[df_rule]}", (df_rule, 1)),
         ("two-sided fail test", (old_rule, 2))) if test(rule, sides)[1].state != before]
+    if t.state != before and not why:
+        why = [f"the two together: {eq.DF_RULE_TEXT[df_rule]} and a two-sided fail test"]
     return t.state, e.lo, e.hi, t.p_fail, "; ".join(why)
 
 
