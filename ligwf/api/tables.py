@@ -47,7 +47,8 @@ TABLES: tuple[TableSpec, ...] = (
               "errors also m_floor, m_floor_source, m_vs_floor"),
     TableSpec("verdict", layout.REPORT_DIR, layout.VERDICT_TABLE, REPORT, False,
               "one row per (sweep group, CG level, rule, criterion): pass / fail / undecided "
-              "with the value, its 95 % interval and the budget, the speedup"),
+              "with the value, its interval (its level: the verdict record's statistics) and "
+              "the budget, the speedup"),
     TableSpec("extrapolation", layout.REPORT_DIR, layout.EXTRAPOLATION_REPORT, REPORT, False,
               "one row per (sweep group, rule, signed criterion) with two or more CG-n "
               "levels: the CG1 value extrapolated from them (95 % interval, model term, "
