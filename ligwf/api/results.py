@@ -19,7 +19,7 @@ from ligwf.analysis.records.fields import CaseFields, read_fields
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.api import fields, plots
 from ligwf.api.tables import (ANALYSE, REPORT, TABLES, MissingOutput, TableSpec,
-                              column_problem, read_table, typed)
+                              read_checked, typed)
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.report import dictionary
 from ligwf.report.digests import damaged_report_files
@@ -381,14 +381,7 @@ class StudyResults:
                 if (why := self._why_no_granules()) is not None:
                     raise MissingOutput(f"{self.path}: no {name} table: {why}")
             path = self._file(spec.folder, spec.file, spec.command, f"{name} table")
-            try:
-                cache[name] = read_table(path)
-            except (OSError, ValueError) as exc:
-                raise MissingOutput(f"{path}: unreadable ({type(exc).__name__}: {exc}); run "
-                                    f"`{spec.command} {self.path}` again") from None
-            if (why := column_problem(cache[name], spec)) is not None:
-                del cache[name]
-                raise MissingOutput(f"{path}: {why}; run `{spec.command} {self.path}` again")
+            cache[name] = read_checked(path, spec, self.path)
         return cache[name]
 
     def _why_no_granules(self) -> str | None:

@@ -155,6 +155,20 @@ def column_problem(table: pd.DataFrame, spec: TableSpec) -> str | None:
     return None
 
 
+def read_checked(path: Path, spec: TableSpec, study: Path) -> pd.DataFrame:
+    """:func:`read_table` of ``spec``'s file at ``path`` in the study folder ``study``;
+    MissingOutput naming the command that writes it when the file cannot be read or is not
+    the table ligwf writes (:func:`column_problem`)."""
+    try:
+        table = read_table(path)
+    except (OSError, ValueError) as exc:
+        raise MissingOutput(f"{path}: unreadable ({type(exc).__name__}: {exc}); run "
+                            f"`{spec.command} {study}` again") from None
+    if (why := column_problem(table, spec)) is not None:
+        raise MissingOutput(f"{path}: {why}; run `{spec.command} {study}` again")
+    return table
+
+
 def read_table(path: Path) -> pd.DataFrame:
     """A study table (``.csv`` or ``.parquet``) with the API's dtypes; an empty file is an
     empty table. An analysis table written by the previous release has its renamed
