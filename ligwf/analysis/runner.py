@@ -67,6 +67,7 @@ from pathlib import Path
 from ligwf.analysis.granules.case import FrameResult, GranuleAnalysis, RunFacts
 from ligwf.analysis.frames.dumps import FrameFiles
 from ligwf.analysis.flow.stage import field_files, flow_cases, flow_record, flow_table
+from ligwf.scene.grains import scaled_mean_diameter, study_strip
 from ligwf.analysis.frames.checks import ExpectedFrames, plan_frames, shared_checks
 from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.granule_stage import (GRANULE_OUTPUTS, frame_tables,
@@ -122,6 +123,13 @@ class AnalysisShares:
     absent: list[dict]
     facts: list[RunFacts]
     tasks: list[tuple[int, FrameFiles]]
+
+    @property
+    def strip(self) -> float | None:
+        """The angle's surface strips (m): one physical width for every case of the study
+        (:func:`~ligwf.analysis.flow.surface.study_strip`), the same on every rank."""
+        return study_strip([scaled_mean_diameter(c.scaled) for c in self.usable],
+                           self.settings.surface_strip)
 
     def share(self, rank: int, size: int) -> tuple[list[tuple[int, FrameFiles]], list[CaseFolder]]:
         """The tasks and flow cases of rank ``rank`` of ``size``: a contiguous run of the
@@ -185,7 +193,7 @@ def compute_share(plan: AnalysisShares, outputs: OutputSet, rank: int, size: int
     share = Share()
     with shared_checks():
         share.flows, share.notes = flow_cases(flow_of, plan.settings.steady_after,
-                                              plan.settings.field_kernel)
+                                              plan.settings.field_kernel, plan.strip)
         analyses: dict[int, GranuleAnalysis] = {}   # one per case: held windows share reads
         for fi, ff in tasks:
             f = plan.facts[fi]

@@ -46,6 +46,11 @@ def cmd_check(args: argparse.Namespace) -> int:
                              f"({settings.cores_source}): what "
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     console.print(regime_table(prepared))
+    console.print(grains_table(prepared))
+    for g in level_grains(prepared):
+        if g.warning:
+            err_console.print(f"[yellow]ligwf: warning:[/] {escape(g.warning)}",
+                              highlight=False, soft_wrap=True)
     for line in size_relation_lines(prepared):
         console.print(line, highlight=False, soft_wrap=True)
     try:
@@ -71,6 +76,28 @@ def regime_table(prepared) -> Table:
         table.add_row(rc.case.case_id, *(f"{own[k]:.3g}" for k in
                                          ("stokes_viscous", "bond_granular", "capillary", "froude")),
                       f"{cg1['stokes_viscous']:.3g}", f"{cg1['bond_granular']:.3g}", verdict)
+    return table
+
+
+def level_grains(prepared) -> list:
+    """The drum's lengths in grains of each CG level of the study (its first scene)."""
+    from ligwf.scene.grains import grains
+
+    if not prepared.rendered:
+        return []
+    scene = prepared.rendered[0].case.scene
+    return [grains(scene, cg) for cg in sorted({rc.case.cg for rc in prepared.rendered})]
+
+
+def grains_table(prepared) -> Table:
+    """Lifter height, periodic slice and bed depth counted in grains of each CG level."""
+    table = Table(title="the drum in grains of each CG level (ligwf.scene.grains; the "
+                  "report adds the measured flowing layer)")
+    for col in ("CG", "diameter [mm]", "lifter height", "slice length", "bed depth"):
+        table.add_column(col, justify="right")
+    for g in level_grains(prepared):
+        table.add_row(f"{g.cg:g}", f"{g.diameter * 1e3:.3g}", f"{g.lifter:.2g}",
+                      f"{g.slice:.3g}", f"{g.bed_depth:.3g}")
     return table
 
 

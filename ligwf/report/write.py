@@ -40,6 +40,7 @@ from ligwf.report.table_sections import (markdown_tables, noise_markdown, paravi
 from ligwf.report.tables import build_tables
 from ligwf.report.criteria import SIGNED_COLUMNS
 from ligwf.report.extrapolation_report import extrapolation_inputs, extrapolation_section
+from ligwf.report.scale_section import scale_section
 from ligwf.inference.reference import extrapolation_rows
 from ligwf.report.planning import noise_table
 from ligwf.report.rounds import rounds_sections
@@ -97,6 +98,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     figures = report_figures(study, flow, cases, conditions, out, snapshots)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
                                verdict, [*extrapolation_section(extrapolated, ratio),
+                                         *scale_section(study, conditions),
                                          *flow_field_sections(study, cases, conditions, out)])
     title = f"{study.name}: error against run time"
     preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "

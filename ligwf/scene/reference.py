@@ -73,6 +73,7 @@ UNITS: dict[str, str] = {
     "AnalysisSettings.error_band": "1", "AnalysisSettings.bootstrap": "count",
     "AnalysisSettings.seed": "id", "AnalysisSettings.sensitivity_frames": "count",
     "AnalysisSettings.field_kernel": "1",
+    "AnalysisSettings.surface_strip": "m",
     "AcceptSettings.angle_deg": "deg", "AcceptSettings.profile_error": "1",
     "AcceptSettings.rigid_share": "1", "AcceptSettings.flowing_layer": "1",
     "AcceptSettings.gsd_error": "1", "AcceptSettings.field_error": "1",

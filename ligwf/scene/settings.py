@@ -104,6 +104,13 @@ class AnalysisSettings(Frozen):
         "Gaussian kernel of the cross-section fields (solid fraction, velocity, granular "
         "temperature), in CG1 mean particle diameters: a physical length, the same at every "
         "CG level (ligwf.analysis.flow.fields)")
+    surface_strip: float | None = Field(
+        None, ge=0.0, le=1.0, allow_inf_nan=False, description="width of the strips the "
+        "angle of repose's surface fit takes its points from, m: the angle's resolution. "
+        "None: twice the largest mean particle diameter of the study's cases (its coarsest "
+        "CG level), the same physical width at every level, so a CG-n - CG1 difference "
+        "carries no difference of resolution; 0: twice each case's own diameter (the rule "
+        "before 2026-12-07, whose resolution moved with the CG level)")
     sensitivity_frames: int = Field(
         4, ge=0, le=1000, description="steady frames of one case re-analysed with each "
         "threshold moved x0.8 / x1.25 (0: no sensitivity table)")

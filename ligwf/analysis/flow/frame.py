@@ -40,6 +40,7 @@ from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.analysis.records.statistics import relative_l2
 from ligwf.analysis.flow.surface import fit_surface
 from ligwf.scene.axis import Axis
+from ligwf.scene.grains import scaled_mean_diameter
 from ligwf.scene.scaled import ScaledScene
 
 RIGID_FRAME_SHARE = 0.9  # a frame is rigid when more than this share co-rotates
@@ -55,16 +56,17 @@ class DrumGeometry:
     axis: Axis               # the drum axis (a letter is taken as its Axis)
     omega: float             # rad/s, rotation about +axis (counter-clockwise seen from +axis)
     d_mean: float            # m, a typical particle diameter (sets bins and bands)
+    #: m, the angle's surface strips (the study's one resolution, surface.study_strip);
+    #: None: twice this case's own d_mean
+    strip: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "axis", Axis(self.axis))
 
     @classmethod
-    def from_scaled(cls, scaled: ScaledScene) -> "DrumGeometry":
-        d = np.asarray(scaled.particles.diameters, float)
-        f = np.asarray(scaled.particles.number_fractions, float)
+    def from_scaled(cls, scaled: ScaledScene, strip: float | None = None) -> "DrumGeometry":
         return cls(radius=0.5 * scaled.drum.diameter, axis=scaled.drum.axis,
-                   omega=scaled.drum.omega, d_mean=float(np.sum(d * f)))
+                   omega=scaled.drum.omega, d_mean=scaled_mean_diameter(scaled), strip=strip)
 
 
 @dataclass(frozen=True)
@@ -118,7 +120,7 @@ def frame_flow(frame: ParticleFrame, geo: DrumGeometry, rigid_tolerance: float =
     r = frame.radii
     mass = frame.volumes  # one density: volume weights are mass weights
     side = rising_side(geo)
-    surf = fit_surface(u, v, r, geo.radius, geo.d_mean, side)
+    surf = fit_surface(u, v, r, geo.radius, geo.d_mean, side, strip=geo.strip)
 
     cu, cv = np.average(u, weights=mass), np.average(v, weights=mass)
     com_angle = float(np.degrees(np.arctan2(cu, -cv)))

@@ -68,12 +68,13 @@ class FlowFrames(FrameAnalysis):
 
     case: CaseFolder
     plan: ExpectedFrames
+    strip: float | None = None      # m, the study's surface strips (surface.study_strip)
     results: list = field(default_factory=list)
     problems: list[dict] = field(default_factory=list)
 
     def _prepare(self, frames) -> list:
         self.results = []
-        self._geo = DrumGeometry.from_scaled(self.case.scaled)
+        self._geo = DrumGeometry.from_scaled(self.case.scaled, self.strip)
         production = self.case.production_start_step
         self.problems = [p for p in self.plan.problems if p["step"] >= production]
         return [ff for ff in (self.plan.frames if frames is None else frames)
@@ -102,10 +103,11 @@ class FlowFrames(FrameAnalysis):
         self.results = [r for r in self.results if r is not None]
 
 
-def _production_frames(case: CaseFolder, plan) -> tuple[list, list, list, list[dict]]:
+def _production_frames(case: CaseFolder, plan, strip: float | None = None
+                       ) -> tuple[list, list, list, list[dict]]:
     """Checked particle frames of the production phase, their flows, their registered
     series, and the frames refused or missing (``{"step", "reason"}``)."""
-    done = FlowFrames(case, plan).run()
+    done = FlowFrames(case, plan, strip).run()
     return ([(frame, ff) for frame, ff, _, _ in done.results],
             [flow for _, _, flow, _ in done.results],
             [values for *_, values in done.results], done.problems)
@@ -115,15 +117,16 @@ def _listed(v) -> list | float:
     return [float(x) for x in np.ravel(v)] if np.ndim(v) else float(v)
 
 
-def case_flow(case: CaseFolder, steady_after, field_kernel: float = FIELD_KERNEL
-              ) -> tuple[CaseFlow, list[str]]:
+def case_flow(case: CaseFolder, steady_after, field_kernel: float = FIELD_KERNEL,
+              strip: float | None = None) -> tuple[CaseFlow, list[str]]:
     """The flow of one case folder and its skipped-frame notes (the steady window's); the
     record is ``measured`` only when a frame of the window was usable (else the one note
     says why), and then carries the window's cross-section fields (kernel width
     ``field_kernel`` CG1 diameters, :mod:`ligwf.analysis.flow.fields`). ConfigError when
-    its dump record is unreadable."""
+    its dump record is unreadable. ``strip``: the angle's surface strips in m, the study's
+    one resolution (None: twice the case's own diameter)."""
     plan = plan_frames(case)
-    frames, all_flows, all_series, problems = _production_frames(case, plan)
+    frames, all_flows, all_series, problems = _production_frames(case, plan, strip)
     fraction = steady_fraction(case, steady_after, all_flows)
     first = case.steady_start_step(fraction)
     rel = {ff.step: os.path.relpath(ff.particles, case.path) for ff in plan.frames}
@@ -138,7 +141,7 @@ def case_flow(case: CaseFolder, steady_after, field_kernel: float = FIELD_KERNEL
         return CaseFlow(**head), [
             f"{case.path}: no readable particle dump in the steady part (steps >= "
             f"{first:.0f})" + (f"; first refused: {problems[-1]['reason']}" if problems else "")]
-    geo = DrumGeometry.from_scaled(case.scaled)
+    geo = DrumGeometry.from_scaled(case.scaled, strip)
     steady_frames = [frames[k][0] for k in steady]
     fields = case_fields(steady_frames, geo, kernel_width(geo, case.cg, field_kernel),
                          case.scaled.drum.length,
@@ -172,14 +175,15 @@ def measured_flow(head: dict, steady_frames: list, flows: list, series: list[dic
         summary=summ.scalars(), fields=fields)
 
 
-def flow_cases(cases: list[CaseFolder], steady_after, field_kernel: float = FIELD_KERNEL
-               ) -> tuple[dict[str, CaseFlow], dict[str, list[str]]]:
-    """(flow per case, skipped-frame notes per case) of ``cases``; a case whose dump
-    record is unreadable is left out with its reason as the note."""
+def flow_cases(cases: list[CaseFolder], steady_after, field_kernel: float = FIELD_KERNEL,
+               strip: float | None = None) -> tuple[dict[str, CaseFlow], dict[str, list[str]]]:
+    """(flow per case, skipped-frame notes per case) of ``cases`` (``strip``: the study's
+    surface strips, m); a case whose dump record is unreadable is left out with its reason
+    as the note."""
     out, notes = {}, {}
     for c in cases:
         try:
-            flow, skipped = case_flow(c, steady_after, field_kernel)
+            flow, skipped = case_flow(c, steady_after, field_kernel, strip)
         except ConfigError as exc:
             notes[c.case_id] = [str(exc)]
             continue

@@ -13,13 +13,18 @@ The estimator (all lengths in m, angles in degrees):
    surface tangent is tilted by the centre-of-mass angle from straight down.
 2. Rotate into surface coordinates (x along the guessed tangent, y along its upward normal)
    and cut the central part of the chord (``span`` of the half chord, away from the walls
-   and the lifters) into strips of width 2 d across the surface.
+   and the lifters) into strips across the surface, on a grid anchored at the centre line.
+   Their width is the measurement's resolution: one physical width for every CG level of
+   a study (twice its coarsest level's diameter, :func:`ligwf.scene.grains.study_strip`), so CG1 and CG-n
+   surfaces are sampled at the same places (with strips of 2 d, a CG3 bed gave 5 strips
+   where CG1 gave 16, and the line through a curved surface moved by up to 1 deg with d
+   alone: tests/analysis/flow/test_surface_resolution.py).
 3. Surface point of a strip: walk down from its highest particle top (y + r) and take the
    first one whose next lower neighbour in the strip is less than one diameter below it
    (a particle separated from the bed by a gap is airborne, not surface).
 4. Robust line fit: least median of squares over all point pairs (up to half the points
    may be outliers), then least squares on the points within 3 scaled median absolute
-   deviations of it (at least half a diameter), until nothing changes.
+   deviations of it (at least a quarter of the strip width), until nothing changes.
 5. Repeat 2-4 once about the refined tangent (strips then cut the surface square on);
    when that pass finds fewer than 4 strips, the first pass's line is the fit.
 
@@ -53,8 +58,11 @@ class SurfaceFit:
 
 def _strip_tops(x: np.ndarray, top: np.ndarray, width: float, half: float,
                 gap: float) -> tuple[np.ndarray, np.ndarray]:
-    """(x centre, surface height) per strip over |x| < half; airborne particles skipped."""
-    edges = np.arange(-half, half + width, width)
+    """(x centre, surface height) per strip over |x| < half; airborne particles skipped.
+    The strips sit on a grid anchored at the bed's centre line (x = 0), not at -half, so two
+    beds of other particle sizes are cut at the same places when ``width`` is the same."""
+    k = math.floor(half / width)
+    edges = np.arange(-k, k + 1) * width
     idx = np.digitize(x, edges) - 1
     xs, ys = [], []
     for k in range(len(edges) - 1):
@@ -99,12 +107,17 @@ def robust_line(x: np.ndarray, y: np.ndarray, floor: float) -> tuple[float, floa
 
 
 def fit_surface(u: np.ndarray, v: np.ndarray, r: np.ndarray, radius: float, d: float,
-                rising_side: float, span: float = SPAN) -> SurfaceFit | None:
+                rising_side: float, span: float = SPAN, strip: float | None = None
+                ) -> SurfaceFit | None:
     """Fit the free surface of a bed (see the module docstring); None when too few strips.
 
     ``u, v, r``: particle centres and radii in the cross-section (m); ``radius``: drum
-    radius; ``d``: particle diameter (strip width, gaps); ``rising_side``: +1 when the wall
-    at +u moves up, -1 when the wall at -u does.
+    radius; ``d``: particle diameter (the gaps between particles of a strip, the fit's
+    floor); ``strip``: the strips' width in m, the measurement's resolution (None: 2 d,
+    the particle's own scale, which makes the resolution move with the CG level: a study
+    passes one physical width for all its levels,
+    :func:`ligwf.scene.grains.study_strip`); ``rising_side``:
+    +1 when the wall at +u moves up, -1 when the wall at -u does.
     """
     if len(u) < 10:
         return None
@@ -117,10 +130,11 @@ def fit_surface(u: np.ndarray, v: np.ndarray, r: np.ndarray, radius: float, d: f
         x, y = u * c + v * s, -u * s + v * c
         h = float(np.quantile(y + r, 0.98))
         half = span * math.sqrt(max(radius**2 - min(h * h, radius**2), 0.0))
-        xs, ys = _strip_tops(x, y + r, 2.0 * d, half, d)
+        width = strip if strip else 2.0 * d
+        xs, ys = _strip_tops(x, y + r, width, half, d)
         if len(xs) < 4:
             break   # the first pass's line stands when the second finds too few strips
-        a, b, keep = robust_line(xs, ys, 0.5 * d)
+        a, b, keep = robust_line(xs, ys, 0.25 * width)   # 0.5 d at the former 2 d strips
         tangent += math.atan(a)
         fit = (tangent, b * math.cos(math.atan(a)), int(keep.sum()), int((~keep).sum()))
     if fit is None:
@@ -130,3 +144,4 @@ def fit_surface(u: np.ndarray, v: np.ndarray, r: np.ndarray, radius: float, d: f
     deg = (deg + 90.0) % 180.0 - 90.0
     return SurfaceFit(tangent_deg=deg, angle_deg=deg * (1.0 if rising_side >= 0 else -1.0),
                       offset=offset, points=used, rejected=rejected)
+

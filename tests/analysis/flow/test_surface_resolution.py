@@ -1,0 +1,68 @@
+"""The angle of repose is measured at one physical resolution at every CG level: the same
+curved free surface built of beads of 1, 2 and 3 mm gives the same angle when the strips
+have one width, and the estimator whose strips are twice each bead's diameter (the rule
+before 2026-12-07) is shown to move with the bead size alone on the same surfaces (the
+check can fail: it catches a size-dependent estimator)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ligwf.analysis.flow.surface import fit_surface
+from ligwf.scene.grains import study_strip
+
+R = 0.05          # drum radius, m
+SIZES = (0.001, 0.002, 0.003)
+
+
+def bed(d: float, curvature: float, theta: float = 35.0) -> tuple[np.ndarray, ...]:
+    """A bed whose free surface is the S-curve y = curvature x^3 (x along the mean
+    surface, tilted by ``theta``): a dense row of beads with their tops on the curve, a
+    square packing below it, inside the drum."""
+    t = math.radians(theta)
+    xs = np.arange(-R, R, d / 4)
+    ys = curvature * xs ** 3 - d / 2
+    gx, gy = (a.ravel() for a in np.meshgrid(np.arange(-R, R, d), np.arange(-R, 0, d)))
+    below = gy < curvature * gx ** 3 - 1.5 * d
+    x, y = np.concatenate([xs, gx[below]]), np.concatenate([ys, gy[below]])
+    u, v = x * math.cos(t) - y * math.sin(t), x * math.sin(t) + y * math.cos(t)
+    inside = u * u + v * v < (R - d / 2) ** 2
+    return u[inside], v[inside], np.full(int(inside.sum()), d / 2)
+
+
+def angles(curvature: float, strip: float | None) -> list[float]:
+    return [fit_surface(*bed(d, curvature), R, d, +1.0, strip=strip).angle_deg for d in SIZES]
+
+
+def size_dependence(curvature: float, strip: float | None) -> float:
+    """Largest minus smallest angle over the bead sizes, deg."""
+    a = angles(curvature, strip)
+    return max(a) - min(a)
+
+
+def test_a_flat_surface_is_measured_exactly_at_every_size():
+    for strip in (None, study_strip([*SIZES])):
+        assert angles(0.0, strip) == pytest.approx([35.0] * 3, abs=1e-9)
+
+
+@pytest.mark.parametrize("curvature", [30.0, 60.0, 120.0])
+def test_one_resolution_gives_one_angle_on_a_curved_surface(curvature):
+    strip = study_strip([*SIZES])            # twice the coarsest: 6 mm
+    assert strip == pytest.approx(0.006)
+    assert size_dependence(curvature, strip) < 0.05
+
+
+@pytest.mark.parametrize("curvature", [60.0, 120.0])
+def test_strips_at_each_beads_own_size_move_the_angle(curvature):
+    """The former rule on the same surfaces: the check above fails for it."""
+    assert size_dependence(curvature, None) > 0.3
+
+
+def test_study_strip_setting():
+    assert study_strip([0.001, 0.004]) == pytest.approx(0.008)
+    assert study_strip([0.001, 0.004], 0.01) == pytest.approx(0.01)
+    assert study_strip([0.001, 0.004], 0.0) is None       # 0: each case's own diameter
+    assert study_strip([]) is None
