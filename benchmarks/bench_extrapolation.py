@@ -34,7 +34,8 @@ from ligwf.inference.size_relation import SLOPE_DEG as SLOPE_SCALE  # noqa: E402
 
 #: (name, CG levels, d / D): the ladder's drum, a 3-level small drum, the source's drum
 DESIGNS = (("ladder CG2-3", (2.0, 3.0), 1 / 50), ("small drum CG2-4", (2.0, 3.0, 4.0), 1 / 25),
-           ("source drum CG3/4/6", (3.0, 4.0, 6.0), 1 / 200))
+           ("source drum CG3/4/6", (3.0, 4.0, 6.0), 1 / 200),
+           ("source drum CG4/6/8", (4.0, 6.0, 8.0), 1 / 200))
 SEEDS = (2, 3, 6)
 CURVATURES = ("prior", "none", "+2 sd")
 FRAMES, PHI, FRAME_SD, OFFSET_SD, THETA1 = 50, 0.9, 0.8, 0.2, 38.0

@@ -145,13 +145,20 @@ def main(argv=None) -> int:
     ap.add_argument("--runs", type=Path, default=None,
                     help="folder holding the new drums' analysed study folders")
     ap.add_argument("--check", action="store_true", help="compare, do not write")
+    ap.add_argument("--no-figure", action="store_true", help="tables only")
     args = ap.parse_args(argv)
     rows = size_rows()
     fit = size_fit(rows)
     val = validation(args.runs)
     tables = {"size_relation.csv": csv_text(rows), "size_fit.csv": csv_text(fit)}
-    if args.runs is not None or not (OUT / "validation.csv").is_file():
-        tables["validation.csv"] = csv_text(val)
+    committed = OUT / "validation.csv"
+    if args.runs is None and committed.is_file():
+        # without the run folders the new drums' rows are kept as committed: the committed
+        # pairs' rows are recomputed, the others carried over
+        kept = pd.read_csv(committed)
+        kept = kept[~kept["pair"].isin([name for name, _, _ in PAIRS])]
+        val = pd.concat([val, kept], ignore_index=True)
+    tables["validation.csv"] = csv_text(val)
     if args.check:
         bad = [n for n, text in tables.items()
                if not (OUT / n).is_file() or (OUT / n).read_text() != text]
@@ -160,7 +167,8 @@ def main(argv=None) -> int:
     OUT.mkdir(parents=True, exist_ok=True)
     for n, text in tables.items():
         (OUT / n).write_text(text)
-    figure(rows, fit, OUT / "size_relation.png")
+    if not args.no_figure:
+        figure(rows, fit, OUT / "size_relation.png")
     print(fit.to_string(index=False))
     print(val.to_string(index=False))
     return 0
