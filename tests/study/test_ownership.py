@@ -79,13 +79,19 @@ def test_the_same_study_and_its_analysis_settings_are_its_own(study):
 
 
 def test_replace_writes_the_other_study_and_keeps_the_cases_it_does_not_change(study):
-    kept = study / "cg3-weber-r0" / layout.POST_DIR / "particles_100.vtu"
+    """Another sweep (one rule, another seed base for nothing else): the weber case is the
+    same scene, so its record stays byte for byte (same scene hash: its run is skipped
+    as done) and its outputs stay; the study record is the new one."""
+    case = study / "cg3-weber-r0"
+    kept = case / layout.POST_DIR / "particles_100.vtu"
     kept.write_text("a frame of the finished run")
+    scene = (case / layout.SCENE_FILE).read_bytes()
     assert main(["render", str(TINY), "--out", str(study), "--replace", "--set",
-                 "name=other", "--set", "sweep.rules=[weber]"]) == 0
+                 "sweep.rules=[weber]"]) == 0
     record = json.loads((study / layout.STUDY_FILE).read_text())
-    assert record["name"] == "other" and [c["case_id"] for c in record["cases"]] == [
-        "cg3-weber-r0"]
+    assert [c["case_id"] for c in record["cases"]] == ["cg3-weber-r0"]
+    assert record["workflow"]["sweep"]["rules"] == ["weber"]
+    assert (case / layout.SCENE_FILE).read_bytes() == scene
     assert kept.read_text() == "a frame of the finished run"
 
 
