@@ -79,7 +79,7 @@ def test_the_same_study_and_its_analysis_settings_are_its_own(study):
 
 
 def test_replace_writes_the_other_study_and_keeps_the_cases_it_does_not_change(study):
-    """Another sweep (one rule, another seed base for nothing else): the weber case is the
+    """Another sweep (one rule instead of two): the weber case is the
     same scene, so its record stays byte for byte (same scene hash: its run is skipped
     as done) and its outputs stay; the study record is the new one."""
     case = study / "cg3-weber-r0"
