@@ -119,3 +119,30 @@ def test_second_run_numbers_are_its_file():
         assert quoted.format(value) in README, label
     zero = re.findall(r"^60 vs 60 +([\d.]+) +[\d.]+ \| +([\d.]+)", text, re.M)
     assert dict(zero) == {"1.0": "0.0495", "0.2": "0.0000"}
+
+
+def test_third_run_numbers_are_its_file():
+    text = (HERE / "rates_3.txt").read_text()
+    assert "--seed 20261209" in text.splitlines()[0] and "behrens-fisher" in text.splitlines()[0]
+    assert "summary: 4 of 4 registered checks hold" in text
+    assert "**4 of 4 registered checks hold.** Check 1: 72 of 72" in README
+    span = re.search(r"check unequal intervals: 72 of 72 cells in \[0.92, 0.99\] "
+                     r"\(([\d.]+-[\d.]+)\): holds", text).group(1)
+    assert f"lie in [0.92, 0.99] ({span}) with the Behrens-Fisher interval" in README
+    rates = re.search(r"check unequal rates: at most ([\d.]+); 0 of 72", text).group(1)
+    assert f"wrong pass and wrong fail at most {rates}, none shown above 0.05" in README
+    cells = [r for r in re.findall(r"^ *24 vs 3 +([\d.]+) +([\d.]+) +([\d.]+) \| +[\d.]+ +"
+                                   r"[\d.]+ \| +([\d.]+) +([\d.]+)$", text, re.M)]
+    above = sorted(float(c[3]) for c in cells if float(c[3]) > 0.05)     # wrong passes
+    assert len(above) == 2 and all(float(c[4]) <= 0.05 for c in cells)
+    assert all(c[0] == "0.5" for c in cells if float(c[3]) > 0.05)
+    assert (f"above 0.05, {above[0]:.4f} and {above[1]:.4f}, both 24 vs 3" in README
+            and f"bounds of {_lower(above[0], 4000):.2g} and {_lower(above[1], 4000):.2g}"
+            in README)
+    for label, quoted in (("check all-zero wrong pass: at most ([\\d.]+)",
+                           "all-zero shares at most {}"),
+                          ("check family-wise wrong decision: at most ([\\d.]+)",
+                           "family-wise at most {}"),
+                          ("check cheapest level disclosed: at most ([\\d.]+)",
+                           "meets in at most {} of studies")):
+        assert quoted.format(re.search(label, text).group(1)) in README, label
