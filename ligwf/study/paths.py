@@ -72,14 +72,6 @@ def shown(text: str, limit: int = 80) -> str:
     return r if len(r) <= limit else r[:limit - 4] + "...'"
 
 
-def check_path_text(path: str | os.PathLike, what: str) -> None:
-    """ConfigError naming ``what`` and the path unless it is one line of text of a
-    length the system takes."""
-    why = path_text_problem(os.fspath(path))
-    if why is not None:
-        raise ConfigError(f"{what} {shown(os.fspath(path))}: {why}")
-
-
 def case_id_problem(case_id: object) -> str | None:
     """Why ``case_id`` cannot be a case folder's name (None: it can)."""
     if not isinstance(case_id, str) or not case_id:

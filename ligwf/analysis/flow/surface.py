@@ -15,8 +15,8 @@ The estimator (all lengths in m, angles in degrees):
    and cut the central part of the chord (``span`` of the half chord, away from the walls
    and the lifters) into strips across the surface, on a grid anchored at the centre line.
    Their width is the measurement's resolution: one physical width for every CG level of
-   a study (twice its coarsest level's diameter, :func:`ligwf.scene.grains.study_strip`), so CG1 and CG-n
-   surfaces are sampled at the same places (with strips of 2 d, a CG3 bed gave 5 strips
+   a study (twice its coarsest level's diameter, :func:`ligwf.scene.grains.study_strip`), so
+   CG1 and CG-n surfaces are sampled at the same places (with strips of 2 d, a CG3 bed gave 5 strips
    where CG1 gave 16, and the line through a curved surface moved by up to 1 deg with d
    alone: tests/analysis/flow/test_surface_resolution.py).
 3. Surface point of a strip: walk down from its highest particle top (y + r) and take the
@@ -59,11 +59,13 @@ class SurfaceFit:
 def _strip_tops(x: np.ndarray, top: np.ndarray, width: float, half: float,
                 gap: float) -> tuple[np.ndarray, np.ndarray]:
     """(x centre, surface height) per strip over |x| < half; airborne particles skipped.
-    The strips sit on a grid anchored at the bed's centre line (x = 0), not at -half, so two
-    beds of other particle sizes are cut at the same places when ``width`` is the same."""
-    k = math.floor(half / width)
-    edges = np.arange(-k, k + 1) * width
-    idx = np.digitize(x, edges) - 1
+    The strips sit on a grid anchored at the bed's centre line (x = 0) and end at +-half
+    (the end strips narrower), so two beds of other particle sizes are cut at the same
+    places when ``width`` is the same. (The former grid started at -half and its last strip
+    ran up to a width past +half: the window itself grew with the strip width.)"""
+    k = math.ceil(half / width)
+    edges = np.unique(np.clip(np.arange(-k, k + 1) * width, -half, half))
+    idx = np.where(np.abs(x) < half, np.digitize(x, edges) - 1, -1)
     xs, ys = [], []
     for k in range(len(edges) - 1):
         h = np.sort(top[idx == k])[::-1]
