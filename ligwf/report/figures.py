@@ -24,7 +24,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from ligwf.analysis.records.conditions import REFERENCE_CG
+from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
 from ligwf.fsio import atomic_write_bytes
 from ligwf.study.case import group_label
 
@@ -170,15 +170,76 @@ def run_cost_ax(ax: Axes, conditions: pd.DataFrame) -> Axes:
     return ax
 
 
-def pareto(conditions: pd.DataFrame, path: Path) -> Path:
-    """Error vs run time (angle of repose, velocity profile) and the run cost by phase."""
+def criterion_error_ax(ax: Axes, conditions: pd.DataFrame, verdict_rows: pd.DataFrame,
+                       criterion: str) -> Axes | None:
+    """One criterion of the verdict against the production cost per CG-n level: the
+    verdict's estimate and interval in its unit (degrees for the angle, the same numbers
+    as the verdict table: ``verdict_rows`` is :func:`ligwf.report.forest.forest_rows`),
+    the budget shaded, each CG1 reference's cost as a dashed line; x as :func:`error_ax`.
+    Each point is a line with ``gid`` ``"<condition>|<criterion>"`` (its interval) and
+    ``...|value`` (its estimate). None (nothing drawn) when the verdict has no value of it."""
+    rows = verdict_rows[verdict_rows["criterion"] == criterion] if not verdict_rows.empty \
+        else verdict_rows
+    if rows.empty or not np.isfinite(rows["value"].to_numpy(float)).any():
+        return None
+    cost = {}
+    for _, r in conditions.iterrows():
+        name = Condition(str(r.get("group", "{}")), float(r["cg"]), str(r["rule"])).name
+        cost[name] = float(r["production_core_rate_k"])
+        if r["cg"] == REFERENCE_CG and np.isfinite(cost[name]):
+            ax.axvline(cost[name], ls="--", lw=1, color="grey",
+                       label=f"{_label(r)} cost (reference)")
+    first = rows.iloc[0]
+    budget = float(np.nanmax(rows["budget"])) if rows["budget"].notna().any() else math.nan
+    if math.isfinite(budget):
+        ax.axhspan(-budget if first["signed"] else 0.0, budget, color="tab:green", alpha=0.12,
+                   lw=0, label=f"budget {'+-' if first['signed'] else '<= '}{budget:g}")
+    compared = len(rows)
+    for j, (_, r) in enumerate(rows.iterrows()):
+        x = cost.get(r["condition"], math.nan) * (1 + DODGE * (j - (compared - 1) / 2))
+        if not (np.isfinite(x) and math.isfinite(r["value"])):
+            continue
+        tag = f"{r['condition']}|{criterion}"
+        if math.isfinite(r["lo"]) and math.isfinite(r["hi"]):
+            ax.plot([x, x], [r["lo"], r["hi"]], color=f"C{j}", lw=1.5, gid=tag)
+        ax.plot([x], [r["value"]], "o", color=f"C{j}", gid=tag + "|value",
+                label=f"{r['condition']} ({r['state']})")
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.margins(x=0.15)
+    log_scale(ax, "x", conditions["production_core_rate_k"], "no production cost recorded")
+    unit = f" [{first['unit']}]" if first["unit"] else ""
+    what = "CG-n - CG1" if first["signed"] else "error vs CG1"
+    ax.set_xlabel("production core-s / simulated s / 1k original particles")
+    ax.set_ylabel(f"{first['label']}, {what}{unit}")
+    ax.set_title(f"{first['label']}: the verdict's interval and budget", fontsize=10)
+    ax.grid(alpha=0.3)
+    legend_below(ax, ncol=1)
+    return ax
+
+
+def pareto_figure(conditions: pd.DataFrame, verdict_rows: pd.DataFrame | None = None
+                  ) -> Figure:
+    """Error vs run time (angle of repose, velocity profile) and the run cost by phase.
+    With the verdict's rows (:func:`ligwf.report.forest.forest_rows`) the two error panels
+    show the verdict's criteria, so the figure and the verdict table show the same numbers
+    in the same units; without a verdict the conditions table's relative errors."""
     fig = Figure(figsize=(15, 4.8))
     axes = fig.subplots(1, 3)
-    error_ax(axes[0], conditions, "angle_error", "angle of repose error vs CG1")
-    error_ax(axes[1], conditions, "profile_error", "velocity profile error (rel. L2) vs CG1")
+    rows = verdict_rows if verdict_rows is not None else pd.DataFrame()
+    for ax, criterion, col, title in (
+            (axes[0], "angle_deg", "angle_error", "angle of repose error vs CG1"),
+            (axes[1], "profile_error", "profile_error", "velocity profile error (rel. L2) vs CG1")):
+        if criterion_error_ax(ax, conditions, rows, criterion) is None:
+            error_ax(ax, conditions, col, title)
     run_cost_ax(axes[2], conditions)
     fig.subplots_adjust(wspace=0.32)
-    return save(fig, path)
+    return fig
+
+
+def pareto(conditions: pd.DataFrame, path: Path, verdict_rows: pd.DataFrame | None = None
+           ) -> Path:
+    """The error-vs-run-time figure of the report (:func:`pareto_figure`) as PNG."""
+    return save(pareto_figure(conditions, verdict_rows), path)
 
 
 #: axis label and title part of each analysis.gsd_volume convention

@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import math
 
-from rich.table import Table
 from rich.text import Text
 
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.report.criteria import CRITERIA, RELATIVE, SIGNED, CriterionResult
+from ligwf.report.forest_text import compact_lines
 from ligwf.report.verdict import FAILS, MEETS, ConditionVerdict, GroupVerdict, Verdict, band_text
 from ligwf.report.verdict_statistics import (cheapest_disclosure, method_text,
                                              shown_within_heading)
@@ -129,9 +129,14 @@ def group_markdown(g: GroupVerdict, several: bool, stats: dict | None = None) ->
     return lines + [""]
 
 
-def verdict_section(verdict: Verdict) -> str:
-    """The verdict as the report's first markdown section."""
-    lines = [f"## {TITLE}", "",
+def verdict_section(verdict: Verdict, figure: str | None = None) -> str:
+    """The verdict as the report's first markdown section; ``figure`` (a path relative to
+    the report folder): its forest plot (:mod:`ligwf.report.forest`), shown first."""
+    lines = [f"## {TITLE}", ""]
+    if figure:
+        lines += [f"![Verdict: each criterion's interval against its budget, the speedup "
+                  f"beside]({figure})", ""]
+    lines += [
              f"Budget (`accept:` block): {budget_line(verdict.accept)}. The unit is the run "
              f"(its steady-window mean). {method_text(verdict.statistics)} Coverage and error "
              "rates measured by `benchmarks/bench_coverage.py`. Control twins are not "
@@ -146,7 +151,9 @@ def verdict_section(verdict: Verdict) -> str:
 
 
 def verdict_renderables(verdict: Verdict) -> list:
-    """Rich renderables for the terminal: per group its sentence and a table."""
+    """Rich renderables for the terminal: per group its sentence, then the forest plot as
+    a compact table (:mod:`ligwf.report.forest_text`: a line per level and per criterion,
+    each at most 100 characters), what each level is shown to stay within and the notes."""
     out: list = [Text(f"{TITLE} ({budget_line(verdict.accept)})", style="bold")]
     for g in verdict.groups:
         title = group_title(g.group)
@@ -155,14 +162,8 @@ def verdict_renderables(verdict: Verdict) -> list:
                         style="bold green" if g.cheapest else "bold"))
         if not g.conditions:
             continue
-        table = Table(show_header=True, header_style="bold", box=None, pad_edge=False)
-        for col in ("condition", "speedup", "verdict", *_columns(g)):
-            table.add_column(col)
-        for c in g.conditions:
-            table.add_row(c.name, band_text(c.speedup, c.speedup_lo, c.speedup_hi),
-                          Text(c.state, style=STYLE.get(c.state, "yellow")),
-                          *[Text(cell(r), style=STYLE.get(r.state, "dim")) for r in c.criteria])
-        out.append(table)
+        out += [Text(line, style=STYLE.get(state, "dim"), no_wrap=True, overflow="crop")
+                for line, state in compact_lines(verdict, g.group)]
         out += [Text(f"  {c.name} is shown to stay within: {shown_within(c)}")
                 for c in g.conditions]
         out += [Text(f"  {n}", style="dim") for n in _notes(g)]

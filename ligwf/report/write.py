@@ -3,10 +3,11 @@
 The study's report folder (:attr:`ligwf.study.study.Study.report_dir`):
 ``cases.csv`` and ``conditions.csv`` (the numbers), ``summary.md`` and ``index.html``
 (the same sections, :mod:`ligwf.report.sections`, in the same order: the verdict first),
-``figures/*.png`` (error vs run time, GSD overlay, velocity profiles, one snapshot per case
-coloured by speed and one by granule id) and ``paraview/<case>.pvd`` (particles + turning
-drum, open in ParaView). Whatever was not used -- skipped cases, missing or refused frames,
-missing analysis outputs -- is listed with its reason (:mod:`ligwf.report.problems`).
+``figures/*.png`` (the verdict's forest plot, error vs run time, GSD overlay, velocity
+profiles, one snapshot per case coloured by speed and one by granule id) and
+``paraview/<case>.pvd`` (particles + turning drum, open in ParaView). Whatever was not
+used -- skipped cases, missing or refused frames, missing analysis outputs -- is listed
+with its reason (:mod:`ligwf.report.problems`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
 from ligwf.report.controls import controls_markdown
 from ligwf.report.fields import fields_report
+from ligwf.report.forest import forest, forest_rows
 from ligwf.report.granule_figures import granule_figures
 from ligwf.report.html import render_page
 from ligwf.report.paraview import case_collection
@@ -66,6 +68,7 @@ SNAPSHOTS = ("The last frame of each case seen along the drum axis (the arrow: t
 class ReportFigures:
     """The figures of a report by the section that shows them, and the ParaView files."""
 
+    verdict: Figure | None = None                           # the forest plot, first
     flow: list[Figure] = field(default_factory=list)        # error vs run time, profiles
     gsd: list[Figure] = field(default_factory=list)
     kinetics: list[Figure] = field(default_factory=list)    # kinetics, definition sensitivity
@@ -95,7 +98,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     write_verdict(verdict, out)
     extrapolated = extrapolation_rows(cases, SIGNED_COLUMNS, ratio)
     atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
-    figures = report_figures(study, flow, cases, conditions, out, snapshots)
+    figures = report_figures(study, flow, cases, conditions, out, snapshots, verdict)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
                                verdict, [*extrapolation_section(extrapolated, ratio),
                                          *scale_section(study, conditions),
@@ -119,7 +122,7 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
     fig_dir = layout.FIGURES_DIR
     tables = (markdown_tables(cases, conditions, flow) if not cases.empty
               else "## Cases\n\nNo usable case.")
-    parts = [*verdict_sections(verdict),
+    parts = [*verdict_sections(verdict, figures.verdict),
              *rounds_sections(read_rounds(study.path), study.report_dir / fig_dir),
              *split_markdown(tables),
              *split_markdown(noise_markdown(conditions, floors, flow)),
@@ -151,11 +154,13 @@ def sequential_level(rounds) -> tuple[float, str]:
     return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH_BF)
 
 
-def verdict_sections(verdict: Verdict | None) -> list[Section]:
-    """The verdict per sweep group (:mod:`ligwf.report.verdict`), first in the report."""
+def verdict_sections(verdict: Verdict | None, figure: Figure | None = None) -> list[Section]:
+    """The verdict per sweep group (:mod:`ligwf.report.verdict`), first in the report, its
+    forest plot (``figure``) first in it."""
     if verdict is None:
         return [Section("Verdict", "verdict", NO_VERDICT)]
-    return split_markdown(verdict_section(verdict))
+    where = f"{layout.FIGURES_DIR}/{figure.path.name}" if figure is not None else None
+    return split_markdown(verdict_section(verdict, where))
 
 
 def flow_field_sections(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame,
@@ -166,13 +171,18 @@ def flow_field_sections(study: Study, cases: pd.DataFrame, conditions: pd.DataFr
 
 
 def report_figures(study: Study, flow: FlowRecord, cases: pd.DataFrame,
-                   conditions: pd.DataFrame, out: Path, snapshots: bool) -> ReportFigures:
-    """Write every figure and ParaView collection of the report; what was written."""
+                   conditions: pd.DataFrame, out: Path, snapshots: bool,
+                   verdict: Verdict | None = None) -> ReportFigures:
+    """Write every figure and ParaView collection of the report; what was written (the
+    verdict's forest plot and the error-vs-run-time figure both from the verdict's rows)."""
     fig_dir, pv_dir = out / layout.FIGURES_DIR, out / layout.PARAVIEW_DIR
     found = ReportFigures()
+    rows = forest_rows(verdict) if verdict is not None else None
+    if verdict is not None and (path := forest(verdict, fig_dir / layout.FIGURE_VERDICT_FOREST)):
+        found.verdict = Figure("Verdict", path)
     if not conditions.empty:
         found.flow.append(Figure("Error vs run time", figs.pareto(
-            conditions, fig_dir / layout.FIGURE_ERROR_VS_RUNTIME)))
+            conditions, fig_dir / layout.FIGURE_ERROR_VS_RUNTIME, rows)))
         found.flow.append(Figure("Velocity profiles", figs.velocity_profiles(
             cases, flow.cases, fig_dir / layout.FIGURE_VELOCITY_PROFILES)))
     gsd_path = study.analysis_dir / layout.GSD_TABLE

@@ -274,6 +274,7 @@ FIGURE_GLOB = "*.png"
 #: ParaView collections: ``PARAVIEW_DIR/<case_id>.pvd`` + ``PARAVIEW_DIR/<case_id>/drum_<step>.vtu``
 PARAVIEW_DIR = "paraview"
 FIGURE_ERROR_VS_RUNTIME = "error_vs_runtime.png"
+FIGURE_VERDICT_FOREST = "verdict_forest.png"   # the verdict as one picture, first on the page
 FIGURE_VELOCITY_PROFILES = "velocity_profiles.png"
 FIGURE_GSD_OVERLAY = "gsd_overlay.png"
 FIGURE_KINETICS = "granule_kinetics.png"
