@@ -1,0 +1,100 @@
+"""docs/results/paper_scale/: the source study's own drum (0.2 m, 360,000 beads of 1 mm at
+CG1, D/d = 200) decided without CG1 (issue 44 item 4).
+
+Copies the reported tables of the two background studies (`ligwf report` wrote them: the
+verdict against the CG1 value extrapolated from the Weber levels, the extrapolation table,
+the cases) and writes `claims.csv`: the source's two flow claims answered at its own scale
+from the same case tables (Weber against Bond at each level both ran: the angle of repose,
+the rigid-block share, and the share of frames in which one granule holds most of the bed,
+with Welch's 95 % interval of the difference over runs). `--check` compares instead of
+writing.
+
+    .venv/bin/python scripts/paper_scale_results.py [--runs runs] [--check]
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import math
+import shutil
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from ligwf.analysis.records.equivalence import difference_estimate, mean_estimate
+
+ROOT = Path(__file__).resolve().parent.parent
+OUT = ROOT / "docs/results/paper_scale"
+STUDIES = {"weber": "paper_scale_cg", "bond": "paper_scale_cg_bond"}
+#: report tables copied per study (prefix: the rule)
+COPIED = ("cases.csv", "conditions.csv", "verdict.csv", "extrapolation.csv")
+#: the claims' metrics: (column, what it says)
+CLAIMS = (("angle_of_repose", "angle of repose (deg)"),
+          ("rigid_frame_share", "share of frames turning as a rigid block"),
+          ("largest_cluster_fraction", "largest connected cluster, share of the bed"),
+          ("one_granule_frame_share", "share of frames where one granule holds most of the bed"))
+
+
+def claims(we: pd.DataFrame, bo: pd.DataFrame) -> pd.DataFrame:
+    """Per CG level both rules ran and per claim metric: Bond - Weber over runs."""
+    rows = []
+    for cg in sorted(set(we["cg"]) & set(bo["cg"])):
+        for column, what in CLAIMS:
+            if column not in we or column not in bo:
+                continue
+            x = pd.to_numeric(bo.loc[bo["cg"] == cg, column], errors="coerce").dropna()
+            y = pd.to_numeric(we.loc[we["cg"] == cg, column], errors="coerce").dropna()
+            if not len(x) or not len(y):
+                continue
+            d = difference_estimate(x.to_numpy(), y.to_numpy(), alpha=0.025)
+            mb, mw = mean_estimate(x.to_numpy(), 0.025), mean_estimate(y.to_numpy(), 0.025)
+            rows.append(dict(cg=cg, metric=column, what=what, bond=mb.value, bond_lo=mb.lo,
+                             bond_hi=mb.hi, weber=mw.value, weber_lo=mw.lo, weber_hi=mw.hi,
+                             bond_minus_weber=d.value, lo=d.lo, hi=d.hi,
+                             bond_runs=len(x), weber_runs=len(y),
+                             differs=bool(d.has_interval and (d.lo > 0 or d.hi < 0))))
+    return pd.DataFrame(rows)
+
+
+def csv_text(t: pd.DataFrame) -> str:
+    buf = io.StringIO()
+    t.to_csv(buf, index=False, float_format="%.6g")
+    return buf.getvalue()
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--runs", type=Path, default=ROOT / "runs")
+    ap.add_argument("--check", action="store_true")
+    args = ap.parse_args(argv)
+    OUT.mkdir(parents=True, exist_ok=True)
+    tables: dict[str, str] = {}
+    cases = {}
+    for rule, folder in STUDIES.items():
+        report = args.runs / folder / "report"
+        for name in COPIED:
+            src = report / name
+            if src.is_file():
+                tables[f"{rule}_{name}"] = src.read_text()
+        if (report / "cases.csv").is_file():
+            cases[rule] = pd.read_csv(report / "cases.csv")
+    if len(cases) == 2:
+        tables["claims.csv"] = csv_text(claims(cases["weber"], cases["bond"]))
+    if args.check:
+        bad = [n for n, text in tables.items() if (OUT / n).read_text() != text]
+        print("differ: " + ", ".join(bad) if bad else "tables reproduce")
+        return 1 if bad else 0
+    for name, text in tables.items():
+        (OUT / name).write_text(text)
+    for rule, folder in STUDIES.items():
+        summary = args.runs / folder / "report" / "summary.md"
+        if summary.is_file():
+            shutil.copyfile(summary, OUT / f"{rule}_summary.md")
+    print("wrote " + ", ".join(sorted(tables)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,79 @@
+"""docs/results/paper_scale: the README's numbers are those of the committed report tables
+(the verdict against the extrapolated CG1, the extrapolation, the cases)."""
+
+from __future__ import annotations
+
+import pandas as pd
+
+from ligwf.inference.size_relation import SLOPE_DEG
+from ligwf.scene.grains import grains
+from ligwf.scene.model import Scene
+from ligwf.yamlio import read_yaml_file
+from tests.helpers import ROOT
+
+HERE = ROOT / "docs" / "results" / "paper_scale"
+README = " ".join((HERE / "README.md").read_text().split())
+
+
+def _verdict() -> pd.DataFrame:
+    return pd.read_csv(HERE / "weber_verdict.csv")
+
+
+def test_extrapolated_cg1_and_level_means():
+    e = pd.read_csv(HERE / "weber_extrapolation.csv")
+    a = e[e["column"] == "angle_of_repose"].iloc[0]
+    assert a["form"] == "checked" and a["levels"] == "4 6 8"
+    assert (f"**The extrapolated CG1 angle of repose is {a['extrapolated']:.1f} deg "
+            f"[{a['lo']:.1f}, {a['hi']:.1f}]**") in README
+    assert f"lack of fit p = {a['lack_of_fit_p']:.2f}" in README
+    assert f"observed order {a['observed_order']:.1f}" in README
+    assert f"{abs(a['slope_per_level']):.2f} deg a level" in README and a["slope_per_level"] < 0
+    means = pd.read_csv(HERE / "weber_cases.csv").groupby("cg")["angle_of_repose"].mean()
+    assert " / ".join(f"{m:.2f}" for m in means) + " deg at CG4 / CG6 / CG8" in README
+
+
+def test_verdict_rows_are_the_readme():
+    v = _verdict()
+    assert set(v["condition_state"]) == {"fails"}
+    angle = v[v["criterion"] == "angle_deg"].sort_values("cg")
+    assert (angle["state"] == "fail").all()
+    for _, r in angle.iterrows():
+        assert f"{r['value']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}]" in README
+    assert " / ".join(f"{b:.2f}" for b in angle["shown_within"]) in README
+    rigid = v[v["criterion"] == "rigid_share"]
+    assert (rigid["state"] == "pass").all()
+    layer = v[v["criterion"] == "flowing_layer"].sort_values("cg")
+    assert list(layer["state"]) == ["pass", "undecided", "undecided"]
+    r = layer.iloc[0]
+    assert f"{r['value']:.3f} [{r['lo']:.3f}, {r['hi']:.2f}]" in README
+    norms = v[v["criterion"].isin(["profile_error", "field_error", "gsd_error"])]
+    assert (norms["state"] == "not assessed").all()
+
+
+def test_speedups_and_expected_excess():
+    v = _verdict().drop_duplicates("cg").sort_values("cg")
+    assert ", ".join(f"{s:,.0f} at CG{c:g}" for c, s in zip(v["cg"], v["speedup_core"])
+                     ) in README
+    expected = " / ".join(f"{SLOPE_DEG * (n - 1) / 200:.1f}" for n in (4, 6, 8))
+    assert f"expected each level {expected} deg *steeper*" in README
+
+
+def test_grains_in_the_readme():
+    scene = Scene.model_validate(read_yaml_file(ROOT / "workflows" / "paper_scale_cg.yaml",
+                                                 "workflow")["scene"])
+    lifters = " / ".join(f"{grains(scene, n).lifter:.2g}" for n in (4, 6, 8))
+    assert f"lifters are {lifters} grains high" in README
+    cases = pd.read_csv(HERE / "weber_cases.csv")
+    layer = cases.groupby("cg")["flowing_layer_thickness_mean"].mean()
+    assert " / ".join(f"{t / (n * 0.001):.1f}" for n, t in layer.items()) + " grains" in README
+
+
+def test_timing_is_the_recorded_one():
+    import re
+    text = (HERE / "timing.txt").read_text()
+    wall = float(re.search(r"^([\d.]+) s wall", text, re.M).group(1))
+    planned = float(re.search(r"^estimated (\d+) min wall", text, re.M).group(1))
+    cluster = int(re.search(r"estimated (\d+) core-hours in all", text).group(1))
+    assert f"Wall time of the runs: {wall:,.0f} s (the planner predicted {planned:.0f} min)" in README
+    assert f"took {wall / (60 * planned):.1f}x the planner's wall time" in README
+    assert f"prices it at {cluster} core-hours" in README
