@@ -152,7 +152,9 @@ def _arm(runs: pd.DataFrame, column: str, noise: pd.DataFrame | None,
                         col(planning.WINDOW), steady_share=share,
                         replica_core_seconds=float(np.nanmean(col(planning.REPLICA_COST))),
                         production_core_seconds=float(np.nanmean(
-                            col(planning.PRODUCTION_COST)))).scaled(scale)
+                            col(planning.PRODUCTION_COST))),
+                        least_extension=float(np.nanmax(col(planning.LEAST_EXTENSION),
+                                                        initial=0.0))).scaled(scale)
 
 
 def _replica_cost(runs: pd.DataFrame, noise: pd.DataFrame | None) -> float:

@@ -18,10 +18,12 @@ import math
 
 import numpy as np
 
+from ligwf.analysis.records import steady_window as steady
 from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records import sampling
 from ligwf.analysis.records.equivalence import UNDECIDED
 from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
+from ligwf.report import planning
 
 
 def round_fields(o: "sampling.Option | None") -> dict:
@@ -43,17 +45,41 @@ def signed_plan(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
     best = sampling.cheapest(x, y, e.value, budget, alpha, df_rule)
     fields = round_fields(sampling.cheapest(x, y, budget + 0.5 * (e.hi - e.lo) / 2, budget,
                                              alpha, df_rule)) if e.has_interval else {}
+    seeds = cg1_seeds_text(x, y, e.value, budget, alpha, unit, df_rule)
     if best is None:
-        return fields, (f"the difference sits near the budget for its spread: neither "
-                        f"{sampling.MOST_REPLICAS} replicas of an arm nor "
-                        f"{sampling.MOST_EXTENSION:g}x longer runs would decide it")
+        return fields, "; ".join(p for p in (
+            f"the difference sits near the budget for its spread: neither "
+            f"{sampling.MOST_REPLICAS} replicas of an arm nor "
+            f"{sampling.MOST_EXTENSION:g}x longer runs would decide it", seeds) if p)
     fields |= dict(decide_by=best.kind, decide_arm=best.arm, decide_amount=best.amount,
                   decide_amount_cg1=(best.amount_cg1 if best.kind == sampling.REPLICAS
                                      else math.nan),
                   decide_core_hours=best.core_hours,
                   decide_half_width=best.predicted_half_width)
-    return fields, (f"cheapest to decide: {best.text(unit)}; the {sampling.dominant_arm(x, y)} "
-                    "scatter dominates the width now")
+    return fields, "; ".join(p for p in (
+        f"cheapest to decide: {best.text(unit)}; the {sampling.dominant_arm(x, y)} scatter "
+        "dominates the width now", seeds) if p)
+
+
+def cg1_seeds_text(x: sampling.Arm, y: sampling.Arm, difference: float, budget: float,
+                   alpha: float, unit: str, df_rule: str = eq.WELCH) -> str:
+    """When the CG1 seeds bound the degrees of freedom, say so: CG1 is the smaller arm (Hsu's
+    df are its runs - 1, and Welch's fall towards that as CG-n runs are added) and even the
+    most CG-n replicas the planner tries would leave the half-width above the distance of
+    the difference from the budget. Empty otherwise."""
+    gap = abs(abs(difference) - budget)
+    if not (2 <= y.n < x.n) or not gap > 0:
+        return ""
+    most = sampling.MOST_REPLICAS - x.n
+    limit = sampling.half_width(x, y, alpha, add=(most, 0), df_rule=df_rule)
+    if not limit >= gap:
+        return ""
+    df = eq.degrees_of_freedom(x.variance, x.n, y.variance, y.n, df_rule)
+    u = f" {unit}" if unit else ""
+    return (f"CG1 seeds bound the degrees of freedom (df {df:.3g} with {y.n} CG1 runs against "
+            f"{x.n} CG-n; more CG-n runs take it towards {y.n - 1}): even "
+            f"{sampling.MOST_REPLICAS} CG-n runs would leave the half-width at {limit:.3g}{u}, "
+            f"above the {gap:.3g}{u} a decision needs; more CG1 seeds decide it")
 
 
 def profile_plan(x: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
@@ -140,3 +166,30 @@ def decide_text(r) -> str:
     return "cheapest to decide: " + sampling.Option(
         r.decide_by, r.decide_arm, r.decide_amount, r.decide_core_hours,
         r.decide_half_width, 0, cg1).text(r.unit)
+
+
+def too_short_note(runs, ref_runs, noise) -> str:
+    """Whether a level's comparison rests on runs too short to show a steady state: the runs
+    of either arm (``runs`` CG-n, ``ref_runs`` CG1; case tables) whose steady window starts
+    at its cap (the noise table's :data:`~ligwf.report.planning.AT_CAP`), and the
+    production each would need (:data:`~ligwf.report.planning.LEAST_EXTENSION`, the
+    planner's rule). Empty when no run is at its cap or there is no noise table."""
+    if noise is None or noise.empty or planning.AT_CAP not in noise:
+        return ""
+    parts, fixes = [], []
+    for name, arm in (("CG-n", runs), ("CG1", ref_runs)):
+        ids = [i for i in (arm["case_id"] if arm is not None and "case_id" in arm else [])
+               if i in noise.index]
+        capped = [i for i in ids if bool(noise.at[i, planning.AT_CAP])]
+        if capped:
+            parts.append(f"{len(capped)} of {len(ids)} {name} runs")
+            more = max(float(noise.at[i, planning.LEAST_EXTENSION]) for i in capped)
+            fixes.append(f"{more:.3g} s more production on each of those {name} runs")
+    if not parts:
+        return ""
+    return (f"runs too short to show a steady state: the steady window of {' and '.join(parts)} "
+            f"starts at its {100 * steady.CAP:.0f} % cap (steady_after: auto found no steady "
+            f"start in the first half); what would fix it: {' and '.join(fixes)} (the "
+            f"planner's rule: production >= {1 / steady.TARGET_SHARE:g} x the truncation, so "
+            f"the window starts by {100 * steady.TARGET_SHARE:.0f} % of it), then analyse "
+            "again, which tests the start again")

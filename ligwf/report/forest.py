@@ -53,6 +53,7 @@ def forest_rows(verdict: Verdict) -> pd.DataFrame:
         for c in g.conditions:
             for r in c.criteria:
                 rows.append({"group": g.group, "condition": c.name, "level_state": c.state,
+                             "too_short": bool(c.too_short),
                              "speedup": c.speedup, "speedup_lo": c.speedup_lo,
                              "speedup_hi": c.speedup_hi, "criterion": r.name,
                              "label": r.label, "unit": r.unit, "state": r.state,
@@ -126,7 +127,9 @@ def forest_figure(verdict: Verdict) -> Figure | None:
         _criterion_panel(ax, rows[rows["criterion"] == name], ys)
     _speedup_panel(axes[-1], levels, ys)
     axes[0].set_yticks([ys[n] for n in order],
-                       [f"{n}\n({s})" for n, s in zip(order, levels["level_state"])],
+                       [f"{n}\n({s}{'; runs too short' if short else ''})"
+                        for n, s, short in zip(order, levels["level_state"],
+                                               levels["too_short"])],
                        fontsize=8)
     axes[0].set_ylim(-0.7, len(order) - 0.3)
     shown = verdict.statistics.get("interval_level")

@@ -104,7 +104,8 @@ def compact_lines(verdict: Verdict, group: str | None = None) -> list[tuple[str,
     out = []
     for condition, sub in rows.groupby("condition", sort=False):
         first = sub.iloc[0]
-        out.append((head_line(str(condition), first["level_state"], first["speedup"],
+        state = first["level_state"] + ("; runs too short" if first["too_short"] else "")
+        out.append((head_line(str(condition), state, first["speedup"],
                               first["speedup_lo"], first["speedup_hi"]),
                     first["level_state"]))
         for _, r in sub.iterrows():

@@ -8,6 +8,11 @@ Per usable case (one row, indexed by case id):
 * ``window_seconds``: the steady window's length (frames x their spacing, s) and
   ``steady_share``: the share of added production that would be steady window (1 - the
   run's steady fraction: the window is a fraction of the production time);
+* ``steady_at_cap``: the window starts at its cap (``steady_after: auto`` found no steady
+  start in the first half: the run is too short) and ``least_extension_seconds``: the
+  production to add to each run so its truncation is at most a quarter of production (both
+  :mod:`ligwf.analysis.records.steady_window`; 0 for a fixed ``steady_after``, whose window
+  is a fixed share of any production);
 * ``replica_core_seconds``: a new replica from its fill to its end, and
   ``production_core_seconds``: one simulated second of production, both on one rank from
   the planner's measured rates (:func:`ligwf.engine.plan.estimated_seconds`) times what
@@ -25,6 +30,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from ligwf.analysis.records import steady_window as steady
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.sampling import within_variance
 from ligwf.analysis.records.statistics import MEAN, SHARE_ABOVE
@@ -35,6 +41,7 @@ from ligwf.study.case import CaseFolder
 #: the columns of a noise table besides the per-criterion within-run variances
 WINDOW, STEADY_SHARE = "window_seconds", "steady_share"
 REPLICA_COST, PRODUCTION_COST = "replica_core_seconds", "production_core_seconds"
+AT_CAP, LEAST_EXTENSION = "steady_at_cap", "least_extension_seconds"
 
 
 def within_column(column: str) -> str:
@@ -105,8 +112,14 @@ def noise_table(cases: list[CaseFolder], flow: FlowRecord, columns: tuple[str, .
                                for x in run_costs(case.scaled))
         c = flow.cases.get(case.case_id)
         share = 1.0 - float(c.steady_fraction) if c is not None else math.nan
+        fraction = float(c.steady_fraction) if c is not None else math.nan
+        production_time = case.scaled.numerics.run_steps * case.scaled.numerics.dt
+        auto = flow.steady_auto
         row = {"case_id": case.case_id, WINDOW: _window_seconds(flow, case.case_id),
-               STEADY_SHARE: share, REPLICA_COST: replica, PRODUCTION_COST: production}
+               STEADY_SHARE: share, REPLICA_COST: replica, PRODUCTION_COST: production,
+               AT_CAP: auto and steady.at_cap(fraction),
+               LEAST_EXTENSION: (steady.least_extension(fraction, production_time) if auto
+                                 else 0.0)}
         row.update({within_column(col): _series_value_noise(flow, case.case_id, col)
                     for col in columns})
         rows.append(row)

@@ -42,6 +42,7 @@ from ligwf.analysis.records import equivalence as eq
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
 from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.report.criteria import CriterionResult, Gate, band, condition_criteria
+from ligwf.report.deciding import too_short_note
 from ligwf.report.extrapolated import extrapolated_criteria
 from ligwf.report.verdict_statistics import statistics_record
 from ligwf.scene.accept import AcceptSettings
@@ -61,6 +62,9 @@ class ConditionVerdict:
     speedup_lo: float
     speedup_hi: float
     criteria: tuple[CriterionResult, ...]
+    #: runs of either arm too short to show a steady state, and what would fix it
+    #: (:func:`ligwf.report.deciding.too_short_note`; "" when every window starts in time)
+    too_short: str = ""
 
     @property
     def name(self) -> str:
@@ -184,7 +188,7 @@ def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[st
 
 def extrapolated_group(group: str, sub: pd.DataFrame, in_group: pd.DataFrame,
                        accept: AcceptSettings, alpha: float, size_ratio: float,
-                       speedups: dict) -> GroupVerdict:
+                       speedups: dict, noise: pd.DataFrame | None = None) -> GroupVerdict:
     """The verdict of a group without CG1: every CG-n level of a rule with two or more
     levels judged against that rule's extrapolated CG1."""
     out = []
@@ -195,8 +199,10 @@ def extrapolated_group(group: str, sub: pd.DataFrame, in_group: pd.DataFrame,
             continue
         results = extrapolated_criteria(accept, runs, float(row["cg"]), size_ratio, alpha)
         speedup = speedups.get((group, float(row["cg"]), rule), math.nan)
+        level = runs[runs["cg"] == float(row["cg"])]
         out.append(ConditionVerdict(group, float(row["cg"]), rule, int(row["replicas"]),
-                                    speedup, math.nan, math.nan, results))
+                                    speedup, math.nan, math.nan, results,
+                                    too_short_note(level, None, noise)))
     if not out:
         return GroupVerdict(group, (), "No CG1 case in this group and no rule with two CG "
                                        "levels to extrapolate CG1 from: nothing to compare "
@@ -234,7 +240,7 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
         in_group = cases[cases["group"].astype(str) == group]
         if sub[sub["cg"] == REFERENCE_CG].empty:
             groups.append(extrapolated_group(group, sub, in_group, accept, alpha, size_ratio,
-                                             speedups or {}))
+                                             speedups or {}, noise))
             continue
         ref_runs = in_group[in_group["cg"] == REFERENCE_CG]
         gate = gates.get(group, Gate(None, "no cohesionless control ran"))
@@ -246,7 +252,7 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
                                          noise, df_rule)
             out.append(ConditionVerdict(group, float(row["cg"]), str(row["rule"]),
                                         int(row["replicas"]), *band(row, "speedup_core"),
-                                        results))
+                                        results, too_short_note(runs, ref_runs, noise)))
         sentence, cheapest = group_sentence(out)
         groups.append(GroupVerdict(group, tuple(out), sentence, cheapest))
     return Verdict(tuple(groups), accept.model_dump(mode="json"),

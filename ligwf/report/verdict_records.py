@@ -87,7 +87,8 @@ def read_verdict(out: Path) -> Verdict | None:
                              for r in c["criteria"])
                 conds.append(ConditionVerdict(c["group"], float(c["cg"]), c["rule"],
                                               int(c["replicas"]), _nan(c["speedup"]),
-                                              _nan(c["speedup_lo"]), _nan(c["speedup_hi"]), crit))
+                                              _nan(c["speedup_lo"]), _nan(c["speedup_hi"]), crit,
+                                              c.get("too_short") or ""))
             groups.append(GroupVerdict(g["group"], tuple(conds), g["sentence"], g["cheapest"]))
         return Verdict(tuple(groups), rec.get("accept", {}), rec.get("statistics") or {})
     except (OSError, ValueError, KeyError, TypeError):

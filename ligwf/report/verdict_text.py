@@ -77,9 +77,10 @@ def shown_within(c: ConditionVerdict) -> str:
 
 
 def _notes(g: GroupVerdict) -> list[str]:
-    """What would decide each undecided criterion; why a criterion was not assessed or
-    measured, once per group when it is the same for every condition."""
-    out: list[str] = []
+    """Levels whose runs are too short to show a steady state (first: it qualifies every
+    interval of the level); what would decide each undecided criterion; why a criterion
+    was not assessed or measured, once per group when it is the same for every condition."""
+    out: list[str] = [f"{c.name}: {c.too_short}" for c in g.conditions if c.too_short]
     for c in g.conditions:
         out += [f"{c.name}, {r.label}: {r.note}" for r in c.criteria if r.assessed and r.note]
     seen: list[str] = []

@@ -25,11 +25,19 @@ measured spin-up. Rule for ``auto`` (per case, on the production frames):
 
 The result is a fraction of the production time, so the flow metrics and the GSD use the
 same steps (:meth:`ligwf.study.case.CaseFolder.steady_start_step` turns it into a step).
+
+The start is tested, not assumed: a window that starts at the cap means the run is too
+short to show a steady state; the verdict flags it and the planner sizes extensions by the
+rule of :mod:`ligwf.analysis.records.steady_window` (production >= 4 x the truncation).
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+from ligwf.analysis.records.steady_window import CAP
 
 AUTO = "auto"
 RUNNING = 3             # frames per running mean
@@ -98,7 +106,7 @@ def auto_fraction(times: np.ndarray, signals: list[np.ndarray], production_start
     k = min(k, len(t) // 2)
     frac = (t[k] - production_start) / production_time
     # just below the frame time, so the frame itself is inside the window
-    return float(min(max(frac - 1e-9, 0.0), 0.5))
+    return float(min(max(frac - 1e-9, 0.0), CAP))
 
 
 def is_auto(steady_after) -> bool:

@@ -14,6 +14,8 @@ Two ways to narrow Welch's interval of CG-n - CG1:
 * **extend** the arm's existing runs by S seconds of production (continued from their
   restarts: no fill, no settle): the window of each run grows by ``steady_share x S`` and
   only the within part of its run mean shrinks (``v_within x W / (W + steady_share S)``);
+  S is at least the arm's ``least_extension``, so that the steady window's truncation stays
+  at most a quarter of production (half its cap: :mod:`ligwf.analysis.records.steady_window`);
 * **add K replicas** to the arm: the variance of its mean shrinks as 1 / (R + K), the
   degrees of freedom grow.
 
@@ -58,7 +60,10 @@ def within_variance(series) -> float:
 class Arm:
     """One arm of a comparison as the planning sees it: per run its value (the
     steady-window mean), the within-run variance of that value, its window length (s), and
-    the cost of a replica and of one second of production (core-seconds, per run)."""
+    the cost of a replica and of one second of production (core-seconds, per run), and the
+    least extension its runs need to be steady (s of production per run,
+    :func:`ligwf.analysis.records.steady_window.least_extension`: 0 when every window
+    starts by a quarter of production)."""
 
     values: np.ndarray
     within: np.ndarray
@@ -66,6 +71,7 @@ class Arm:
     steady_share: float = 0.75          # share of added production that is steady window
     replica_core_seconds: float = math.nan
     production_core_seconds: float = math.nan   # per simulated second, per run
+    least_extension: float = 0.0
 
     @property
     def n(self) -> int:
@@ -79,7 +85,8 @@ class Arm:
     def scaled(self, factor: float) -> "Arm":
         """The arm in another unit (values x factor, variances x factor^2)."""
         return Arm(self.values * factor, self.within * factor**2, self.window,
-                   self.steady_share, self.replica_core_seconds, self.production_core_seconds)
+                   self.steady_share, self.replica_core_seconds, self.production_core_seconds,
+                   self.least_extension)
 
 
 def arm(values, within=None, window=None, **kw) -> Arm:
@@ -231,12 +238,15 @@ def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool
 
     if not h(longest) < gap or h(0.0) < gap:
         return None                 # nothing decides it, or it is decided at this alpha
-    lo, hi = 0.0, longest
+    # an extension keeps the steady window's truncation well below its cap: at least the
+    # production its runs need for that (the steady module's rule), more if the gap asks
+    least = max(a.least_extension for a in arms)
+    lo, hi = 0.0, max(longest, least)
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if h(mid) < gap else (mid, hi)
     s = float(f"{hi:.2g}")
-    s = s if h(s) < gap else hi
+    s = max(s if h(s) < gap else hi, least)
     cost = sum(a.n * a.production_core_seconds * s for a in arms) / 3600.0
     name = "CG-n and CG1" if all(which) else ("CG-n" if which[0] else "CG1")
     return Option(EXTEND, name, s, cost, h(s), sum(a.n for a in arms))

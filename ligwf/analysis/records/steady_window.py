@@ -1,0 +1,43 @@
+"""Whether a steady window shows a steady state, and how much longer production would.
+
+``steady_after: auto`` (:mod:`ligwf.analysis.flow.steady`) never starts the window later than
+:data:`CAP` of the production time. The start is tested, not assumed: a window that starts
+at the cap (:func:`at_cap`) means the rule found no steady start in the first half, i.e.
+the run is too short to show a steady state (MSER practice: a truncation near n / 2 means
+more data are needed). The verdict flags such runs and says how much longer production
+would fix it, and the planner sizes extensions by the same rule (:func:`least_extension`):
+**production at least 1 / TARGET_SHARE = 4 x the truncation**, so the window starts by 25 %
+of production, half the cap. A capped run's truncation is only known to be at least half
+its production, so its production at least doubles; the start is tested again on the
+longer run (``benchmarks/bench_steady.py --extension`` checks the rule on synthetic runs).
+Pure: numbers in, numbers out.
+"""
+
+from __future__ import annotations
+
+import math
+
+#: the window never starts later than this fraction of production
+CAP = 0.5
+#: a start at or after this fraction counts as at the cap: the cap is frame n // 2, which
+#: sits up to a frame or two below 0.5 (benchmarks/bench_steady.py counts the same way)
+AT_CAP = 0.45
+#: the truncation a planned production keeps to: well below the cap (half of it)
+TARGET_SHARE = 0.25
+
+
+def at_cap(fraction: float) -> bool:
+    """True when a steady window starts at its cap (:data:`AT_CAP` of production or later):
+    ``auto`` found no steady start in the first half of the run."""
+    return math.isfinite(fraction) and fraction >= AT_CAP
+
+
+def least_extension(fraction: float, production_time: float) -> float:
+    """Seconds of production to add to a run whose window starts at ``fraction`` of its
+    ``production_time`` (s) so the truncation is at most :data:`TARGET_SHARE` of the new
+    production: ``max(0, fraction x P / TARGET_SHARE - P)`` (a run at the cap: at least its
+    production again, since its truncation is only known to be >= half of it)."""
+    if not (math.isfinite(fraction) and math.isfinite(production_time)) or production_time <= 0:
+        return 0.0
+    truncation = max(fraction, CAP if at_cap(fraction) else 0.0) * production_time
+    return max(0.0, truncation / TARGET_SHARE - production_time)
