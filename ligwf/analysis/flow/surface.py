@@ -60,7 +60,7 @@ def _strip_tops(x: np.ndarray, top: np.ndarray, width: float, half: float,
                 gap: float) -> tuple[np.ndarray, np.ndarray]:
     """(x centre, surface height) per strip over |x| < half; airborne particles skipped.
     The strips sit on a grid anchored at the bed's centre line (x = 0) and end at +-half
-    (the end strips narrower), so two beds of other particle sizes are cut at the same
+    (an end strip cut to under half a width is left out), so two beds of other particle sizes are cut at the same
     places when ``width`` is the same. (The former grid started at -half and its last strip
     ran up to a width past +half: the window itself grew with the strip width.)"""
     k = math.ceil(half / width)
@@ -68,6 +68,8 @@ def _strip_tops(x: np.ndarray, top: np.ndarray, width: float, half: float,
     idx = np.where(np.abs(x) < half, np.digitize(x, edges) - 1, -1)
     xs, ys = [], []
     for k in range(len(edges) - 1):
+        if edges[k + 1] - edges[k] < 0.5 * width:
+            continue   # an end strip cut to under half a width: too few particles to trust
         h = np.sort(top[idx == k])[::-1]
         if len(h) < 3:
             continue
