@@ -29,6 +29,11 @@ Registered before the first run (2026-12-06 03:30 UTC):
   with a start-up the bias of its window mean lies within +-0.5 standard errors in every cell.
 
     .venv/bin/python benchmarks/bench_steady.py            # ~1 min
+
+The planner's extension rule (``--extension``, :func:`extension_check`; its hypotheses
+H-ext1-3 registered in docs/results/steady/README.md on 2026-12-07 before their run):
+
+    .venv/bin/python -m benchmarks.bench_steady --extension --trials 20000 --seed 20261208
 """
 
 from __future__ import annotations
@@ -82,14 +87,15 @@ def cell(rng, trials: int, frames: int, phi: float, oscillation: float, startup:
 
 
 def extension_check(rng, trials: int, frames: int = 80, phi: float = 0.5,
-                    tau: float = 16.0) -> None:
+                    tau: float = 16.0) -> dict:
     """The planner's extension rule (``--extension``): runs of ``frames`` frames whose
     start-up (5 sds, relaxing with ``tau`` frames: settled to 0.1 sd only after ~4 tau)
     outlasts half of them, so ``auto`` starts their window at the cap; each capped run is
     continued by :func:`least_extension` (production >= 4 x the truncation) and analysed
-    again. Printed: the share capped before, the share still capped after, the median
-    truncation after (fraction of the new production; the rule aims at <= TARGET_SHARE)
-    and the bias of the window mean after, in standard errors."""
+    again. Returned: the share capped before, the number of extended (capped) runs, the
+    share of them still capped after, the median truncation after (fraction of the new
+    production; the rule aims at <= TARGET_SHARE), the share of them truncated later than
+    TARGET_SHARE, and the bias of the window mean after, in standard errors."""
     before, after, share, bias = [], [], [], []
     for _ in range(trials):
         longest = 6 * frames
@@ -110,11 +116,49 @@ def extension_check(rng, trials: int, frames: int = 80, phi: float = 0.5,
         k = int(math.ceil(g * n - 1e-6))
         window = sig[0][k:n]
         bias.append(window.mean() / math.sqrt(ar1_mean_variance(len(window), phi)))
-    print(f"extension rule: {frames} frames, phi {phi}, start-up tau {tau:g} frames, "
-          f"{trials} trials: capped before {np.mean(before):.2f}; of those, capped after the "
-          f"extension {np.mean(after) if after else float('nan'):.2f}, median truncation "
-          f"{np.median(share) if share else float('nan'):.2f} of the new production "
-          f"(rule: <= {TARGET_SHARE:g}), window-mean bias {np.mean(bias) if bias else 0:.2f} se")
+    nan = float("nan")
+    return {"phi": phi, "tau": tau, "trials": trials, "before": float(np.mean(before)),
+            "extended": len(after), "after": float(np.mean(after)) if after else nan,
+            "median": float(np.median(share)) if share else nan,
+            "late": float(np.mean(np.asarray(share) > TARGET_SHARE)) if share else nan,
+            "bias": float(np.mean(bias)) if bias else nan}
+
+
+#: registered 2026-12-07 (docs/results/steady/README.md), before the run with --seed 20261208
+EXT_STILL_CAPPED = 0.05     # H-ext1: share of extended runs still at the cap, every cell
+EXT_MEDIAN = TARGET_SHARE   # H-ext2: median truncation after, fraction of the new production
+EXT_BIAS = 0.25             # H-ext3: |window-mean bias| after, standard errors
+
+
+def extension_main(rng, trials: int) -> None:
+    """The extension check's table and its registered hypotheses (phi 0.5 cells; the phi 0.8
+    cells are reported beside, without a criterion)."""
+    print(f"extension rule: 80 frames of production, {trials} trials a cell; capped = start "
+          f">= {CAP_SHARE:.0%} of production; each capped run extended by least_extension "
+          f"(production >= {1 / TARGET_SHARE:g} x the truncation) and analysed again; "
+          f"median and late (share > {TARGET_SHARE:g}) of the truncation after, in the new "
+          "production; bias = mean (window mean - level) / se")
+    print(f"{'phi':>4} {'tau':>4} | {'trials':>6} {'capped':>6} | {'extended':>8} "
+          f"{'capped':>6} {'median':>6} {'late':>6} {'bias':>6}")
+    cells = []
+    for phi in (0.5, 0.8):
+        for tau in (12.0, 16.0, 24.0):
+            c = extension_check(rng, trials, phi=phi, tau=tau)
+            cells.append(c)
+            print(f"{phi:4.1f} {tau:4.0f} | {c['trials']:6d} {c['before']:6.3f} | "
+                  f"{c['extended']:8d} {c['after']:6.3f} {c['median']:6.4f} {c['late']:6.3f} "
+                  f"{c['bias']:6.2f}", flush=True)
+    registered = [c for c in cells if c["phi"] == 0.5]
+    verdict = {
+        f"H-ext1 (phi 0.5: still at the cap after one extension <= {EXT_STILL_CAPPED:g} in "
+        "every cell)": all(c["after"] <= EXT_STILL_CAPPED for c in registered),
+        f"H-ext2 (phi 0.5: median truncation after <= {EXT_MEDIAN:g} of the new production "
+        "in every cell)": all(c["median"] <= EXT_MEDIAN for c in registered),
+        f"H-ext3 (phi 0.5: |window-mean bias| after <= {EXT_BIAS:g} se in every cell)":
+            all(abs(c["bias"]) <= EXT_BIAS for c in registered),
+    }
+    for line, met in verdict.items():
+        print(f"{line}: {'met' if met else 'not met'}")
 
 
 def main(argv=None) -> int:
@@ -126,8 +170,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     if args.extension:
-        for tau in (12.0, 16.0, 24.0):
-            extension_check(rng, args.trials, tau=tau)
+        extension_main(rng, args.trials)
         return 0
     print(f"steady-window start: {args.trials} trials a cell; capped = start >= "
           f"{CAP_SHARE:.0%} of production; bias = mean (window mean - level) / se")
