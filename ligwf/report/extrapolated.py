@@ -19,6 +19,7 @@ import math
 import pandas as pd
 
 from ligwf.analysis.records import equivalence as eq
+from ligwf.analysis.records import sampling
 from ligwf.analysis.records.equivalence import FAIL, UNDECIDED
 from ligwf.inference import extrapolation as ex
 from ligwf.inference.reference import level_values, slope_scale
@@ -60,11 +61,17 @@ def _signed(spec, tolerance: float, runs: pd.DataFrame, cg: float, ratio: float,
             f"{where}; a level has one run: no interval (run at least 2 replicas a level)")
         ), math.nan
     test = eq.equivalence(d, tolerance, alpha)
-    note = where if test.state != UNDECIDED else (
-        f"{where}; more replicas at every level narrow it (the noise), more levels or a "
-        "finer one shrink the model term")
+    note, rounds = where, {}
+    if test.state == UNDECIDED:
+        note = (f"{where}; more replicas at every level narrow it (the noise), more levels "
+                "or a finer one shrink the model term")
+        # a sequential study's round (--until-decided): double this level's runs (the
+        # level judged weighs most in its own contrast; --every-level doubles them all)
+        n_runs = int(sum(len(v) for k, v in values.items() if float(k) == float(cg)))
+        rounds = dict(round_by=sampling.REPLICAS, round_arm="CG-n",
+                      round_amount=float(max(n_runs, 1)))
     return CriterionResult(**base, state=test.state, value=d.value, lo=d.lo, hi=d.hi,
-                           bound=max(abs(d.lo), abs(d.hi)), note=note), test.p_fail
+                           bound=max(abs(d.lo), abs(d.hi)), note=note, **rounds), test.p_fail
 
 
 def extrapolated_criteria(accept: AcceptSettings, runs: pd.DataFrame, cg: float,
