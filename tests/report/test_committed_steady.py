@@ -1,7 +1,9 @@
-"""docs/results/steady: the README's numbers are those of the committed bench_steady.txt."""
+"""docs/results/steady: the README's numbers are those of the committed bench outputs
+(bench_steady.txt, bench_steady_hybrid.txt, bench_steady_extension.txt and the long check's tables)."""
 
 from __future__ import annotations
 
+import math
 import re
 
 import pandas as pd
@@ -87,3 +89,76 @@ def test_the_new_rule_and_the_long_check_numbers_are_their_files():
     ext = check[check["kind"] == "extension"]
     assert (f"holds in {int(ext['within_30_percent'].sum())} of "
             f"{int(ext['measured_over_predicted'].notna().sum())} rows with a ratio") in text
+
+
+#: registered 2026-12-07 in the README before the run (commit 9913c9d)
+EXT_REGISTERED = {"still_capped": 0.05, "median": 0.25, "bias": 0.25}
+
+
+def _extension_rows() -> tuple[list[dict], str]:
+    """The cells of the committed ``bench_steady --extension`` run, and the file's text."""
+    text = (HERE / "bench_steady_extension.txt").read_text()
+    first = text.splitlines()[0]
+    assert first.startswith("# ") and "bench_steady --extension" in first
+    assert "--trials 20000 --seed 20261208" in first
+    rows = []
+    for line in text.splitlines():
+        m = re.match(r"^\s*([\d.]+)\s+(\d+) \|\s+(\d+)\s+([\d.]+) \|\s+(\d+)\s+([\d.]+)\s+"
+                     r"([\d.]+)\s+([\d.]+)\s+(-?[\d.]+)$", line)
+        if m:
+            rows.append({"phi": float(m.group(1)), "tau": int(m.group(2)),
+                         "trials": int(m.group(3)), "before": m.group(4),
+                         "extended": int(m.group(5)), "after": m.group(6),
+                         "median": m.group(7), "late": m.group(8), "bias": m.group(9)})
+    assert [(r["phi"], r["tau"]) for r in rows] == [(phi, tau) for phi in (0.5, 0.8)
+                                                    for tau in (12, 16, 24)]
+    assert all(r["trials"] == 20000 for r in rows)
+    return rows, text
+
+
+def test_the_extension_rule_numbers_are_their_file():
+    from benchmarks import bench_steady
+
+    # the thresholds the bench applies are the registered ones
+    assert (bench_steady.EXT_STILL_CAPPED, bench_steady.EXT_MEDIAN, bench_steady.EXT_BIAS) == (
+        EXT_REGISTERED["still_capped"], EXT_REGISTERED["median"], EXT_REGISTERED["bias"])
+    rows, verdicts = _extension_rows()
+    text = " ".join((HERE / "README.md").read_text().split())
+    reg = [r for r in rows if r["phi"] == 0.5]
+    beside = [r for r in rows if r["phi"] == 0.8]
+
+    def span(cells, key, fmt=".3f"):
+        values = sorted(float(r[key]) for r in cells)
+        return f"{values[0]:{fmt}}-{values[-1]:{fmt}}"
+
+    def each(key):
+        return ", ".join(r[key] for r in reg[:-1]) + f" and {reg[-1][key]}"
+
+    met = {
+        "H-ext1": all(float(r["after"]) <= EXT_REGISTERED["still_capped"] for r in reg),
+        "H-ext2": all(float(r["median"]) <= EXT_REGISTERED["median"] for r in reg),
+        "H-ext3": all(abs(float(r["bias"])) <= EXT_REGISTERED["bias"] for r in reg),
+    }
+    for h, ok in met.items():
+        # the file's verdict line, recomputed from its table, and the README's, as registered
+        assert re.search(rf"^{h} .*: {'met' if ok else 'not met'}$", verdicts, re.M)
+        assert f"**{h} is {'met' if ok else 'not met'}" in text
+    assert f"starts at the cap in {span(reg, 'before')} of runs" in text
+    assert (f"extended ({min(r['extended'] for r in reg)}-{max(r['extended'] for r in reg)} "
+            f"a cell), the window still starts at the cap in {each('after')}") in text
+    assert f"is {each('median')} of the new production" in text
+    assert f"later than 0.25 in {each('late')} of the extended runs" in text
+    bias = sorted(float(r["bias"]) for r in reg)
+    assert f"off by {bias[0]:.2f} to {bias[-1]:.2f} standard errors" in text
+    assert (f"still at the cap after the extension {span(beside, 'after')}, median truncation "
+            f"{span(beside, 'median', '.4f')}") in text
+    # the sentences around them: which cells fail, by how much, and the registered precision
+    tau16, tau24 = reg[1], reg[2]
+    excess = float(tau16["after"]) - EXT_REGISTERED["still_capped"]
+    precision = 1.96 * math.sqrt(0.05 * 0.95 / min(r["extended"] for r in reg))
+    assert f"at tau 16 by {excess:.3f}" in text and excess < round(precision, 3) == 0.007
+    assert float(tau24["after"]) >= 2 * EXT_REGISTERED["still_capped"]
+    assert f"{float(tau24['after']):.1f}" == "0.1" and "a tenth of the doubled runs" in text
+    assert float(tau24["late"]) > 0.5 and "most start later than a quarter" in text
+    failing = [r["tau"] for r in reg if float(r["median"]) > EXT_REGISTERED["median"]]
+    assert failing == [24] and "**H-ext2 is not met** (tau 24)" in text
