@@ -10,7 +10,8 @@ import math
 
 import pandas as pd
 
-from ligwf.inference.reference import planned_cg1_speedup, size_ratio
+from ligwf.inference.reference import ANGLE_COLUMN, planned_cg1_speedup, size_ratio
+from ligwf.inference.size_relation import expected_excess
 from ligwf.report.sections import Section
 from ligwf.study import layout
 from ligwf.study.study import Study
@@ -41,9 +42,41 @@ def _num(v, fmt: str = ".3g") -> str:
     return format(v, fmt) if math.isfinite(v) else "–"
 
 
-def extrapolation_section(table: pd.DataFrame, ratio: float) -> list[Section]:
-    """The report section of ``extrapolation.csv`` (none when no rule has two CG levels)."""
-    if table.empty:
+def expected_lines(cases: pd.DataFrame, table: pd.DataFrame, ratio: float) -> list[str]:
+    """Per Weber level: the angle excess the size relation expected before the run, beside
+    the one measured (against the group's CG1 runs, else against the extrapolated CG1)."""
+    if cases.empty or not math.isfinite(ratio) or ANGLE_COLUMN not in cases:
+        return []
+    lines = []
+    for group, in_group in cases.groupby(cases["group"].astype(str), sort=True):
+        angle = pd.to_numeric(in_group[ANGLE_COLUMN], errors="coerce")
+        ref = angle[in_group["cg"] == 1.0].mean()
+        source = "its CG1 runs"
+        if not math.isfinite(ref):
+            row = table[(table["group"] == group) & (table["rule"] == "weber")
+                        & (table["column"] == ANGLE_COLUMN)]
+            ref = float(row["extrapolated"].iloc[0]) if len(row) else math.nan
+            source = "the extrapolated CG1"
+        label = (str(in_group["group_label"].iloc[0]) if "group_label" in in_group
+                 else group)
+        weber = in_group["rule"].astype(str) == "weber"
+        for cg in sorted(set(in_group.loc[weber & (in_group["cg"] > 1.0), "cg"])):
+            e = expected_excess(float(cg), ratio)
+            measured = angle[weber & (in_group["cg"] == cg)].mean() - ref
+            lines.append(f"- {label}, CG{cg:g}: expected {e.value:.2g} deg [{e.lo:.2g}, "
+                         f"{e.hi:.2g}] steeper (D / (n d) = {e.d_over_nd:.3g}, "
+                         f"{'inside' if e.inside_fit else 'outside'} the fitted range); "
+                         f"measured {_num(measured)} deg against {source}")
+    return (["", "The size relation's expectation for each Weber level (what `ligwf check` "
+             "printed before the runs) beside what was measured:", ""] + lines) if lines else []
+
+
+def extrapolation_section(table: pd.DataFrame, ratio: float,
+                          cases: pd.DataFrame | None = None) -> list[Section]:
+    """The report section of ``extrapolation.csv`` and the size relation's expectations
+    (none when no rule has two CG levels and no Weber level ran)."""
+    expected = expected_lines(cases if cases is not None else pd.DataFrame(), table, ratio)
+    if table.empty and not expected:
         return []
     lines = [f"The CG1 value of each signed criterion extrapolated from the CG-n levels of "
              f"each rule: a line in n through the level means, its 95 % interval carrying the "
@@ -64,4 +97,6 @@ def extrapolation_section(table: pd.DataFrame, ratio: float) -> list[Section]:
             f"{_num(r['extrapolated'])} [{_num(r['lo'])}, {_num(r['hi'])}] | "
             f"{_num(r['model_term'])} | {r['form']} | {_num(r['lack_of_fit_p'], '.2g')} | "
             f"{_num(r['observed_order'], '.2g')} | {_num(r['cg1_measured'])} | {inside} |")
-    return [Section("Extrapolated CG1", "extrapolated-cg1", "\n".join(lines))]
+    if table.empty:
+        lines = lines[:1]
+    return [Section("Extrapolated CG1", "extrapolated-cg1", "\n".join(lines + expected))]

@@ -100,7 +100,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
     figures = report_figures(study, flow, cases, conditions, out, snapshots, verdict)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
-                               verdict, [*extrapolation_section(extrapolated, ratio),
+                               verdict, [*extrapolation_section(extrapolated, ratio, cases),
                                          *scale_section(study, conditions),
                                          *flow_field_sections(study, cases, conditions, out)])
     title = f"{study.name}: error against run time"
