@@ -121,7 +121,7 @@ def test_stale_and_foreign_analysis_is_refused(study, copy, tmp_path, capsys):
     shutil.copytree(study, other)
     # re-run with another rpm: cases re-rendered and run again, analysis/ left as it was
     assert main(["run", str(TINY), "--out", str(other), "--np", "1", *BOND,
-                 "--set", "scene.process.rotation.rpm=40"]) == 0
+                 "--set", "scene.process.rotation.rpm=40", "--replace"]) == 0
     capsys.readouterr()
     code, _, err = run(capsys, "report", str(other), "--no-snapshots")
     line = one_line(err)
