@@ -47,10 +47,10 @@ def cmd_check(args: argparse.Namespace) -> int:
                              "'ligwf run' / 'ligwf study' do without --np / --ensemble"))
     console.print(regime_table(prepared))
     console.print(grains_table(prepared))
-    for g in level_grains(prepared):
-        if g.warning:
-            err_console.print(f"[yellow]ligwf: warning:[/] {escape(g.warning)}",
-                              highlight=False, soft_wrap=True)
+    warnings = [g.warning for g in level_grains(prepared)] + [strip_problem(prepared)]
+    for w in filter(None, warnings):
+        err_console.print(f"[yellow]ligwf: warning:[/] {escape(w)}", highlight=False,
+                          soft_wrap=True)
     for line in size_relation_lines(prepared):
         console.print(line, highlight=False, soft_wrap=True)
     try:
@@ -87,6 +87,17 @@ def level_grains(prepared) -> list:
         return []
     scene = prepared.rendered[0].case.scene
     return [grains(scene, cg) for cg in sorted({rc.case.cg for rc in prepared.rendered})]
+
+
+def strip_problem(prepared) -> str | None:
+    """Whether the study's one surface resolution leaves its bed too few strips."""
+    from ligwf.scene.grains import scaled_mean_diameter, strip_warning, study_strip
+
+    if not prepared.rendered:
+        return None
+    strip = study_strip([scaled_mean_diameter(rc.scaled) for rc in prepared.rendered],
+                        prepared.workflow.analysis.surface_strip)
+    return strip_warning(prepared.rendered[0].case.scene, strip)
 
 
 def grains_table(prepared) -> Table:

@@ -88,3 +88,33 @@ def study_strip(mean_diameters, setting: float | None = None) -> float | None:
         return float(setting) if setting > 0 else None
     d = [float(x) for x in mean_diameters if x and math.isfinite(float(x))]
     return 2.0 * max(d) if d else None
+
+
+#: the share of the half chord the surface fit uses (ligwf.analysis.flow.surface.SPAN) and
+#: the fewest strips it fits a line through
+SURFACE_SPAN, SURFACE_MIN_STRIPS = 0.7, 4
+
+
+def surface_strips(scene: Scene, strip: float) -> int:
+    """How many full strips of width ``strip`` (m) the surface fit can cut from the chord
+    of the bed at rest: with fewer than SURFACE_MIN_STRIPS no angle of repose is measured
+    (at any level, when ``strip`` is the study's one resolution)."""
+    radius = 0.5 * scene.drum.diameter
+    depth = segment_depth(radius, scene.process.fill_fraction)
+    half = SURFACE_SPAN * math.sqrt(max(radius ** 2 - (radius - depth) ** 2, 0.0))
+    k = math.floor(half / strip)
+    return 2 * k + (2 if half - k * strip >= 0.5 * strip else 0)
+
+
+def strip_warning(scene: Scene, strip: float | None) -> str | None:
+    """One line when the study's strips leave the fit fewer than its fewest strips."""
+    if not strip:
+        return None
+    n = surface_strips(scene, strip)
+    if n >= SURFACE_MIN_STRIPS:
+        return None
+    return (f"analysis.surface_strip: the study's one resolution, strips of "
+            f"{strip * 1e3:.3g} mm, cuts the bed's surface into "
+            f"{n} strips, fewer than the {SURFACE_MIN_STRIPS} the fit needs: no angle of "
+            "repose at any level; lower the coarsest CG level or set analysis.surface_strip "
+            "(0: each case's own 2 d, whose resolution moves with the level)")

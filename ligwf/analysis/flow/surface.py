@@ -40,7 +40,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-SPAN = 0.7          # share of the half chord used for the fit (walls and lifters left out)
+from ligwf.scene.grains import SURFACE_SPAN
+
+SPAN = SURFACE_SPAN  # share of the half chord used for the fit (walls and lifters left out)
 MAD_CUT = 3.0       # outliers: residual beyond this many scaled MADs
 MAD_SCALE = 1.4826  # MAD -> standard deviation for normal scatter
 

@@ -14,7 +14,10 @@ import pytest
 
 from ligwf.analysis.flow import surface
 from ligwf.analysis.flow.surface import fit_surface
-from ligwf.scene.grains import study_strip
+from ligwf.scene.grains import strip_warning, study_strip, surface_strips
+from ligwf.scene.model import Scene
+from ligwf.yamlio import read_yaml_file
+from helpers import ROOT
 
 R = 0.05          # drum radius, m
 SIZES = (0.001, 0.002, 0.003)
@@ -86,3 +89,17 @@ def test_study_strip_setting():
     assert study_strip([0.001, 0.004], 0.01) == pytest.approx(0.01)
     assert study_strip([0.001, 0.004], 0.0) is None       # 0: each case's own diameter
     assert study_strip([]) is None
+
+
+def _scene(name: str) -> Scene:
+    return Scene.model_validate(read_yaml_file(ROOT / "workflows" / name, "workflow")["scene"])
+
+
+def test_check_warns_when_the_one_resolution_leaves_too_few_strips():
+    """The demo drum at CG4 (8 mm beads, 50 mm drum): 16 mm strips leave 2; the source drum
+    at CG8 (16 mm strips in 0.2 m) leaves plenty."""
+    demo = _scene("extrapolation_demo_drum.yaml")
+    assert surface_strips(demo, 0.016) == 2
+    assert "2 strips, fewer than the 4" in strip_warning(demo, 0.016)
+    assert strip_warning(demo, 0.004) is None and strip_warning(demo, None) is None
+    assert surface_strips(_scene("paper_scale_cg.yaml"), 0.016) >= 8
