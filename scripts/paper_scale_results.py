@@ -24,6 +24,8 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf.analysis.records.equivalence import difference_estimate, mean_estimate
+from ligwf.inference import extrapolation as ex
+from ligwf.inference.reference import level_values, slope_scale
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs/results/paper_scale"
@@ -55,6 +57,21 @@ def claims(we: pd.DataFrame, bo: pd.DataFrame) -> pd.DataFrame:
                              bond_minus_weber=d.value, lo=d.lo, hi=d.hi,
                              bond_runs=len(x), weber_runs=len(y),
                              differs=bool(d.has_interval and (d.lo > 0 or d.hi < 0))))
+    # both rules target the same CG1: their extrapolated CG1 angles, and their difference
+    ratio = 0.001 / 0.2
+    fits = {rule: ex.extrapolate(level_values(t, "angle_of_repose"), ratio, 0.025,
+                                 slope_scale=slope_scale("angle_of_repose", ratio))
+            for rule, t in (("weber", we), ("bond", bo))}
+    d = ex.disagreement(fits["bond"], fits["weber"], 0.025)
+    rows.append(dict(cg=1.0, metric="extrapolated_cg1_angle",
+                     what="CG1 angle of repose extrapolated from each rule's levels (deg; "
+                          f"weber {fits['weber'].form}, bond {fits['bond'].form})",
+                     bond=fits["bond"].value, bond_lo=fits["bond"].lo, bond_hi=fits["bond"].hi,
+                     weber=fits["weber"].value, weber_lo=fits["weber"].lo,
+                     weber_hi=fits["weber"].hi, bond_minus_weber=d.value, lo=d.lo, hi=d.hi,
+                     bond_runs=int(sum(fits["bond"].replicas)),
+                     weber_runs=int(sum(fits["weber"].replicas)),
+                     differs=bool(d.has_interval and (d.lo > 0 or d.hi < 0))))
     return pd.DataFrame(rows)
 
 

@@ -77,3 +77,26 @@ def test_timing_is_the_recorded_one():
     assert f"Wall time of the runs: {wall:,.0f} s (the planner predicted {planned:.0f} min)" in README
     assert f"took {wall / (60 * planned):.1f}x the planner's wall time" in README
     assert f"prices it at {cluster} core-hours" in README
+
+
+def _claim(metric: str, cg: float) -> pd.Series:
+    c = pd.read_csv(HERE / "claims.csv")
+    return c[(c["metric"] == metric) & (c["cg"] == cg)].iloc[0]
+
+
+def test_the_two_claims_are_the_table():
+    for cg in (4.0, 6.0):
+        a = _claim("angle_of_repose", cg)
+        assert a["differs"] and a["lo"] > 0
+        assert f"{a['bond_minus_weber']:.1f} [{a['lo']:.1f}, {a['hi']:.1f}] deg" in README
+        r = _claim("rigid_frame_share", cg)
+        assert f"{r['bond']:.3f}" in README and f"{r['weber']:.3f}" in README
+        big = _claim("largest_cluster_fraction", cg)
+        assert f"{big['bond']:.3f} [{big['bond_lo']:.3f}, {big['bond_hi']:.3f}]" in README
+        assert _claim("one_granule_frame_share", cg)[["bond", "weber"]].max() == 0.0
+    x = _claim("extrapolated_cg1_angle", 1.0)
+    assert x["differs"] and "bond unchecked" in x["what"] and "weber checked" in x["what"]
+    assert (f"extrapolate to a CG1 angle of {x['bond']:.1f} deg, {x['bond_minus_weber']:.1f} "
+            f"[{x['lo']:.1f}, {x['hi']:.1f}] deg above Weber's {x['weber']:.1f}") in README
+    bond = pd.read_csv(HERE / "bond_verdict.csv")
+    assert set(bond[bond["criterion"] == "angle_deg"]["state"]) == {"undecided"}
