@@ -43,10 +43,10 @@ PAIRS = (
     ("ladder cap_80min", "docs/results/ladder/cap_80min/cases.csv", 0.001 / 0.05),
     ("we_vs_bo", "docs/results/we_vs_bo/cases.csv", 0.001 / 0.05),
 )
-#: the new drums of criterion.md (run folders, analysed): (name, study folder, d / D)
+#: the new drums of criterion.md (run folders, analysed as amendments 3 and 4 say: each
+#: case's own strips, in the hard-linked copy): (name, study folder, d / D)
 NEW_PAIRS = (
-    ("demo drum CG2-4", "extrapolation_demo_drum", 0.002 / 0.05),
-    ("new drum CG2-4", "extrapolation_new_drum", 0.0025 / 0.07),
+    ("demo drum CG1.5-2.5", "extrapolation_demo_drum_perlevel", 0.002 / 0.05),
 )
 COLUMN = "angle_of_repose"
 

@@ -77,3 +77,36 @@ def test_committed_pairs_counts(rule, word):
     else:
         assert (f"extrapolated {sub['extrapolated'].min():.1f}-{sub['extrapolated'].max():.1f}"
                 in README)
+
+
+def test_new_drum_pairs_and_registered_criteria():
+    v = pd.read_csv(HERE / "validation.csv")
+    new = v[v["pair"] == "demo drum CG1.5-2.5"].set_index("rule")
+    assert list(new["levels"]) == ["1.5 2 2.5"] * 2
+    for rule, inside in (("weber", "yes"), ("bond", "**no**")):
+        r = new.loc[rule]
+        assert (f"| demo drum, {rule.capitalize()} | {r['form']} ({r['lack_of_fit_p']:.2f}) | "
+                f"{r['extrapolated']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}] | "
+                f"{r['cg1_mean']:.2f} | {inside} |") in README
+    checked = new[new["form"] == "checked"]
+    k, n = int(checked["inside"].sum()), len(checked)
+    assert f"in **{k} of {n}** pairs that pass the checks" in README
+    assert k / n < 0.9 and "(registered >= 90 %): **not met**" in README
+    weber = new.loc["weber"]
+    assert weber["form"] == "checked" and "(**1 of 1**): **met**" in README
+    assert weber["half_width"] > 1.0
+    assert f"half-width is **{weber['half_width']:.2f}** deg" in README
+    pooled = v[v["rule"] == "weber"]
+    assert f"inside in {int(pooled['inside'].sum())} of {len(pooled)} pairs, Bond's in " \
+           f"{int(v[v['rule'] == 'bond']['inside'].sum())} of 4" in README
+
+
+def test_demo_drum_report_tables_are_the_readme():
+    e = pd.read_csv(HERE / "demo_drum_extrapolation.csv")
+    row = e[(e["rule"] == "weber - bond") & (e["column"] == "angle_of_repose")].iloc[0]
+    assert f"by {row['extrapolated']:.2f} [{row['lo']:.2f}, {row['hi']:.2f}] deg" in README
+    bond = e[(e["rule"] == "bond") & (e["column"] == "angle_of_repose")].iloc[0]
+    assert f"misses CG1 by {bond['extrapolated'] - bond['cg1_measured']:.1f} deg" in README
+    cases = pd.read_csv(HERE / "demo_drum_cases.csv")
+    spread = cases[cases["rule"] == "weber"].groupby("cg")["angle_of_repose"].std()
+    assert f"(up to {spread.max():.1f} deg between seeds at CG{spread.idxmax():g})" in README
