@@ -60,6 +60,12 @@ def _signed(spec, tolerance: float, runs: pd.DataFrame, cg: float, ratio: float,
         return CriterionResult(**base, state=UNDECIDED, value=d.value, note=(
             f"{where}; a level has one run: no interval (run at least 2 replicas a level)")
         ), math.nan
+    if not d.se > 0:
+        # every run of every level reads the same value (a share of 0 everywhere): no
+        # run-to-run variance and no slope, so a zero-width interval would be false precision
+        return CriterionResult(**base, state=UNDECIDED, value=d.value, note=(
+            f"{where}; every run at every level reads {d.value:.3g}: no run-to-run "
+            "variance to bound it by (more replicas at every level)")), math.nan
     test = eq.equivalence(d, tolerance, alpha)
     note, rounds = where, {}
     if test.state == UNDECIDED:

@@ -35,7 +35,7 @@ ANALYSIS = {"steady_after": 0.5, "granules": "communities", "min_bridge_force": 
             "community_seed": 3, "bins_per_decade": 4,
             "min_particles": 3, "error_band": 0.2, "bootstrap": 50, "seed": 7,
             "sensitivity_frames": 2, "gsd_volume": "primary", "hold_time": 0.5,
-            "field_kernel": 2.0}
+            "field_kernel": 2.0, "surface_strip": 0.0}
 SETS = ["--set", "sweep.replicas=2", *[x for k, v in ANALYSIS.items()
                                        for x in ("--set", f"analysis.{k}={v}")]]
 #: a periodic slice shorter than one CG3 particle: the pre-flight refuses it
