@@ -63,7 +63,8 @@ COMMON: tuple[tuple[str, ...], ...] = (
      "production wall seconds per simulated second of production"),
     ("nprocs", "count", "ranks", "MPI ranks the case ran on"),
     ("speedup_core", "1", "speedup", "CG1 production core-s per simulated second per original "
-     "particle over this case's (CG1 mean of the group)"),
+     "particle over this case's (CG1 mean of the group); in the verdict of a sweep without "
+     "CG1, the planner's CG1 core-s per simulated second over the level's"),
     ("speedup_wall", "1", "speedup (wall)", "as speedup_core with wall time"),
     # flow
     ("steady_fraction", "1", "steady from", "share of production left out as start-up before "
