@@ -110,3 +110,13 @@ def test_demo_drum_report_tables_are_the_readme():
     cases = pd.read_csv(HERE / "demo_drum_cases.csv")
     spread = cases[cases["rule"] == "weber"].groupby("cg")["angle_of_repose"].std()
     assert f"(up to {spread.max():.1f} deg between seeds at CG{spread.idxmax():g})" in README
+
+
+def test_new_weber_rows_beside_the_fit():
+    cases = pd.read_csv(HERE / "demo_drum_cases.csv")
+    rows = [r for r in sr.excess_rows(cases, "demo drum", 0.002 / 0.05) if r["rule"] == "weber"]
+    got = ", ".join(f"{r['excess_deg']:.2f} +- {r['excess_se']:.2f}" for r in rows)
+    assert got.replace(", 4", " and 4") in README
+    assert ", ".join(f"{r['x']:.2f}" for r in rows).replace(", 0.06", " and 0.06") in README
+    want = ", ".join(f"{sr.SLOPE_DEG * r['x']:.2f}" for r in rows)
+    assert want.replace(", 5", " and 5") in README
