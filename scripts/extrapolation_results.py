@@ -14,7 +14,6 @@ size_relation.png. ``--check`` recomputes and compares instead of writing.
 from __future__ import annotations
 
 import argparse
-import io
 import sys
 from pathlib import Path
 
@@ -26,6 +25,9 @@ from ligwf.inference import size_relation as sr
 from ligwf.report.verdict import is_control_group
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+from scripts.results_readme import csv_text  # noqa: E402
+
 OUT = ROOT / "docs/results/extrapolation"
 #: committed studies with CG1 and CG-n runs: (name, case tables pooled (runs seen twice
 #: counted once), d / D, a flow (water-like liquid) or binder bed)
@@ -133,11 +135,6 @@ def figure(rows: pd.DataFrame, fit: pd.DataFrame, path: Path) -> None:
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
-
-def csv_text(t: pd.DataFrame) -> str:
-    buf = io.StringIO()
-    t.to_csv(buf, index=False, float_format="%.6g")
-    return buf.getvalue()
 
 
 def main(argv=None) -> int:

@@ -15,8 +15,6 @@ writing.
 from __future__ import annotations
 
 import argparse
-import io
-import math
 import shutil
 import sys
 from pathlib import Path
@@ -28,6 +26,9 @@ from ligwf.inference import extrapolation as ex
 from ligwf.inference.reference import level_values, slope_scale
 
 ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+from scripts.results_readme import csv_text  # noqa: E402
+
 OUT = ROOT / "docs/results/paper_scale"
 STUDIES = {"weber": "paper_scale_cg", "bond": "paper_scale_cg_bond"}
 #: report tables copied per study (prefix: the rule)
@@ -74,11 +75,6 @@ def claims(we: pd.DataFrame, bo: pd.DataFrame) -> pd.DataFrame:
                      differs=bool(d.has_interval and (d.lo > 0 or d.hi < 0))))
     return pd.DataFrame(rows)
 
-
-def csv_text(t: pd.DataFrame) -> str:
-    buf = io.StringIO()
-    t.to_csv(buf, index=False, float_format="%.6g")
-    return buf.getvalue()
 
 
 def main(argv=None) -> int:

@@ -16,6 +16,12 @@ from typing import Callable, Iterable
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def csv_text(table) -> str:
+    """A committed results table as text: no index, numbers to 6 significant digits (what
+    a results script writes and what its --check compares)."""
+    return table.to_csv(index=False, float_format="%.6g")
+
+
 def number(v, digits: int = 3) -> str:
     """A table value as the README prints it (``–`` for nan or what is not a number)."""
     try:
