@@ -21,7 +21,7 @@ scalars and the value of every registered metric) and the flow record
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -34,6 +34,7 @@ from ligwf.analysis.frames.loop import FrameAnalysis
 from ligwf.analysis.records.flow import CaseFlow, FlowRecord
 from ligwf.analysis.flow.steady import auto_fraction, is_auto
 from ligwf.analysis.flow.fields import case_fields, kernel_width
+from ligwf.analysis.flow.spreading import spread_series
 from ligwf.analysis.records.fields import (CRITERION_KERNELS, CaseFields, fields_bytes,
                                            image_text)
 from ligwf.scene.settings import AnalysisSettings
@@ -147,8 +148,14 @@ def case_flow(case: CaseFolder, steady_after, field_kernel: float = FIELD_KERNEL
                          case.scaled.drum.length,
                          {k: head[k] for k in ("case_id", "cg", "rule", "replica", "group")},
                          tuple(sorted({*CRITERION_KERNELS, float(field_kernel)})))
-    return measured_flow(head, steady_frames, all_flows, all_series, steady, geo,
-                         fields), skipped
+    flow = measured_flow(head, steady_frames, all_flows, all_series, steady, geo, fields)
+    spread = spread_series([f for f, _ in frames],
+                           float(case.scaled.liquid_values.wet_sphere_content or 0.0),
+                           case.scaled.drum.rotation_period)
+    if spread is not None:
+        flow = replace(flow, spreading={k: list(v) if isinstance(v, tuple) else v
+                                        for k, v in asdict(spread).items()})
+    return flow, skipped
 
 
 def measured_flow(head: dict, steady_frames: list, flows: list, series: list[dict],

@@ -66,6 +66,9 @@ class CaseFlow:
     production_times: list[float] = field(default_factory=list)
     production_angles: list = field(default_factory=list)
     production_kinetic: list = field(default_factory=list)
+    #: placed liquid only (:mod:`ligwf.analysis.flow.spreading`): revolutions,
+    #: dry_content_share, dry_wet_share per production frame, dry_particles, particles
+    spreading: dict = field(default_factory=dict)
     summary: dict[str, float] = field(default_factory=dict)   # the flow table's scalars
     #: the cross-section fields of the steady window (written to their own archive by the
     #: analysis, :mod:`ligwf.analysis.records.fields`; not part of this record's JSON)
@@ -88,6 +91,8 @@ class CaseFlow:
         for k in ("profile_v_mean", "profile_v_std", "field_vel_u", "field_vel_v",
                   "production_angles", "production_kinetic"):
             d[k] = _nums(d[k])
+        d["spreading"] = {k: _nums(v) if isinstance(v, (list, tuple)) else v
+                          for k, v in self.spreading.items()}
         return d
 
     @classmethod
