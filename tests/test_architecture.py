@@ -7,9 +7,13 @@
   kernels, frames, records, flow, granules, GSD, the granule stage, the runners);
 * no import cycle between ligwf modules, counting imports inside functions too, and no
   dynamic import (``importlib.import_module`` / ``__import__``) hiding one;
-* every module under 400 lines (split by topic before that);
 * the study folder's file names appear only in the study model (``ligwf/study/``);
 * liquid models are named only inside ``ligwf/liquids/`` (everyone else asks the registry).
+
+No line count: a module is split where its concept divides, and the seams are what is
+checked (here the layers; tests/test_seams.py: no private name crossing a module, no
+re-export shim, no dead code). A cap of 400 lines was here until issue 48: modules were cut
+and docstrings shortened to meet it, which no seam asked for.
 """
 
 from __future__ import annotations
@@ -19,12 +23,10 @@ import re
 from pathlib import Path
 
 import networkx as nx
-import pytest
 
 from helpers import ROOT
 
 PACKAGE = ROOT / "ligwf"
-MAX_LINES = 400
 
 
 def _module_name(path: Path) -> str:
@@ -186,12 +188,6 @@ def test_no_dynamic_imports():
     hits = [f"{p.relative_to(ROOT)}:{n}" for p in MODULES.values()
             for n, line in enumerate(p.read_text().splitlines(), 1) if pattern.search(line)]
     assert not hits, f"dynamic imports hide the dependency graph: {hits}"
-
-
-@pytest.mark.parametrize("module", sorted(MODULES))
-def test_module_is_small(module):
-    lines = len(MODULES[module].read_text().splitlines())
-    assert lines < MAX_LINES, f"{module}: {lines} lines (split it by topic before {MAX_LINES})"
 
 
 def _occurrences(pattern: str, allowed: str) -> list[str]:
