@@ -117,7 +117,8 @@ def dead_code(paths: list[Path], package: Path = PACKAGE,
               whitelist: Path | None = WHITELIST) -> list[str]:
     """Functions, methods and classes in ``package`` that no code of ``paths`` uses
     (vulture, 60 % confidence), and anything there vulture is sure of (100 %)."""
-    v = Vulture(ignore_decorators=["@model_validator", "@field_validator", "@pytest.fixture"])
+    v = Vulture(ignore_decorators=["@model_validator", "@field_validator", "@model_serializer",
+                                   "@pytest.fixture"])
     v.scavenge([str(p) for p in paths] + ([str(whitelist)] if whitelist else []))
     return [f"{item.filename}:{item.first_lineno}: unused {item.typ} {item.name!r} "
             f"({item.confidence} %)" for item in v.get_unused_code(min_confidence=60)

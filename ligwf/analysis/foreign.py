@@ -21,8 +21,11 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
 
 from ligwf import liquids
 from ligwf.analysis.granules.case import GranuleAnalysis, RunFacts
@@ -34,7 +37,9 @@ from ligwf.analysis.granules.bridge_law import Liquid
 from ligwf.analysis.outputs import OutputSet, new_token
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
 from ligwf.errors import ConfigError, DumpReadError
+from ligwf.liquids.base import LiquidModel, LiquidSettings
 from ligwf.scene.axis import Axis
+from ligwf.scene.messages import range_note
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
 
@@ -72,8 +77,9 @@ class ForeignRun:
     dt: float                        # s per step
     liquid_content: float | None = None   # fraction of particle volume, if dumps lack it
     cg: float = 1.0
-    #: washino's lbVolumeFraction of the run (None: the engine default; only washino has it)
-    bridge_volume_fraction: float | None = None
+    #: the liquid model's own settings in the run, by key (e.g. washino's
+    #: ``bridge_volume_fraction``: its lbVolumeFraction); unset: the model's defaults
+    settings: dict[str, Any] = field(default_factory=dict)
 
     def facts(self, name: str) -> RunFacts:
         """The run facts; ConfigError naming the missing or invalid piece."""
@@ -104,18 +110,30 @@ class ForeignRun:
             raise ConfigError(f"--box-length: a periodic axis ({axis}) needs its length, m (> 0)")
         if not (self.dt > 0 and math.isfinite(self.dt)):
             raise ConfigError(f"--dt {self.dt!r}: the time step must be > 0 s")
-        fraction = self.bridge_volume_fraction
-        if fraction is not None and law.default_bridge_volume_fraction is None:
-            raise ConfigError(f"--bridge-volume-fraction {fraction:g}: liquid model "
-                              f"{self.liquid!r} has no bridge volume fraction (washino only)")
-        if fraction is not None and not 0.0 < fraction <= 1.0:
-            raise ConfigError(f"--bridge-volume-fraction {fraction!r}: allowed range (0, 1]")
         content = math.nan if self.liquid_content is None else float(self.liquid_content)
         return RunFacts(name, float(self.cg),
-                        Liquid(self.liquid, gamma, theta, content,
-                               None if fraction is None else float(fraction)),
+                        Liquid(self.liquid, gamma, theta, content, self.model_settings(law)),
                         axis,
                         float(self.box_length or 0.0), float(self.dt))
+
+    def model_settings(self, law: LiquidModel) -> LiquidSettings:
+        """``settings`` validated by the model's own settings class; ConfigError naming the
+        option (``--<key>``), its value and the allowed range."""
+        def option(key: str) -> str:
+            return "--" + key.replace("_", "-")
+
+        for key, value in self.settings.items():
+            if key not in law.settings_type.model_fields:
+                owners = liquids.setting_owners().get(key)
+                raise ConfigError(f"{option(key)} {value!r}: liquid model {self.liquid!r} has "
+                                  "no such setting" + (f" ({', '.join(owners)} only)"
+                                                       if owners else ""))
+        try:
+            return law.settings_type.model_validate(self.settings)
+        except ValidationError as exc:
+            e = exc.errors()[0]
+            raise ConfigError(f"{option(e['loc'][0])} {e['input']!r}: {e['msg']}" + range_note(
+                law.settings_type, e["loc"], e["msg"], e["type"])) from None
 
 
 def find_frames(dump_dir: Path, particles: str, contacts: str) -> list[FrameFiles]:
@@ -197,8 +215,10 @@ def analyse_dumps(dump_dir: Path, run: ForeignRun, out_dir: Path,
                        controls=False,
                        frames_of={facts.case_id: frames})
         run_record = asdict(run)
-        if run.bridge_volume_fraction is None:     # records at the default stay as they were
-            del run_record["bridge_volume_fraction"]
+        # the model's settings as keys of the run, each left out when unset (records at
+        # the defaults stay as they were)
+        run_record.update({k: v for k, v in run_record.pop("settings").items()
+                           if v is not None})
         record = {"dump_dir": str(dump_dir), "run": run_record,
                   "settings": settings.model_dump(mode="json"),
                   "steady_from_step": steady_from_step,

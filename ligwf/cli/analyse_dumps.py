@@ -6,20 +6,37 @@ defaults silently: a missing box length would switch off the detection of granul
 wrap around the periodic axis). The dumps must be ``dump custom/vtk`` particle files
 with the arrays id, type, v, radius (and f_surfaceLiquidContent, else give
 --liquid-content) and ``dump local/gran/vtk`` contact files with id1, id2, delta (see
-README "Analysing foreign dumps"). Outputs are those of ``ligwf analyse``.
+README "Analysing foreign dumps"). A liquid model's own settings (washino's
+``--bridge-volume-fraction``, ...) are one option each, made from the models' settings
+classes. Outputs are those of ``ligwf analyse``.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from ligwf import liquids
 from ligwf.cli.analyse import print_record
 from ligwf.cli.common import folder_to_write, number_in, step_number
+from ligwf.liquids.base import MAX_LIQUID_CONTENT
 from ligwf.scene.axis import Axis
-from ligwf.scene.values import MAX_LIQUID_CONTENT
 from ligwf.study import layout
+
+#: the namespace attribute of a liquid model's setting given as an option
+SETTING_DEST = "liquid_setting_{}"
+
+
+def finite_number(text: str) -> float:
+    """argparse type: a finite number (the liquid model's settings class checks its range)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return value
 
 
 def register(subparsers) -> None:
@@ -46,10 +63,11 @@ def register(subparsers) -> None:
     p.add_argument("--liquid-content", type=number_in(1e-5, MAX_LIQUID_CONTENT),
                    default=None,
                    help="fraction of particle volume, when the dumps lack f_surfaceLiquidContent")
-    p.add_argument("--bridge-volume-fraction", type=number_in(1e-6, 1.0), default=None,
-                   help="washino only: the run's lbVolumeFraction (share of both particles' "
-                   "liquid in a bridge), when its input set modifyLbVolume on; default: the "
-                   "engine's 0.05")
+    for key, models in liquids.setting_owners().items():
+        info = next(liquids.get(m).settings_type.model_fields[key] for m in models)
+        p.add_argument("--" + key.replace("_", "-"), dest=SETTING_DEST.format(key),
+                       metavar=key.upper(), type=finite_number, default=None,
+                       help=f"the run's liquid.{key}: {info.description}")
     p.add_argument("--cg", type=number_in(1.0, 1000.0), default=1.0,
                    help="coarse-graining factor of the run")
     p.add_argument("--steady-from-step", type=step_number, default=0,
@@ -77,9 +95,11 @@ def cmd_analyse_dumps(args: argparse.Namespace) -> int:
             raise ConfigError(f"--set {item!r}: empty key")
         values[key.strip()] = parse_yaml(value, f"--set {key.strip()}: value {value!r}")
     settings = build_analysis_settings(values, "analysis")
+    own = {key: getattr(args, SETTING_DEST.format(key)) for key in liquids.setting_owners()
+           if getattr(args, SETTING_DEST.format(key)) is not None}
     run = ForeignRun(args.liquid, args.surface_tension, args.contact_angle,
                      args.angle_convention, args.periodic_axis, args.box_length, args.dt,
-                     args.liquid_content, args.cg, args.bridge_volume_fraction)
+                     args.liquid_content, args.cg, own)
     out = args.out or args.dump_dir / layout.ANALYSIS_DIR
     record = analyse_dumps(args.dump_dir, run, out, settings, args.steady_from_step,
                            args.particles, args.contacts, not args.no_vtu)

@@ -3,7 +3,9 @@
 Every stage that depends on the liquid (scene validation, scaling, rendering, pre-flight,
 granule analysis) asks :func:`get` for the scene's model instead of comparing names, so a
 new capillary law is one new module (a :class:`~ligwf.liquids.base.LiquidModel`) and one
-:func:`register` call. Built in: ``washino``, ``easo`` and ``none`` (dry).
+:func:`register` call; its own settings are a class it declares (``settings_type``), so a
+new parameter needs no edit elsewhere either. Built in: ``washino``, ``easo`` and ``none``
+(dry).
 """
 
 from __future__ import annotations
@@ -37,6 +39,17 @@ def get(name: str) -> LiquidModel:
     except (KeyError, TypeError):
         raise ValueError(f"unknown liquid model {name!r} (allowed: {', '.join(names())})") \
             from None
+
+
+def setting_owners() -> dict[str, tuple[str, ...]]:
+    """Every registered model's own settings (``LiquidModel.settings_type``) by key: the
+    names of the models that have it, sorted. What the scene refuses for another model and
+    the foreign-dump reader offers as options."""
+    owners: dict[str, list[str]] = {}
+    for name in names():
+        for key in _MODELS[name].settings_type.model_fields:
+            owners.setdefault(key, []).append(name)
+    return {key: tuple(models) for key, models in owners.items()}
 
 
 for _model in (WASHINO, EASO, DRY):

@@ -8,6 +8,12 @@ misspelled property), the force law, bridge volume and rupture distance in numpy
 in numba for the compiled granule kernels, and the pre-flight quantities (force and
 stiffness of a bridge at contact).
 
+A model's own settings (washino's bridge volume fraction and liquid cap) are a frozen
+:class:`LiquidSettings` class the model declares (``settings_type``): the scene's
+``liquid:`` block validates them per model, and scaling, rendering, the granule analysis
+and the foreign-dump reader carry them as one opaque value back to the model
+(:meth:`LiquidModel.configured`), never naming them.
+
 This package knows nothing of scenes, engines or analyses: a model reads the few values
 it needs through the small protocols below, and the other stages ask the registry.
 
@@ -20,10 +26,53 @@ unless the name says ``deg``.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+import copy
 from dataclasses import dataclass
-from typing import Callable, Protocol
+from functools import lru_cache
+from typing import Any, Callable, NamedTuple, Protocol
 
 import numpy as np
+from pydantic import BaseModel, ConfigDict
+
+#: largest liquid content (liquid volume / solid volume) and why: see PENDULAR_REASON
+MAX_LIQUID_CONTENT = 0.2
+PENDULAR_REASON = ("the bridge laws describe separate pendular bridges; at 0.2 of the solid "
+                   "volume a bed at packing 0.6 has its pores 30 % full, the end of the "
+                   "pendular regime (funicular beyond)")
+
+
+class Problem(NamedTuple):
+    """One refusal of the scene's liquid block: the key (``liquid.<field>``), its value and
+    why, with the allowed range when the reason sets one."""
+
+    field: str
+    value: Any
+    reason: str
+
+
+class LiquidSettings(BaseModel):
+    """A model's own settings, declared as a subclass of this (``LiquidModel.settings_type``;
+    this base has none). Each field is a key of the workflow's ``liquid:`` block, validated
+    with its bounds, ``description`` and ``json_schema_extra`` (``unit``, ``bound_reason``)
+    like any scene field, and documented in the workflow reference. Frozen and hashable:
+    :meth:`LiquidModel.configured` may keep one law object per settings value."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", validate_default=True,
+                              allow_inf_nan=False)
+
+    def applied(self) -> "LiquidSettings":
+        """These settings as the engine applies them: a value written out at the engine's
+        own default reads as unset, so it is the same case (the same record and input)."""
+        return self
+
+    def problems(self, liquid: "LiquidBlock") -> list[Problem]:
+        """What these settings refuse in the rest of the liquid block (none here)."""
+        return []
+
+    def record(self) -> dict[str, Any]:
+        """The keys the case's scaled record stores (a setting left unset is left out, so a
+        record at the defaults is the record the model had before it had settings)."""
+        return {k: v for k, v in self.model_dump(mode="json").items() if v is not None}
 
 
 class LiquidBlock(Protocol):
@@ -35,8 +84,15 @@ class LiquidBlock(Protocol):
     liquid_content: float       # liquid volume / solid volume
     min_separation_ratio: float
     max_separation_ratio: float
-    bridge_volume_fraction: float | None    # share of both partners' liquid (None: default)
-    max_liquid_content: float | None        # cap of a particle's liquid content (None: none)
+    settings: LiquidSettings    # the model's own (its settings_type)
+
+    @property
+    def start_content(self) -> float:
+        """The largest liquid content a particle starts with (placed granules included)."""
+
+    @property
+    def changed_fields(self) -> frozenset[str]:
+        """The keys set to a value other than their default."""
 
 
 class ScaledLiquid(Protocol):
@@ -48,9 +104,8 @@ class ScaledLiquid(Protocol):
     contact_angle_deg: float    # the scene's angle
     liquid_content: float
     min_separation_ratio: float
-    max_separation_ratio: float
-    bridge_volume_fraction: float | None    # None: the model's default (unchanged by CG)
-    max_liquid_content: float | None        # None: no cap (unchanged by CG)
+    max_separation_ratio: float     # the cut the engine applies (its own when a setting
+    #                                 makes it compute one: engine_separation_ratio)
 
 
 @dataclass(frozen=True)
@@ -115,13 +170,12 @@ class LiquidModel(ABC):
     #: properties the cohesion model reads only when one of its switches is on (each
     #: written at most once, together with its switch: :meth:`cohesion_settings`)
     optional_properties: tuple[str, ...] = ()
-    #: the share of both partners' surface liquid a bridge takes when the scene leaves
-    #: ``liquid.bridge_volume_fraction`` unset; None: the model has no such share (its
-    #: bridge volume is computed otherwise, e.g. easo's caps), so the setting is refused
-    default_bridge_volume_fraction: float | None = None
-    #: True when the engine model can cap each particle's liquid content
-    #: (``liquid.max_liquid_content``); False: the setting is refused
-    limits_liquid_content: bool = False
+    #: the model's own settings (keys of ``liquid:`` only this model has); see
+    #: :class:`LiquidSettings`
+    settings_type: type[LiquidSettings] = LiquidSettings
+    #: what else a scene can set so the engine cuts a bridge at the law's own rupture gap
+    #: (the pre-flight adds it to its warning about a short cut); "": nothing
+    bridge_cut_remedy: str = ""
     #: True when the engine forms a bridge only once the pair has touched
     bridge_needs_contact: bool = False
     #: per-atom columns the cohesion model creates, dumped with the particles
@@ -130,35 +184,49 @@ class LiquidModel(ABC):
     kernels: Kernels
 
     def validate(self, liquid: LiquidBlock) -> list[str]:
-        """Model-specific problems of the scene's liquid block (one message each): here,
-        settings the model does not have."""
-        problems = []
-        fraction = getattr(liquid, "bridge_volume_fraction", None)
-        if fraction is not None and self.default_bridge_volume_fraction is None:
-            problems.append(f"bridge_volume_fraction = {fraction:g}: liquid model "
-                            f"{self.name!r} has no bridge volume fraction (only "
-                            "washino's bridge takes a share of both partners' liquid); "
-                            "leave it unset")
-        cap = getattr(liquid, "max_liquid_content", None)
-        if cap is not None and not self.limits_liquid_content:
-            problems.append(f"max_liquid_content = {cap:g}: liquid model {self.name!r} "
-                            "cannot cap the liquid content (only washino can); leave it unset")
-        return problems
+        """Model-specific problems of the scene's liquid block (one message each, starting
+        with ``field = value:``); none here."""
+        return []
 
-    def configured(self, bridge_volume_fraction: float | None) -> "LiquidModel":
-        """This model applying ``bridge_volume_fraction`` (None or the model's default: the
-        registered instance itself, so every default output stays as it was)."""
-        if bridge_volume_fraction is None or (
-                bridge_volume_fraction == self.default_bridge_volume_fraction):
+    #: the settings this law object applies (None: the defaults; see :meth:`configured`)
+    _settings: LiquidSettings | None = None
+
+    @property
+    def settings(self) -> LiquidSettings:
+        """The model's own settings this law object applies (the registered instance: the
+        defaults)."""
+        return self._settings if self._settings is not None else self.settings_type()
+
+    def configured(self, settings: LiquidSettings | None) -> "LiquidModel":
+        """This model's law at ``settings`` as the engine applies them (None or the
+        defaults: the registered instance itself, so every default output stays as it was;
+        otherwise one law object per settings value, :meth:`with_settings`)."""
+        if settings is None:
             return self
-        raise ValueError(f"liquid model {self.name!r} has no bridge volume fraction "
-                         f"(bridge_volume_fraction = {bridge_volume_fraction:g})")
+        if not isinstance(settings, self.settings_type):
+            raise TypeError(f"liquid model {self.name!r}: settings {settings!r} are not its "
+                            f"{self.settings_type.__name__}")
+        settings = settings.applied()
+        return self if settings == self.settings else _configured(self, settings)
 
-    def capped_separation_ratio(self, r_min: float, r_max: float, max_liquid_content: float,
-                                theta_rad: float) -> float:
-        """The ``maxSeparationDistanceRatio`` the engine applies when it caps the liquid
-        content at ``max_liquid_content`` (radii in m, the applied angle in rad)."""
-        raise ValueError(f"liquid model {self.name!r} cannot cap the liquid content")
+    def with_settings(self, settings: LiquidSettings) -> "LiquidModel":
+        """A copy of this law applying ``settings`` (its methods read ``self.settings``); a
+        model whose compiled kernels depend on a setting builds them here instead."""
+        law = copy.copy(self)
+        law._settings = settings
+        return law
+
+    def engine_separation_ratio(self, r_min: float, r_max: float, theta_rad: float,
+                                written: float) -> float:
+        """The ``maxSeparationDistanceRatio`` the engine applies for this law: the
+        ``written`` one unless a setting makes the engine compute its own (radii in m, the
+        applied angle in rad)."""
+        return written
+
+    def clip_content(self, content: np.ndarray) -> np.ndarray:
+        """Each particle's liquid content as the engine uses it in a pair (a setting may
+        clip it); unchanged here."""
+        return content
 
     def cohesion_settings(self, s: ScaledLiquid) -> tuple[str, ...]:
         """Words the ``pair_style gran`` line appends after all its models (the cohesion
@@ -223,3 +291,9 @@ class LiquidModel(ABC):
         """(gap at which the engine cuts the bridge force, largest gap of a pair in the
         neighbour lists), m, for two spheres of ``radius``; None when not known."""
         return None
+
+
+@lru_cache(maxsize=None)
+def _configured(model: LiquidModel, settings: LiquidSettings) -> LiquidModel:
+    """One law object per model and settings (its kernels compile once per process)."""
+    return model.with_settings(settings)

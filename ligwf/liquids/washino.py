@@ -6,12 +6,13 @@ both particles' surface liquid, and the force follows Rabinovich et al., Langmui
 engine's pair force to 1e-9 (``tests/engine/test_engine_bridge.py``).
 
 Two switches of the engine model (3.8.0 source lines 89-92, 128-129, 153-163, 206-222,
-254-260; docs/liquid_bridges.md) are scene settings:
+254-260; docs/liquid_bridges.md) are washino's own settings (:class:`WashinoSettings`, keys
+of the scene's ``liquid:`` block only washino has):
 
 * ``liquid.bridge_volume_fraction`` (the engine's ``lbVolumeFraction``, read only with the
   pair_style keyword ``modifyLbVolume on``; default 0.05): the share of both particles'
-  liquid a bridge takes. :meth:`Washino.configured` gives the law at another share, its
-  numba volume kernel compiled with that share (:func:`volume_kernel`).
+  liquid a bridge takes. ``configured`` gives the law at another share, its numba volume
+  kernel compiled with that share (:func:`volume_kernel`).
 * ``liquid.max_liquid_content`` (``maxLiquidContent``, per atom type, read only with
   ``limitLiquidContent on``): the engine clips a particle's content to it whenever one of
   its pairs is evaluated, and REPLACES ``maxSeparationDistanceRatio`` by the ratio at
@@ -27,13 +28,65 @@ import numpy as np
 
 from functools import lru_cache
 
-from ligwf.liquids.base import InputAngle, Kernels, Line, ScaledLiquid, sphere_volume
+from pydantic import Field
+
+from ligwf.liquids.base import (MAX_LIQUID_CONTENT, PENDULAR_REASON, InputAngle, Kernels,
+                                Line, LiquidBlock, LiquidSettings, Problem, ScaledLiquid,
+                                sphere_volume)
 from ligwf.liquids.capillary import CapillaryModel, within_rupture
 from ligwf.numba_cache import cached_jit, specialised
 
 #: LIGGGHTS' default fraction of the two particles' liquid that forms a washino bridge
 #: (``lbVolumeFraction``, used unless ``modifyLbVolume`` is switched on).
 BRIDGE_VOLUME_FRACTION = 0.05
+
+
+class WashinoSettings(LiquidSettings):
+    """washino's own settings: two switches of the engine model, None at its defaults.
+    Both are fractions and stay as they are under CG scaling."""
+
+    bridge_volume_fraction: float | None = Field(
+        None, gt=0.0, le=1.0, description="washino only: share of both particles' surface "
+        "liquid that forms a bridge (LIGGGHTS lbVolumeFraction, written with modifyLbVolume "
+        "on); unset: the engine default 0.05. A fraction: unchanged by CG scaling",
+        json_schema_extra={"unit": "1"})
+    max_liquid_content: float | None = Field(
+        None, gt=0.0, le=MAX_LIQUID_CONTENT, description="washino only: cap of each "
+        "particle's liquid content, liquid volume / solid volume (LIGGGHTS maxLiquidContent, "
+        "written with limitLiquidContent on; the engine deletes liquid above it and sets "
+        "maxSeparationDistanceRatio itself, so max_separation_ratio must stay unset); unset: "
+        "no cap. Unchanged by CG scaling",
+        json_schema_extra={"bound_reason": PENDULAR_REASON, "unit": "1"})
+
+    def applied(self) -> "WashinoSettings":
+        if self.bridge_volume_fraction == BRIDGE_VOLUME_FRACTION:   # the default written out
+            return self.model_copy(update={"bridge_volume_fraction": None})
+        return self
+
+    @property
+    def fraction(self) -> float:
+        """The bridge volume fraction the engine applies."""
+        return (BRIDGE_VOLUME_FRACTION if self.bridge_volume_fraction is None
+                else self.bridge_volume_fraction)
+
+    def problems(self, liquid: LiquidBlock) -> list[Problem]:
+        """A cap below the liquid a particle starts with deletes liquid at its first
+        contact; and the engine replaces maxSeparationDistanceRatio when capping."""
+        cap = self.max_liquid_content
+        if cap is None:
+            return []
+        start = liquid.start_content
+        if cap < start:
+            return [Problem("max_liquid_content", cap, (
+                f"below the liquid content the particles start with ({start:g}), the engine "
+                f"would delete the rest at their first contact (allowed range [{start:g}, "
+                f"{MAX_LIQUID_CONTENT:g}])"))]
+        if "max_separation_ratio" in liquid.changed_fields:
+            return [Problem("max_separation_ratio", liquid.max_separation_ratio, (
+                f"with max_liquid_content = {cap:g} the engine sets "
+                "maxSeparationDistanceRatio itself (the rupture gap at the cap); leave "
+                "max_separation_ratio unset"))]
+        return []
 
 
 def bridge_volume(r_i, r_j, content_i, content_j, fraction: float = BRIDGE_VOLUME_FRACTION):
@@ -94,48 +147,60 @@ def _force(ri, rj, gap, gamma, theta, cos_theta, sin_theta, vol):
 
 
 class Washino(CapillaryModel):
-    """The law at one bridge volume fraction (the registered instance: the default 0.05;
-    others from :meth:`configured`)."""
+    """The law at one set of :class:`WashinoSettings` (the registered instance: the
+    defaults; others from ``configured``)."""
 
     name = "washino"
     cohesion = "washino/capillary/viscous"
     optional_properties = ("lbVolumeFraction", "maxLiquidContent")
-    default_bridge_volume_fraction = BRIDGE_VOLUME_FRACTION
-    limits_liquid_content = True
+    settings_type = WashinoSettings
+    bridge_cut_remedy = ("set max_liquid_content (the engine then cuts at the law's own "
+                         "rupture gap of two particles holding that content)")
 
-    def __init__(self, bridge_volume_fraction: float = BRIDGE_VOLUME_FRACTION) -> None:
-        self.bridge_volume_fraction = float(bridge_volume_fraction)
+    def __init__(self, settings: WashinoSettings | None = None) -> None:
+        self._settings = settings
         self.kernels = Kernels(volume=volume_kernel(self.bridge_volume_fraction),
                                within_rupture=within_rupture, force=_force)
 
-    def configured(self, bridge_volume_fraction: float | None) -> "Washino":
-        fraction = (BRIDGE_VOLUME_FRACTION if bridge_volume_fraction is None
-                    else float(bridge_volume_fraction))
-        return WASHINO if fraction == BRIDGE_VOLUME_FRACTION else _washino(fraction)
+    @property
+    def bridge_volume_fraction(self) -> float:
+        """The share of both partners' liquid this law's bridge takes."""
+        return self.settings.fraction
 
-    def capped_separation_ratio(self, r_min: float, r_max: float, max_liquid_content: float,
-                                theta_rad: float) -> float:
-        return engine_max_separation_ratio(r_min, r_max, max_liquid_content, theta_rad,
+    def with_settings(self, settings: WashinoSettings) -> "Washino":
+        return Washino(settings)
+
+    def engine_separation_ratio(self, r_min: float, r_max: float, theta_rad: float,
+                                written: float) -> float:
+        cap = self.settings.max_liquid_content
+        if cap is None:
+            return written
+        return engine_max_separation_ratio(r_min, r_max, cap, theta_rad,
                                            self.bridge_volume_fraction)
+
+    def clip_content(self, content: np.ndarray) -> np.ndarray:
+        # the engine clips a content above the cap before every pair it evaluates
+        cap = self.settings.max_liquid_content
+        return content if cap is None else np.minimum(content, cap)
 
     def cohesion_settings(self, s: ScaledLiquid) -> tuple[str, ...]:
         words: tuple[str, ...] = ()
-        if s.bridge_volume_fraction is not None and (
-                s.bridge_volume_fraction != BRIDGE_VOLUME_FRACTION):
+        if self.settings.bridge_volume_fraction is not None:
             words += ("modifyLbVolume", "on")
-        if s.max_liquid_content is not None:
+        if self.settings.max_liquid_content is not None:
             words += ("limitLiquidContent", "on")
         return words
 
     def liggghts_lines(self, s: ScaledLiquid, angle: InputAngle) -> tuple[Line, ...]:
         lines = super().liggghts_lines(s, angle)
-        if "modifyLbVolume" in self.cohesion_settings(s):
+        own = self.settings
+        if own.bridge_volume_fraction is not None:
             lines += (self.property_line("lq_lbvol", "lbVolumeFraction", "scalar",
-                                         s.bridge_volume_fraction),)
-        if s.max_liquid_content is not None:
+                                         own.bridge_volume_fraction),)
+        if own.max_liquid_content is not None:
             # per atom type (particles, wall); the wall's never binds (walls hold no liquid)
             lines += (self.property_line("lq_maxlc", "maxLiquidContent", "peratomtype",
-                                         s.max_liquid_content, s.max_liquid_content),)
+                                         own.max_liquid_content, own.max_liquid_content),)
         return self.checked_lines(lines)
 
     def bridge_volume(self, r_i, r_j, content_i, content_j):
@@ -196,9 +261,3 @@ class Washino(CapillaryModel):
 
 
 WASHINO = Washino()
-
-
-@lru_cache(maxsize=None)
-def _washino(fraction: float) -> Washino:
-    """One law object per non-default fraction (its kernels compile once per process)."""
-    return Washino(fraction)

@@ -1,20 +1,36 @@
 """The scene's liquid block: the binder liquid, its bridge model and where it starts.
 
 Fields of ``scene.liquid`` (:class:`Liquid`, :class:`WetGranules`), checked when the scene
-is built: the model's own limits (``ligwf.liquids``' ``validate``), the placement, and
-washino's optional settings (``bridge_volume_fraction``, ``max_liquid_content``) against
-the liquid the particles start with.
+is built: the placement, the model's own limits (``ligwf.liquids``' ``validate``) and the
+model's own settings. Those are keys of the same ``liquid:`` block that only one model
+has (washino's ``bridge_volume_fraction``, ...): the model declares them as a frozen class
+(its ``settings_type``), this block validates them with it, refusing each in one line
+(field, value, allowed range) like its own fields, and carries them as one opaque value,
+``Liquid.settings``, to scaling and on to the model's law. A key of another model's
+settings is refused (left at null it is ignored, as older scene records write it).
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, Field, model_validator
+from pydantic import (AfterValidator, Field, SerializerFunctionWrapHandler, ValidationError,
+                      model_serializer, model_validator)
+from pydantic.json_schema import SkipJsonSchema
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from ligwf import liquids
-from ligwf.scene.values import MAX_LIQUID_CONTENT, PENDULAR_REASON, Frozen, zero_or_at_least
+from ligwf.liquids.base import MAX_LIQUID_CONTENT, PENDULAR_REASON, LiquidSettings
+from ligwf.scene.messages import range_note
+from ligwf.scene.values import Frozen, scalar_problem, zero_or_at_least
 
+
+
+def refusal(field: str, value: Any, reason: str) -> InitErrorDetails:
+    """One line of a refusal of ``liquid.<field>`` (``field = value: reason``)."""
+    return InitErrorDetails(type=PydanticCustomError("liquid_setting", "{reason}",
+                                                     {"reason": reason}),
+                            loc=(field,), input=value)
 
 
 def check_liquid_model(name: str) -> str:
@@ -75,17 +91,66 @@ class Liquid(Frozen):
         "granules: a dry bed with pre-formed wet granules (wet_granules)")
     wet_granules: WetGranules | None = Field(None, description="the wet granules of "
                                              "placement: granules")
-    bridge_volume_fraction: float | None = Field(
-        None, gt=0.0, le=1.0, description="washino only: share of both particles' surface "
-        "liquid that forms a bridge (LIGGGHTS lbVolumeFraction, written with modifyLbVolume "
-        "on); unset: the engine default 0.05. A fraction: unchanged by CG scaling")
-    max_liquid_content: float | None = Field(
-        None, gt=0.0, le=MAX_LIQUID_CONTENT, description="washino only: cap of each "
-        "particle's liquid content, liquid volume / solid volume (LIGGGHTS maxLiquidContent, "
-        "written with limitLiquidContent on; the engine deletes liquid above it and sets "
-        "maxSeparationDistanceRatio itself, so max_separation_ratio must stay unset); unset: "
-        "no cap. Unchanged by CG scaling",
-        json_schema_extra={"bound_reason": PENDULAR_REASON})
+    settings: SkipJsonSchema[LiquidSettings] = Field(
+        default_factory=LiquidSettings, exclude=True, description="the model's own settings "
+        "(its settings_type), given as keys of this block")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _own_settings(cls, data: Any) -> Any:
+        """Validate the model's own keys with its settings class into ``settings``."""
+        if not isinstance(data, dict) or isinstance(data.get("settings"), LiquidSettings):
+            return data
+        data, problems = dict(data), []
+        if "settings" in data:          # given as its keys, never as a mapping of its own
+            problems.append(InitErrorDetails(type="extra_forbidden", loc=("settings",),
+                                             input=data.pop("settings")))
+        name = data.get("model", cls.model_fields["model"].default)
+        law = liquids.get(name) if name in liquids.names() else None  # else: model refuses
+        own_type = law.settings_type if law is not None else LiquidSettings
+        own, owners = {}, liquids.setting_owners()
+        for key in [k for k in data if k not in cls.model_fields]:
+            if key in own_type.model_fields:
+                own[key] = data.pop(key)
+                item = scalar_problem(own[key], own_type.model_fields[key].annotation)
+                if item is not None:
+                    problems.append(refusal(key, own[key], str(item) + range_note(
+                        own_type, (key,), str(item), "value_error")))
+            elif key in owners:
+                value = data.pop(key)
+                if value is not None and law is not None:
+                    problems.append(refusal(key, value, (
+                        f"liquid model {name!r} has no such setting (only "
+                        f"{', '.join(owners[key])} has it); leave it unset")))
+        if not problems:
+            try:
+                data["settings"] = own_type.model_validate(own)
+            except ValidationError as exc:
+                problems = [refusal(e["loc"][0], e["input"], e["msg"] + range_note(
+                    own_type, e["loc"], e["msg"], e["type"])) for e in exc.errors()]
+        if problems:
+            raise ValidationError.from_exception_data(cls.__name__, problems)
+        return data
+
+    @model_serializer(mode="wrap")
+    def _flat(self, handler: SerializerFunctionWrapHandler, info: Any) -> dict[str, Any]:
+        """The block as the workflow writes it: the model's own keys beside the others."""
+        return {**handler(self), **self.settings.model_dump(mode=info.mode)}
+
+    @property
+    def start_content(self) -> float:
+        """The largest liquid content a particle starts with (placed granules included)."""
+        if self.placement == "granules" and self.wet_granules is not None:
+            return max(self.liquid_content, self.wet_granules.liquid_content)
+        return self.liquid_content
+
+    @property
+    def changed_fields(self) -> frozenset[str]:
+        """The keys set to a value other than their default (a scene record writes every
+        key: read back, those at their defaults are still unchanged)."""
+        return frozenset(k for k in self.model_fields_set
+                         if getattr(self, k) != type(self).model_fields[k].get_default(
+                             call_default_factory=True))
 
     @property
     def wet(self) -> bool:
@@ -106,29 +171,12 @@ class Liquid(Frozen):
         return self
 
     @model_validator(mode="after")
-    def _cap_above_content(self) -> "Liquid":
-        """A cap below the liquid a particle starts with deletes liquid at its first
-        contact; and the engine replaces maxSeparationDistanceRatio when capping."""
-        cap = self.max_liquid_content
-        if cap is None:
-            return self
-        start = self.liquid_content if self.placement == "uniform" else max(
-            self.liquid_content, self.wet_granules.liquid_content)  # type: ignore[union-attr]
-        if cap < start:
-            raise ValueError(f"max_liquid_content = {cap:g}: below the liquid content the "
-                             f"particles start with ({start:g}), the engine would delete the "
-                             f"rest at their first contact (allowed range [{start:g}, "
-                             f"{MAX_LIQUID_CONTENT:g}])")
-        if "max_separation_ratio" in self.model_fields_set:
-            raise ValueError(f"max_separation_ratio = {self.max_separation_ratio:g}: with "
-                             f"max_liquid_content = {cap:g} the engine sets "
-                             "maxSeparationDistanceRatio itself (the rupture gap at the cap); "
-                             "leave max_separation_ratio unset")
-        return self
-
-    @model_validator(mode="after")
     def _model_limits(self) -> "Liquid":
         problems = liquids.get(self.model).validate(self)
         if problems:
             raise ValueError("; ".join(problems))
+        own = self.settings.problems(self)
+        if own:
+            raise ValidationError.from_exception_data(
+                type(self).__name__, [refusal(*problem) for problem in own])
         return self

@@ -104,6 +104,22 @@ def _bound_reason(model: type[BaseModel] | None, loc: tuple[Any, ...]) -> str | 
     return extra.get("bound_reason") if isinstance(extra, dict) else None
 
 
+def range_note(model: type[BaseModel] | None, loc: tuple[Any, ...], msg: str,
+               error_type: str) -> str:
+    """What a refusal line adds after the message of an error of the field at ``loc`` of
+    ``model``: its allowed range (unless the message states one) and, when the value broke
+    a bound, why the bound is there; "" for a field without bounds."""
+    rng = _allowed_range(model, loc) if "allowed" not in msg else None
+    if not rng:
+        return ""
+    note = f" (allowed range {rng})"
+    reason = _bound_reason(model, loc)
+    if reason and error_type in ("less_than", "less_than_equal", "greater_than",
+                                 "greater_than_equal"):
+        note += f": {reason}"
+    return note
+
+
 _LEADING_FIELD = re.compile(r"([A-Za-z_][A-Za-z0-9_]*(?:\.[A-Za-z_][A-Za-z0-9_]*)*)(?= = |: )")
 
 
@@ -150,14 +166,8 @@ def format_validation_error(exc: ValidationError, root: type[BaseModel], prefix:
                 and _model_at(root, loc) is not None:
             line = _model_level(root, loc, prefix, msg)
         else:
-            line = f"{path} = {short_repr(value)}: {msg}"
-            rng = _allowed_range(root, loc) if "allowed" not in msg else None
-            if rng:
-                line += f" (allowed range {rng})"
-                reason = _bound_reason(root, loc)
-                if reason and err["type"] in ("less_than", "less_than_equal",
-                                              "greater_than", "greater_than_equal"):
-                    line += f": {reason}"
+            line = f"{path} = {short_repr(value)}: {msg}" + range_note(root, loc, msg,
+                                                                       err["type"])
         if line not in lines:
             lines.append(line)
     return "\n".join(lines)

@@ -24,11 +24,13 @@ import re
 from typing import Any
 
 from pydantic import BaseModel
+from pydantic.fields import FieldInfo
 
 from ligwf import liquids
 from ligwf.scene.accept import AcceptSettings
+from ligwf.scene.liquid import Liquid
 from ligwf.scene.model import MAX_DUMPS, Scene
-from ligwf.scene.values import MAX_LIQUID_CONTENT
+from ligwf.liquids.base import MAX_LIQUID_CONTENT
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.scene.stability import CLOSED_MIN, SLICE_MIN, SLICE_WARN
 from ligwf.scene.workflow import MAX_CASES, MAX_REPLICAS, Sweep
@@ -55,7 +57,6 @@ UNITS: dict[str, str] = {
     "Liquid.surface_tension": "N/m", "Liquid.contact_angle_deg": "deg",
     "Liquid.viscosity": "Pa s", "Liquid.liquid_content": "1",
     "Liquid.min_separation_ratio": "1", "Liquid.max_separation_ratio": "1",
-    "Liquid.bridge_volume_fraction": "1", "Liquid.max_liquid_content": "1",
     "WetGranules.count": "count", "WetGranules.radius": "m",
     "WetGranules.liquid_content": "1",
     "Rotation.rpm": "1/min", "Rotation.froude": "1",
@@ -130,17 +131,33 @@ def _code_checked(defs: dict[str, Any]) -> None:
                        {"const": "auto", "type": "string"}]
 
 
-def _model_schema(model: type[BaseModel]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(the model's schema, its nested definitions) with ``$ref`` into ``#/$defs``."""
-    schema = model.model_json_schema(ref_template="#/$defs/{model}", mode="validation")
-    return schema, schema.pop("$defs", {})
-
-
 def shipped_liquid_models() -> list[str]:
     """The liquid models ligwf ships (a model registered from elsewhere, such as the
     tests' toy model, is not part of the published schema)."""
     return [n for n in liquids.names()
             if type(liquids.get(n)).__module__.startswith("ligwf.liquids.")]
+
+
+def liquid_settings() -> dict[str, tuple[type[BaseModel], FieldInfo]]:
+    """The shipped liquid models' own settings (keys of the ``liquid:`` block only some
+    models have): key -> (the settings class that declares it first, its field)."""
+    out: dict[str, tuple[type[BaseModel], FieldInfo]] = {}
+    for name in shipped_liquid_models():
+        own = liquids.get(name).settings_type
+        for key, info in own.model_fields.items():
+            out.setdefault(key, (own, info))
+    return out
+
+
+# each model's settings declare their unit (``json_schema_extra={"unit": ...}``)
+UNITS.update({f"Liquid.{key}": (info.json_schema_extra or {}).get("unit", "")  # type: ignore
+              for key, (_, info) in liquid_settings().items()})
+
+
+def _model_schema(model: type[BaseModel]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(the model's schema, its nested definitions) with ``$ref`` into ``#/$defs``."""
+    schema = model.model_json_schema(ref_template="#/$defs/{model}", mode="validation")
+    return schema, schema.pop("$defs", {})
 
 
 def _annotate(name: str, schema: dict[str, Any]) -> None:
@@ -170,6 +187,8 @@ def workflow_schema() -> dict[str, Any]:
         defs.update(nested)
         defs[model.__name__] = schema
         props[key] = {"$ref": f"#/$defs/{model.__name__}"}
+    for key, (own, _) in liquid_settings().items():      # after the block's own keys
+        defs["Liquid"]["properties"][key] = _model_schema(own)[0]["properties"][key]
     for name, schema in defs.items():
         _annotate(name, schema)
     _code_checked(defs)
@@ -351,7 +370,11 @@ def model_fields(model: type[BaseModel] | None = None, prefix: str = ""
     if model is None:
         return [f for key, m, _ in BLOCKS for f in model_fields(m, key)]
     out = []
-    for name, info in model.model_fields.items():
+    fields = dict(model.model_fields)
+    if model is Liquid:     # the models' own settings, not the field that carries them
+        del fields["settings"]
+        fields.update({k: info for k, (_, info) in liquid_settings().items()})
+    for name, info in fields.items():
         key = f"{prefix}.{name}"
         out.append((key, f"{model.__name__}.{name}"))
         stack, seen = [info.annotation], set()

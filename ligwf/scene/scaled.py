@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ligwf import liquids
-from ligwf.liquids.base import LiquidModel
+from ligwf.liquids.base import LiquidModel, LiquidSettings
 from ligwf.scene.axis import Axis
 from ligwf.scene.model import GRAVITY
 from ligwf.scene.neighbour import fill_skin
@@ -128,15 +128,15 @@ class ScaledLiquidValues:
     contact_angle_deg: float                 # the scene's angle
     liquid_content: float                    # liquid volume / solid volume
     min_separation_ratio: float
-    max_separation_ratio: float              # with max_liquid_content: the engine's own
+    max_separation_ratio: float              # the cut the engine applies (a setting may
+    #                                          make it its own: engine_separation_ratio)
     contact_angle_compensation: bool         # 3.8.0's 0.5 theta_i theta_j compensated
     # placed liquid (ligwf.scene.placement): wet spheres (axial, across, vertical, r), m
     wet_spheres: tuple[tuple[float, float, float, float], ...] = ()
     wet_sphere_content: float = 0.0
-    # washino's optional settings (None: the engine default, nothing rendered), fractions
-    # unchanged by CG
-    bridge_volume_fraction: float | None = None
-    max_liquid_content: float | None = None
+    # the model's own settings as the engine applies them (its settings_type; unchanged by
+    # CG): opaque here, read by the model's law (ScaledScene.liquid)
+    settings: LiquidSettings = dataclasses.field(default_factory=LiquidSettings)
 
 
 @dataclass(frozen=True)
@@ -188,9 +188,8 @@ class ScaledScene:
     @property
     def liquid(self) -> LiquidModel:
         """The liquid model of this case (from :mod:`ligwf.liquids`' registry), applying
-        the case's bridge volume fraction."""
-        return liquids.get(self.liquid_values.model).configured(
-            self.liquid_values.bridge_volume_fraction)
+        the case's settings of that model."""
+        return liquids.get(self.liquid_values.model).configured(self.liquid_values.settings)
 
     @property
     def insertion_steps(self) -> int:
@@ -227,7 +226,10 @@ class ScaledScene:
         """From :meth:`to_dict` (a case folder's stored scaled scene): lists back to tuples;
         a missing or unknown key is a TypeError, never a default; a derived value that does
         not follow from the stored ones is a ValueError naming it."""
-        unknown = sorted(set(data) - set(FLAT_KEYS) - set(DERIVED_KEYS))
+        settings_type = (liquids.get(data["liquid_model"]).settings_type
+                         if data.get("liquid_model") in liquids.names() else LiquidSettings)
+        own = {k: data[k] for k in data if k in settings_type.model_fields}
+        unknown = sorted(set(data) - set(FLAT_KEYS) - set(DERIVED_KEYS) - set(own))
         if unknown:
             raise TypeError(f"scaled scene record: unknown key(s) {', '.join(unknown)}")
         groups: dict[str, dict[str, Any]] = {g: {} for g in GROUPS}
@@ -243,6 +245,7 @@ class ScaledScene:
         liquid = groups["liquid_values"]
         if "wet_spheres" in liquid:
             liquid["wet_spheres"] = tuple(tuple(w) for w in liquid["wet_spheres"])
+        liquid["settings"] = settings_type.model_validate(own)
         groups["drum"]["axis"] = Axis(groups["drum"]["axis"])
         scaled = cls(**top, **{g: GROUPS[g](**values) for g, values in groups.items()})
         for key in DERIVED_KEYS:
@@ -268,9 +271,9 @@ class ScaledScene:
         out["axis"] = self.drum.axis.value
         if not self.liquid_values.wet_spheres:   # records of uniform beds stay as they were
             del out["wet_spheres"], out["wet_sphere_content"]
-        for key in ("bridge_volume_fraction", "max_liquid_content"):
-            if out[key] is None:                 # so do records at the engine's defaults
-                del out[key]
+        # the model's own settings last, each left out when unset (as records at the
+        # model's defaults always were)
+        out.update(self.liquid_values.settings.record())
         return out
 
 
@@ -313,16 +316,14 @@ FLAT_KEYS: dict[str, tuple[str, str]] = {
     "granules": ("", "contact_dumps"),
     "wet_spheres": ("liquid_values", "wet_spheres"),
     "wet_sphere_content": ("liquid_values", "wet_sphere_content"),
-    "bridge_volume_fraction": ("liquid_values", "bridge_volume_fraction"),
-    "max_liquid_content": ("liquid_values", "max_liquid_content"),
 }
 
 #: keys stored as JSON lists (wet_spheres stays a tuple of tuples, as it always was)
 LIST_KEYS = ("diameters", "number_fractions", "seeds", "insertion_waves")
 
-#: keys a record leaves out at their defaults (uniform bed, the engine's washino defaults)
-OPTIONAL_KEYS = ("wet_spheres", "wet_sphere_content", "bridge_volume_fraction",
-                 "max_liquid_content")
+#: keys a record leaves out at their defaults (a uniform bed; the liquid model's own
+#: settings, stored after these, are left out when unset: ``LiquidSettings.record``)
+OPTIONAL_KEYS = ("wet_spheres", "wet_sphere_content")
 
 #: derived values the flat record carries (written by to_dict, checked by from_dict)
 DERIVED_KEYS = {

@@ -23,15 +23,15 @@ is a fraction of solid volume, so V_bridge/R^3 is unchanged, as are the separati
 and the contact angle; at the same dimensionless gap and the same velocity the forces
 therefore grow like n * gamma' and n * mu'. Forces x n^k need gamma' = n^(k-1) gamma.
 
-The washino law's two optional settings are fractions and pass through both rules
-unchanged: ``bridge_volume_fraction`` (the share of both particles' liquid a bridge takes:
-V_bridge/R^3 stays as it is) and ``max_liquid_content`` (a cap on the liquid content, itself
-a fraction of solid volume). With the cap set, the engine replaces
-``maxSeparationDistanceRatio`` by the rupture gap of two of the largest particles at the
-cap over twice the smallest radius (:func:`ligwf.liquids.washino.engine_max_separation_ratio`),
-a ratio of lengths that also stays unchanged; the scaled scene carries that ratio (the
-model's ``capped_separation_ratio``), so
-rendering, pre-flight and analysis use the cut the engine applies.
+A liquid model's own settings (``scene.liquid.settings``, e.g. washino's bridge volume
+fraction and liquid cap, both fractions) pass through every rule unchanged, as one value
+scaling does not look into, in the form the engine applies them (``applied``: a value at
+the engine's default reads as unset). A setting may make the engine compute its own
+``maxSeparationDistanceRatio`` (washino's cap: the rupture gap of two of the largest
+particles at the cap over twice the smallest radius, a ratio of lengths unchanged by CG);
+the scaled scene carries the ratio the engine applies (the model's
+``engine_separation_ratio``), so rendering, pre-flight and analysis use the cut the engine
+applies.
 
 Particle sizes follow Same Statistic Weight (SSW): every class of the size distribution is
 multiplied by n and keeps its number fraction, so the distribution keeps its shape and the
@@ -199,15 +199,11 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
     thermo_every = _every(num.thermo_interval, dt)
     r_ins, waves = insertion_waves(scene, diameters, fractions, count)
     fall_time = math.sqrt(2.0 * drum.diameter / GRAVITY)
-    law = liquids.get(liq.model)
-    fraction = liq.bridge_volume_fraction
-    if fraction == law.default_bridge_volume_fraction:
-        fraction = None                  # the default written out: the same case as unset
-    max_separation_ratio = liq.max_separation_ratio
-    if liq.max_liquid_content is not None:
-        max_separation_ratio = law.configured(fraction).capped_separation_ratio(
-            0.5 * min(diameters), 0.5 * max(diameters), liq.max_liquid_content,
-            applied_contact_angle_rad(liq.contact_angle_deg, num.contact_angle_compensation))
+    settings = liq.settings.applied()    # a default written out: the same case as unset
+    max_separation_ratio = liquids.get(liq.model).configured(settings).engine_separation_ratio(
+        0.5 * min(diameters), 0.5 * max(diameters),
+        applied_contact_angle_rad(liq.contact_angle_deg, num.contact_angle_compensation),
+        liq.max_separation_ratio)
 
     return ScaledScene(
         name=scene.name, cg=float(cg), rule=rule.value, replica=replica,
@@ -232,7 +228,7 @@ def scale(scene: Scene, cg: float, rule: Rule | str, replica: int = 0) -> Scaled
             max_separation_ratio=max_separation_ratio,
             contact_angle_compensation=num.contact_angle_compensation,
             **wet_sphere_fields(scene, max(diameters), cg),
-            bridge_volume_fraction=fraction, max_liquid_content=liq.max_liquid_content),
+            settings=settings),
         numerics=ScaledNumerics(
             dt=dt, dt_rayleigh_fraction=num.dt_rayleigh_fraction if num.dt is None else dt / t_r,
             skin=(num.skin_ratio * min(diameters) if num.skin_ratio is not None

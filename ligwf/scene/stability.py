@@ -240,9 +240,8 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
         if verdict != OK:
             msg += (f"; bridges between the two gaps never act nor show in the contact dumps:"
                     f" use max_separation_ratio >= {1.0 + sc.rupture_distance / d:.3g}")
-            if s.liquid.limits_liquid_content:
-                msg += (" or set max_liquid_content (the engine then cuts at the law's own "
-                        "rupture gap of two particles holding that content)")
+            if s.liquid.bridge_cut_remedy:
+                msg += f" or {s.liquid.bridge_cut_remedy}"
         out.append(Finding("bridge_cut", "liquid.max_separation_ratio", ratio,
                            BRIDGE_CUT_WARN, verdict, msg))
 

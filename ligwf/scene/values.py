@@ -55,11 +55,6 @@ MIN_LENGTH = 1e-6
 MIN_TIME = 1e-6
 #: smallest restitution coefficient (LIGGGHTS damps with ln e)
 MIN_RESTITUTION = 1e-3
-#: largest liquid content (liquid volume / solid volume) and why: see PENDULAR_REASON
-MAX_LIQUID_CONTENT = 0.2
-PENDULAR_REASON = ("the bridge laws describe separate pendular bridges; at 0.2 of the solid "
-                   "volume a bed at packing 0.6 has its pores 30 % full, the end of the "
-                   "pendular regime (funicular beyond)")
 
 
 def _members(annotation: Any) -> tuple[Any, ...]:
@@ -116,8 +111,8 @@ def _text_for_number(text: str) -> str:
     return f"{why}: write {word} without quotes"
 
 
-def _scalar_problem(value: Any, annotation: Any,
-                    where: tuple[Any, ...] = ()) -> ItemProblem | None:
+def scalar_problem(value: Any, annotation: Any,
+                   where: tuple[Any, ...] = ()) -> ItemProblem | None:
     """Why ``value`` may not stand where ``annotation`` is, looking into lists and mappings
     (``cg_levels: [true]`` names ``cg_levels[0]``), or None. Pydantic's lax mode would read
     ``true`` as 1 and ``"2500"`` as 2500; a workflow says what it means."""
@@ -137,7 +132,7 @@ def _scalar_problem(value: Any, annotation: Any,
             if typing.get_origin(member) in (tuple, list) and args:
                 items = (args[0],) * len(value) if len(args) == 1 or args[1:] == (...,) else args
                 for k, (item, ann) in enumerate(zip(value, items)):
-                    problem = _scalar_problem(item, ann, (*where, k))
+                    problem = scalar_problem(item, ann, (*where, k))
                     if problem:
                         return problem
     if isinstance(value, dict):
@@ -145,8 +140,8 @@ def _scalar_problem(value: Any, annotation: Any,
             args = typing.get_args(member)
             if typing.get_origin(member) is dict and len(args) == 2:
                 for key, item in value.items():
-                    problem = (_scalar_problem(key, args[0], (*where, key))
-                               or _scalar_problem(item, args[1], (*where, key)))
+                    problem = (scalar_problem(key, args[0], (*where, key))
+                               or scalar_problem(item, args[1], (*where, key)))
                     if problem:
                         return problem
     return None
@@ -164,7 +159,7 @@ class Frozen(BaseModel):
     @classmethod
     def _numbers_are_numbers(cls, value: Any, info: ValidationInfo) -> Any:
         field = cls.model_fields.get(info.field_name) if info.field_name else None
-        problem = _scalar_problem(value, field.annotation) if field is not None else None
+        problem = scalar_problem(value, field.annotation) if field is not None else None
         if problem:
             raise problem
         return value

@@ -18,7 +18,7 @@ from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.analysis.granules.bridge_law import Liquid, content_of
 from ligwf.engine.render import render
 from ligwf.errors import ConfigError
-from ligwf.liquids.washino import BRIDGE_VOLUME_FRACTION, bridge_volume
+from ligwf.liquids.washino import BRIDGE_VOLUME_FRACTION, WashinoSettings, bridge_volume
 from ligwf.scene.scaling import scale
 from ligwf.scene.workflow import load_workflow
 
@@ -79,22 +79,44 @@ def test_out_of_range_refused_in_one_line(overrides, field, value, allowed):
 
 def test_settings_of_other_models_refused():
     msg = refusal("scene.liquid.model=easo", "scene.liquid.bridge_volume_fraction=0.1")
-    assert "bridge_volume_fraction = 0.1" in msg and "'easo'" in msg
+    assert "scene.liquid.bridge_volume_fraction = 0.1" in msg and "'easo'" in msg
+    assert "only washino" in msg
     msg = refusal("scene.liquid.model=easo", "scene.liquid.max_liquid_content=0.1")
-    assert "max_liquid_content = 0.1" in msg and "'easo'" in msg
+    assert "scene.liquid.max_liquid_content = 0.1" in msg and "'easo'" in msg
+    # a scene record of an older ligwf writes them as null for every model: still read
+    easo = load_workflow(DRUM, ["scene.liquid.model=easo"]).cases[0].scene
+    old = easo.model_dump(mode="json")
+    old["liquid"].update(bridge_volume_fraction=None, max_liquid_content=None)
+    assert type(easo).model_validate(old) == easo
+
+
+def test_settings_are_one_value_written_as_keys_of_the_block():
+    """The scene carries washino's settings as one value and writes them back as keys of
+    ``liquid:`` (a scene record reads back to the same scene)."""
+    sc = scene("scene.liquid.bridge_volume_fraction=0.2")
+    assert sc.liquid.settings == WashinoSettings(bridge_volume_fraction=0.2)
+    dumped = sc.model_dump(mode="json")["liquid"]
+    assert dumped["bridge_volume_fraction"] == 0.2 and "settings" not in dumped
+    assert type(sc).model_validate(sc.model_dump(mode="json")) == sc
+    assert "scene.liquid.settings: unknown key" in refusal(*WASHINO,
+                                                          "scene.liquid.settings={a: 1}")
 
 
 def test_cap_refuses_a_separation_ratio_the_engine_would_overwrite():
     msg = refusal(*WASHINO, "scene.liquid.max_liquid_content=0.1",
                   "scene.liquid.max_separation_ratio=1.2")
     assert "max_separation_ratio = 1.2" in msg and "max_liquid_content = 0.1" in msg
+    # a case's scene record writes every key, the ratio at its default too: it reads back
+    capped = scene("scene.liquid.max_liquid_content=0.1")
+    assert type(capped).model_validate(capped.model_dump(mode="json")) == capped
 
 
 @pytest.mark.parametrize("n,rule,power", [(2, "weber", 2), (3, "bond", 3)])
 def test_fractions_unchanged_by_cg_and_forces_scale_as_the_rule(n, rule, power):
     sc = scene("scene.liquid.bridge_volume_fraction=0.2", "scene.liquid.max_liquid_content=0.1")
     s1, sn = scale(sc, 1, "none"), scale(sc, n, rule)
-    assert (sn.liquid_values.bridge_volume_fraction, sn.liquid_values.max_liquid_content) == (0.2, 0.1)
+    assert sn.liquid_values.settings == WashinoSettings(bridge_volume_fraction=0.2,
+                                                        max_liquid_content=0.1)
     assert sn.liquid_values.max_separation_ratio == pytest.approx(s1.liquid_values.max_separation_ratio, rel=1e-12)
     theta = math.radians(sc.liquid.contact_angle_deg)
     for g in (0.0, 0.05, 0.1):
@@ -106,8 +128,9 @@ def test_fractions_unchanged_by_cg_and_forces_scale_as_the_rule(n, rule, power):
 
 def test_law_follows_the_fraction_in_numpy_and_numba():
     r, gamma, theta, c = 5e-4, 0.024, math.radians(30), 0.02
-    law = liquids.get("washino").configured(0.2)
-    assert law is liquids.get("washino").configured(0.2)          # one object per fraction
+    law = liquids.get("washino").configured(WashinoSettings(bridge_volume_fraction=0.2))
+    assert law is liquids.get("washino").configured(           # one object per settings
+        WashinoSettings(bridge_volume_fraction=0.2))
     assert law.bridge_volume(r, r, c, c) == pytest.approx(4 * bridge_volume(r, r, c, c))
     # the force at 0.2 is the default law's expression at the 0.2 bridge volume ...
     vol = float(bridge_volume(r, r, c, c, 0.2))
@@ -130,8 +153,10 @@ def test_analysis_applies_the_cases_fraction_and_cap():
     s = scale(scene("scene.liquid.bridge_volume_fraction=0.2",
                     "scene.liquid.max_liquid_content=0.1"), 1, "none")
     liquid = Liquid.from_scaled(s)
-    assert (liquid.bridge_volume_fraction, liquid.max_liquid_content) == (0.2, 0.1)
-    assert liquid.law is liquids.get("washino").configured(0.2)
+    own = WashinoSettings(bridge_volume_fraction=0.2, max_liquid_content=0.1)
+    assert liquid.settings == own
+    assert liquid.law is liquids.get("washino").configured(own)
+    assert liquid.law.bridge_volume_fraction == 0.2
     assert Liquid.from_scaled(scale(scene(), 1, "none")).law is liquids.get("washino")
 
     frame = ParticleFrame(Path("particles_0.vtu"), 0, 0.0, np.arange(1, 4), np.ones(3, np.int32),
@@ -149,13 +174,15 @@ def test_foreign_runs_are_analysed_at_their_fraction():
     from ligwf.analysis.foreign import ForeignRun
 
     def run(liquid, fraction):
-        return ForeignRun(liquid, 0.02, 30.0, "scene", "y", 0.01, 1e-5, None, 1.0, fraction)
+        own = {} if fraction is None else {"bridge_volume_fraction": fraction}
+        return ForeignRun(liquid, 0.02, 30.0, "scene", "y", 0.01, 1e-5, None, 1.0, own)
 
-    assert run("washino", 0.2).facts("r").liquid.law is liquids.get("washino").configured(0.2)
+    assert run("washino", 0.2).facts("r").liquid.law is liquids.get("washino").configured(
+        WashinoSettings(bridge_volume_fraction=0.2))
     assert run("washino", None).facts("r").liquid.law is liquids.get("washino")
     with pytest.raises(ConfigError, match=r"--bridge-volume-fraction 0.2: liquid model 'easo'"):
         run("easo", 0.2).facts("r")
-    with pytest.raises(ConfigError, match=r"allowed range \(0, 1\]"):
+    with pytest.raises(ConfigError, match=r"--bridge-volume-fraction 1.5: .*allowed range \(0, 1\]"):
         run("washino", 1.5).facts("r")
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from ligwf import liquids
 from ligwf.analysis.frames.dumps import ParticleFrame
 from ligwf.liquids.contact_angle import applied_contact_angle_rad
-from ligwf.liquids.base import LiquidModel
+from ligwf.liquids.base import LiquidModel, LiquidSettings
 from ligwf.scene.scaled import ScaledScene
 
 
@@ -27,17 +27,14 @@ class Liquid:
     surface_tension: float      # N/m, already CG-scaled
     contact_angle_rad: float    # the angle the engine APPLIED (see ligwf.liquids.contact_angle)
     liquid_content: float       # fraction of particle volume, used if a dump lacks it
-    #: washino's share of both partners' liquid in a bridge (None: the engine default)
-    bridge_volume_fraction: float | None = None
-    #: the engine's cap of a particle's liquid content (None: none); it clips a content
-    #: above the cap before every pair it evaluates, so the analysis clips too
-    max_liquid_content: float | None = None
+    #: the model's own settings in the run (its settings_type; None: the model's defaults)
+    settings: LiquidSettings | None = None
 
     @property
     def law(self) -> LiquidModel:
         """The liquid model (its force law, bridge volume and rupture distance) at the run's
-        bridge volume fraction."""
-        return liquids.get(self.model).configured(self.bridge_volume_fraction)
+        settings."""
+        return liquids.get(self.model).configured(self.settings)
 
     @classmethod
     def from_scaled(cls, scaled: ScaledScene, engine_product_bug: bool = True) -> "Liquid":
@@ -48,19 +45,16 @@ class Liquid:
         theta = applied_contact_angle_rad(liq.contact_angle_deg, liq.contact_angle_compensation,
                                           engine_product_bug)
         return cls(liq.model, float(liq.surface_tension), theta, float(liq.liquid_content),
-                   liq.bridge_volume_fraction, liq.max_liquid_content)
+                   liq.settings)
 
 
 def content_of(particles: ParticleFrame, liquid: Liquid) -> np.ndarray:
-    """Liquid content per particle: the dump's, or the scene's when the dump lacks it;
-    clipped to the run's cap (``max_liquid_content``) as the engine clips it."""
+    """Liquid content per particle: the dump's, or the scene's when the dump lacks it; as
+    the engine uses it in a pair (the law's ``clip_content``: washino's liquid cap)."""
     content = particles.liquid_content
     if content is None:
         content = np.full(len(particles), liquid.liquid_content)
-    content = np.asarray(content, dtype=np.float64)
-    if liquid.max_liquid_content is not None:
-        content = np.minimum(content, liquid.max_liquid_content)
-    return content
+    return liquid.law.clip_content(np.asarray(content, dtype=np.float64))
 
 
 def pair_forces(particles: ParticleFrame, i: np.ndarray, j: np.ndarray, gap: np.ndarray,
