@@ -14,7 +14,6 @@ README from the committed tables and fails when the committed README differs.
 
 from __future__ import annotations
 
-import shutil
 import sys
 from pathlib import Path
 
@@ -23,16 +22,24 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from ligwf.api.results_folder import (ResultsFolder, number as _n, results_command,  # noqa: E402
+                                      runs_rows, verdict_rows)
+from ligwf.inference.budget import criteria  # noqa: E402
+from ligwf.study import layout  # noqa: E402
 from ligwf.yamlio import read_yaml_mapping  # noqa: E402
-from scripts.results_readme import copy_files, number as _n, parser, write_or_check  # noqa: E402
 
 WORKFLOW = ROOT / "workflows" / "demo.yaml"
 OUT = ROOT / "docs" / "results" / "demo"
-TABLES = ("verdict.csv", "verdict.json", "cases.csv", "conditions.csv", "noise_floor.csv",
-          "fields_null_check.csv", "summary.md", "index.html")
+#: the report files committed (the ParaView series are not)
+REPORT_FILES = (layout.VERDICT_TABLE, layout.VERDICT_RECORD, layout.CASES_REPORT,
+                layout.CONDITIONS_REPORT, layout.NOISE_FLOOR_REPORT, layout.FIELD_NULL_REPORT,
+                layout.SUMMARY_REPORT, layout.HTML_REPORT)
+#: the study's measured wall time and the machine it ran on (written by this script)
+TIMING = "timing.csv"
 COMMAND = "ligwf study workflows/demo.yaml --out runs/demo"
-#: the flow criteria whose decisions the README counts
-FLOW = ("angle_deg", "profile_error", "rigid_share", "flowing_layer", "field_error")
+#: the flow criteria whose decisions the README counts: every criterion of the budget that
+#: is not gated on the granules beating their control
+FLOW = tuple(c.name for c in criteria() if not c.gated)
 
 
 def scene_text(wf: dict) -> str:
@@ -73,21 +80,12 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, null: pd.DataFrame,
              "| condition | runs | particles | angle of repose per run [deg] | its std over "
              "frames [deg] | rigid-block share per run | wall s per run |",
              "|---|---|---|---|---|---|---|"]
-    for (cg, rule), sub in cases.groupby(["cg", "rule"], sort=True):
-        lines.append(f"| cg{cg:g}-{rule} | {len(sub)} | {int(sub['particles'].iloc[0]):,} | "
-                     + ", ".join(f"{a:.2f}" for a in sub["angle_of_repose"]) + " | "
-                     + ", ".join(f"{a:.2f}" for a in sub["angle_of_repose_std"]) + " | "
-                     + ", ".join(f"{a:.2f}" for a in sub["rigid_frame_share"]) + " | "
-                     + ", ".join(f"{a:.0f}" for a in sub["wall_seconds"]) + " |")
+    lines += runs_rows(cases, [("angle_of_repose", ".2f"), ("angle_of_repose_std", ".2f"),
+                               ("rigid_frame_share", ".2f"), ("wall_seconds", ".0f")])
     lines += ["", "## Verdict (budget: the workflow's `accept:` block, the defaults)", "",
               "| condition | speedup (core-s) | verdict | criterion | state | value [bounds] | "
               "shown within | budget |", "|---|---|---|---|---|---|---|---|"]
-    for _, r in verdict.iterrows():
-        unit = f" {r['unit']}" if isinstance(r["unit"], str) and r["unit"] else ""
-        lines.append(f"| {r['condition']} | {_n(r['speedup_core'])} | {r['condition_state']} | "
-                     f"{r['label']} | {r['state']} | {_n(r['value'])} [{_n(r['lo'])}, "
-                     f"{_n(r['hi'])}]{unit} | {_n(r['shown_within'])}{unit} | "
-                     f"{_n(r['budget'])}{unit} |")
+    lines += verdict_rows(verdict)
     lines += ["", "## Reading", ""]
     for cond, sub in verdict.groupby("condition", sort=True):
         decided = sub[sub["state"].isin(["pass", "fail"])]
@@ -106,33 +104,33 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, null: pd.DataFrame,
     return "\n".join(lines) + "\n"
 
 
-def _text() -> str:
-    return readme(pd.read_csv(OUT / "verdict.csv"), pd.read_csv(OUT / "cases.csv"),
-                  pd.read_csv(OUT / "fields_null_check.csv"), pd.read_csv(OUT / "timing.csv"))
+def render(folder: ResultsFolder) -> str:
+    return readme(folder.table(layout.VERDICT_TABLE), folder.table(layout.CASES_REPORT),
+                  folder.table(layout.FIELD_NULL_REPORT), folder.table(TIMING))
 
 
-def main(argv=None) -> int:
-    ap = parser(__doc__, "demo")
+FOLDER = ResultsFolder(OUT, render, "scripts/demo_results.py runs/demo --wall-seconds S")
+
+
+def arguments(ap) -> None:
     ap.add_argument("--wall-seconds", type=float, help="measured wall time of the study")
     ap.add_argument("--machine", default="2 cores", help="where it ran (for timing.csv)")
     ap.add_argument("--loaded", action="store_true",
                     help="the machine was shared: the wall time is no claim")
-    args = ap.parse_args(argv)
-    if not args.check:
-        if args.study is None or args.wall_seconds is None:
-            ap.error("give the study folder and --wall-seconds (or --check)")
-        report = args.study / "report"
-        copy_files(report, OUT, TABLES)
-        if (OUT / "figures").exists():
-            shutil.rmtree(OUT / "figures")
-        shutil.copytree(report / "figures", OUT / "figures")
-        for stale in ("controls.csv",):
-            (OUT / stale).unlink(missing_ok=True)
-        pd.DataFrame([{"wall_seconds": args.wall_seconds, "machine": args.machine,
-                       "quiet": not args.loaded}]).to_csv(
-            OUT / "timing.csv", index=False)
-    return write_or_check(OUT, _text, args.check,
-                          "scripts/demo_results.py runs/demo --wall-seconds S")
+
+
+def make(args) -> ResultsFolder:
+    """Copy the study's report (and figures) and write timing.csv."""
+    if args.study is None or args.wall_seconds is None:
+        args.error("give the study folder and --wall-seconds (or --check)")
+    FOLDER.copy_report(args.study, REPORT_FILES, figures=True)
+    pd.DataFrame([{"wall_seconds": args.wall_seconds, "machine": args.machine,
+                   "quiet": not args.loaded}]).to_csv(OUT / TIMING, index=False)
+    return FOLDER
+
+
+def main(argv=None) -> int:
+    return results_command(__doc__, [FOLDER], make, argv, arguments)
 
 
 if __name__ == "__main__":

@@ -23,9 +23,9 @@ from its table.
 from __future__ import annotations
 
 import re
-import shutil
 import sys
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import pandas as pd
@@ -33,14 +33,20 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from ligwf.api.results_folder import (ResultsFolder, number as _n, results_command,  # noqa: E402
+                                      runs_rows, verdict_rows)
 from ligwf.report.rounds import look_line  # noqa: E402
+from ligwf.study import layout  # noqa: E402
 from ligwf.study.rounds import read_rounds  # noqa: E402
-from scripts.results_readme import copy_files, number as _n, parser, write_or_check  # noqa: E402
+from ligwf.yamlio import read_yaml_mapping  # noqa: E402
 
 OUT = ROOT / "docs" / "results" / "ladder"
-TABLES = ("verdict.csv", "cases.csv", "conditions.csv", "summary.md")
-#: the sequential study's record (in the study folder, beside report/)
-ROUNDS = "rounds.json"
+REPORT_FILES = (layout.VERDICT_TABLE, layout.CASES_REPORT, layout.CONDITIONS_REPORT,
+                layout.SUMMARY_REPORT)
+#: the registered criteria: the keys of the workflow's ``accept:`` block, committed before
+#: the runs (criterion.md); the verdict also has criteria added since (the fields)
+REGISTERED = tuple(read_yaml_mapping(ROOT / "workflows" / "ladder.yaml", "ladder workflow")
+                   ["accept"])
 #: the runs' commands: the sequential run of amendment 2 (stopped at look 1, stuck), then
 #: its continuation (amendment 3) on the same study folder
 COMMANDS = ("ligwf study workflows/ladder.yaml --out runs/ladder --no-snapshots --until-decided "
@@ -90,6 +96,11 @@ class Ladder:
     commands: tuple[str, ...]
     timing: str                     # the paragraph on timings and amendments
     title: str = "The ladder: which CG level and rule keeps the flow of the we_vs_bo drum"
+
+    @property
+    def folder(self) -> ResultsFolder:
+        return ResultsFolder(self.out, partial(render, self),
+                             f"scripts/ladder_results.py {self.study} --ladder {self.name}")
 
 
 LADDERS = {
@@ -162,28 +173,18 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
              "", "## Looks (`rounds.json`)", "", *rounds_lines(rounds if rounds is not None
                                                              else read_rounds(OUT / "none")),
              "", "## Runs", ""]
-    runs = cases.groupby(["cg", "rule"], sort=True)
     lines += ["| condition | runs | particles | angle of repose per run [deg] | rigid-block "
               "share per run | core-s per run |", "|---|---|---|---|---|---|"]
-    for (cg, rule), sub in runs:
-        lines.append(f"| cg{cg:g}-{rule} | {len(sub)} | {int(sub['particles'].iloc[0]):,} | "
-                     + ", ".join(f"{a:.2f}" for a in sub["angle_of_repose"]) + " | "
-                     + ", ".join(f"{a:.2f}" for a in sub["rigid_frame_share"]) + " | "
-                     + ", ".join(f"{a:.0f}" for a in sub["core_seconds"]) + " |")
+    lines += runs_rows(cases, [("angle_of_repose", ".2f"), ("rigid_frame_share", ".2f"),
+                               ("core_seconds", ".0f")])
     lines += ["", "## Verdict (budget: the workflow's `accept:` block)", ""]
     alpha = rounds.alpha_per_look if rounds is not None and rounds.looks else 0.05
     lines += ["| condition | speedup (core-s) | verdict | criterion | state | CG-n - CG1 "
               f"[{100 * (1 - 2 * alpha):.3g} % interval] | shown within | budget |",
               "|---|---|---|---|---|---|---|---|"]
-    for _, r in verdict.iterrows():
-        unit = f" {r['unit']}" if isinstance(r["unit"], str) and r["unit"] else ""
-        lines.append(f"| {r['condition']} | {_n(r['speedup_core'])} | {r['condition_state']} | "
-                     f"{r['label']} | {r['state']} | {_n(r['value'])} [{_n(r['lo'])}, "
-                     f"{_n(r['hi'])}]{unit} | {_n(r['shown_within'])}{unit} | "
-                     f"{_n(r['budget'])}{unit} |")
+    lines += verdict_rows(verdict)
     lines += ["", "## Reading", ""]
-    flow = verdict[verdict["criterion"].isin(["angle_deg", "rigid_share", "flowing_layer",
-                                              "profile_error"])]
+    flow = verdict[verdict["criterion"].isin(REGISTERED)]
     decided = flow[flow["state"].isin(["pass", "fail"])]
     lines.append(f"- Flow criteria decided: {len(decided)} of {len(flow)} "
                  "(angle, velocity profile, rigid-block share, flowing layer of every level).")
@@ -233,10 +234,8 @@ def reanalysed_lines(verdict: pd.DataFrame, cases: pd.DataFrame, verdict_again: 
                      cases_again: pd.DataFrame) -> list[str]:
     """The same runs re-analysed with the steady window of a1377ba (MSER-5 from 80 frames
     on): windows at the cap, flow criteria decided, and each state that changed."""
-    flow = ["angle_deg", "rigid_share", "flowing_layer", "profile_error"]
-
     def decided(v):
-        f = v[v["criterion"].isin(flow)]
+        f = v[v["criterion"].isin(REGISTERED)]
         return int(f["state"].isin(["pass", "fail"]).sum()), len(f)
 
     both = beside(verdict, verdict_again)
@@ -289,8 +288,7 @@ def repeat_lines(cases: pd.DataFrame, repeated: pd.DataFrame) -> list[str]:
             "every digit of cases.csv" + (f"; not: {differ}." if differ else ".")]
 
 
-def main(argv=None) -> int:
-    ap = parser(__doc__, "ladder")
+def arguments(ap) -> None:
     ap.add_argument("--ladder", choices=sorted(LADDERS), default="continuation",
                     help="which committed ladder the study folder is (default continuation)")
     ap.add_argument("--replanned", type=Path, metavar="REPORT",
@@ -299,51 +297,56 @@ def main(argv=None) -> int:
     ap.add_argument("--reanalysed", type=Path, metavar="REPORT",
                     help="the report folder of a copy of the study re-analysed with today's "
                          f"steady window: its verdict.csv and cases.csv -> {', '.join(REANALYSED)}")
-    args = ap.parse_args(argv)
-    if args.check:
-        return max(check(ladder) for ladder in LADDERS.values()
-                   if (ladder.out / "verdict.csv").exists())
+
+
+def make(args) -> ResultsFolder:
+    """Copy the study's report tables, its rounds record and what the options name."""
     if args.study is None:
-        ap.error("give the study folder (or --check)")
+        args.error("give the study folder (or --check)")
     ladder = LADDERS[args.ladder]
-    ladder.out.mkdir(parents=True, exist_ok=True)
+    folder = ladder.folder
     if args.replanned is not None:
-        shutil.copyfile(args.replanned / "verdict.csv", ladder.out / REPLANNED)
+        folder.copy(args.replanned, layout.VERDICT_TABLE, REPLANNED)
     if args.reanalysed is not None:
-        for name, target in zip(("verdict.csv", "cases.csv"), REANALYSED):
-            shutil.copyfile(args.reanalysed / name, ladder.out / target)
-    copy_files(args.study / "report", ladder.out, TABLES)
-    copy_files(args.study, ladder.out, [ROUNDS])
+        for name, target in zip((layout.VERDICT_TABLE, layout.CASES_REPORT), REANALYSED):
+            folder.copy(args.reanalysed, name, target)
+    folder.copy_report(args.study, REPORT_FILES)
+    folder.copy(args.study, layout.ROUNDS_FILE)
     first = args.study.parent / "ladder_rounds_look1_amendment2.json"
     if ladder.out == OUT and first.is_file():
-        copy_files(first.parent, ladder.out, [first.name])
-        (ladder.out / first.name).rename(ladder.out / FIRST_LOOK)
+        folder.copy(first.parent, first.name, FIRST_LOOK)
     timed = args.study.parent / f"{args.study.name}.time"
     if ladder.out != OUT and timed.is_file():
         (ladder.out / WALL).write_text(next(line.strip() + "\n" for line in
                                             timed.read_text().splitlines()
                                             if "Elapsed (wall clock)" in line))
-    return write_or_check(ladder.out, lambda: text(ladder), False, "")
+    return folder
 
 
-def text(ladder: Ladder) -> str:
-    """The README of ``ladder`` from its committed tables."""
+def main(argv=None) -> int:
+    committed = [ladder.folder for ladder in LADDERS.values()
+                 if (ladder.out / layout.VERDICT_TABLE).exists()]
+    return results_command(__doc__, committed, make, argv, arguments)
+
+
+def render(ladder: Ladder, folder: ResultsFolder) -> str:
+    """The README of ``ladder`` from its committed tables (in ``folder``)."""
+    again = [folder.optional_table(name) for name in REANALYSED]
     wall = ladder.out / WALL
-    replanned = ladder.out / REPLANNED
-    again = [ladder.out / name for name in REANALYSED]
-    return readme(pd.read_csv(ladder.out / "verdict.csv"), pd.read_csv(ladder.out / "cases.csv"),
+    return readme(folder.table(layout.VERDICT_TABLE), folder.table(layout.CASES_REPORT),
                   read_rounds(ladder.out), ladder,
                   wall.read_text() if wall.is_file() else None,
-                  None if ladder.out == OUT else pd.read_csv(OUT / "cases.csv"),
-                  pd.read_csv(replanned) if replanned.is_file() else None,
-                  tuple(pd.read_csv(f) for f in again) if all(f.is_file() for f in again)
-                  else None)
+                  None if ladder.out == OUT else pd.read_csv(OUT / layout.CASES_REPORT),
+                  folder.optional_table(REPLANNED),
+                  None if any(t is None for t in again) else tuple(again))
 
 
 def check(ladder: Ladder) -> int:
     """0 when the committed README of ``ladder`` is what its tables give."""
-    return write_or_check(ladder.out, lambda: text(ladder), True,
-                          f"scripts/ladder_results.py {ladder.study} --ladder {ladder.name}")
+    problem = ladder.folder.check()
+    if problem is not None:
+        print(problem, file=sys.stderr)
+    return 0 if problem is None else 1
 
 
 if __name__ == "__main__":

@@ -1,34 +1,21 @@
-"""The part every results script shares: a committed results folder (docs/results/NAME/)
-holds a study's tables and a README written from them; the script either copies the tables
-from a study folder and writes the README, or (``--check``, what the committed-results tests
-run) rebuilds the README from the committed tables and fails when it differs, so that a
-sentence cannot drift from its table."""
+"""The older form of a results script's shared part, kept for the scripts that still use it
+(liquid_spreading_results.py, granule_screen_results.py, profile_correlation.py,
+extrapolation_results.py, paper_scale_results.py). A results folder is now a type of the
+package: :class:`ligwf.api.results_folder.ResultsFolder` (its tables, its README rendered
+from them, ``check``); a new script declares one (see demo_results.py) instead."""
 
 from __future__ import annotations
 
 import argparse
-import math
-import shutil
 import sys
 from pathlib import Path
-from typing import Callable, Iterable
+from typing import Callable
+
+from ligwf.api.results_folder import csv_text, number
+
+__all__ = ["ROOT", "csv_text", "number", "parser", "write_or_check"]
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def csv_text(table) -> str:
-    """A committed results table as text: no index, numbers to 6 significant digits (what
-    a results script writes and what its --check compares)."""
-    return table.to_csv(index=False, float_format="%.6g")
-
-
-def number(v, digits: int = 3) -> str:
-    """A table value as the README prints it (``–`` for nan or what is not a number)."""
-    try:
-        v = float(v)
-    except (TypeError, ValueError):
-        return "–"
-    return f"{v:.{digits}g}" if math.isfinite(v) else "–"
 
 
 def parser(doc: str, what: str) -> argparse.ArgumentParser:
@@ -38,12 +25,6 @@ def parser(doc: str, what: str) -> argparse.ArgumentParser:
     ap.add_argument("--check", action="store_true",
                     help="only check that the committed README is what its tables give")
     return ap
-
-
-def copy_files(source: Path, out: Path, names: Iterable[str]) -> None:
-    """Copy ``names`` from ``source`` into the results folder ``out``."""
-    for name in names:
-        shutil.copyfile(source / name, out / name)
 
 
 def write_or_check(out: Path, text: Callable[[], str], check: bool, remake: str) -> int:

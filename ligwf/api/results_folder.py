@@ -1,0 +1,185 @@
+"""A committed results folder: a study's tables beside a README written from them.
+
+``docs/results/NAME/`` holds the tables a finding rests on (copied from a study's report,
+or measured by a script) and a README whose every number is read from those tables. A
+results script declares one :class:`ResultsFolder` -- where it is, which function renders
+its README from its tables, which command remakes it -- and the folder does the rest:
+
+* :meth:`ResultsFolder.copy_report` copies a study's report files into it, reading each
+  table first through :func:`ligwf.api.open_study` (a table ligwf did not write, or one that
+  is missing, is refused with the command that writes it) and then copying its bytes, so
+  the committed table is the study's file exactly;
+* :meth:`ResultsFolder.write` renders the README from the committed tables (not from the
+  study folder: what is committed is what is checked) and writes it;
+* :meth:`ResultsFolder.check` renders it again and says how it differs from the committed
+  one: a sentence cannot drift from its table. The committed-results tests run it, on the
+  committed tables alone (the run folders are not committed).
+
+Table names come from :mod:`ligwf.study.layout` (a copied report table keeps its name);
+a table a script measures itself is named by that script. :func:`number` and
+:func:`csv_text` are how a README prints a value and how a measured table is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import shutil
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Iterable, Sequence
+
+import pandas as pd
+
+from ligwf.api.results import open_study
+from ligwf.api.tables import TABLES
+from ligwf.errors import ConfigError
+from ligwf.study import layout
+
+#: the README of every results folder
+README = "README.md"
+
+
+def number(value, digits: int = 3) -> str:
+    """A table value as a README prints it: ``digits`` significant digits, ``–`` for nan or
+    what is not a number."""
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return "–"
+    return f"{value:.{digits}g}" if math.isfinite(value) else "–"
+
+
+def csv_text(table: pd.DataFrame) -> str:
+    """A table a results script measured, as committed: no index, numbers to 6 significant
+    digits."""
+    return table.to_csv(index=False, float_format="%.6g")
+
+
+@dataclass(frozen=True)
+class ResultsFolder:
+    """One committed results folder: ``path``, the function that renders its README from its
+    committed tables (``render(folder) -> text``) and ``remake``, the command that writes it
+    again (named when :meth:`check` finds the README stale)."""
+
+    path: Path
+    render: Callable[["ResultsFolder"], str]
+    remake: str
+
+    @property
+    def readme(self) -> Path:
+        return self.path / README
+
+    def table(self, name: str) -> pd.DataFrame:
+        """The committed table ``name`` as its CSV reads (the README's source)."""
+        return pd.read_csv(self.path / name)
+
+    def optional_table(self, name: str) -> pd.DataFrame | None:
+        """:meth:`table`, or None when the folder does not have it."""
+        return self.table(name) if self.has(name) else None
+
+    def has(self, name: str) -> bool:
+        return (self.path / name).is_file()
+
+    def text(self) -> str:
+        """The README its committed tables give."""
+        return self.render(self)
+
+    def check(self) -> str | None:
+        """None when the committed README is what its tables give; else one line saying it
+        differs and which command remakes it."""
+        if self.readme.is_file() and self.readme.read_text() == self.text():
+            return None
+        return f"{self.readme} differs from its tables: run {self.remake}"
+
+    def write(self) -> str:
+        """Render the README from the committed tables and write it; return its text."""
+        self.path.mkdir(parents=True, exist_ok=True)
+        body = self.text()
+        self.readme.write_text(body)
+        return body
+
+    def copy_report(self, study: Path, names: Iterable[str], *, figures: bool = False) -> None:
+        """Copy the report files ``names`` (:mod:`ligwf.study.layout` names) of the study
+        folder ``study`` here, byte for byte; with ``figures`` its figures folder too
+        (replacing the one here). A report table is first read through
+        :func:`~ligwf.api.open_study` (MissingOutput, naming the command that writes it,
+        when it is missing or is not the table ligwf writes)."""
+        results = open_study(study)
+        tables = {spec.file: spec.attribute for spec in TABLES
+                  if spec.folder == layout.REPORT_DIR}
+        self.path.mkdir(parents=True, exist_ok=True)
+        for name in names:
+            if name in tables:
+                results.table(tables[name])
+            source = results.report_dir / name
+            if not source.is_file():
+                raise ConfigError(f"{source}: missing; run `ligwf report {study}`")
+            shutil.copyfile(source, self.path / name)
+        if figures:
+            target = self.path / layout.FIGURES_DIR
+            if target.exists():
+                shutil.rmtree(target)
+            shutil.copytree(results.report_dir / layout.FIGURES_DIR, target)
+
+    def copy(self, source: Path, name: str, as_name: str | None = None) -> None:
+        """Copy the file ``source``/``name`` here (as ``as_name``), byte for byte: a record a
+        study keeps beside its report (``layout.ROUNDS_FILE``) or a file a run left."""
+        self.path.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(source / name, self.path / (as_name or name))
+
+
+def check_all(folders: Iterable[ResultsFolder]) -> list[str]:
+    """The problems of ``folders`` (:meth:`ResultsFolder.check`), one line each."""
+    return [problem for folder in folders if (problem := folder.check()) is not None]
+
+
+def results_command(doc: str, folders: Sequence[ResultsFolder],
+                    make: Callable[[argparse.Namespace], ResultsFolder],
+                    argv: Sequence[str] | None = None,
+                    arguments: Callable[[argparse.ArgumentParser], None] | None = None) -> int:
+    """The command line of a results script (its docstring ``doc``): ``STUDY [options]``
+    fills a folder (``make(args)``: copy or measure its tables, return the folder) and writes
+    its README; ``--check`` renders every README of ``folders`` from the committed tables
+    and fails (1, one line each) where one differs. ``arguments`` adds the script's own
+    options; ``make`` may call ``args.error(message)`` for a usage error."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("study", nargs="?", type=Path, help="the study (or run) folder")
+    ap.add_argument("--check", action="store_true",
+                    help="only check that each committed README is what its tables give")
+    if arguments is not None:
+        arguments(ap)
+    args = ap.parse_args(argv)
+    if args.check:
+        problems = check_all(folders)
+        for problem in problems:
+            print(problem, file=sys.stderr)
+        return 1 if problems else 0
+    args.error = ap.error
+    print(make(args).write())
+    return 0
+
+
+def runs_rows(cases: pd.DataFrame, columns: Sequence[tuple[str, str]]) -> list[str]:
+    """The runs of a study's cases table as README table rows, one per CG level and rule:
+    ``| cgN-rule | runs | particles | ... |`` with, per ``(column, format)``, the column's
+    value of every run in that format."""
+    return [f"| cg{cg:g}-{rule} | {len(sub)} | {int(sub['particles'].iloc[0]):,} | "
+            + " | ".join(", ".join(format(v, spec) for v in sub[column])
+                         for column, spec in columns) + " |"
+            for (cg, rule), sub in cases.groupby(["cg", "rule"], sort=True)]
+
+
+def verdict_rows(verdict: pd.DataFrame) -> list[str]:
+    """A study's verdict table as README table rows: condition, speedup (core-s), the
+    condition's state, criterion, its state, value [lo, hi], shown within, budget (with the
+    criterion's unit)."""
+    rows = []
+    for _, r in verdict.iterrows():
+        unit = f" {r['unit']}" if isinstance(r["unit"], str) and r["unit"] else ""
+        rows.append(f"| {r['condition']} | {number(r['speedup_core'])} | "
+                    f"{r['condition_state']} | {r['label']} | {r['state']} | "
+                    f"{number(r['value'])} [{number(r['lo'])}, {number(r['hi'])}]{unit} | "
+                    f"{number(r['shown_within'])}{unit} | {number(r['budget'])}{unit} |")
+    return rows
