@@ -2,6 +2,7 @@
 
     .venv/bin/python scripts/granule_growth_results.py RUNDIR docs/results/granule_growth [CALIBRATION_DIR ...]
     .venv/bin/python scripts/granule_growth_results.py --measure-finished RUNDIR
+    .venv/bin/python scripts/granule_growth_results.py --check      # README == text from tables
 
 RUNDIR is the folder of ``ligwf run workflows/granule_growth.yaml --out RUNDIR``. Writes
 ``growth_rows.csv`` (every start frame of every run), ``cadence.csv`` (the held share at
@@ -9,6 +10,7 @@ window cadences 0.01 / 0.02 / 0.05 s), ``flow.csv`` (angle of repose per frame),
 (one row per wet seed beside its control, each criterion judged) and
 ``controls_verdict.csv`` (k of n seeds per criterion), then README.md from those tables
 (``tests/report/test_committed_granule_growth.py`` recomputes its numbers from them).
+``--check`` renders the README from the committed tables and fails when it differs.
 """
 
 from __future__ import annotations
@@ -21,8 +23,20 @@ import pandas as pd
 from ligwf.analysis.granules.growth import GrowthSettings
 from ligwf.analysis.granules.growth_study import (CRITERIA, cadence_table, measure_case,
                                                   seed_table, verdict)
+from ligwf.api.results_folder import ResultsFolder, csv_text, results_command
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import is_case_folder
+from ligwf.study.layout import CALIBRATION_TABLE, is_case_folder
+
+OUT = Path(__file__).resolve().parents[1] / "docs" / "results" / "granule_growth"
+#: the tables this script measures (a results folder's own, not a study's)
+GROWTH_ROWS = "growth_rows.csv"      # every start frame of every run
+CADENCE = "cadence.csv"              # the held share at three window cadences
+FRAME_FLOW = "flow.csv"              # angle of repose per frame
+SEEDS = "seeds.csv"                  # one row per wet seed beside its control
+SEED_VERDICT = "controls_verdict.csv"   # k of n seeds per criterion
+RUNS = "cases.csv"                   # the runs
+#: the candidates' pickled measures, cached beside each run
+CACHE = ("growth-rows.pkl", "growth-shares.pkl", "growth-flow.pkl")
 
 COMMAND = ("ligwf run workflows/granule_growth.yaml --out runs/granule_growth\n"
            "ligwf calibrate-control workflows/granule_growth.yaml --out runs/cal1 "
@@ -200,23 +214,33 @@ def case_table(run_dir: Path, case_ids: list[str]) -> pd.DataFrame:
 def measured(case_dir: Path) -> tuple[pd.DataFrame, ...]:
     """The case's measures, cached beside its run (``growth-*.csv``; a case measured while
     others still ran is not measured again)."""
-    names = ("growth-rows.pkl", "growth-shares.pkl", "growth-flow.pkl")
-    if all((case_dir / n).exists() for n in names):
-        return tuple(pd.read_pickle(case_dir / n) for n in names)
+    if all((case_dir / n).exists() for n in CACHE):
+        return tuple(pd.read_pickle(case_dir / n) for n in CACHE)
     print(f"measuring {case_dir.name} ...", flush=True)
     tables = measure_case(case_dir)
-    for n, t in zip(names, tables):
+    for n, t in zip(CACHE, tables):
         tmp = case_dir / (n + ".tmp")
         t.to_pickle(tmp)
         tmp.replace(case_dir / n)
     return tables
 
 
-def main(run_dir: str, out_dir: str, processes: int = 2,
-         calibrations: tuple[str, ...] = ()) -> int:
+def render(folder: ResultsFolder) -> str:
+    """The README of a granule-growth folder from its committed tables."""
+    return readme(folder.table(SEEDS), folder.table(SEED_VERDICT), folder.table(CADENCE),
+                  folder.table(RUNS), folder.optional_table(CALIBRATION_TABLE))
+
+
+FOLDER = ResultsFolder(OUT, render, "scripts/granule_growth_results.py runs/granule_growth "
+                       "docs/results/granule_growth runs/cal1 runs/cal2")
+
+
+def measure(run: Path, out: Path, calibrations: tuple[str, ...] = (),
+            processes: int = 2) -> ResultsFolder:
+    """Measure every case of the run folder ``run`` into the tables of ``out``."""
     from multiprocessing import Pool
 
-    run, out = Path(run_dir), Path(out_dir)
+    folder = ResultsFolder(out, render, FOLDER.remake)
     out.mkdir(parents=True, exist_ok=True)
     case_ids = sorted(p.name for p in run.iterdir() if is_case_folder(p))
     with Pool(processes) as pool:
@@ -224,28 +248,20 @@ def main(run_dir: str, out_dir: str, processes: int = 2,
     rows_df, shares_df, flows_df = (pd.concat([r[i] for r in results], ignore_index=True)
                                     for i in range(3))
     seeds = seed_table(rows_df, flows_df)
-    ver = verdict(seeds)
-    cad = cadence_table(shares_df)
-    cases = case_table(run, case_ids)
-    rows_df.to_csv(out / "growth_rows.csv", index=False, float_format="%.6g")
-    cad.to_csv(out / "cadence.csv", index=False, float_format="%.6g")
-    flows_df.to_csv(out / "flow.csv", index=False, float_format="%.6g")
-    seeds.to_csv(out / "seeds.csv", index=False, float_format="%.6g")
-    ver.to_csv(out / "controls_verdict.csv", index=False)
-    cases.to_csv(out / "cases.csv", index=False)
+    tables = {GROWTH_ROWS: rows_df, CADENCE: cadence_table(shares_df), FRAME_FLOW: flows_df,
+              SEEDS: seeds}
+    for name, table in tables.items():
+        (out / name).write_text(csv_text(table))
+    verdict(seeds).to_csv(out / SEED_VERDICT, index=False)
+    case_table(run, case_ids).to_csv(out / RUNS, index=False)
     if calibrations:
-        cal = pd.concat([pd.read_csv(Path(c) / "calibration.csv").assign(round=k + 1)
+        cal = pd.concat([pd.read_csv(Path(c) / CALIBRATION_TABLE).assign(round=k + 1)
                          for k, c in enumerate(calibrations)], ignore_index=True)
         ref = cal[cal["role"] == "wet reference"].drop_duplicates("case_id")
         cal = pd.concat([ref, cal[cal["role"] == "candidate"]], ignore_index=True)
-        cal.to_csv(out / "calibration.csv", index=False, float_format="%.6g")
-    # the README reads the tables as written (what its test recomputes from)
-    seeds, ver, cad, cases = (pd.read_csv(out / f) for f in
-                              ("seeds.csv", "controls_verdict.csv", "cadence.csv", "cases.csv"))
-    cal = pd.read_csv(out / "calibration.csv") if (out / "calibration.csv").exists() else None
-    (out / "README.md").write_text(readme(seeds, ver, cad, cases, cal))
-    print(ver.to_string(index=False))
-    return 0
+        (out / CALIBRATION_TABLE).write_text(csv_text(cal))
+    print(folder.table(SEED_VERDICT).to_string(index=False))
+    return folder
 
 
 def measure_finished(run_dir: str) -> int:
@@ -258,9 +274,27 @@ def measure_finished(run_dir: str) -> int:
     return 0
 
 
+def arguments(ap) -> None:
+    ap.add_argument("out", nargs="?", type=Path, help="the results folder to write")
+    ap.add_argument("calibrations", nargs="*", help="calibrate-control output folders")
+    ap.add_argument("--measure-finished", action="store_true",
+                    help="only measure (and cache) the runs of STUDY that are done")
+
+
+def make(args) -> ResultsFolder | None:
+    """Measure the run folder into the results folder (None: --measure-finished only
+    caches the measures of the runs that are done)."""
+    if args.study is None or (args.out is None and not args.measure_finished):
+        args.error("give the run folder and the results folder (or --check)")
+    if args.measure_finished:
+        measure_finished(args.study)
+        return None
+    return measure(args.study, args.out, tuple(args.calibrations))
+
+
+def main(argv=None) -> int:
+    return results_command(__doc__, [FOLDER], make, argv, arguments)
+
+
 if __name__ == "__main__":
-    if len(sys.argv) == 3 and sys.argv[1] == "--measure-finished":
-        sys.exit(measure_finished(sys.argv[2]))
-    if len(sys.argv) < 3:
-        sys.exit(__doc__)
-    sys.exit(main(sys.argv[1], sys.argv[2], 2, tuple(sys.argv[3:])))
+    sys.exit(main())

@@ -136,12 +136,12 @@ def check_all(folders: Iterable[ResultsFolder]) -> list[str]:
 
 
 def results_command(doc: str, folders: Sequence[ResultsFolder],
-                    make: Callable[[argparse.Namespace], ResultsFolder],
+                    make: Callable[[argparse.Namespace], ResultsFolder | None],
                     argv: Sequence[str] | None = None,
                     arguments: Callable[[argparse.ArgumentParser], None] | None = None) -> int:
     """The command line of a results script (its docstring ``doc``): ``STUDY [options]``
     fills a folder (``make(args)``: copy or measure its tables, return the folder) and writes
-    its README; ``--check`` renders every README of ``folders`` from the committed tables
+    its README (``make`` returns None for a step that writes no folder); ``--check`` renders every README of ``folders`` from the committed tables
     and fails (1, one line each) where one differs. ``arguments`` adds the script's own
     options; ``make`` may call ``args.error(message)`` for a usage error."""
     ap = argparse.ArgumentParser(description=doc.splitlines()[0])
@@ -157,7 +157,9 @@ def results_command(doc: str, folders: Sequence[ResultsFolder],
             print(problem, file=sys.stderr)
         return 1 if problems else 0
     args.error = ap.error
-    print(make(args).write())
+    folder = make(args)
+    if folder is not None:
+        print(folder.write())
     return 0
 
 

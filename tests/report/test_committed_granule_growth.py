@@ -1,21 +1,18 @@
 """The committed granule-growth study (docs/results/granule_growth): its README is the text
-its tables give, every seed's criteria recompute from the per-frame rows, and the verdict's
-"k of n seeds" from the seed table."""
+its tables give (scripts/granule_growth_results.py --check), every seed's criteria recompute
+from the per-frame rows, and the verdict's "k of n seeds" from the seed table."""
 
 from __future__ import annotations
-
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from ligwf.analysis.granules.growth_study import seed_table, verdict
-from scripts.granule_growth_results import readme
+from scripts.granule_growth_results import (FRAME_FLOW, GROWTH_ROWS, OUT, SEED_VERDICT, SEEDS,
+                                            main)
 
-OUT = Path(__file__).resolve().parents[2] / "docs" / "results" / "granule_growth"
-
-pytestmark = pytest.mark.skipif(not (OUT / "seeds.csv").exists(),
+pytestmark = pytest.mark.skipif(not (OUT / SEEDS).exists(),
                                 reason="the granule-growth tables are not committed yet")
 
 
@@ -24,15 +21,12 @@ def _read(name: str) -> pd.DataFrame:
 
 
 def test_readme_is_what_the_tables_say():
-    cal = _read("calibration.csv") if (OUT / "calibration.csv").exists() else None
-    text = readme(_read("seeds.csv"), _read("controls_verdict.csv"), _read("cadence.csv"),
-                  _read("cases.csv"), cal)
-    assert (OUT / "README.md").read_text() == text
+    assert main(["--check"]) == 0
 
 
 def test_seed_criteria_recompute_from_the_frames():
-    committed = _read("seeds.csv")
-    again = seed_table(_read("growth_rows.csv"), _read("flow.csv"))
+    committed = _read(SEEDS)
+    again = seed_table(_read(GROWTH_ROWS), _read(FRAME_FLOW))
     assert list(again["seed"]) == list(committed["seed"])
     for col in committed.columns:
         if col in ("seed", "control"):
@@ -46,7 +40,7 @@ def test_seed_criteria_recompute_from_the_frames():
 
 
 def test_verdict_counts_the_seeds():
-    committed = _read("controls_verdict.csv")
-    again = verdict(_read("seeds.csv"))
+    committed = _read(SEED_VERDICT)
+    again = verdict(_read(SEEDS))
     assert list(again["seeds_pass"]) == list(committed["seeds_pass"])
     assert list(again["passes"]) == list(committed["passes"])
