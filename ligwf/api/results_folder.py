@@ -140,10 +140,11 @@ def results_command(doc: str, folders: Sequence[ResultsFolder],
                     argv: Sequence[str] | None = None,
                     arguments: Callable[[argparse.ArgumentParser], None] | None = None) -> int:
     """The command line of a results script (its docstring ``doc``): ``STUDY [options]``
-    fills a folder (``make(args)``: copy or measure its tables, return the folder) and writes
-    its README (``make`` returns None for a step that writes no folder); ``--check`` renders every README of ``folders`` from the committed tables
-    and fails (1, one line each) where one differs. ``arguments`` adds the script's own
-    options; ``make`` may call ``args.error(message)`` for a usage error."""
+    fills a folder (``make(args)``: copy or measure its tables, return the folder; None for
+    a step that writes no folder) and writes its README; ``--check`` renders every README of
+    ``folders`` from the committed tables and fails (1, one line each) where one differs.
+    ``arguments`` adds the script's own options; ``make`` may call ``args.error(message)``
+    for a usage error."""
     ap = argparse.ArgumentParser(description=doc.splitlines()[0])
     ap.add_argument("study", nargs="?", type=Path, help="the study (or run) folder")
     ap.add_argument("--check", action="store_true",
