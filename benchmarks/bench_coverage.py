@@ -49,7 +49,7 @@ import sys
 import numpy as np
 from scipy import stats
 
-from ligwf.analysis.records.equivalence import (ALPHA, HSU, PASS, WELCH, difference_estimate,
+from ligwf.inference.equivalence import (ALPHA, HSU, PASS, WELCH, difference_estimate,
                                                 equivalence, mean_estimate, norm_estimate)
 
 LOW, HIGH = 0.92, 0.99
@@ -171,7 +171,7 @@ FILL_FRAMES, CG1_PRICE = 100, 10.0
 
 
 def _synth_arm(runs: list, price: float) -> "sp.Arm":
-    from ligwf.analysis.records import sampling as sp
+    from ligwf.inference import sampling as sp
     series = [r.series() for r in runs]
     return sp.arm([s.mean() for s in series], [sp.within_variance(s) for s in series],
                   [float(len(s)) for s in series], steady_share=1.0,
@@ -184,9 +184,9 @@ def sequential_study(rng, R: int, frames: int, phi: float, offset: float, delta:
     """The whole sequential procedure of ``ligwf study --until-decided`` on one synthetic
     comparison (true CG-n - CG1 = ``delta``): up to ``looks`` looks, each two one-sided
     tests at alpha / looks (Bonferroni spending); after an undecided look the cheapest
-    option of :func:`ligwf.analysis.records.sampling.cheapest` that halves the half-width
+    option of :func:`ligwf.inference.sampling.cheapest` that halves the half-width
     is done (runs continued or replicas added, new seeds). Returns the final state."""
-    from ligwf.analysis.records import sampling as sp
+    from ligwf.inference import sampling as sp
     alpha = ALPHA / looks
     arms = [[SynthRun(rng, frames, phi, offset, delta) for _ in range(R)],
             [SynthRun(rng, frames, phi, offset) for _ in range(R)]]

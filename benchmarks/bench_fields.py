@@ -20,7 +20,7 @@ from ligwf.analysis.flow.fields import (field_grid, flux_moments, fluctuation_mo
                                         mean_velocity)
 from ligwf.analysis.flow.frame import DrumGeometry
 from ligwf.analysis.frames.dumps import ParticleFrame
-from ligwf.analysis.records.field_errors import field_intervals
+from ligwf.inference.field_errors import field_intervals
 from ligwf.analysis.records.fields import CaseFields
 
 N, R, D, L, OMEGA = 360_000, 0.1, 0.001, 0.06, 2.0

@@ -5,7 +5,7 @@ The synthetic benchmark (``bench_coverage.py``) assumes AR(1) frames and normal 
 offsets; this one takes real runs of ONE condition (R seeds of the same scene, CG level and
 rule), splits them into two disjoint pseudo-conditions of R runs each, and computes the
 interval the report computes for CG-n - CG1 (Welch on the run means, as
-:func:`ligwf.analysis.records.equivalence.difference_estimate`) for every signed criterion's
+:func:`ligwf.inference.equivalence.difference_estimate`) for every signed criterion's
 statistic. The true difference is 0, so the 95 % interval must hold 0 in about 95 % of the
 splits (the issue asks >= 90 %), and the 90 % interval the two one-sided tests use in about
 90 %. Every split of the seeds into two groups of R (unordered) is used once.
@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.records.equivalence import difference_estimate
-from ligwf.report.criteria import SIGNED_COLUMNS
+from ligwf.inference.equivalence import difference_estimate
+from ligwf.inference.budget import signed_columns
 from ligwf.study import layout
 
 #: the interval levels checked: the report's 95 % statement and the TOST's 90 % interval
@@ -70,7 +70,7 @@ def main(argv=None) -> int:
     for study in args.studies:
         cases = pd.read_csv(study / layout.REPORT_DIR / layout.CASES_REPORT)
         for (cg, rule), sub in cases.groupby(["cg", "rule"], sort=True):
-            for col in SIGNED_COLUMNS:
+            for col in signed_columns():
                 if col not in sub:
                     continue
                 values = sub[col].to_numpy(float)

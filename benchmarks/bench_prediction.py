@@ -2,7 +2,7 @@
 """How well can any planner predict the half-width an extension leaves? (issue 30, item 4)
 
 ``scripts/prediction_check.py`` asks of a real study that the half-width the planner
-(:func:`ligwf.analysis.records.sampling.half_width`) predicts for a doubled steady window be
+(:func:`ligwf.inference.sampling.half_width`) predicts for a doubled steady window be
 within +-30 % of the one measured after it; on the demo it held in 1 of 6 rows, on the
 ladder in 3 of 7, every miss on the conservative side. This benchmark measures, on synthetic
 studies shaped like ours, what that criterion can ask of a prediction at all:
@@ -68,8 +68,8 @@ import sys
 import numpy as np
 
 from benchmarks.bench_coverage import ar1_runs
-from ligwf.analysis.records import sampling
-from ligwf.analysis.records.equivalence import ALPHA, t_quantile, welch_df
+from ligwf.inference import sampling
+from ligwf.inference.equivalence import ALPHA, t_quantile, welch_df
 
 TOLERANCE = 0.30
 CG1_RUNS = 3

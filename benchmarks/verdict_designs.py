@@ -4,8 +4,8 @@
 
 Runs are AR(1) frame series plus a replica offset, as in the coverage cells
 (:func:`bench_coverage.ar1_runs`); a run's value is its window mean. Each design is decided
-with the verdict's own functions (:mod:`ligwf.analysis.records.equivalence`,
-:mod:`ligwf.analysis.records.shares`, Holm's step-down) under the single-look rules:
+with the verdict's own functions (:mod:`ligwf.inference.equivalence`,
+:mod:`ligwf.inference.shares`, Holm's step-down) under the single-look rules:
 alpha 0.05, Welch's df for equal arms and Hsu's for unequal ones (``--df-rule``: or the
 Behrens-Fisher distribution for unequal ones), two-sided fail tests.
 
@@ -35,8 +35,8 @@ import numpy as np
 from scipy import stats
 
 from benchmarks.bench_coverage import ar1_runs
-from ligwf.analysis.records import equivalence as eq
-from ligwf.analysis.records.shares import share_test
+from ligwf.inference import equivalence as eq
+from ligwf.inference.shares import share_test
 
 ALPHA = eq.ALPHA
 LOW, HIGH = 0.92, 0.99

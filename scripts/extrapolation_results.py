@@ -22,7 +22,7 @@ import pandas as pd
 
 from ligwf.inference import extrapolation as ex
 from ligwf.inference import size_relation as sr
-from ligwf.report.verdict import is_control_group
+from ligwf.inference.verdict import is_control_group
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))

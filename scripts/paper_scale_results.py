@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.records.equivalence import difference_estimate, mean_estimate
+from ligwf.inference.equivalence import difference_estimate, mean_estimate
 from ligwf.inference import extrapolation as ex
 from ligwf.inference.reference import level_values, slope_scale
 

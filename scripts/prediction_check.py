@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Does "what would decide" predict the half-width it promises? (issue 30 item 4, on real runs)
 
-The report's planning (:mod:`ligwf.analysis.records.sampling`) predicts the half-width of a
+The report's planning (:mod:`ligwf.inference.sampling`) predicts the half-width of a
 CG-n - CG1 interval after S more seconds of production on the existing runs (only the
 within-run part of each run mean's variance shrinks) or after K more replicas. This checks
 both predictions on a finished study's own runs:
@@ -32,10 +32,10 @@ import numpy as np
 import pandas as pd
 
 from benchmarks.bench_prediction import halves_within_variance
-from ligwf.analysis.records import sampling
+from ligwf.inference import sampling
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.statistics import MEAN, SHARE_ABOVE
-from ligwf.report.criteria import SIGNED_COLUMNS
+from ligwf.inference.budget import signed_columns
 from ligwf.study import layout
 
 TOLERANCE = 0.30
@@ -65,7 +65,7 @@ def check(study: Path, within=sampling.within_variance) -> pd.DataFrame:
     flow = FlowRecord.read(study / layout.ANALYSIS_DIR / layout.FLOW_PROFILES)
     cases = pd.read_csv(study / layout.REPORT_DIR / layout.CASES_REPORT)
     rows = []
-    for column in SIGNED_COLUMNS:
+    for column in signed_columns():
         spec = flow.metric(column)
         if spec.statistic not in (MEAN, SHARE_ABOVE):
             continue

@@ -30,9 +30,9 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from ligwf.analysis.records import equivalence as eq  # noqa: E402
-from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise  # noqa: E402
-from ligwf.analysis.records.shares import share_test  # noqa: E402
+from ligwf.inference import equivalence as eq  # noqa: E402
+from ligwf.inference.field_errors import FIELD_NOISE_COLUMNS, LayerNoise  # noqa: E402
+from ligwf.inference.shares import share_test  # noqa: E402
 from ligwf.study.rounds import read_rounds  # noqa: E402
 
 OUT = ROOT / "docs" / "results" / "verdict_rates"

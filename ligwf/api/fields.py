@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 
-from ligwf.analysis.records.field_errors import MATERIAL_SOLID
+from ligwf.inference.field_errors import MATERIAL_SOLID
 from ligwf.analysis.records.fields import FIELD_UNITS, CaseFields, fields_of
 from ligwf.api.plots import axes
 from ligwf.api.tables import typed

@@ -24,9 +24,9 @@ from ligwf.errors import ConfigError, LigwfError
 from ligwf.report import dictionary
 from ligwf.report.digests import damaged_report_files
 from ligwf.report.problems import Problems, study_problems
-from ligwf.report.verdict import Verdict
+from ligwf.inference.verdict import Verdict
 from ligwf.report.write import checked_analysis
-from ligwf.report.verdict_records import read_verdict
+from ligwf.inference.verdict_records import read_verdict
 from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study import layout
@@ -149,7 +149,7 @@ class StudyResults:
 
     @cached_property
     def verdict_result(self) -> Verdict:
-        """The verdict as typed objects (``ligwf.report.verdict.Verdict``): per group its
+        """The verdict as typed objects (``ligwf.inference.verdict.Verdict``): per group its
         conditions and criteria and the sentence naming the cheapest level that meets the
         whole budget (``groups[i].sentence``, ``groups[i].cheapest``)."""
         found = read_verdict(self.report_dir)

@@ -88,7 +88,7 @@ TEXT_COLUMNS = frozenset({
     "case_id", "condition", "group", "rule", "status", "reason", "metric", "source",
     "variant", "definition", "control", "twin_id", "twin_case_id", "verdict", "method",
     "velocity_frame", "pool", "reference", "comparison", "split",
-    # the verdict table (ligwf.report.verdict)
+    # the verdict table (ligwf.inference.verdict)
     "criterion", "label", "unit", "state", "condition_state", "budget_source", "note",
     # describe(): the data dictionary's columns
     "column", "dtype", "meaning"})

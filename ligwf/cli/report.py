@@ -15,7 +15,7 @@ from ligwf.study.study import Study
 def print_report(study_dir: Path, out: Path) -> None:
     """Where the report is, its verdict, and on stderr how much it lists as not used."""
     from ligwf.report.problems import study_problems
-    from ligwf.report.verdict_records import read_verdict
+    from ligwf.inference.verdict_records import read_verdict
     from ligwf.report.verdict_text import verdict_renderables
 
     console.print(f"report: {out / layout.SUMMARY_REPORT} and {out / layout.HTML_REPORT}")

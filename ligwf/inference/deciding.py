@@ -1,14 +1,14 @@
 """What would decide an undecided criterion of the verdict, and what a sequential round
-does instead (:mod:`ligwf.report.criteria` decides; this module plans).
+does instead (:mod:`ligwf.inference.criteria` decides; this module plans).
 
 Two plans per undecided criterion, both from the variance components as measured
-(:mod:`ligwf.analysis.records.sampling`): the cheapest way to **decide** it (longer
+(:mod:`ligwf.inference.sampling`): the cheapest way to **decide** it (longer
 production or more replicas of an arm, the difference as measured: what the report tells
 a user) and the cheapest way to **halve** its half-width (what a round of ``ligwf study
 --until-decided`` does: it depends on the variances only, so it does not bias the next
 look's test). Signed criteria plan on the arms' run values, the velocity profile on its
 noncentral-F bounds with the same number more of both arms, the field criterion on its
-noise pieces (:class:`~ligwf.analysis.records.field_errors.LayerNoise`) with more CG-n
+noise pieces (:class:`~ligwf.inference.field_errors.LayerNoise`) with more CG-n
 replicas, more CG1 replicas or both.
 """
 
@@ -19,11 +19,11 @@ import math
 import numpy as np
 
 from ligwf.analysis.records import steady_window as steady
-from ligwf.analysis.records import equivalence as eq
-from ligwf.analysis.records import sampling
-from ligwf.analysis.records.equivalence import UNDECIDED
-from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
-from ligwf.report import planning
+from ligwf.inference import equivalence as eq
+from ligwf.inference import sampling
+from ligwf.inference.equivalence import UNDECIDED
+from ligwf.inference.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
+from ligwf.inference import planning
 
 
 def round_fields(o: "sampling.Option | None") -> dict:
@@ -171,8 +171,8 @@ def decide_text(r) -> str:
 def too_short_note(runs, ref_runs, noise) -> str:
     """Whether a level's comparison rests on runs too short to show a steady state: the runs
     of either arm (``runs`` CG-n, ``ref_runs`` CG1; case tables) whose steady window starts
-    at its cap (the noise table's :data:`~ligwf.report.planning.AT_CAP`), and the
-    production each would need (:data:`~ligwf.report.planning.LEAST_EXTENSION`, the
+    at its cap (the noise table's :data:`~ligwf.inference.planning.AT_CAP`), and the
+    production each would need (:data:`~ligwf.inference.planning.LEAST_EXTENSION`, the
     planner's rule). Empty when no run is at its cap or there is no noise table."""
     if noise is None or noise.empty or planning.AT_CAP not in noise:
         return ""

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, special, stats
 
-from ligwf.analysis.records import behrens_fisher
+from ligwf.inference import behrens_fisher
 
 #: a decision's error rate per side (the two one-sided tests each at ALPHA: a 90 % interval)
 ALPHA = 0.05

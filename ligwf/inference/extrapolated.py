@@ -18,13 +18,14 @@ import math
 
 import pandas as pd
 
-from ligwf.analysis.records import equivalence as eq
-from ligwf.analysis.records import sampling
-from ligwf.analysis.records.equivalence import FAIL, UNDECIDED
+from ligwf.inference import equivalence as eq
+from ligwf.inference import sampling
+from ligwf.inference.equivalence import FAIL, UNDECIDED
 from ligwf.inference import extrapolation as ex
 from ligwf.inference.reference import level_values, slope_scale
-from ligwf.report.criteria import (CRITERIA, NOT_ASSESSED, NOT_MEASURED, RELATIVE, SIGNED,
-                                   CriterionResult)
+from ligwf.inference.budget import criteria
+from ligwf.inference.registry import (DIFFERENCES, NOT_ASSESSED, NOT_MEASURED, RELATIVE,
+                                      CriterionResult)
 from ligwf.scene.accept import AcceptSettings
 
 #: the note of a criterion with no signed value to extrapolate
@@ -38,12 +39,12 @@ def _signed(spec, tolerance: float, runs: pd.DataFrame, cg: float, ratio: float,
     test's p-value for Holm)."""
     base = dict(name=spec.name, label=spec.label, unit=spec.unit, budget=tolerance,
                 budget_source="tolerance")
-    values = level_values(runs, spec.column)
-    scale_b = slope_scale(spec.column, ratio)
+    values = level_values(runs, spec.metric)
+    scale_b = slope_scale(spec.metric, ratio)
     e = ex.extrapolate(values, ratio, alpha, slope_scale=scale_b)
     if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED, note=(
-            f"not measured: fewer than two CG levels with a {spec.column} value")), math.nan
+            f"not measured: fewer than two CG levels with a {spec.metric} value")), math.nan
     where = (f"against CG1 extrapolated from CG{'/'.join(f'{n:g}' for n in e.levels)} "
              f"({e.value:.3g}, {e.form_text})")
     if e.form == ex.REJECTED:
@@ -51,7 +52,7 @@ def _signed(spec, tolerance: float, runs: pd.DataFrame, cg: float, ratio: float,
             f"not assessed: the rule does not extrapolate on the {spec.label}: "
             f"{e.form_text}")), math.nan
     d = ex.level_difference(values, cg, ratio, alpha, slope_scale=scale_b)
-    if spec.kind == RELATIVE:
+    if spec.estimate == RELATIVE:
         if not e.value > 0:
             return CriterionResult(**base, state=NOT_MEASURED, note=(
                 f"not measured: the extrapolated CG1 {spec.label} is not positive")), math.nan
@@ -86,11 +87,11 @@ def extrapolated_criteria(accept: AcceptSettings, runs: pd.DataFrame, cg: float,
     """Every criterion of the budget for CG level ``cg`` of one rule (``runs``: that rule's
     CG-n runs at every level), with Holm's step-down over the level's tested criteria."""
     out, p_fail = [], []
-    for spec in CRITERIA:
-        tol = getattr(accept, spec.name)
+    for spec in criteria():
+        tol = accept.tolerance(spec.name)
         if tol is None:
             continue
-        if spec.kind in (SIGNED, RELATIVE):
+        if spec.estimate in DIFFERENCES:
             r, p = _signed(spec, tol, runs, cg, ratio, alpha)
         else:
             r, p = CriterionResult(name=spec.name, label=spec.label, unit=spec.unit,

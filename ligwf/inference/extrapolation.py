@@ -47,7 +47,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize, stats
 
-from ligwf.analysis.records.equivalence import ALPHA, Estimate, finite_values, t_quantile
+from ligwf.inference.equivalence import ALPHA, Estimate, finite_values, t_quantile
 
 #: the standard deviation of the prior on the size relation's relative curvature c / b, per
 #: unit of (n - 1) d / D. The three committed ladders with CG1, CG2 and CG3 estimate it as
@@ -274,7 +274,7 @@ def level_difference(values: Mapping[float, object], n: float, size_ratio: float
                      slope_scale: float = 0.0) -> Estimate:
     """CG-n - extrapolated CG1 as one contrast of the level means (the level judged is
     part of its reference); ``se`` is the noise and the model term in quadrature, so the
-    two one-sided tests' p-values (:func:`ligwf.analysis.records.equivalence.equivalence`)
+    two one-sided tests' p-values (:func:`ligwf.inference.equivalence.equivalence`)
     match the interval."""
     levels = levels_from(values)
     ns = np.array([lv.n for lv in levels])

@@ -18,7 +18,7 @@ and the solid-fraction error.
   distance lies within D +- |e|, e the noise; |e| <= t sqrt(S) with t Student's 1 - alpha / 2
   quantile at the Satterthwaite degrees of freedom of S taken as one component (the
   most correlated case, the widest), so each bound holds with probability >= 1 - alpha
-  whatever the nodes' correlation (``tests/analysis/records/test_field_criterion.py`` measures it).
+  whatever the nodes' correlation (``tests/inference/test_field_criterion.py`` measures it).
   Reported at the kernel widths ``CRITERION_KERNELS`` (CG1 diameters); the verdict uses
   the study's ``analysis.field_kernel``.
 
@@ -49,7 +49,7 @@ import numpy as np
 
 from scipy import stats
 
-from ligwf.analysis.records.equivalence import ALPHA, NormEstimate, welch_df
+from ligwf.inference.equivalence import ALPHA, NormEstimate, welch_df
 from ligwf.analysis.records.fields import (CRITERION_KERNELS, EMPTY_SOLID, IN_PLANE,
                                            CaseFields, FieldGrid, WindowMeans)
 from ligwf.analysis.records.intervals import (Interval, block_indices, block_length,
@@ -235,7 +235,7 @@ class LayerNoise:
     mean fields (sqrt(D^2), units of omega R), each arm's per-run noise (sum_x w s^2 over
     its runs, units of (omega R)^2) and its number of runs. Its bounds at other run counts
     are what more replicas would give, the distance and the per-run scatter as measured
-    (what would decide the criterion, :mod:`ligwf.report.criteria`)."""
+    (what would decide the criterion, :mod:`ligwf.inference.criteria`)."""
 
     distance: float
     run_variance: float

@@ -3,7 +3,7 @@
 Per usable case (one row, indexed by case id):
 
 * for every signed criterion's column, the within-run variance of the run's value from its
-  own steady-window frames (:func:`ligwf.analysis.records.sampling.within_variance`; a
+  own steady-window frames (:func:`ligwf.inference.sampling.within_variance`; a
   share of frames above a threshold is the mean of its 0/1 series);
 * ``window_seconds``: the steady window's length (frames x their spacing, s) and
   ``steady_share``: the share of added production that would be steady window (1 - the
@@ -32,7 +32,7 @@ import pandas as pd
 
 from ligwf.analysis.records import steady_window as steady
 from ligwf.analysis.records.flow import FlowRecord
-from ligwf.analysis.records.sampling import within_variance
+from ligwf.inference.sampling import within_variance
 from ligwf.analysis.records.statistics import MEAN, SHARE_ABOVE
 from ligwf.engine.plan import case_load, estimated_seconds
 from ligwf.scene.scaled import ScaledScene

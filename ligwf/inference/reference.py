@@ -4,7 +4,7 @@ table of every extrapolated CG1 value beside the measured one where CG1 ran
 (``report/extrapolation.csv``, :data:`EXTRAPOLATION_COLUMNS`).
 
 The statistics are :mod:`ligwf.inference.extrapolation`; the verdict's criteria judged
-against the reference are :mod:`ligwf.report.extrapolated`.
+against the reference are :mod:`ligwf.inference.extrapolated`.
 """
 
 from __future__ import annotations

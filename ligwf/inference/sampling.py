@@ -35,7 +35,7 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ligwf.analysis.records.equivalence import (ALPHA, WELCH, degrees_of_freedom,
+from ligwf.inference.equivalence import (ALPHA, WELCH, degrees_of_freedom,
                                                 finite_values, t_quantile)
 from ligwf.analysis.records.intervals import autocorrelation_time
 

@@ -2,7 +2,7 @@
 interval on run means has no variance to go on there and read "pass, shown within 0 [0, 0]"
 (issue 45). An all-zero arm's mean is bounded over its runs instead (the rule of three),
 the other arm keeps its t bound, and the test of CG-n - CG1 against +-budget is made of the
-two. Pure, like :mod:`ligwf.analysis.records.equivalence`, whose Estimate and Test it
+two. Pure, like :mod:`ligwf.inference.equivalence`, whose Estimate and Test it
 returns; measured by ``benchmarks/bench_coverage.py --designs`` (all-zero arms).
 """
 
@@ -13,7 +13,7 @@ import math
 import numpy as np
 from scipy import optimize, stats
 
-from ligwf.analysis.records.equivalence import (ALPHA, FAIL, PASS, UNDECIDED, Estimate,
+from ligwf.inference.equivalence import (ALPHA, FAIL, PASS, UNDECIDED, Estimate,
                                                 Test, finite_values)
 
 

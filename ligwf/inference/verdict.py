@@ -5,7 +5,7 @@ Pure functions of the report's case table (one row per run), its condition table
 per sweep group, CG level and rule), the runs' velocity profiles, the workflow's
 ``accept:`` block (:class:`~ligwf.scene.accept.AcceptSettings`) and the granule control
 verdicts (:func:`granule_gates`). The statistics are
-:mod:`ligwf.analysis.records.equivalence` (their coverage: ``benchmarks/bench_coverage.py``):
+:mod:`ligwf.inference.equivalence` (their coverage: ``benchmarks/bench_coverage.py``):
 
 - **signed criteria** (angle of repose in deg, rigid-block share, flowing-layer thickness
   relative to CG1) are the difference of run means CG-n - CG1 with its (1 - 2 alpha)
@@ -26,7 +26,7 @@ each at alpha); it fails when a criterion fails after Holm's step-down over ever
 the level was tested on (each with its own p-value). The alpha, levels and rules travel with
 the verdict (``Verdict.statistics``). Every criterion also carries ``bound``: the largest error its interval allows
 (the error the level is shown to stay within), so a user with another budget reads the
-answer without a rerun. Written by :mod:`ligwf.report.verdict_records`, shown by
+answer without a rerun. Written by :mod:`ligwf.inference.verdict_records`, shown by
 :mod:`ligwf.report.verdict_text`.
 """
 
@@ -38,13 +38,14 @@ from dataclasses import dataclass, field
 
 import pandas as pd
 
-from ligwf.analysis.records import equivalence as eq
+from ligwf.inference import equivalence as eq
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
-from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
-from ligwf.report.criteria import CriterionResult, Gate, band, condition_criteria
-from ligwf.report.deciding import too_short_note
-from ligwf.report.extrapolated import extrapolated_criteria
-from ligwf.report.verdict_statistics import statistics_record
+from ligwf.inference.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.inference.criteria import condition_criteria
+from ligwf.inference.registry import CriterionResult, Gate, band
+from ligwf.inference.deciding import too_short_note
+from ligwf.inference.extrapolated import extrapolated_criteria
+from ligwf.inference.verdict_statistics import statistics_record
 from ligwf.scene.accept import AcceptSettings
 from ligwf.scene.workflow import CONTROL_KEY
 
@@ -63,7 +64,7 @@ class ConditionVerdict:
     speedup_hi: float
     criteria: tuple[CriterionResult, ...]
     #: runs of either arm too short to show a steady state, and what would fix it
-    #: (:func:`ligwf.report.deciding.too_short_note`; "" when every window starts in time)
+    #: (:func:`ligwf.inference.deciding.too_short_note`; "" when every window starts in time)
     too_short: str = ""
 
     @property
@@ -94,7 +95,7 @@ class Verdict:
     groups: tuple[GroupVerdict, ...]
     accept: dict = field(default_factory=dict)   # the tolerances it was decided with
     #: alpha, interval level, df rule, fail test and family rule it was decided with
-    #: (:func:`ligwf.report.verdict_statistics.statistics_record`; {} in older records)
+    #: (:func:`ligwf.inference.verdict_statistics.statistics_record`; {} in older records)
     statistics: dict = field(default_factory=dict)
 
 
@@ -221,10 +222,10 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
     """The verdict of every sweep group of a condition table (control groups left out);
     ``cases`` (one row per run) and ``profiles`` (case id -> mean velocity profile) hold
     the run values the signed and profile criteria are decided on; ``noise`` (by case id,
-    :func:`ligwf.report.planning.noise_table`) what would decide an undecided one and its
+    :func:`ligwf.inference.planning.noise_table`) what would decide an undecided one and its
     cost; ``alpha`` each test's level and ``df_rule`` its degrees of freedom (a sequential
     study's per-look level, Hsu's conservative df). A group without CG1 is judged against
-    the CG1 value extrapolated from its CG-n levels (:mod:`ligwf.report.extrapolated`;
+    the CG1 value extrapolated from its CG-n levels (:mod:`ligwf.inference.extrapolated`;
     ``size_ratio``: the drum's d / D, the model term's scale; ``speedups``: (group, cg,
     rule) -> the planner's CG1 cost over the level's, the speedup it reports)."""
     gates, profiles = gates or {}, profiles or {}

@@ -12,11 +12,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.records.equivalence import ALPHA, WELCH
+from ligwf.inference.equivalence import ALPHA, WELCH
 from ligwf.fsio import atomic_write_json, atomic_write_text
-from ligwf.report.controls import read_controls
-from ligwf.report.criteria import CriterionResult
-from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict, decide, granule_gates
+from ligwf.inference.registry import CriterionResult
+from ligwf.inference.verdict import ConditionVerdict, GroupVerdict, Verdict, decide, granule_gates
 from ligwf.scene.accept import AcceptSettings
 from ligwf.study import layout
 
@@ -50,7 +49,9 @@ def verdict_rows(verdict: Verdict) -> pd.DataFrame:
                              "decide_amount_cg1": r.decide_amount_cg1,
                              "decide_core_hours": r.decide_core_hours,
                              "decide_half_width": r.decide_half_width,
-                             "note": r.note, "cheapest": g.cheapest == c.name})
+                             "note": r.note, "too_short": bool(c.too_short),
+                             "too_short_note": c.too_short,
+                             "cheapest": g.cheapest == c.name})
     return pd.DataFrame(rows)
 
 
@@ -96,15 +97,15 @@ def read_verdict(out: Path) -> Verdict | None:
 
 
 def study_verdict(cases: pd.DataFrame, conditions: pd.DataFrame, accept: AcceptSettings,
-                  analysis_dir: Path, profiles: dict | None = None,
+                  controls: pd.DataFrame | None, profiles: dict | None = None,
                   noise: pd.DataFrame | None = None, alpha: float = ALPHA,
                   df_rule: str = WELCH, size_ratio: float = math.nan,
                   speedups: dict | None = None) -> Verdict:
-    """The verdict of a study's report tables, with its granule control verdicts read from
-    the analysis folder (``noise``: the runs' noise and prices, what would decide;
-    ``alpha``: each test's level; ``size_ratio`` and ``speedups``: a sweep without CG1,
-    :func:`ligwf.report.verdict.decide`)."""
+    """The verdict of a study's report tables, with its granule control verdicts
+    (``controls``: the analysis' controls table, None without twins; ``noise``: the runs'
+    noise and prices, what would decide; ``alpha``: each test's level; ``size_ratio`` and ``speedups``: a sweep without CG1,
+    :func:`ligwf.inference.verdict.decide`)."""
     if cases.empty or conditions.empty:
         return Verdict((), accept.model_dump(mode="json"))
-    return decide(conditions, accept, granule_gates(cases, read_controls(analysis_dir)),
+    return decide(conditions, accept, granule_gates(cases, controls),
                   cases, profiles, alpha, noise, df_rule, size_ratio, speedups)

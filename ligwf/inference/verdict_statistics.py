@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ligwf.analysis.records.equivalence import DF_RULE_TEXT, FAIL_SIDES
+from ligwf.inference.equivalence import DF_RULE_TEXT, FAIL_SIDES
 
 #: the family rule and the fail test of this version, in words
 FAMILY = ("Holm's step-down over the fail tests of every criterion the level was tested on, "

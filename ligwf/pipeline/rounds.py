@@ -5,7 +5,7 @@ of each sweep group that can still pass (the fastest condition that does not fai
 the round's target (with ``--every-level``: every level with an undecided criterion, so
 that each level's error is decided, as a ladder study asks; an arm several levels share,
 their CG1 runs, gets the most any of them asks, not the sum); each of its undecided criteria names the cheapest way to HALVE its
-interval's half-width (:mod:`ligwf.analysis.records.sampling`: more production on the runs
+interval's half-width (:mod:`ligwf.inference.sampling`: more production on the runs
 there are, or more replicas of an arm); the round does all of them (per arm the longest
 extension and the most replicas asked for) and looks again, until the target meets the
 budget, every level fails, the planned looks are spent or the next round would pass the
@@ -37,15 +37,15 @@ from pathlib import Path
 from typing import Callable
 
 from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
-from ligwf.analysis.records.equivalence import UNDECIDED
+from ligwf.inference.equivalence import UNDECIDED
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
 from ligwf.local import LocalExecutor
 from ligwf.pipeline.run import StudyRun, scheduled, site_engine
-from ligwf.report.planning import calibration, run_costs
-from ligwf.report.verdict import FAILS, MEETS, Verdict, is_control_group
-from ligwf.report.verdict_records import read_verdict
+from ligwf.inference.planning import calibration, run_costs
+from ligwf.inference.verdict import FAILS, MEETS, Verdict, is_control_group
+from ligwf.inference.verdict_records import read_verdict
 from ligwf.scheduler import Executor
 from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
 from ligwf.study.case import CaseFolder, group_of
@@ -200,7 +200,7 @@ def _actions(study: Study, needs: dict[tuple, list[float]]) -> tuple[list[dict],
     """The round's actions on each arm ``needs`` names (longer production on its runs,
     then new replicas as long as them) and their planned core-hours (the planner's rates
     calibrated by the arm's own runs,
-    :func:`~ligwf.report.planning.calibration`)."""
+    :func:`~ligwf.inference.planning.calibration`)."""
     actions, hours = [], 0.0
     for (group, cg, rule), (extend, add) in needs.items():
         cases = _arm_cases(study, group, cg, rule)

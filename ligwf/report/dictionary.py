@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ligwf.inference.budget import criteria
 from ligwf.report.dictionary_entries import COMMON, OVERRIDES
 from ligwf.study import layout
 
@@ -94,12 +95,12 @@ POOLED = ("_mean", "_min", "_max", "_nan_pools")
 FLOW_METRICS = ("angle_of_repose", "angle_of_repose_std", "angle_error", "profile_error",
                 "rigid_frame_share", "rms_speed_rel_fluctuation", "flowing_layer_thickness_mean")
 GRANULE_METRICS = ("largest_cluster_fraction", "one_granule_frame_share")
-#: the flow-field errors the report adds (ligwf.analysis.records.field_errors.FIELD_ERRORS)
+#: the flow-field errors the report adds (ligwf.inference.field_errors.FIELD_ERRORS)
 FIELD_ERRORS = ("field_error", "field_solid_error")
 #: the field criterion at each reported kernel width (field_errors.KERNEL_COLUMNS)
 FIELD_KERNEL_ERRORS = ("field_error_k1", "field_error_k2", "field_error_k4")
 #: the field criterion's noise pieces, from which its replica plan is made
-#: (report/deciding.py: raw distance, the run variances of each side, their run counts)
+#: (inference/deciding.py: raw distance, the run variances of each side, their run counts)
 FIELD_NOISE = ("field_error_distance", "field_error_run_var", "field_error_ref_var",
                "field_error_runs", "field_error_ref_runs")
 GSD_REPORT = ("gsd_lower_limit", "gsd_lower_limit_diameter", "gsd_error_below_lower",
@@ -188,7 +189,7 @@ TABLES: dict[str, Table] = {
         "speedup_core_lo", "speedup_core_hi", "criterion", "label", "unit", "state", "value",
         "lo", "hi", "budget", "shown_within", "budget_source", "decide_by", "decide_arm",
         "decide_amount", "decide_amount_cg1", "decide_core_hours", "decide_half_width",
-        "note", "cheapest")),
+        "note", "too_short", "too_short_note", "cheapest")),
     layout.EXTRAPOLATION_REPORT: Table(layout.REPORT_DIR, "sweep group, rule and signed "
                                        "criterion with two or more CG-n levels", (
         "group", "rule", "column", "levels", "replicas", "extrapolated", "lo", "hi",
@@ -298,6 +299,24 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|")
 
 
+def criteria_markdown() -> list[str]:
+    """The verdict's criteria as their registry declares them (:mod:`ligwf.inference.budget`):
+    budget key, label, unit, metric, estimate, default tolerance, planner and meaning."""
+    lines = ["## Verdict criteria", "",
+             "The `criterion` of `verdict.csv`: one per budget key of the `accept:` block, "
+             "listed from the criterion registry (`ligwf/inference/registry.py`; the built-in "
+             "ones in `ligwf/inference/budget.py`). `metric` is the case-table (signed) or "
+             "condition-table column it reads; `plan` its planner of what would decide it (`ligwf/inference/deciding.py`).", "",
+             "| criterion | label | unit | metric | estimate | default budget | plan | meaning |",
+             "|---|---|---|---|---|---|---|---|"]
+    for c in criteria():
+        default = "null" if c.default is None else f"{c.default:g}"
+        plan = f"`{c.plan.__name__}`" if c.plan is not None else ""
+        lines.append(f"| `{c.name}` | {_cell(c.label)} | {c.unit or '1'} | `{c.metric}` | "
+                     f"{c.estimate} | {default} | {plan} | {_cell(c.description)} |")
+    return lines + [""]
+
+
 def dictionary_markdown() -> str:
     """``docs/data_dictionary.md``: per table its folder, row, and every column with unit,
     label and meaning; then the suffix rules."""
@@ -320,6 +339,7 @@ def dictionary_markdown() -> str:
             lines.append(f"| `{c.name}` | {c.unit} | {c.shown} | {_cell(c.label)} | "
                          f"{_cell(c.meaning)} |")
         lines.append("")
+    lines += criteria_markdown()
     lines += ["## Suffixes and prefixes", "",
               "A column `x` of a table with one of these families also appears as:", "",
               "| column | unit | label | meaning |", "|---|---|---|---|"]

@@ -154,7 +154,7 @@ COMMON: tuple[tuple[str, ...], ...] = (
      f"{layout.GSD_SUMMARY_TABLE} (nan when no lower limit is located)"),
     ("gsd_error_all", "1", "GSD err all bins", f"error_all of {layout.GSD_SUMMARY_TABLE}: the whole GSD's "
      "relative L1 error against CG1"),
-    # flow fields (ligwf.analysis.records.field_errors)
+    # flow fields (ligwf.inference.field_errors)
     ("field_error", "1", "layer velocity err", "the field criterion (what the verdict's "
      "continuum-fields budget reads): the in-plane velocity in the drum frame, U - omega x "
      "r, inside the flowing layer (CG1 nodes with solid fraction >= 0.1 moving relative to "
@@ -235,12 +235,12 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("source", "text", "from", "what the scatter was estimated from"),
 )
 
-#: the verdict's columns (ligwf.report.verdict_records: one row per criterion)
+#: the verdict's columns (ligwf.inference.verdict_records: one row per criterion)
 VERDICT = (
     ("condition_state", "text", "condition verdict", "meets (every assessed criterion "
      "passes), fails (one fails) or undecided"),
-    ("criterion", "text", "criterion", "the accept: key of the criterion (angle_deg, "
-     "profile_error, rigid_share, flowing_layer, gsd_error, field_error)"),
+    ("criterion", "text", "criterion", "the accept: key of the criterion (the verdict "
+     "criteria, listed from their registry at the end of this page)"),
     ("label", "text", "criterion label", "the criterion as the report names it"),
     ("unit", "text", "unit", "unit of value, lo, hi and budget (empty: a ratio)"),
     ("state", "text", "verdict", "pass (signed criteria: the (1 - 2 alpha) interval of "
@@ -259,7 +259,7 @@ VERDICT = (
     ("budget_source", "text", "budget from", "where the budget came from (the accept: block)"),
     ("decide_by", "text", "decide by", "undecided only: the cheapest way to decide it "
      "(extend: more production on the existing runs, continued from their restarts; "
-     "replicas: more runs), from the arms' variance components (ligwf.analysis.records."
+     "replicas: more runs), from the arms' variance components (ligwf.inference."
      "sampling)"),
     ("decide_arm", "text", "decide on", "the arm(s) to extend or add to: CG-n, CG1 or both"),
     ("decide_amount", "1", "decide amount", "extend: simulated seconds of production more "
@@ -270,6 +270,10 @@ VERDICT = (
     ("decide_half_width", "unit", "predicted half-width", "the half-width of the interval "
      "predicted after it, the difference and variances as measured (a plan)"),
     ("note", "text", "note", "why a criterion was not assessed, or what decides it"),
+    ("too_short", "flag", "runs too short", "the steady window of a run of either arm of "
+     "this condition starts at its cap: the runs are too short to show a steady state"),
+    ("too_short_note", "text", "too short: fix", "which runs are too short and what would "
+     "fix it (the production each needs, the planner's rule; empty when none is)"),
     ("cheapest", "flag", "cheapest", "this condition is the cheapest of its group that meets "
      "the whole budget"),
 )

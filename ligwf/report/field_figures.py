@@ -17,7 +17,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ligwf.analysis.records.conditions import Conditions
-from ligwf.analysis.records.field_errors import MATERIAL_SOLID, condition_mean
+from ligwf.inference.field_errors import MATERIAL_SOLID, condition_mean
 from ligwf.analysis.records.fields import CaseFields, FieldGrid, fields_of
 from ligwf.report.figures import save
 from ligwf.scene.axis import Axis

@@ -2,14 +2,14 @@
 case and condition tables, the null checks, and the "Flow fields" section.
 
 Reads the field archive of the analysis (:func:`ligwf.analysis.records.fields.read_fields`)
-and computes only statistics of it (:mod:`ligwf.analysis.records.field_errors`): per
+and computes only statistics of it (:mod:`ligwf.inference.field_errors`): per
 condition the field criterion (drum-frame velocity in the flowing layer, noise-corrected,
 with bounds; at every width of ``CRITERION_KERNELS`` as ``field_error_k<w>``, and at the
 study's ``analysis.field_kernel`` as ``field_error``, the column the verdict reads) and the
 solid-fraction error with its bootstrap interval, each with the columns every error of the
 condition table has (``_lo``, ``_hi``, ``_se``, ``_floor``, ``_floor_source``,
 ``_vs_floor``). The field criterion's floor is its CG1-vs-CG1 value
-(:func:`~ligwf.analysis.records.field_errors.null_split`).
+(:func:`~ligwf.inference.field_errors.null_split`).
 
 Null checks (one table): per sweep group, CG1 against CG1 (the criterion should find no
 difference); and the cohesionless twin of the wet CG1 case (``sweep.controls:
@@ -29,8 +29,8 @@ import pandas as pd
 
 from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.records.conditions import Conditions
-from ligwf.analysis.records.equivalence import ALPHA, NormEstimate
-from ligwf.analysis.records.field_errors import (ERRORS, FIELD_NOISE_COLUMNS, KERNEL_COLUMNS,
+from ligwf.inference.equivalence import ALPHA, NormEstimate
+from ligwf.inference.field_errors import (ERRORS, FIELD_NOISE_COLUMNS, KERNEL_COLUMNS,
                                                  LAYER_SPEED, MATERIAL_SOLID, condition_mean,
                                                  field_floor, field_intervals,
                                                  layer_components, layer_error, null_split,
@@ -39,7 +39,7 @@ from ligwf.analysis.records.fields import CaseFields, read_fields
 from ligwf.analysis.records.provenance import StaleAnalysis
 from ligwf.fsio import atomic_write_text
 from ligwf.report.field_figures import group_figures, rotation_sense
-from ligwf.report.uncertainty import mark
+from ligwf.inference.uncertainty import mark
 from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study import layout
 from ligwf.study.case import group_label
@@ -196,7 +196,7 @@ CG1_VS_CG1, TWIN_VS_WET = "CG1 vs CG1", "cohesionless twin vs wet CG1"
 def null_check(cases: pd.DataFrame, fields: dict[str, CaseFields], draws: int, seed: int,
                kernel: float) -> pd.DataFrame:
     """The null checks: per sweep group with CG1 cases, the field criterion of CG1 against
-    CG1 (:func:`~ligwf.analysis.records.field_errors.null_split`); per cohesionless twin
+    CG1 (:func:`~ligwf.inference.field_errors.null_split`); per cohesionless twin
     condition at CG1, the field criterion and the solid-fraction error of the twins
     against the wet CG1 cases (with the wet CG1 floor and mark)."""
     rows = []

@@ -1,7 +1,7 @@
 """The verdict as one picture: per CG level each criterion's interval against its budget (a
 forest plot) with the speedup beside, first on the report page and in its figures folder.
 
-Read only from the verdict record (:class:`ligwf.report.verdict.Verdict`), so the picture
+Read only from the verdict record (:class:`ligwf.inference.verdict.Verdict`), so the picture
 shows what the verdict table says and nothing else: one panel per criterion (its own x axis
 in the verdict's unit: degrees for the angle, the share or relative difference for the
 others), one row per level in every panel (so a row across the panels is one level), the
@@ -24,13 +24,13 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
-from ligwf.report.criteria import CRITERIA, RELATIVE, SIGNED
+from ligwf.inference.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.inference.budget import criteria, signed_names
+from ligwf.inference.registry import RELATIVE, SIGNED
 from ligwf.report.figures import log_scale, save
-from ligwf.report.verdict import Verdict
+from ligwf.inference.verdict import Verdict
 
 #: criteria judged on a signed difference: their budget is +-tolerance
-SIGNED_NAMES = frozenset(s.name for s in CRITERIA if s.kind in (SIGNED, RELATIVE))
 #: the speedup's panel and gid suffix
 SPEEDUP = "speedup"
 #: colours of the states (the terminal's words for them: :mod:`ligwf.report.verdict_text`)
@@ -58,12 +58,12 @@ def forest_rows(verdict: Verdict) -> pd.DataFrame:
                              "speedup_hi": c.speedup_hi, "criterion": r.name,
                              "label": r.label, "unit": r.unit, "state": r.state,
                              "assessed": r.assessed, "value": r.value, "lo": r.lo, "hi": r.hi,
-                             "budget": r.budget, "signed": r.name in SIGNED_NAMES})
+                             "budget": r.budget, "signed": r.name in signed_names()})
     return pd.DataFrame(rows)
 
 
 def _axis_label(name: str, label: str, unit: str) -> str:
-    kind = next((s.kind for s in CRITERIA if s.name == name), "")
+    kind = next((s.estimate for s in criteria() if s.name == name), "")
     what = _WHAT.get(kind, "error")
     return f"{label}\n{what}" + (f" [{unit}]" if unit else "")
 

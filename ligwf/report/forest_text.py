@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from ligwf.report.forest import forest_rows
-from ligwf.report.verdict import Verdict
+from ligwf.inference.verdict import Verdict
 
 #: the widest line the table prints (a terminal of 100 columns shows it unwrapped)
 WIDTH = 100

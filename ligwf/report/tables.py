@@ -13,7 +13,7 @@ costs differ), speedup vs CG1 on that footing, and errors vs CG1: angle of repos
 above the lower size limit and over all bins (the limit with them: :data:`GSD_METRICS`),
 largest-cluster fraction.
 Per condition (CG level, rule, group): value with a 95 % interval that respects the data
-(:mod:`ligwf.report.uncertainty`: block bootstrap over frames and replicas, bounded, never
+(:mod:`ligwf.inference.uncertainty`: block bootstrap over frames and replicas, bounded, never
 narrower than the within-run error, none for one replica) and each error against the CG1
 noise floor. Only ``done`` cases with a matching scene hash count; the others are listed
 with their status and reason, never averaged in.
@@ -33,7 +33,7 @@ from ligwf.analysis.records.gsd import GSD_ERRORS, LOWER_LIMIT
 from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
 from ligwf.analysis.records.statistics import MEAN
 from ligwf.report.fields import add_field_errors, case_fields
-from ligwf.report.uncertainty import (ConditionStats, case_series, cost_interval, mark,
+from ligwf.inference.uncertainty import (ConditionStats, case_series, cost_interval, mark,
                                       report_metrics)
 from ligwf.study import layout
 from ligwf.study.case import group_label

@@ -1,4 +1,4 @@
-"""The verdict (:mod:`ligwf.report.verdict`) as the report's first section (markdown:
+"""The verdict (:mod:`ligwf.inference.verdict`) as the report's first section (markdown:
 summary.md shows it, index.html renders it, :mod:`ligwf.report.sections`) and as the
 terminal lines ``ligwf study`` and ``ligwf report`` end with (rich).
 
@@ -7,7 +7,7 @@ the budget, or that none does and why), then per CG level and rule the speedup w
 interval and each criterion's state with its value, interval and budget; undecided
 criteria say what would decide them, unassessed ones why. Every sentence about the statistics
 (interval level, alpha, degrees of freedom, family) is written from the verdict's record
-(:mod:`ligwf.report.verdict_statistics`).
+(:mod:`ligwf.inference.verdict_statistics`).
 """
 
 from __future__ import annotations
@@ -16,21 +16,22 @@ import math
 
 from rich.text import Text
 
-from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
-from ligwf.report.criteria import CRITERIA, RELATIVE, SIGNED, CriterionResult
+from ligwf.inference.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.inference.budget import criteria, signed_names
+from ligwf.inference.registry import CriterionResult
 from ligwf.report.forest_text import compact_lines
-from ligwf.report.verdict import FAILS, MEETS, ConditionVerdict, GroupVerdict, Verdict, band_text
-from ligwf.report.verdict_statistics import (cheapest_disclosure, method_text,
+from ligwf.inference.verdict import FAILS, MEETS, ConditionVerdict, GroupVerdict, Verdict, band_text
+from ligwf.inference.verdict_statistics import (cheapest_disclosure, method_text,
                                              shown_within_heading)
 
 TITLE = "Verdict"
-#: criteria judged on a signed difference (their budget is +-tolerance)
-SIGNED_NAMES = frozenset(s.name for s in CRITERIA if s.kind in (SIGNED, RELATIVE))
 
 
 def _within(name: str) -> str:
     """How a criterion's budget reads: ``+-`` for a signed difference, else ``<= ``."""
-    return "+-" if name in SIGNED_NAMES else "<= "
+    return "+-" if name in signed_names() else "<= "
+
+
 #: rich styles of the states
 STYLE = {PASS: "green", FAIL: "red", UNDECIDED: "yellow", MEETS: "bold green",
          FAILS: "bold red"}
@@ -48,7 +49,7 @@ def group_title(group: str) -> str:
 def budget_line(accept: dict) -> str:
     """The tolerances the verdict was decided with, in the block's order."""
     parts = []
-    for s in CRITERIA:
+    for s in criteria():
         if s.name not in accept:
             continue
         tol = accept[s.name]

@@ -19,7 +19,7 @@ import pandas as pd
 
 from ligwf import __version__
 from ligwf.analysis.records.conditions import REFERENCE_CG
-from ligwf.analysis.records.equivalence import HSU, WELCH_BF
+from ligwf.inference.equivalence import HSU, WELCH_BF
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import LOWER_LIMIT
 from ligwf.analysis.records.analysis_record import AnalysisRecord
@@ -27,7 +27,7 @@ from ligwf.analysis.records.provenance import StaleAnalysis, changed_dumps
 from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
-from ligwf.report.controls import controls_markdown
+from ligwf.report.controls import controls_markdown, read_controls
 from ligwf.report.fields import fields_report
 from ligwf.report.forest import forest, forest_rows
 from ligwf.report.granule_figures import granule_figures
@@ -40,14 +40,14 @@ from ligwf.report.sections import (Figure, Section, figure_section, ordered, ren
 from ligwf.report.table_sections import (markdown_tables, noise_markdown, paraview_markdown,
                                          pooling_markdown, stability_markdown, steady_line)
 from ligwf.report.tables import build_tables
-from ligwf.report.criteria import SIGNED_COLUMNS
+from ligwf.inference.budget import signed_columns
 from ligwf.report.extrapolation_report import extrapolation_inputs, extrapolation_section
 from ligwf.report.scale_section import scale_section
 from ligwf.inference.reference import extrapolation_rows
-from ligwf.report.planning import noise_table
+from ligwf.inference.planning import noise_table
 from ligwf.report.rounds import rounds_sections
-from ligwf.report.verdict import Verdict
-from ligwf.report.verdict_records import study_verdict, write_verdict
+from ligwf.inference.verdict import Verdict
+from ligwf.inference.verdict_records import study_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_section
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -90,13 +90,13 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
     ratio, speedups = extrapolation_inputs(study)
-    verdict = study_verdict(cases, conditions, study.accept, study.analysis_dir,
+    verdict = study_verdict(cases, conditions, study.accept, read_controls(study.analysis_dir),
                             {cid: c.profile_v_mean for cid, c in flow.cases.items()},
-                            noise_table(study.usable_cases()[0], flow, SIGNED_COLUMNS),
+                            noise_table(study.usable_cases()[0], flow, signed_columns()),
                             *sequential_level(read_rounds(study.path)), size_ratio=ratio,
                             speedups=speedups)
     write_verdict(verdict, out)
-    extrapolated = extrapolation_rows(cases, SIGNED_COLUMNS, ratio)
+    extrapolated = extrapolation_rows(cases, signed_columns(), ratio)
     atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
     figures = report_figures(study, flow, cases, conditions, out, snapshots, verdict)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
@@ -155,7 +155,7 @@ def sequential_level(rounds) -> tuple[float, str]:
 
 
 def verdict_sections(verdict: Verdict | None, figure: Figure | None = None) -> list[Section]:
-    """The verdict per sweep group (:mod:`ligwf.report.verdict`), first in the report, its
+    """The verdict per sweep group (:mod:`ligwf.inference.verdict`), first in the report, its
     forest plot (``figure``) first in it."""
     if verdict is None:
         return [Section("Verdict", "verdict", NO_VERDICT)]

@@ -256,7 +256,7 @@ def analysis_part(index: int, count: int) -> str:
 CASES_REPORT = "cases.csv"
 CONDITIONS_REPORT = "conditions.csv"
 NOISE_FLOOR_REPORT = "noise_floor.csv"
-#: the verdict per sweep group, CG level, rule and criterion (ligwf.report.verdict)
+#: the verdict per sweep group, CG level, rule and criterion (ligwf.inference.verdict)
 VERDICT_TABLE = "verdict.csv"
 VERDICT_RECORD = "verdict.json"
 #: the CG1 value extrapolated from the CG-n levels of each rule, beside the measured one

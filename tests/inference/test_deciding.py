@@ -1,4 +1,4 @@
-"""What would decide the field criterion (ligwf.report.deciding.field_plan): from its noise
+"""What would decide the field criterion (ligwf.inference.deciding.field_plan): from its noise
 pieces, the cheapest arm to add replicas to, halving (a round) and deciding (the report),
 checked against the bounds LayerNoise itself predicts."""
 
@@ -8,9 +8,9 @@ import math
 
 import pytest
 
-from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
-from ligwf.analysis.records.sampling import REPLICAS
-from ligwf.report.deciding import field_plan
+from ligwf.inference.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
+from ligwf.inference.sampling import REPLICAS
+from ligwf.inference.deciding import field_plan
 
 ALPHA = 0.05
 

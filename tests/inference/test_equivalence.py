@@ -1,4 +1,4 @@
-"""ligwf.analysis.records.equivalence: Welch against scipy's own test, the two one-sided
+"""ligwf.inference.equivalence: Welch against scipy's own test, the two one-sided
 tests at their edges, Holm's step-down, the noise-corrected profile distance, the
 replicas that would decide, and the coverage the verdict relies on, measured on a few
 cells of benchmarks/bench_coverage.py (the full grid is the benchmark)."""
@@ -12,7 +12,7 @@ import pytest
 from scipy import stats
 
 from benchmarks.bench_coverage import cell, norm_cell
-from ligwf.analysis.records import equivalence as eq
+from ligwf.inference import equivalence as eq
 
 
 def test_welch_interval_matches_scipy():

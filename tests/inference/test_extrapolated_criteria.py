@@ -1,4 +1,4 @@
-"""The verdict against an extrapolated CG1 (ligwf.report.extrapolated) on hand-made run
+"""The verdict against an extrapolated CG1 (ligwf.inference.extrapolated) on hand-made run
 tables: a level on the line passes, a level off it fails after Holm, a curve is "does not
 extrapolate", identical runs everywhere are not a zero-width pass, norms are not assessed."""
 
@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ligwf.report.extrapolated import extrapolated_criteria
+from ligwf.inference.extrapolated import extrapolated_criteria
 from ligwf.scene.accept import AcceptSettings
 
 ACCEPT = AcceptSettings()

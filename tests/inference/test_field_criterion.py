@@ -1,4 +1,4 @@
-"""The field criterion's statistics (ligwf.analysis.records.field_errors.layer_norm and the
+"""The field criterion's statistics (ligwf.inference.field_errors.layer_norm and the
 drum frame): exact on noiseless fields, no bounds from one run, and bounds that hold at
 least 95 % of the time on synthetic noisy fields whose true distance is known, for
 independent nodes and for nodes that move together (the case the bound is built for)."""
@@ -13,7 +13,7 @@ import pytest
 
 from ligwf.analysis.flow.frame import DrumGeometry, rigid_rotation_velocity
 from ligwf.analysis.frames.dumps import ParticleFrame
-from ligwf.analysis.records.field_errors import layer_norm, rotation_velocity
+from ligwf.inference.field_errors import layer_norm, rotation_velocity
 from ligwf.analysis.records.fields import FieldGrid
 
 TRIALS = 1000

@@ -17,8 +17,8 @@ import math
 import numpy as np
 from scipy import stats
 
-from ligwf.analysis.records import equivalence as eq
-from ligwf.report.deciding import profile_plan
+from ligwf.inference import equivalence as eq
+from ligwf.inference.deciding import profile_plan
 from tests.helpers import ROOT
 
 CRASH = ROOT / "tests" / "data" / "profile_planner_crash.npz"

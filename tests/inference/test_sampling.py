@@ -1,4 +1,4 @@
-"""ligwf.analysis.records.sampling: what would decide an undecided criterion, and its cost.
+"""ligwf.inference.sampling: what would decide an undecided criterion, and its cost.
 
 The options are checked against the arithmetic of Welch's interval they rest on, the arm
 they name against the arm whose scatter dominates, and the half-width they predict for a
@@ -14,8 +14,8 @@ import pytest
 from scipy import stats
 
 from benchmarks.bench_coverage import ar1_runs
-from ligwf.analysis.records import equivalence as eq
-from ligwf.analysis.records import sampling as sp
+from ligwf.inference import equivalence as eq
+from ligwf.inference import sampling as sp
 
 
 def test_replicas_of_the_wide_arm_decide_and_the_arithmetic_holds():

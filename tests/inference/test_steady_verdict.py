@@ -11,16 +11,16 @@ import pandas as pd
 import pytest
 
 from ligwf.analysis.records import steady_window as steady
-from ligwf.analysis.records import equivalence as eq
-from ligwf.analysis.records import sampling
-from ligwf.analysis.records.equivalence import UNDECIDED
-from ligwf.report import planning
+from ligwf.inference import equivalence as eq
+from ligwf.inference import sampling
+from ligwf.inference.equivalence import UNDECIDED
+from ligwf.inference import planning
 from ligwf.report.forest_text import compact_lines
-from ligwf.report.verdict import decide
-from ligwf.report.verdict_records import read_verdict, write_verdict
+from ligwf.inference.verdict import decide
+from ligwf.inference.verdict_records import read_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_section
 from ligwf.scene.accept import AcceptSettings
-from tests.report.test_verdict import CG1, GROUP, PASSING, crit, runs, study, verdict
+from tests.inference.test_verdict import CG1, GROUP, PASSING, crit, runs, study, verdict
 
 
 def test_the_cap_and_the_least_extension_rule():

@@ -1,8 +1,8 @@
-"""ligwf.report.uncertainty on hand-made series: condition intervals, errors against CG1
+"""ligwf.inference.uncertainty on hand-made series: condition intervals, errors against CG1
 (pooled over replicas), the CG1 noise floor, the within / beyond decision, the scatter.
 
 Every expected value is derived here from the definition (the module docstrings of
-ligwf.report.uncertainty and ligwf.analysis.records.intervals), on series built so the
+ligwf.inference.uncertainty and ligwf.analysis.records.intervals), on series built so the
 answer is exact (runs constant over their frames: the bootstrap can only pick replicas) or
 known in distribution (independent Gaussian frames); nothing is computed by calling the
 code under test a second way.
@@ -17,7 +17,7 @@ import pytest
 
 from ligwf.analysis.records import statistics as st
 from ligwf.analysis.records.metrics import POSITIVE, UNIT, MetricSpec
-from ligwf.report.uncertainty import ConditionStats, Floor, mark, replicas_to_decide
+from ligwf.inference.uncertainty import ConditionStats, Floor, mark, replicas_to_decide
 
 #: 97.5 % point of the standard normal, and of Student's t with 1 degree of freedom
 Z = 1.959963984540054
@@ -292,7 +292,7 @@ def test_cost_interval_t_on_the_logarithm():
     t(0.975, 1) x ln(4) / 2 on the log scale; the value is the arithmetic mean 5."""
     import pandas as pd
 
-    from ligwf.report.uncertainty import cost_interval
+    from ligwf.inference.uncertainty import cost_interval
 
     iv = cost_interval(pd.Series([2.0, 8.0]))
     half = T1 * math.log(4.0) / 2.0

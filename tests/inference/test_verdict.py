@@ -1,4 +1,4 @@
-"""ligwf.report.verdict on hand-made run tables: signed criteria decided by two one-sided
+"""ligwf.inference.verdict on hand-made run tables: signed criteria decided by two one-sided
 tests on the difference of run means (pass inside +-budget, fail wholly outside, else
 undecided with the arm whose replicas would decide), the noise-corrected profile distance,
 Holm over a level's fail tests, the bound each level is shown to stay within, the
@@ -6,7 +6,7 @@ cheapest-level sentence, the GSD gated by the granule controls, control twins le
 the ``accept:`` block (validation, ``--set``) and the written records.
 
 The runs are chosen so the expected state follows from the arithmetic of Welch's interval
-(checked against scipy's own Welch test in tests/analysis/records/test_equivalence.py).
+(checked against scipy's own Welch test in tests/inference/test_equivalence.py).
 """
 
 from __future__ import annotations
@@ -19,10 +19,10 @@ import pandas as pd
 import pytest
 
 from ligwf.errors import ConfigError
-from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
-from ligwf.report.criteria import NOT_ASSESSED, NOT_MEASURED, Gate
-from ligwf.report.verdict import FAILS, MEETS, decide, granule_gates
-from ligwf.report.verdict_records import read_verdict, write_verdict
+from ligwf.inference.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.inference.registry import NOT_ASSESSED, NOT_MEASURED, Gate
+from ligwf.inference.verdict import FAILS, MEETS, decide, granule_gates
+from ligwf.inference.verdict_records import read_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_renderables, verdict_section
 from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.workflow import load_workflow

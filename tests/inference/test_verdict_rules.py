@@ -22,14 +22,14 @@ import pandas as pd
 import pytest
 from scipy import integrate, stats
 
-from ligwf.analysis.records import behrens_fisher
-from ligwf.analysis.records import equivalence as eq
-from ligwf.analysis.records.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
-from ligwf.analysis.records.shares import share_bounds, share_test
+from ligwf.inference import behrens_fisher
+from ligwf.inference import equivalence as eq
+from ligwf.inference.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
+from ligwf.inference.shares import share_bounds, share_test
 from ligwf.report.write import sequential_level
 from ligwf.study.rounds import read_rounds
 from tests.helpers import ROOT
-from tests.report.test_verdict import CG1, crit, runs, verdict
+from tests.inference.test_verdict import CG1, crit, runs, verdict
 
 LADDER = ROOT / "docs" / "results" / "ladder"
 

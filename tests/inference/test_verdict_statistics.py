@@ -9,13 +9,13 @@ from __future__ import annotations
 import json
 import re
 
-from ligwf.analysis.records import equivalence as eq
-from ligwf.report.verdict import decide
-from ligwf.report.verdict_records import read_verdict, write_verdict
+from ligwf.inference import equivalence as eq
+from ligwf.inference.verdict import decide
+from ligwf.inference.verdict_records import read_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_renderables, verdict_section
 from ligwf.scene.accept import AcceptSettings
 from tests.helpers import ROOT
-from tests.report.test_verdict import CG1, GROUP, PASSING, runs, study
+from tests.inference.test_verdict import CG1, GROUP, PASSING, runs, study
 
 
 def _verdict(alpha: float, df_rule: str):

@@ -15,8 +15,8 @@ from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import prepare_workflow, write
 from ligwf.pipeline.rounds import (RoundPlan, added_cases, apply_extensions, plan_look,
                                    start_rounds)
-from ligwf.report.criteria import CriterionResult
-from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict
+from ligwf.inference.registry import CriterionResult
+from ligwf.inference.verdict import ConditionVerdict, GroupVerdict, Verdict
 from ligwf.study.case import CaseFolder
 from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Look,
                                 Rounds, read_rounds, write_rounds)
@@ -196,7 +196,7 @@ def test_a_stuck_look_is_taken_again_by_the_next_call(study):
 def test_round_costs_are_calibrated_by_the_arms_fastest_run(study):
     """A round's planned core-hours scale the planner's rates by measured / planned of the
     arm's fastest finished run (a run slowed by a loaded machine does not inflate it)."""
-    from ligwf.report.planning import run_costs
+    from ligwf.inference.planning import run_costs
     from ligwf.study.manifest import Manifest, write_manifest
     _, s = study
     v = verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n", round_amount=1))

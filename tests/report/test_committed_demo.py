@@ -8,7 +8,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from ligwf.analysis.records import equivalence as eq
+from ligwf.inference import equivalence as eq
 from scripts.demo_results import OUT, main
 
 SIGNED = {"angle_deg": "angle_of_repose", "rigid_share": "rigid_frame_share"}

@@ -8,7 +8,7 @@ from __future__ import annotations
 import pandas as pd
 import pytest
 
-from ligwf.analysis.records import equivalence as eq
+from ligwf.inference import equivalence as eq
 from ligwf.study.rounds import read_rounds
 from scripts.ladder_results import LADDERS, check, main
 

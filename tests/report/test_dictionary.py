@@ -67,7 +67,7 @@ def test_report_tables_from_hand_made_inputs_are_documented():
 
 
 def test_field_error_columns_are_documented():
-    from ligwf.analysis.records.field_errors import FIELD_ERRORS
+    from ligwf.inference.field_errors import FIELD_ERRORS
 
     assert set(FIELD_ERRORS) == set(dic.FIELD_ERRORS)
     for name in FIELD_ERRORS:
@@ -77,9 +77,9 @@ def test_field_error_columns_are_documented():
 
 
 def test_verdict_table_columns_are_documented():
-    from ligwf.report.criteria import CriterionResult
-    from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict
-    from ligwf.report.verdict_records import verdict_rows
+    from ligwf.inference.registry import CriterionResult
+    from ligwf.inference.verdict import ConditionVerdict, GroupVerdict, Verdict
+    from ligwf.inference.verdict_records import verdict_rows
 
     crit = CriterionResult("angle_deg", "angle of repose", "deg", "pass", 0.5, 0.1, 0.9, 1.0,
                            "tolerance")
@@ -189,7 +189,7 @@ def test_the_field_columns_of_the_dictionary_are_the_ones_the_report_writes():
     """The field criterion's columns (kernel widths, noise pieces) are listed once in
     analysis/records/field_errors and once in the dictionary: kept in step here, in the
     fast lane (the real-study test above found the noise pieces missing only in CI)."""
-    from ligwf.analysis.records import field_errors
+    from ligwf.inference import field_errors
 
     assert dic.FIELD_NOISE == field_errors.FIELD_NOISE_COLUMNS
     assert dic.FIELD_KERNEL_ERRORS == tuple(field_errors.KERNEL_COLUMNS.values())

@@ -12,19 +12,19 @@ import numpy as np
 import pytest
 from rich.console import Console
 
-from ligwf.analysis.records.equivalence import FAIL, PASS, UNDECIDED
-from ligwf.report.criteria import NOT_ASSESSED, CriterionResult
+from ligwf.inference.equivalence import FAIL, PASS, UNDECIDED
+from ligwf.inference.registry import NOT_ASSESSED, CriterionResult
 from ligwf.report.figures import pareto_figure
 from ligwf.report.forest import SPEEDUP, forest, forest_figure, forest_rows, gid
 from ligwf.report.forest_text import WIDTH, bar, compact_lines
-from ligwf.report.verdict import ConditionVerdict, GroupVerdict, Verdict, decide
+from ligwf.inference.verdict import ConditionVerdict, GroupVerdict, Verdict, decide
 from ligwf.report.html import render_page
 from ligwf.report.sections import Figure, Section, ordered
 from ligwf.report.verdict_text import verdict_renderables, verdict_section
 from ligwf.report.write import verdict_sections
 from ligwf.study import layout
 from ligwf.scene.accept import AcceptSettings
-from tests.report.test_verdict import CG1, GROUP, PASSING, runs, study, verdict
+from tests.inference.test_verdict import CG1, GROUP, PASSING, runs, study, verdict
 
 
 def drawn(fig) -> dict[str, np.ndarray]:

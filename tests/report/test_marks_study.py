@@ -25,7 +25,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from ligwf.analysis.records import equivalence as eq
+from ligwf.inference import equivalence as eq
 
 from ligwf.study import layout
 from ligwf.study.manifest import read_manifest

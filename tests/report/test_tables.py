@@ -19,7 +19,7 @@ from ligwf.analysis.records.flow import CaseFlow, FlowRecord
 from ligwf.analysis.records.metrics import POSITIVE, MetricSpec
 from ligwf.report.tables import compare_to_cg1, condition_table, merge_analysis, \
     noise_floor_table
-from ligwf.report.uncertainty import ConditionStats
+from ligwf.inference.uncertainty import ConditionStats
 from ligwf.study import layout
 
 T1 = 12.706204736174704      # Student t, 97.5 %, 1 degree of freedom

@@ -37,7 +37,7 @@ as the width is), and kernel weight beyond the node square is dropped: on the de
 96-99 % of the bed's volume is on the grid.
 
 The per-frame sums are kept (:class:`~ligwf.analysis.records.fields.CaseFields`): the
-solid-fraction error's interval resamples them (:mod:`ligwf.analysis.records.field_errors`).
+solid-fraction error's interval resamples them (:mod:`ligwf.inference.field_errors`).
 Beside them, at each width of ``CRITERION_KERNELS`` CG1 diameters, the window means of the
 in-plane sums (whole window and its two halves) and the drum's omega and radius: the field
 criterion compares runs by these.

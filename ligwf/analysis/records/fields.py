@@ -5,7 +5,7 @@ them) into the analysis folder as one compressed numpy archive (``layout.FIELDS_
 listed with its digest in the analysis record) and, per case, a VTK ImageData file of the
 time-averaged fields that ParaView opens (``layout.field_image``). The report reads the
 archive through :func:`read_fields` and computes only statistics of it (the field error,
-its interval and its CG1 floor: :mod:`ligwf.analysis.records.field_errors`).
+its interval and its CG1 floor: :mod:`ligwf.inference.field_errors`).
 
 Per case and steady frame, the kernel sums ``MOMENTS`` on the grid nodes (units: phi
 dimensionless, the fluxes m/s, the fluctuation m^2/s^2, all per unit solid fraction
@@ -16,7 +16,7 @@ Per case also, at each kernel width of ``CRITERION_KERNELS`` (CG1 mean diameters
 window-mean in-plane kernel sums of the whole window and of its two halves
 (:class:`WindowMeans`), with the drum's angular velocity and radius: what the field
 criterion reads (the drum-frame velocity in the flowing layer, per run,
-:mod:`ligwf.analysis.records.field_errors`).
+:mod:`ligwf.inference.field_errors`).
 """
 
 from __future__ import annotations

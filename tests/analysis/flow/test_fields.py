@@ -27,7 +27,7 @@ from ligwf.analysis.flow.fields import (case_fields, field_grid, flux_moments,
                                         reference_moments)
 from ligwf.analysis.flow.frame import DrumGeometry
 from ligwf.analysis.frames.dumps import ParticleFrame
-from ligwf.analysis.records.field_errors import (field_floor, field_interval, layer_error,
+from ligwf.inference.field_errors import (field_floor, field_interval, layer_error,
                                                  solid_error, whole_windows)
 from ligwf.analysis.records.fields import fields_bytes, fields_of, image_text, read_fields
 from ligwf.errors import ConfigError

@@ -15,7 +15,7 @@ import shutil
 import numpy as np
 import pandas as pd
 
-from ligwf.analysis.records.field_errors import FIELD_ERRORS, field_floor
+from ligwf.inference.field_errors import FIELD_ERRORS, field_floor
 from ligwf.analysis.records.fields import fields_of, read_fields
 from ligwf.cli.main import main
 from ligwf.report.fields import add_field_errors
