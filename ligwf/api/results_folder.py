@@ -37,10 +37,6 @@ from ligwf.api.tables import TABLES
 from ligwf.errors import ConfigError
 from ligwf.study import layout
 
-#: the README of every results folder
-README = "README.md"
-
-
 def number(value, digits: int = 3) -> str:
     """A table value as a README prints it: ``digits`` significant digits, ``–`` for nan or
     what is not a number."""
@@ -69,7 +65,7 @@ class ResultsFolder:
 
     @property
     def readme(self) -> Path:
-        return self.path / README
+        return self.path / layout.RESULTS_README
 
     def table(self, name: str) -> pd.DataFrame:
         """The committed table ``name`` as its CSV reads (the README's source)."""

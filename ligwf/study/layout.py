@@ -304,6 +304,10 @@ def drum_frame(step: int) -> str:
     return f"drum_{step}.vtu"
 
 
+#: a committed results folder's README, rendered from its tables (ligwf.api.results_folder)
+RESULTS_README = "README.md"
+
+
 def is_study_folder(path: Path) -> bool:
     """Whether ``path`` holds a rendered study (its study record)."""
     return (Path(path) / STUDY_FILE).is_file()
