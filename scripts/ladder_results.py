@@ -343,10 +343,10 @@ def render(ladder: Ladder, folder: ResultsFolder) -> str:
 
 def check(ladder: Ladder) -> int:
     """0 when the committed README of ``ladder`` is what its tables give."""
-    problem = ladder.folder.check()
-    if problem is not None:
+    problems = ladder.folder.check()
+    for problem in problems:
         print(problem, file=sys.stderr)
-    return 0 if problem is None else 1
+    return 1 if problems else 0
 
 
 if __name__ == "__main__":

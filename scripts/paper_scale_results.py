@@ -6,33 +6,34 @@ verdict against the CG1 value extrapolated from the Weber levels, the extrapolat
 the cases) and writes `claims.csv`: the source's two flow claims answered at its own scale
 from the same case tables (Weber against Bond at each level both ran: the angle of repose,
 the rigid-block share, and the share of frames in which one granule holds most of the bed,
-with Welch's 95 % interval of the difference over runs). `--check` compares instead of
-writing.
+with Welch's 95 % interval of the difference over runs) from the copied case tables.
+`--check` recomputes `claims.csv` from the committed case tables and compares.
 
-    .venv/bin/python scripts/paper_scale_results.py [--runs runs] [--check]
+    .venv/bin/python scripts/paper_scale_results.py [RUNS] [--check]    # RUNS: runs/
 """
 
 from __future__ import annotations
 
-import argparse
-import shutil
 import sys
 from pathlib import Path
 
 import pandas as pd
 
+from ligwf.api.results_folder import ResultsFolder, csv_text, results_command
 from ligwf.inference.equivalence import difference_estimate, mean_estimate
 from ligwf.inference import extrapolation as ex
 from ligwf.inference.reference import level_values, slope_scale
+from ligwf.study import layout
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from scripts.results_readme import csv_text  # noqa: E402
-
 OUT = ROOT / "docs/results/paper_scale"
+#: the two background studies (run folders in RUNS), by rule
 STUDIES = {"weber": "paper_scale_cg", "bond": "paper_scale_cg_bond"}
-#: report tables copied per study (prefix: the rule)
-COPIED = ("cases.csv", "conditions.csv", "verdict.csv", "extrapolation.csv")
+#: report files copied per study, as <rule>_<name>
+COPIED = (layout.CASES_REPORT, layout.CONDITIONS_REPORT, layout.VERDICT_TABLE,
+          layout.EXTRAPOLATION_REPORT, layout.SUMMARY_REPORT)
+#: the source's claims answered from the copied case tables (derived)
+CLAIMS_TABLE = "claims.csv"
 #: the claims' metrics: (column, what it says)
 CLAIMS = (("angle_of_repose", "angle of repose (deg)"),
           ("rigid_frame_share", "share of frames turning as a rigid block"),
@@ -76,37 +77,25 @@ def claims(we: pd.DataFrame, bo: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+def derived(folder: ResultsFolder) -> dict[str, str]:
+    """claims.csv from the committed case tables of both rules."""
+    cases = {rule: folder.table(f"{rule}_{layout.CASES_REPORT}") for rule in STUDIES}
+    return {CLAIMS_TABLE: csv_text(claims(cases["weber"], cases["bond"]))}
+
+
+FOLDER = ResultsFolder(OUT, None, "scripts/paper_scale_results.py RUNS", derived)
+
+
+def make(args) -> ResultsFolder:
+    """Copy both studies' report files from RUNS (default runs/)."""
+    runs = args.study or ROOT / "runs"
+    for rule, folder in STUDIES.items():
+        FOLDER.copy_report(runs / folder, COPIED, prefix=f"{rule}_")
+    return FOLDER
+
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--runs", type=Path, default=ROOT / "runs")
-    ap.add_argument("--check", action="store_true")
-    args = ap.parse_args(argv)
-    OUT.mkdir(parents=True, exist_ok=True)
-    tables: dict[str, str] = {}
-    cases = {}
-    for rule, folder in STUDIES.items():
-        report = args.runs / folder / "report"
-        for name in COPIED:
-            src = report / name
-            if src.is_file():
-                tables[f"{rule}_{name}"] = src.read_text()
-        if (report / "cases.csv").is_file():
-            cases[rule] = pd.read_csv(report / "cases.csv")
-    if len(cases) == 2:
-        tables["claims.csv"] = csv_text(claims(cases["weber"], cases["bond"]))
-    if args.check:
-        bad = [n for n, text in tables.items() if (OUT / n).read_text() != text]
-        print("differ: " + ", ".join(bad) if bad else "tables reproduce")
-        return 1 if bad else 0
-    for name, text in tables.items():
-        (OUT / name).write_text(text)
-    for rule, folder in STUDIES.items():
-        summary = args.runs / folder / "report" / "summary.md"
-        if summary.is_file():
-            shutil.copyfile(summary, OUT / f"{rule}_summary.md")
-    print("wrote " + ", ".join(sorted(tables)))
-    return 0
+    return results_command(__doc__, [FOLDER], make, argv)
 
 
 if __name__ == "__main__":

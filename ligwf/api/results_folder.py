@@ -9,11 +9,16 @@ its README from its tables, which command remakes it -- and the folder does the 
   table first through :func:`ligwf.api.open_study` (a table ligwf did not write, or one that
   is missing, is refused with the command that writes it) and then copying its bytes, so
   the committed table is the study's file exactly;
+* a table the folder derives from committed tables (its own, or another folder's: a claim
+  computed from copied case tables, a fit over several studies) is declared as
+  ``derived``: :meth:`ResultsFolder.write` writes it, :meth:`ResultsFolder.check`
+  recomputes it and compares the text;
 * :meth:`ResultsFolder.write` renders the README from the committed tables (not from the
   study folder: what is committed is what is checked) and writes it;
 * :meth:`ResultsFolder.check` renders it again and says how it differs from the committed
   one: a sentence cannot drift from its table. The committed-results tests run it, on the
-  committed tables alone (the run folders are not committed).
+  committed tables alone (the run folders are not committed). A README still written by
+  hand (``render`` None) is checked by its folder's test, number by number.
 
 Table names come from :mod:`ligwf.study.layout` (a copied report table keeps its name);
 a table a script measures itself is named by that script. :func:`number` and
@@ -55,13 +60,17 @@ def csv_text(table: pd.DataFrame) -> str:
 
 @dataclass(frozen=True)
 class ResultsFolder:
-    """One committed results folder: ``path``, the function that renders its README from its
-    committed tables (``render(folder) -> text``) and ``remake``, the command that writes it
-    again (named when :meth:`check` finds the README stale)."""
+    """One committed results folder: ``path``; ``render(folder) -> text``, its README from
+    its committed tables (None: a README written by hand, whose numbers the folder's test
+    reads from the tables); ``remake``, the command that writes it again (named when
+    :meth:`check` finds it stale); ``derived(folder) -> {name: text}``, the tables it
+    recomputes from committed tables (its own or other folders'), written and checked byte
+    for byte."""
 
     path: Path
-    render: Callable[["ResultsFolder"], str]
+    render: Callable[["ResultsFolder"], str] | None
     remake: str
+    derived: Callable[["ResultsFolder"], dict[str, str]] | None = None
 
     @property
     def readme(self) -> Path:
@@ -78,28 +87,42 @@ class ResultsFolder:
     def has(self, name: str) -> bool:
         return (self.path / name).is_file()
 
-    def text(self) -> str:
-        """The README its committed tables give."""
-        return self.render(self)
+    def text(self) -> str | None:
+        """The README its committed tables give (None: written by hand)."""
+        return None if self.render is None else self.render(self)
 
-    def check(self) -> str | None:
-        """None when the committed README is what its tables give; else one line saying it
-        differs and which command remakes it."""
-        if self.readme.is_file() and self.readme.read_text() == self.text():
-            return None
-        return f"{self.readme} differs from its tables: run {self.remake}"
+    def check(self) -> list[str]:
+        """What differs from what the committed tables give, one line each naming the
+        command that remakes it: each derived table, then the README (empty: nothing)."""
+        problems = []
+        for name, text in ({} if self.derived is None else self.derived(self)).items():
+            if not self.has(name) or (self.path / name).read_text() != text:
+                problems.append(f"{self.path / name} differs from what the committed tables "
+                                f"give: run {self.remake}")
+        body = self.text()
+        if body is not None and (not self.readme.is_file() or self.readme.read_text() != body):
+            problems.append(f"{self.readme} differs from its tables: run {self.remake}")
+        return problems
 
     def write(self) -> str:
-        """Render the README from the committed tables and write it; return its text."""
+        """Write the derived tables, then the README rendered from the committed tables;
+        return what was written (the README's text, or the derived tables' names)."""
         self.path.mkdir(parents=True, exist_ok=True)
+        derived = {} if self.derived is None else self.derived(self)
+        for name, text in derived.items():
+            (self.path / name).write_text(text)
         body = self.text()
+        if body is None:
+            return "wrote " + ", ".join(sorted(derived))
         self.readme.write_text(body)
         return body
 
-    def copy_report(self, study: Path, names: Iterable[str], *, figures: bool = False) -> None:
+    def copy_report(self, study: Path, names: Iterable[str], *, figures: bool = False,
+                    prefix: str = "") -> None:
         """Copy the report files ``names`` (:mod:`ligwf.study.layout` names) of the study
-        folder ``study`` here, byte for byte; with ``figures`` its figures folder too
-        (replacing the one here). A report table is first read through
+        folder ``study`` here, byte for byte, as ``prefix + name`` (a folder holding several
+        studies' reports); with ``figures`` its figures folder too (replacing the one
+        here). A report table is first read through
         :func:`~ligwf.api.open_study` (MissingOutput, naming the command that writes it,
         when it is missing or is not the table ligwf writes)."""
         results = open_study(study)
@@ -112,7 +135,7 @@ class ResultsFolder:
             source = results.report_dir / name
             if not source.is_file():
                 raise ConfigError(f"{source}: missing; run `ligwf report {study}`")
-            shutil.copyfile(source, self.path / name)
+            shutil.copyfile(source, self.path / (prefix + name))
         if figures:
             target = self.path / layout.FIGURES_DIR
             if target.exists():
@@ -128,7 +151,7 @@ class ResultsFolder:
 
 def check_all(folders: Iterable[ResultsFolder]) -> list[str]:
     """The problems of ``folders`` (:meth:`ResultsFolder.check`), one line each."""
-    return [problem for folder in folders if (problem := folder.check()) is not None]
+    return [problem for folder in folders for problem in folder.check()]
 
 
 def results_command(doc: str, folders: Sequence[ResultsFolder],

@@ -53,12 +53,26 @@ def test_number_and_csv_text():
 
 
 def test_written_readme_checks_and_a_changed_table_does_not(folder):
-    assert folder.check() is not None          # no README yet
+    assert folder.check()                      # no README yet
     assert folder.write() == "2 rows\n" == folder.readme.read_text()
-    assert folder.check() is None and check_all([folder]) == []
+    assert folder.check() == [] and check_all([folder]) == []
     (folder.path / "t.csv").write_text("x\n1\n")
-    problem = folder.check()
+    [problem] = folder.check()
     assert "differs from its tables" in problem and "scripts/make_t.py STUDY" in problem
+
+
+def doubled(folder: ResultsFolder) -> dict[str, str]:
+    return {"d.csv": csv_text(folder.table("t.csv") * 2)}
+
+
+def test_a_derived_table_is_written_and_checked_byte_for_byte(folder):
+    derived = ResultsFolder(folder.path, None, "scripts/make_d.py", doubled)
+    assert derived.text() is None and derived.write() == "wrote d.csv"
+    assert (folder.path / "d.csv").read_text() == "x\n2\n1.33333\n"
+    assert not folder.readme.exists() and derived.check() == []
+    (folder.path / "t.csv").write_text("x\n1\n")
+    [problem] = derived.check()
+    assert "d.csv differs" in problem and "scripts/make_d.py" in problem
 
 
 def test_the_command_checks_every_folder_and_writes_what_make_fills(folder, capsys):

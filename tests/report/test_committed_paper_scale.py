@@ -1,5 +1,7 @@
-"""docs/results/paper_scale: the README's numbers are those of the committed report tables
-(the verdict against the extrapolated CG1, the extrapolation, the cases)."""
+"""docs/results/paper_scale: claims.csv recomputes from the committed case tables
+(scripts/paper_scale_results.py --check), and the README's numbers are those of the
+committed report tables (the verdict against the extrapolated CG1, the extrapolation, the
+cases)."""
 
 from __future__ import annotations
 
@@ -9,10 +11,15 @@ from ligwf.inference.size_relation import SLOPE_DEG
 from ligwf.scene.grains import grains
 from ligwf.scene.model import Scene
 from ligwf.yamlio import read_yaml_file
+from scripts.paper_scale_results import main
 from tests.helpers import ROOT
 
 HERE = ROOT / "docs" / "results" / "paper_scale"
 README = " ".join((HERE / "README.md").read_text().split())
+
+
+def test_claims_recompute_from_the_committed_cases():
+    assert main(["--check"]) == 0
 
 
 def _verdict() -> pd.DataFrame:
