@@ -1,49 +1,53 @@
 """docs/results/extrapolation/: the size relation over every committed study and the
 extrapolated CG1 reference checked where CG1 exists (issue 44 items 3 and 5).
 
-Reads only committed case tables (and, with --runs, the new drums' analysed study folders);
-writes size_relation.csv (one row per study, rule and CG level: the angle's excess over
+Reads only committed case tables (and, given RUNS, the new drums' analysed study folders in
+it, through open_study); writes size_relation.csv (one row per study, rule and CG level: the angle's excess over
 CG1 against x = (n - 1) d / D), size_fit.csv (the Weber slope through the origin that
 ``ligwf/inference/size_relation.py`` carries as constants), validation.csv (per (drum,
 rule) pair: the extrapolated 95 % interval, the form's checks, the measured CG1 mean) and
-size_relation.png. ``--check`` recomputes and compares instead of writing.
+size_relation.png. ``--check`` recomputes the tables from the committed case tables and
+compares them byte for byte (the new drums' rows of validation.csv are carried over when
+RUNS is not given).
 
-    .venv/bin/python scripts/extrapolation_results.py [--runs runs] [--check]
+    .venv/bin/python scripts/extrapolation_results.py [RUNS] [--check] [--no-figure]
 """
 
 from __future__ import annotations
 
-import argparse
 import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ligwf.api.results import open_study
+from ligwf.api.results_folder import ResultsFolder, csv_text, results_command
 from ligwf.inference import extrapolation as ex
 from ligwf.inference import size_relation as sr
 from ligwf.inference.verdict import is_control_group
+from ligwf.study import layout
 
 ROOT = Path(__file__).resolve().parent.parent
-sys.path.insert(0, str(ROOT))
-from scripts.results_readme import csv_text  # noqa: E402
-
-OUT = ROOT / "docs/results/extrapolation"
-#: committed studies with CG1 and CG-n runs: (name, case tables pooled (runs seen twice
-#: counted once), d / D, a flow (water-like liquid) or binder bed)
+RESULTS = ROOT / "docs" / "results"
+OUT = RESULTS / "extrapolation"
+#: the tables this folder derives
+SIZE_RELATION, SIZE_FIT, VALIDATION = "size_relation.csv", "size_fit.csv", "validation.csv"
+FIGURE = "size_relation.png"
+#: committed studies with CG1 and CG-n runs: (name, results folders whose case tables are
+#: pooled (runs seen twice counted once), d / D, a flow (water-like liquid) or binder bed)
 STUDIES = (
     ("we_vs_bo drum (ladder, 80-min ladder, we_vs_bo)",
-     ("docs/results/we_vs_bo/cases.csv", "docs/results/ladder/cases.csv",
-      "docs/results/ladder/cap_80min/cases.csv"), 0.001 / 0.05, "flow"),
-    ("demo", ("docs/results/demo/cases.csv",), 0.002 / 0.05, "flow"),
-    ("granules", ("docs/results/granules/cases.csv",), 0.0015 / 0.04, "binder"),
-    ("gsd_cg", ("docs/results/gsd_cg/report/cases.csv",), 0.0015 / 0.04, "binder"),
+     ("we_vs_bo", "ladder", "ladder/cap_80min"), 0.001 / 0.05, "flow"),
+    ("demo", ("demo",), 0.002 / 0.05, "flow"),
+    ("granules", ("granules",), 0.0015 / 0.04, "binder"),
+    ("gsd_cg", (f"gsd_cg/{layout.REPORT_DIR}",), 0.0015 / 0.04, "binder"),
 )
-#: (drum, rule) pairs with CG1 and two or more CG-n levels: (name, case table, d / D)
+#: (drum, rule) pairs with CG1 and two or more CG-n levels: (name, results folder, d / D)
 PAIRS = (
-    ("ladder", "docs/results/ladder/cases.csv", 0.001 / 0.05),
-    ("ladder cap_80min", "docs/results/ladder/cap_80min/cases.csv", 0.001 / 0.05),
-    ("we_vs_bo", "docs/results/we_vs_bo/cases.csv", 0.001 / 0.05),
+    ("ladder", "ladder", 0.001 / 0.05),
+    ("ladder cap_80min", "ladder/cap_80min", 0.001 / 0.05),
+    ("we_vs_bo", "we_vs_bo", 0.001 / 0.05),
 )
 #: the new drums of criterion.md (run folders, analysed as amendments 3 and 4 say: each
 #: case's own strips, in the hard-linked copy): (name, study folder, d / D)
@@ -53,9 +57,14 @@ NEW_PAIRS = (
 COLUMN = "angle_of_repose"
 
 
-def study_cases(paths) -> pd.DataFrame:
+def committed_cases(folder: str) -> pd.DataFrame:
+    """The case table of the committed results folder ``folder`` (under docs/results/)."""
+    return pd.read_csv(RESULTS / folder / layout.CASES_REPORT)
+
+
+def study_cases(folders) -> pd.DataFrame:
     """The case tables pooled, control twins left out, a run seen in two tables once."""
-    frames = [pd.read_csv(ROOT / p) for p in paths]
+    frames = [committed_cases(f) for f in folders]
     t = pd.concat(frames, ignore_index=True)
     t = t[~t["group"].astype(str).map(is_control_group)]
     t = t.assign(_key=t[COLUMN].round(9)).drop_duplicates(["cg", "rule", "_key"])
@@ -102,13 +111,12 @@ def pair_row(name: str, cases: pd.DataFrame, rule: str, ratio: float) -> dict:
 
 def validation(runs: Path | None) -> pd.DataFrame:
     rows = []
-    for name, path, ratio in PAIRS:
-        cases = pd.read_csv(ROOT / path)
+    for name, folder, ratio in PAIRS:
+        cases = committed_cases(folder)
         rows += [pair_row(name, cases, rule, ratio) for rule in ("weber", "bond")]
     for name, folder, ratio in NEW_PAIRS:
-        table = (runs / folder / "report" / "cases.csv") if runs else None
-        if table is not None and table.is_file():
-            cases = pd.read_csv(table)
+        if runs is not None and (runs / folder).is_dir():
+            cases = open_study(runs / folder).cases
             rows += [pair_row(name, cases, rule, ratio) for rule in ("weber", "bond")]
     return pd.DataFrame(rows)
 
@@ -136,39 +144,39 @@ def figure(rows: pd.DataFrame, fit: pd.DataFrame, path: Path) -> None:
     plt.close(fig)
 
 
-
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--runs", type=Path, default=None,
-                    help="folder holding the new drums' analysed study folders")
-    ap.add_argument("--check", action="store_true", help="compare, do not write")
-    ap.add_argument("--no-figure", action="store_true", help="tables only")
-    args = ap.parse_args(argv)
+def derived(folder: ResultsFolder) -> dict[str, str]:
+    """The size relation, its fit and the validation from the committed case tables; the
+    new drums' rows of the committed validation.csv carried over (their run folders are
+    not committed)."""
     rows = size_rows()
-    fit = size_fit(rows)
-    val = validation(args.runs)
-    tables = {"size_relation.csv": csv_text(rows), "size_fit.csv": csv_text(fit)}
-    committed = OUT / "validation.csv"
-    if args.runs is None and committed.is_file():
-        # without the run folders the new drums' rows are kept as committed: the committed
-        # pairs' rows are recomputed, the others carried over
-        kept = pd.read_csv(committed)
+    val = validation(None)
+    kept = folder.optional_table(VALIDATION)
+    if kept is not None:
         kept = kept[~kept["pair"].isin([name for name, _, _ in PAIRS])]
         val = pd.concat([val, kept], ignore_index=True)
-    tables["validation.csv"] = csv_text(val)
-    if args.check:
-        bad = [n for n, text in tables.items()
-               if not (OUT / n).is_file() or (OUT / n).read_text() != text]
-        print("differ: " + ", ".join(bad) if bad else "tables reproduce")
-        return 1 if bad else 0
-    OUT.mkdir(parents=True, exist_ok=True)
-    for n, text in tables.items():
-        (OUT / n).write_text(text)
+    return {SIZE_RELATION: csv_text(rows), SIZE_FIT: csv_text(size_fit(rows)),
+            VALIDATION: csv_text(val)}
+
+
+FOLDER = ResultsFolder(OUT, None, "scripts/extrapolation_results.py [RUNS]", derived)
+
+
+def arguments(ap) -> None:
+    ap.add_argument("--no-figure", action="store_true", help="tables only")
+
+
+def make(args) -> ResultsFolder:
+    """With RUNS, the new drums' validation rows from their study folders; the figure."""
+    if args.study is not None:
+        (OUT / VALIDATION).write_text(csv_text(validation(args.study)))
     if not args.no_figure:
-        figure(rows, fit, OUT / "size_relation.png")
-    print(fit.to_string(index=False))
-    print(val.to_string(index=False))
-    return 0
+        rows = size_rows()
+        figure(rows, size_fit(rows), OUT / FIGURE)
+    return FOLDER
+
+
+def main(argv=None) -> int:
+    return results_command(__doc__, [FOLDER], make, argv, arguments)
 
 
 if __name__ == "__main__":
