@@ -19,7 +19,6 @@ for the field criterion of a table without its noise pieces (the demo's).
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 from dataclasses import dataclass
@@ -30,14 +29,18 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from ligwf.api.results_folder import ResultsFolder, csv_text, results_command  # noqa: E402
 from ligwf.inference import equivalence as eq  # noqa: E402
+from ligwf.inference.budget import criteria  # noqa: E402
 from ligwf.inference.field_errors import FIELD_NOISE_COLUMNS, LayerNoise  # noqa: E402
+from ligwf.inference.registry import DIFFERENCES, RELATIVE  # noqa: E402
 from ligwf.inference.shares import share_test  # noqa: E402
+from ligwf.study import layout  # noqa: E402
 from ligwf.study.rounds import read_rounds  # noqa: E402
 
 OUT = ROOT / "docs" / "results" / "verdict_rates"
-SIGNED = {"angle_deg": "angle_of_repose", "rigid_share": "rigid_frame_share",
-          "flowing_layer": "flowing_layer_thickness_mean"}
+#: the signed criteria (a difference of run means, recomputable from cases.csv), by name
+SIGNED = {c.name: c for c in criteria() if c.estimate in DIFFERENCES}
 
 
 @dataclass(frozen=True)
@@ -61,14 +64,14 @@ def levels(folder: Path) -> tuple[float, str]:
 def _signed(x, y, name: str, budget: float, alpha: float, df_rule: str
             ) -> tuple[str, float, float, float, str]:
     """(state, lo, hi, fail p, why) of a signed criterion under the new rules."""
-    if name == "rigid_share":
+    if SIGNED[name].share:
         zero = share_test(x, y, budget, alpha)
         if zero is not None:
             e, t = zero
             return t.state, e.lo, e.hi, t.p_fail, "an arm reads 0 in every run: bounded over runs"
     def test(rule: str, sides: int) -> tuple[eq.Estimate, eq.Test]:
         e = eq.difference_estimate(x, y, alpha, rule)
-        if name == "flowing_layer":
+        if SIGNED[name].estimate == RELATIVE:
             e = eq.scaled(e, 1.0 / float(y.mean()))
         return e, eq.equivalence(e, budget, alpha, fail_sides=sides)
 
@@ -84,9 +87,9 @@ def _signed(x, y, name: str, budget: float, alpha: float, df_rule: str
 
 
 def redecide(study: Study) -> pd.DataFrame:
-    verdict = pd.read_csv(study.folder / "verdict.csv")
-    cases = pd.read_csv(study.folder / "cases.csv")
-    conditions = pd.read_csv(study.folder / "conditions.csv")
+    verdict = pd.read_csv(study.folder / layout.VERDICT_TABLE)
+    cases = pd.read_csv(study.folder / layout.CASES_REPORT)
+    conditions = pd.read_csv(study.folder / layout.CONDITIONS_REPORT)
     alpha, df_rule = levels(study.folder)
     cg1 = cases[cases["cg"] == 1.0]
     rows = []
@@ -98,7 +101,7 @@ def redecide(study: Study) -> pd.DataFrame:
             row = dict(condition=r["condition"], criterion=name, old_state=old,
                        old_lo=r["lo"], old_hi=r["hi"], budget=r["budget"])
             if name in SIGNED:
-                col = SIGNED[name]
+                col = SIGNED[name].metric
                 state, lo, hi, p, why = _signed(arm[col].to_numpy(float), cg1[col].to_numpy(float),
                                                 name, float(r["budget"]), alpha, df_rule)
                 crit.append(dict(row, own_state=state, lo=lo, hi=hi, p_fail=p, why=why,
@@ -152,20 +155,17 @@ def path(study: Study) -> Path:
     return OUT / f"redecided_{study.name}.csv"
 
 
+def derived(folder: ResultsFolder) -> dict[str, str]:
+    """Every committed study re-decided, one table each."""
+    return {path(s).name: csv_text(redecide(s)) for s in STUDIES}
+
+
+#: the README (with rates*.txt of benchmarks/verdict_designs.py) is written by hand
+FOLDER = ResultsFolder(OUT, None, "scripts/redecide_issue45.py", derived)
+
+
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--check", action="store_true")
-    args = ap.parse_args(argv)
-    bad = 0
-    for s in STUDIES:
-        text = redecide(s).to_csv(index=False, float_format="%.6g")
-        if args.check:
-            same = path(s).exists() and path(s).read_text() == text
-            bad += not same
-            print(f"{path(s).relative_to(ROOT)}: {'recomputes' if same else 'DIFFERS'}")
-        else:
-            path(s).write_text(text)
-    return int(bad > 0)
+    return results_command(__doc__, [FOLDER], lambda args: FOLDER, argv)
 
 
 if __name__ == "__main__":
