@@ -39,7 +39,6 @@ property of the definition, and the text says so.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from dataclasses import dataclass
@@ -50,10 +49,10 @@ import pandas as pd
 
 from ligwf.analysis.gsd import bins as gsd
 from ligwf.analysis.gsd.pooling import frame_histograms, pooling_summary, pooling_table
-from ligwf.analysis.records.renamed import current_names
+from ligwf.analysis.records.analysis_record import AnalysisRecord
+from ligwf.api.results import open_study
 from ligwf.fsio import atomic_write_bytes, atomic_write_text
 from ligwf.scene.settings import AnalysisSettings
-from ligwf.study import layout
 
 GROUP = "gsd_cg"
 CONFIDENCE = 0.95
@@ -78,14 +77,13 @@ class CaseRecord:
 def _load(study: Path, label: str | None) -> tuple[pd.DataFrame, list[CaseRecord], pd.DataFrame]:
     """Steady-window granule table, case records and flow table of one study; CG-n rules of
     a longer-slice study are relabelled ``<rule> <label>`` (its own condition)."""
-    ana = study / layout.ANALYSIS_DIR
-    record = json.loads((ana / layout.ANALYSIS_RECORD).read_text())
-    g = pd.read_parquet(ana / layout.GRANULES_TABLE)
-    flow = current_names(pd.read_csv(ana / layout.FLOW_TABLE), layout.FLOW_TABLE)
-    steady = {c["case_id"]: c["steady_from_step"] for c in record["cases"]}
+    results = open_study(study)
+    analysed = AnalysisRecord.load(results.analysis_dir).items("cases")
+    g, flow = results.granules, results.flow
+    steady = {c["case_id"]: c["steady_from_step"] for c in analysed}
     g = g[g["step"] >= g["case_id"].map(steady).astype(float)].copy()
     cases = []
-    for c in record["cases"]:
+    for c in analysed:
         rule = c["rule"] if label is None else f"{c['rule']} {label}"
         cases.append(CaseRecord(c["case_id"] + ("" if label is None else f"@{label}"),
                                 float(c["cg"]), rule, int(c["replica"])))
@@ -321,8 +319,7 @@ def main(argv=None) -> int:
         print(f"# {volume}: done", file=sys.stderr)
     limits_df, dist_df = pd.concat(limits), pd.concat(dists)
     flow_df = flow_table(flow, cases)
-    controls = current_names(pd.read_csv(args.runs / "main" / layout.ANALYSIS_DIR
-                                         / layout.CONTROLS_TABLE), layout.CONTROLS_TABLE)
+    controls = open_study(args.runs / "main").controls
     for name, df in (("claim_limits.csv", limits_df), ("claim_distances.csv", dist_df),
                      ("claim_flow.csv", flow_df), ("claim_controls.csv", controls)):
         atomic_write_text(args.out / name, df.to_csv(index=False, float_format="%.6g"))
