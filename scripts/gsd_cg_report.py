@@ -20,7 +20,6 @@ every case's steady frames (the window the study's analysis used, from
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -29,6 +28,7 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis.gsd import bins as gsd
+from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.granules.case import GranuleAnalysis
 from ligwf.analysis.frames.checks import plan_frames
 from ligwf.analysis.gsd.pooling import pooling_summary, pooling_table
@@ -47,8 +47,8 @@ DEFINITIONS = {
 
 def steady_tables(study: Study, definition: AnalysisSettings) -> tuple[pd.DataFrame, list]:
     """Granule table of every case's steady frames under ``definition``."""
-    record = json.loads((study.analysis_dir / "analysis.json").read_text())
-    steady_from = {c["case_id"]: c["steady_from_step"] for c in record["cases"]}
+    analysed = AnalysisRecord.load(study.analysis_dir).items("cases")
+    steady_from = {c["case_id"]: c["steady_from_step"] for c in analysed}
     tables, cases = [], []
     for case in study.cases:
         if case.case_id not in steady_from:
