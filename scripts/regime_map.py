@@ -2,11 +2,13 @@
 
 Usage: .venv/bin/python scripts/regime_map.py runs/regime docs/results/regime
        .venv/bin/python scripts/regime_map.py --verdict-only docs/results/regime
+       .venv/bin/python scripts/regime_map.py --check
 Writes OUT/controls_rows.csv (one row per run, definition and start frame),
 OUT/controls.csv (means per run and definition, with the run's dimensionless numbers) and
-OUT/regime_map.png. ``--verdict-only`` re-judges the committed OUT/controls.csv with the
-criteria of today's code (ligwf.analysis.granules.control_verdict) and rewrites
-OUT/controls_verdict.csv and .md (the runs are not needed).
+OUT/regime_map.png, then OUT/controls_verdict.csv and .md: the committed OUT/controls.csv
+judged with the criteria of today's code (ligwf.analysis.granules.control_verdict).
+``--verdict-only`` writes only those two (the runs are not needed), ``--check`` compares
+them with the committed ones.
 """
 
 from __future__ import annotations
@@ -18,17 +20,27 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf.analysis.granules.control_run import control_rows, load_series, summarise
+from ligwf.api.results_folder import ResultsFolder, results_command
 from ligwf.scene.regime import regime_numbers
 from ligwf.study.case import CaseFolder
+from ligwf.study.layout import SCENE_FILE
+
+OUT = Path(__file__).resolve().parents[1] / "docs" / "results" / "regime"
+#: the tables it measures (the map's own names)
+ROWS, SUMMARY = "controls_rows.csv", "controls.csv"
+#: what it derives from SUMMARY: the verdict per wet point and definition
+VERDICT, VERDICT_PAGE = "controls_verdict.csv", "controls_verdict.md"
+FIGURE = "regime_map.png"
 
 
-def main(run_root: Path, out: Path) -> int:
+def measure(run_root: Path, out: Path) -> None:
+    """Measure every finished point of ``run_root`` into ``out``'s tables and figure."""
     out.mkdir(parents=True, exist_ok=True)
     rows, numbers = [], []
     for point in sorted(p for p in run_root.iterdir() if (p / ".done").exists()):
-        for case_dir in sorted(d for d in point.iterdir() if (d / "scene.json").exists()):
+        for case_dir in sorted(d for d in point.iterdir() if (d / SCENE_FILE).exists()):
             t0 = time.perf_counter()
-            cached = point / "controls_rows.csv"       # beside the run: measured once
+            cached = point / ROWS                       # beside the run: measured once
             if cached.is_file():
                 # a cache measured before percolating was renamed percolating_frames
                 r = pd.read_csv(cached).rename(columns={"percolating": "percolating_frames"})
@@ -41,17 +53,13 @@ def main(run_root: Path, out: Path) -> int:
             numbers.append({"point": point.name, **nums})
             print(f"{point.name}: {time.perf_counter() - t0:.0f} s", flush=True)
     all_rows = pd.concat(rows, ignore_index=True)
-    all_rows.to_csv(out / "controls_rows.csv", index=False, float_format="%.4g")
+    all_rows.to_csv(out / ROWS, index=False, float_format="%.4g")
     summary = summarise(all_rows.drop(columns=["point"]).assign(case_id=all_rows["point"]))
     summary = summary.rename(columns={"case_id": "point"}).merge(pd.DataFrame(numbers), on="point")
-    summary.to_csv(out / "controls.csv", index=False, float_format="%.4g")
+    summary.to_csv(out / SUMMARY, index=False, float_format="%.4g")
     with pd.option_context("display.width", 250, "display.max_columns", 30):
         print(summary.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
-    figure(summary, all_rows, out / "regime_map.png")
-    verdicts = pair_verdicts(summary)
-    verdicts.to_csv(out / "controls_verdict.csv", index=False, float_format="%.4g")
-    (out / "controls_verdict.md").write_text(markdown(verdicts))
-    return 0
+    figure(summary, all_rows, out / FIGURE)
 
 
 #: each wet point and the cohesionless twin it is judged against: the twins (surface tension
@@ -113,12 +121,20 @@ def markdown(v: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
-def verdict_only(out: Path) -> int:
-    """Re-judge the committed controls.csv (no runs needed)."""
-    verdicts = pair_verdicts(pd.read_csv(out / "controls.csv"))
-    verdicts.to_csv(out / "controls_verdict.csv", index=False, float_format="%.4g")
-    (out / "controls_verdict.md").write_text(markdown(verdicts))
-    return 0
+def derived(folder: ResultsFolder) -> dict[str, str]:
+    """The verdict of the committed controls.csv, as a table and a page. A table measured
+    before 988a134 names St_v,Ennis ``stokes_viscous`` (the map had lubrication off): it
+    is read as ``stokes_viscous_ennis``."""
+    summary = folder.table(SUMMARY)
+    if "stokes_viscous_ennis" not in summary:
+        summary = summary.rename(columns={"stokes_viscous": "stokes_viscous_ennis"})
+    verdicts = pair_verdicts(summary)
+    return {VERDICT: verdicts.to_csv(index=False, float_format="%.4g"),
+            VERDICT_PAGE: markdown(verdicts)}
+
+
+FOLDER = ResultsFolder(OUT, None, "scripts/regime_map.py --verdict-only docs/results/regime",
+                       derived)
 
 
 def figure(summary: pd.DataFrame, rows: pd.DataFrame, path: Path,
@@ -171,7 +187,25 @@ def figure(summary: pd.DataFrame, rows: pd.DataFrame, path: Path,
     plt.close(fig)
 
 
+def arguments(ap) -> None:
+    ap.add_argument("out", nargs="?", type=Path, default=OUT, help="the results folder")
+    ap.add_argument("--verdict-only", action="store_true",
+                    help="only judge the committed controls.csv of the folder given")
+
+
+def make(args) -> ResultsFolder:
+    if args.study is None:
+        args.error("give the run folder and the results folder (or --verdict-only OUT, "
+                   "or --check)")
+    if args.verdict_only:
+        return ResultsFolder(args.study, None, FOLDER.remake, derived)
+    measure(args.study, args.out)
+    return ResultsFolder(args.out, None, FOLDER.remake, derived)
+
+
+def main(argv=None) -> int:
+    return results_command(__doc__, [FOLDER], make, argv, arguments)
+
+
 if __name__ == "__main__":
-    if len(sys.argv) == 3 and sys.argv[1] == "--verdict-only":
-        sys.exit(verdict_only(Path(sys.argv[2])))
-    sys.exit(main(Path(sys.argv[1]), Path(sys.argv[2])))
+    sys.exit(main())
