@@ -33,10 +33,9 @@ import pandas as pd
 
 from benchmarks.bench_prediction import halves_within_variance
 from ligwf.inference import sampling
-from ligwf.analysis.records.flow import FlowRecord
+from ligwf.api.results import open_study
 from ligwf.analysis.records.statistics import MEAN, SHARE_ABOVE
 from ligwf.inference.budget import signed_columns
-from ligwf.study import layout
 
 TOLERANCE = 0.30
 ALPHA = 0.05
@@ -62,8 +61,8 @@ def arm(series: list[np.ndarray], seconds: list[float], within=sampling.within_v
 
 
 def check(study: Path, within=sampling.within_variance) -> pd.DataFrame:
-    flow = FlowRecord.read(study / layout.ANALYSIS_DIR / layout.FLOW_PROFILES)
-    cases = pd.read_csv(study / layout.REPORT_DIR / layout.CASES_REPORT)
+    results = open_study(study)
+    flow, cases = results.flow_record, results.cases
     rows = []
     for column in signed_columns():
         spec = flow.metric(column)
