@@ -1,8 +1,8 @@
 """The older form of a results script's shared part, kept for the scripts that still use it
-(liquid_spreading_results.py, granule_screen_results.py, profile_correlation.py,
-extrapolation_results.py, paper_scale_results.py). A results folder is now a type of the
-package: :class:`ligwf.api.results_folder.ResultsFolder` (its tables, its README rendered
-from them, ``check``); a new script declares one (see demo_results.py) instead."""
+(liquid_spreading_results.py, granule_screen_results.py, profile_correlation.py). A results
+folder is now a type of the package: :class:`ligwf.api.results_folder.ResultsFolder` (its
+tables, its README rendered from them, the tables it derives, ``check``); a new script
+declares one (see demo_results.py) instead."""
 
 from __future__ import annotations
 
