@@ -35,7 +35,8 @@ from functools import cached_property, lru_cache
 
 import numpy as np
 
-from ligwf.inference.equivalence import (ALPHA, WELCH, degrees_of_freedom,
+from ligwf.inference import behrens_fisher
+from ligwf.inference.equivalence import (ALPHA, WELCH, WELCH_BF, degrees_of_freedom,
                                                 finite_values, t_quantile)
 from ligwf.analysis.records.intervals import autocorrelation_time
 
@@ -137,8 +138,12 @@ def run_variance(a: Arm, extend_seconds: float = 0.0) -> float:
 
 def half_width(x: Arm, y: Arm, alpha: float = ALPHA, add: tuple[int, int] = (0, 0),
                extend: tuple[float, float] = (0.0, 0.0), df_rule: str = WELCH) -> float:
-    """Half-width of the (1 - 2 alpha) Welch interval of mean(x) - mean(y) after ``add``
-    replicas and ``extend`` seconds of production on every run (of x, of y)."""
+    """Half-width of the (1 - 2 alpha) interval of mean(x) - mean(y) after ``add``
+    replicas and ``extend`` seconds of production on every run (of x, of y), with the
+    reference distribution the verdict's interval uses under ``df_rule``
+    (:func:`~ligwf.inference.equivalence.difference_estimate`): Student's t at the rule's
+    degrees of freedom, or the Behrens-Fisher distribution for unequal arms under
+    ``WELCH_BF``."""
     if x.n < 2 or y.n < 2:
         return math.nan
     vx, vy = run_variance(x, extend[0]), run_variance(y, extend[1])
@@ -148,8 +153,17 @@ def half_width(x: Arm, y: Arm, alpha: float = ALPHA, add: tuple[int, int] = (0, 
         return 0.0
     # the variances are still estimated from the runs there are: their degrees of freedom
     # grow with added replicas, not with a longer window
+    if df_rule == WELCH_BF and nx != ny:
+        theta = math.atan2(math.sqrt(vy / ny), math.sqrt(vx / nx))
+        return _bf_planned(round(theta, 3), float(nx - 1), float(ny - 1), alpha) * se
     df = degrees_of_freedom(vx, nx, vy, ny, df_rule)
     return _t_planned(float(f"{df:.3g}") if math.isfinite(df) else df, alpha) * se
+
+
+@lru_cache(maxsize=4096)
+def _bf_planned(theta: float, df_x: float, df_y: float, alpha: float) -> float:
+    """The Behrens-Fisher 1 - alpha quantile at ``theta`` rounded to 3 decimals (a plan)."""
+    return behrens_fisher.quantile(1.0 - alpha, theta, df_x, df_y)
 
 
 @lru_cache(maxsize=4096)

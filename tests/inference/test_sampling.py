@@ -127,3 +127,17 @@ def test_hsu_degrees_of_freedom_are_the_smaller_arm_less_one():
     a, b = sp.arm(x), sp.arm(y)
     assert sp.half_width(a, b, 0.05 / 3, df_rule=eq.HSU) == pytest.approx(
         0.5 * (hsu.hi - hsu.lo), rel=1e-3)
+
+
+@pytest.mark.parametrize("sizes", [(6, 2), (24, 3), (4, 4)])
+def test_the_planner_predicts_with_the_verdicts_reference_distribution(sizes):
+    """Under the single-look rule (Welch for equal arms, Behrens-Fisher for unequal ones) the
+    planner's half-width as the runs stand is the verdict interval's half-width (to the
+    plan's rounding of theta / df), not Welch's, which is narrower for unequal arms."""
+    rng = np.random.default_rng(7)
+    x, y = rng.normal(0.0, 1.0, sizes[0]), rng.normal(0.0, 2.0, sizes[1])
+    e = eq.difference_estimate(x, y, eq.ALPHA, eq.WELCH_BF)
+    planned = sp.half_width(sp.arm(x), sp.arm(y), eq.ALPHA, df_rule=eq.WELCH_BF)
+    assert planned == pytest.approx(0.5 * (e.hi - e.lo), rel=2e-3)
+    if sizes[0] != sizes[1]:
+        assert sp.half_width(sp.arm(x), sp.arm(y), eq.ALPHA, df_rule=eq.WELCH) < planned

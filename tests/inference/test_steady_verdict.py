@@ -20,6 +20,7 @@ from ligwf.inference.verdict import decide
 from ligwf.inference.verdict_records import read_verdict, write_verdict
 from ligwf.report.verdict_text import verdict_section
 from ligwf.scene.accept import AcceptSettings
+from ligwf.study import layout
 from tests.inference.test_verdict import CG1, GROUP, PASSING, crit, runs, study, verdict
 
 
@@ -68,6 +69,11 @@ def test_a_level_whose_windows_start_at_the_cap_is_flagged_with_what_fixes_it(tm
     assert any("runs too short" in line for line, _ in compact_lines(v))
     write_verdict(v, tmp_path)
     assert read_verdict(tmp_path).groups[0].conditions[0].too_short == short["cg2-weber"]
+    # verdict.csv carries the flag and the sentence on every row of the level
+    table = pd.read_csv(tmp_path / layout.VERDICT_TABLE, keep_default_na=False)
+    rows = table[table["condition"] == "cg2-weber"]
+    assert rows["too_short"].astype(str).eq("True").all()
+    assert (rows["too_short_note"] == short["cg2-weber"]).all()
     # every window in time: no flag
     calm = decide(conditions, AcceptSettings(), {GROUP: PASSING}, cases, profiles,
                   noise=noise(cases, set()))
