@@ -25,7 +25,8 @@ from ligwf.analysis.granules.growth_study import (CRITERIA, cadence_table, measu
                                                   seed_table, verdict)
 from ligwf.api.results_folder import ResultsFolder, csv_text, results_command
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import CALIBRATION_TABLE, is_case_folder
+from ligwf.study.layout import (CALIBRATION_TABLE, PARTICLE_DUMP_RE, POST_DIR,
+                                 is_case_folder)
 
 OUT = Path(__file__).resolve().parents[1] / "docs" / "results" / "granule_growth"
 #: the tables this script measures (a results folder's own, not a study's)
@@ -199,14 +200,17 @@ def reading(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame) -> list[s
 
 
 def case_table(run_dir: Path, case_ids: list[str]) -> pd.DataFrame:
+    """One row per run: its particles, production, particle dumps and status."""
     rows = []
     for cid in case_ids:
         case = CaseFolder.open(run_dir / cid)
         m = case.manifest()
+        post = run_dir / cid / POST_DIR
         rows.append({"case_id": cid, "particles": int(case.scaled.particles.count),
                      "production_s": round(case.scaled.numerics.run_steps
                                            * case.scaled.numerics.dt, 3),
-                     "frames": len(list((run_dir / cid / "post").glob("particles_[0-9]*.vtu"))),
+                     "frames": sum(bool(PARTICLE_DUMP_RE.match(p.name)) for p in
+                                   (post.iterdir() if post.is_dir() else ())),
                      "status": m.status if m is not None else "not run"})
     return pd.DataFrame(rows)
 
