@@ -140,10 +140,15 @@ def _changed_fields(rec: dict, scaled: ScaledScene) -> list[str]:
 
 def scene_record_problem(path: Path, rec: dict, scaled: ScaledScene,
                          check_hash: bool = True) -> str | None:
-    """Why a case folder's scene record is not the one rendering wrote (None: its content
-    hash recomputes, its CG level and rule are the scaled scene's, and its original block
-    scaled again gives its scaled values: the hash does not cover the original), naming
-    the changed fields where they can be told."""
+    """Why a case folder's scene record is not the one rendering wrote (None: its stored
+    content hash is recomputed and matches, its CG level and rule are the scaled scene's,
+    and its original scene block, scaled again, gives exactly its scaled values), naming
+    the changed fields where they can be told. The content hash covers the scaled values,
+    the input and the mesh, not the original block: an original edited after rendering
+    (a surface tension multiplied by 10) is caught by scaling it again. With
+    ``check_hash`` False the hash is not recomputed: an input or mesh edited by hand is
+    no problem then (the runner launches an edited input and lets the engine's verdict
+    judge it), only the record's own fields are checked."""
     if str(rec["rule"]) != scaled.rule or float(rec["cg"]) != scaled.cg:
         return "changed: " + "; ".join(_changed_fields(rec, scaled))
     digest = recomputed_hash(path, scaled) if check_hash else None

@@ -40,6 +40,16 @@ def study(engine, tmp_path_factory) -> Path:
     return out
 
 
+@pytest.fixture(scope="module")
+def analysed(study, tmp_path_factory) -> Path:
+    """The study analysed once by ``ligwf analyse``, for the tests that damage or check its
+    analysis outputs (each works on a copy; one analysis instead of one per test)."""
+    out = tmp_path_factory.mktemp("analysed") / "study"
+    shutil.copytree(study, out)
+    assert main(["analyse", str(out)]) == 0
+    return out
+
+
 def post(study: Path, case: str = R0) -> Path:
     return study / case / "post"
 
@@ -221,10 +231,9 @@ def test_broken_study_record_is_refused(study, tmp_path, capsys, target, content
 
 @pytest.mark.engine
 @pytest.mark.mpi
-def test_nothing_analysable_is_refused_and_keeps_results(study, tmp_path, capsys):
+def test_nothing_analysable_is_refused_and_keeps_results(analysed, tmp_path, capsys):
     copy = tmp_path / "study"
-    shutil.copytree(study, copy)
-    assert run(capsys, "analyse", str(copy))[0] == 0
+    shutil.copytree(analysed, copy)
     before = {p.name: p.read_bytes() for p in (copy / "analysis").iterdir() if p.is_file()}
     for case in (R0, R1):
         for p in post(copy, case).glob("*.vtu"):
@@ -238,13 +247,12 @@ def test_nothing_analysable_is_refused_and_keeps_results(study, tmp_path, capsys
 @pytest.mark.mpi
 @pytest.mark.parametrize("output", ["gsd.csv", "frames.csv", "analysis.json", "analysis",
                                     "flow_profiles.json"])
-def test_deleted_analysis_output_is_flagged(study, tmp_path, capsys, output):
+def test_deleted_analysis_output_is_flagged(analysed, tmp_path, capsys, output):
     """A deleted granule table is listed in the report; without the analysis record or the
     flow record (the report reads its flow metrics from the analysis) the report refuses in
     one line and says to run ``ligwf analyse``."""
     copy = tmp_path / "study"
-    shutil.copytree(study, copy)
-    assert run(capsys, "analyse", str(copy))[0] == 0
+    shutil.copytree(analysed, copy)
     target = copy / "analysis" / output if output != "analysis" else copy / "analysis"
     shutil.rmtree(target) if target.is_dir() else target.unlink()
     code, err = run(capsys, "report", str(copy), "--no-snapshots")

@@ -11,6 +11,7 @@ import math
 import pandas as pd
 import pytest
 
+from apistudy import api_study
 from helpers import ROOT
 from ligwf.analysis.flow.registry import METRICS
 from ligwf.analysis.gsd.kinetics import QUANTITIES
@@ -150,17 +151,10 @@ def test_no_lower_limit_is_said_in_the_gsd_cells():
 
 
 @pytest.fixture(scope="module")
-def real_study(tmp_path_factory):
-    """A tiny real study: 2 CG1 replicas with their cohesionless twins and 2 We-CG2."""
-    from ligwf.cli.main import main
-
-    out = tmp_path_factory.mktemp("dictionary") / "tiny"
-    rc = main(["study", str(ROOT / "tests" / "workflows" / "tiny_study.yaml"), "--out",
-               str(out), "--no-snapshots", "--set", "sweep.rules=[weber]",
-               "--set", "sweep.replicas={1: 2, 2: 2}",
-               "--set", "sweep.controls=[cohesionless]"])
-    assert rc == 0
-    return out
+def real_study(engine, tmp_path_factory):
+    """A tiny real study: 2 CG1 replicas with their cohesionless twins and 2 We-CG2, the
+    session's one (tests/apistudy.py, shared with the API tests; only read here)."""
+    return api_study(engine, tmp_path_factory)
 
 
 @pytest.mark.engine
