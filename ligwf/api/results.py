@@ -160,6 +160,9 @@ class StudyResults:
 
     extrapolation = property(lambda s: s.table("extrapolation"), doc="CG1 from CG-n levels")
 
+    spreading = property(lambda s: s.table("spreading"), doc="placed liquid's spreading "
+                         "rate per CG-n level against CG1 (no rows without placed liquid)")
+
     @property
     def noise_floor(self) -> pd.DataFrame:
         """Per sweep group and metric the CG1 value and its CG1-vs-CG1 scatter."""

@@ -53,6 +53,10 @@ TABLES: tuple[TableSpec, ...] = (
               "one row per (sweep group, rule, signed criterion) with two or more CG-n "
               "levels: the CG1 value extrapolated from them (95 % interval, model term, "
               "lack-of-fit check, observed order) beside the measured CG1 mean"),
+    TableSpec("spreading", layout.REPORT_DIR, layout.SPREADING_REPORT, REPORT, False,
+              "one row per (sweep group, rule, CG-n level) of a study with placed liquid: how "
+              "many times faster the liquid spreads than at CG1 (interval, exponent against "
+              "n^2, the CG1 seeds' own spread)"),
     TableSpec("noise_floor", layout.REPORT_DIR, layout.NOISE_FLOOR_REPORT, REPORT, False,
               "one row per (sweep group, metric): the CG1 value and CG1-vs-CG1 scatter"),
     TableSpec("field_null_check", layout.REPORT_DIR, layout.FIELD_NULL_REPORT, REPORT, False,

@@ -23,7 +23,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from ligwf.analysis.flow.spreading import SPREAD_LEVEL, time_to_share
+from ligwf.analysis.flow.spreading import DRY_FRACTION, SPREAD_LEVEL, time_to_share
 
 #: one row per case with placed liquid
 CASE_COLUMNS = ("group", "rule", "cg", "replica", "case_id", "dry_particles", "particles",
@@ -36,6 +36,13 @@ LEVEL_COLUMNS = ("group", "rule", "cg", "runs", "censored_runs", "t_spread_rev_g
                  "exponent_low", "exponent_high", "expected_ratio", "contains_expected",
                  "above_one", "is_bound", "cg1_spread")
 LEVEL = 0.95
+
+
+def spreading_time_meaning() -> str:
+    """What a spreading time is, in one sentence (the report's and the dictionary's)."""
+    return (f"revolutions of production until the particles dry at the first frame (below "
+            f"{DRY_FRACTION:g} of the placed content) hold {SPREAD_LEVEL:g} of their uniform "
+            f"share of the liquid")
 
 
 def case_times(flows) -> pd.DataFrame:

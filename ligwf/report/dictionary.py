@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 
 from ligwf.inference.budget import criteria
 from ligwf.report.dictionary_entries import COMMON, OVERRIDES
+from ligwf.inference.spreading import LEVEL_COLUMNS as SPREADING_COLUMNS
 from ligwf.study import layout
 
 #: units that a header does not print (a ratio, a count, text, a flag, a step number; a
@@ -196,6 +197,9 @@ TABLES: dict[str, Table] = {
         "half_width", "noise_se", "model_term", "df", "form", "lack_of_fit_p",
         "observed_order", "slope_per_level", "cg1_measured", "cg1_se", "cg1_replicas",
         "cg1_inside")),
+    layout.SPREADING_REPORT: Table(layout.REPORT_DIR, "sweep group, rule and CG-n level "
+                                   "of a study with placed liquid, against its CG1 runs",
+                                   SPREADING_COLUMNS),
     layout.FIELD_NULL_REPORT: Table(layout.REPORT_DIR, "null check: per sweep group CG1 "
                                     "against CG1, per cohesionless-twin condition the twins "
                                     "against the wet CG1 cases", (

@@ -278,6 +278,34 @@ VERDICT = (
      "the whole budget"),
 )
 
+#: placed liquid's spreading per CG-n level (ligwf.inference.spreading)
+SPREADING = (
+    ("runs", "count", "runs", "runs of the CG-n level"),
+    ("censored_runs", "count", "not reached", "runs whose dry particles never held the "
+     "registered share of the liquid (their time is a lower bound)"),
+    ("t_spread_rev_geomean", "rev", "spreading time", "geometric mean over the level's runs "
+     "of the revolutions until the particles dry at the first frame hold 0.25 of their "
+     "uniform share of the liquid (ligwf.analysis.flow.spreading)"),
+    ("cg1_runs", "count", "CG1 runs", "CG1 runs of the sweep group"),
+    ("t_spread_rev_cg1", "rev", "CG1 spreading time", "the same over the CG1 runs"),
+    ("rate_ratio", "1", "rate ratio", "CG1 spreading time over the level's: how many times "
+     "faster the liquid spreads in physical space at CG-n"),
+    ("rate_ratio_low", "1", "lo", "lower bound of its 95 % interval (Welch's t on log times; "
+     "coverage not measured on data like these)"),
+    ("rate_ratio_high", "1", "hi", "upper bound of its 95 % interval"),
+    ("df", "1", "df", "Welch degrees of freedom of the log-time difference"),
+    ("exponent", "1", "exponent k", "log(rate ratio) / log(n): 2 for the n^2 a walk over "
+     "contacts with n times longer steps predicts"),
+    ("exponent_low", "1", "k lo", "the interval's lower bound mapped through log(n)"),
+    ("exponent_high", "1", "k hi", "the interval's upper bound mapped through log(n)"),
+    ("expected_ratio", "1", "n^2", "the expected rate ratio, n^2"),
+    ("contains_expected", "flag", "n^2 inside", "the interval contains n^2"),
+    ("above_one", "flag", "faster", "the interval lies above 1: shown faster than CG1"),
+    ("is_bound", "flag", "bound", "a run never reached the share: the ratio is a bound"),
+    ("cg1_spread", "1", "CG1 seeds' ratio", "the largest ratio of two CG1 runs' spreading "
+     "times (the null: CG1 against CG1)"),
+)
+
 #: table file -> (name, unit, label, meaning[, shown]) that differ there from COMMON
 #: the extrapolated CG1 reference's columns (ligwf.inference.reference)
 EXTRAPOLATION = (
@@ -360,4 +388,5 @@ OVERRIDES: dict[str, tuple[tuple[str, ...], ...]] = {
     ),
     layout.VERDICT_TABLE: VERDICT,
     layout.EXTRAPOLATION_REPORT: EXTRAPOLATION,
+    layout.SPREADING_REPORT: SPREADING,
 }

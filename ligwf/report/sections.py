@@ -21,7 +21,7 @@ from typing import Iterable
 
 #: the report's sections by anchor, in reading order (a section without an entry goes last)
 SECTION_ORDER = ("verdict", "extrapolated-cg1", "rounds", "cases", "conditions", "cg1-noise-floor", "size-limit",
-                 "steady-window", "resolution-and-grains", "granule-controls", "gsd", "kinetics", "flow-fields",
+                 "steady-window", "resolution-and-grains", "liquid-spreading", "granule-controls", "gsd", "kinetics", "flow-fields",
                  "skipped-cases", "skipped-or-missing-frames", "analysis-outputs", "granules",
                  "figures", "snapshots", "stability", "paraview")
 

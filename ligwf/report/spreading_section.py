@@ -14,8 +14,7 @@ import math
 
 import pandas as pd
 
-from ligwf.analysis.flow.spreading import DRY_FRACTION, SPREAD_LEVEL
-from ligwf.inference.spreading import LEVEL, case_times, level_rates
+from ligwf.inference.spreading import LEVEL, case_times, level_rates, spreading_time_meaning
 from ligwf.report.sections import Section
 
 
@@ -40,9 +39,7 @@ def spreading_section(cases: pd.DataFrame, levels: pd.DataFrame) -> list[Section
     lines = [f"Placed liquid spreads only when a bridge ruptures (the engine splits its "
              f"liquid between the two particles), a walk over contacts whose step is one "
              f"particle: about n^2 times faster in physical space at CG-n, which no CG rule "
-             f"corrects. Spreading time: revolutions of production until the particles dry "
-             f"at the first frame (below {DRY_FRACTION:g} of the placed content) hold "
-             f"{SPREAD_LEVEL:g} of their uniform share of the liquid.", "",
+             f"corrects. Spreading time: {spreading_time_meaning()}.", "",
              "| case | CG | dry at start | spreading time [rev] | dry share of liquid at "
              "the end | dry particles wet at the end |", "|---|---|---|---|---|---|"]
     for _, r in cases.sort_values(["group", "cg", "rule", "replica"]).iterrows():

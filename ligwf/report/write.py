@@ -43,6 +43,7 @@ from ligwf.report.tables import build_tables
 from ligwf.inference.budget import signed_columns
 from ligwf.report.extrapolation_report import extrapolation_inputs, extrapolation_section
 from ligwf.report.scale_section import scale_section
+from ligwf.report.spreading_section import spreading_section, spreading_tables
 from ligwf.inference.reference import extrapolation_rows
 from ligwf.inference.planning import noise_table
 from ligwf.report.rounds import rounds_sections
@@ -98,10 +99,13 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     write_verdict(verdict, out)
     extrapolated = extrapolation_rows(cases, signed_columns(), ratio)
     atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
+    spread_cases, spread_levels = spreading_tables(flow)     # no rows without placed liquid
+    atomic_write_text(out / layout.SPREADING_REPORT, spread_levels.to_csv(index=False))
     figures = report_figures(study, flow, cases, conditions, out, snapshots, verdict)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
                                verdict, [*extrapolation_section(extrapolated, ratio, cases),
                                          *scale_section(study, conditions),
+                                         *spreading_section(spread_cases, spread_levels),
                                          *flow_field_sections(study, cases, conditions, out)])
     title = f"{study.name}: error against run time"
     preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "

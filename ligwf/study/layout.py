@@ -262,6 +262,8 @@ VERDICT_RECORD = "verdict.json"
 #: the CG1 value extrapolated from the CG-n levels of each rule, beside the measured one
 #: (ligwf.inference.reference)
 EXTRAPOLATION_REPORT = "extrapolation.csv"
+#: placed liquid's spreading rate per CG-n level against CG1 (ligwf.inference.spreading)
+SPREADING_REPORT = "spreading.csv"
 #: the cohesionless twins' field errors against the wet CG1 cases (ligwf.report.fields)
 FIELD_NULL_REPORT = "fields_null_check.csv"
 SUMMARY_REPORT = "summary.md"
