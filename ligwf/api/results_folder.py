@@ -42,6 +42,7 @@ from ligwf.api.tables import TABLES
 from ligwf.errors import ConfigError
 from ligwf.study import layout
 
+
 def number(value, digits: int = 3) -> str:
     """A table value as a README prints it: ``digits`` significant digits, ``–`` for nan or
     what is not a number."""
@@ -122,9 +123,9 @@ class ResultsFolder:
         """Copy the report files ``names`` (:mod:`ligwf.study.layout` names) of the study
         folder ``study`` here, byte for byte, as ``prefix + name`` (a folder holding several
         studies' reports); with ``figures`` its figures folder too (replacing the one
-        here). A report table is first read through
-        :func:`~ligwf.api.open_study` (MissingOutput, naming the command that writes it,
-        when it is missing or is not the table ligwf writes)."""
+        here). A report table is first read through :func:`~ligwf.api.open_study`
+        (MissingOutput, naming the command that writes it, when it is missing or is not
+        the table ligwf writes)."""
         results = open_study(study)
         tables = {spec.file: spec.attribute for spec in TABLES
                   if spec.folder == layout.REPORT_DIR}
@@ -160,14 +161,16 @@ def results_command(doc: str, folders: Sequence[ResultsFolder],
                     arguments: Callable[[argparse.ArgumentParser], None] | None = None) -> int:
     """The command line of a results script (its docstring ``doc``): ``STUDY [options]``
     fills a folder (``make(args)``: copy or measure its tables, return the folder; None for
-    a step that writes no folder) and writes its README; ``--check`` renders every README of
-    ``folders`` from the committed tables and fails (1, one line each) where one differs.
+    a step that writes no folder) and writes its derived tables and README; ``--check``
+    recomputes them for every folder of ``folders`` from the committed tables and fails (1,
+    one line each) where one differs.
     ``arguments`` adds the script's own options; ``make`` may call ``args.error(message)``
     for a usage error."""
     ap = argparse.ArgumentParser(description=doc.splitlines()[0])
     ap.add_argument("study", nargs="?", type=Path, help="the study (or run) folder")
     ap.add_argument("--check", action="store_true",
-                    help="only check that each committed README is what its tables give")
+                    help="only check that each committed README and derived table is what "
+                         "the committed tables give")
     if arguments is not None:
         arguments(ap)
     args = ap.parse_args(argv)
