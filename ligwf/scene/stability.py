@@ -53,6 +53,12 @@ DT_HERTZ_LIMIT = 0.2
 #: dt / t_c limit for the capillary spring: velocity Verlet is stable for dt < 2 t_c; the
 #: same 20 % accuracy margin as for contacts keeps the bridge oscillation resolved.
 DT_CAPILLARY_LIMIT = 0.2
+#: dt / (m* / c) of the viscous force at contact (timescales.viscous_time): an explicit
+#: step damps a linear damper stably only below 2 (warned above: the damping is not
+#: resolved); refused above 5. Measured 2026-12-07 on runner_tiny at CG3 (84 beads, washino,
+#: s_min 0.02, 0.3 s): 4.7 ran to the end, 9.4, 14 and 19 lost atoms (runner: unstable).
+DT_VISCOUS_WARN = 2.0
+DT_VISCOUS_LIMIT = 5.0
 #: Share of a limit above which a value is marginal (warned) rather than ok.
 MARGINAL_SHARE = 0.9
 #: Expected overlap / smallest diameter: above OVERLAP_WARN the Hertz contact is outside
@@ -187,6 +193,20 @@ def preflight(s: ScaledScene, case_id: str = "", explicit_dt: bool = False) -> P
         timestep("dt_capillary", "capillary time sqrt(m*/k_bridge)", sc.capillary_time,
                  DT_CAPILLARY_LIMIT, " or lower liquid.surface_tension (scaled "
                  f"{s.liquid_values.surface_tension:.3g} N/m)")
+
+    if sc.viscous_time is not None and math.isfinite(sc.viscous_time):
+        ratio = dt / sc.viscous_time
+        verdict = (REFUSED if ratio > DT_VISCOUS_LIMIT else
+                   MARGINAL if ratio > DT_VISCOUS_WARN else OK)
+        msg = (f"{dt_field}: dt = {dt:.2g} s is {ratio:.3g}x the viscous damping time m*/c of "
+               f"the smallest {tag} pair in contact ({sc.viscous_time:.2g} s; c = 6 pi mu R* / "
+               f"s_min, mu = {s.liquid_values.viscosity:.3g} Pa s scaled, s_min = "
+               f"{s.liquid_values.min_separation_ratio:g}); warn above {DT_VISCOUS_WARN:g}, "
+               f"limit {DT_VISCOUS_LIMIT:g}")
+        if verdict != OK:
+            msg += (f"; use dt <= {DT_VISCOUS_WARN * sc.viscous_time:.2g} s, or a larger "
+                    "liquid.min_separation_ratio, or a lower liquid.viscosity")
+        out.append(Finding("dt_viscous", dt_field, ratio, DT_VISCOUS_LIMIT, verdict, msg))
 
     d = s.d_min
     ratio = sc.hertz_overlap / d

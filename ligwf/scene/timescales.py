@@ -70,6 +70,7 @@ class TimeScales:
     bridge_force: float | None = None   # N, bridge force at contact F_0 (wet)
     bed_depth: float = 0.0              # m, depth of the bed at rest (chord height)
     cohesion_number: float | None = None  # Co (wet), see the module docstring
+    viscous_time: float | None = None   # s, m* / c of the viscous force at contact (wet)
 
 
 def effective_modulus(youngs_modulus: float, poisson_ratio: float) -> float:
@@ -157,6 +158,19 @@ def cohesion_number(bridge_force: float, diameter: float, density: float,
     return bridge_force / (BED_POROSITY * diameter**2 * density * gravity * depth)
 
 
+def viscous_time(radius: float, density: float, viscosity: float,
+                 min_separation_ratio: float) -> float:
+    """m* / c of two equal particles of ``radius`` in contact: the engine's viscous normal
+    force 6 pi mu R* v_n / max(s_min, gap / R*) (ligwf.liquids.capillary) is a damper of
+    c = 6 pi mu R* / s_min there, which an explicit step resolves only for dt well below
+    m* / c (inf without viscosity)."""
+    if viscosity <= 0.0:
+        return math.inf
+    r_eff = 0.5 * radius
+    c = 6.0 * math.pi * viscosity * r_eff / min_separation_ratio
+    return 0.5 * sphere_mass(radius, density) / c
+
+
 def regime(froude: float) -> str:
     for edge, name in REGIMES:
         if froude < edge:
@@ -171,7 +185,7 @@ def time_scales(s: ScaledScene) -> TimeScales:
     v_imp = impact_velocity(s.drum.omega, s.drum.diameter)
     t_h = hertz_time(r, p.density, p.youngs_modulus, p.poisson_ratio, 2.0 * v_imp)
     overlap = hertz_max_overlap(r, p.density, p.youngs_modulus, p.poisson_ratio, v_imp)
-    t_c = cap_overlap = rupture = cutoff = reach = f0 = co = None
+    t_c = cap_overlap = rupture = cutoff = reach = f0 = co = t_v = None
     # the bed the particles make (a particle_count may differ from the fill fraction)
     v_mean = sum(f * math.pi * d**3 / 6.0 for d, f in zip(p.diameters, p.number_fractions))
     fill = p.count * v_mean / ((1.0 - BED_POROSITY) * math.pi
@@ -192,6 +206,7 @@ def time_scales(s: ScaledScene) -> TimeScales:
         f0_mean, _ = model.contact_force_and_stiffness(0.5 * d_mean, liq.surface_tension, theta,
                                                        liq.liquid_content)
         co = cohesion_number(f0_mean, d_mean, p.density, depth)
+        t_v = viscous_time(r, p.density, liq.viscosity, liq.min_separation_ratio)
     radius = 0.5 * s.drum.diameter
     return TimeScales(
         rayleigh_time=s.particles.rayleigh_time, impact_velocity=v_imp, hertz_time=t_h,
@@ -200,4 +215,4 @@ def time_scales(s: ScaledScene) -> TimeScales:
         froude=s.drum.froude,
         critical_rpm=60.0 / (2.0 * math.pi) * math.sqrt(GRAVITY / radius),
         regime=regime(s.drum.froude), bridge_force=f0 if f0 is None else float(f0),
-        bed_depth=depth, cohesion_number=co)
+        bed_depth=depth, cohesion_number=co, viscous_time=t_v)

@@ -182,3 +182,56 @@ def test_suite_sweeps_every_axis_the_issue_asks_for():
     assert min(fractions) <= 0.05 and max(fractions) >= 1.5
     for cases in scaled.values():
         assert all(s.particles.count <= 300 for s in cases)
+
+
+# ---- the viscous damping time (lubrication on: small s_min makes the damper stiff)
+#   r = 1 mm, rho = 2500: m = 1.0472e-5 kg, m* = 5.236e-6 kg; R* = 5e-4 m
+#   mu = 0.1 Pa s, s_min = 0.02: c = 6 pi 0.1 5e-4 / 0.02 = 4.7124e-2 N s/m
+#   m* / c = 1.1111e-4 s
+RUNNER_TINY = ROOT / "tests" / "workflows" / "runner_tiny.yaml"
+
+
+def test_viscous_time_hand_value():
+    assert ts.viscous_time(R, RHO, 0.1, 0.02) == pytest.approx(1.1111e-4, rel=2e-4)
+    assert ts.viscous_time(R, RHO, 0.0, 0.02) == math.inf
+
+
+def _viscous(viscosity: float):
+    wf = load_workflow(RUNNER_TINY, [f"scene.liquid.viscosity={viscosity}",
+                                     "scene.liquid.min_separation_ratio=0.02",
+                                     "sweep.rules=[weber]"])
+    rep = st.preflight(wf.cases[0].scaled(), wf.cases[0].case_id)
+    return next(f for f in rep.findings if f.check == "dt_viscous")
+
+
+@pytest.mark.parametrize("viscosity, ratio, verdict", [
+    (1.0, 2.35, st.MARGINAL), (2.0, 4.7, st.MARGINAL), (4.0, 9.4, st.REFUSED),
+    (0.1, 0.235, st.OK)])
+def test_viscous_damping_is_graded_where_the_engine_was_measured(viscosity, ratio, verdict):
+    """runner_tiny at CG3 (We: mu x 3), s_min 0.02: the engine ran 4.7 to the end and lost
+    atoms at 9.4 (measured 2026-12-07); the pre-flight warns above 2 and refuses above 5."""
+    f = _viscous(viscosity)
+    assert f.value == pytest.approx(ratio, rel=0.01) and f.verdict == verdict
+    if verdict != st.OK:
+        assert "liquid.min_separation_ratio" in f.message and "use dt <=" in f.message
+
+
+def test_lubrication_off_leaves_the_viscous_damper_resolved():
+    wf = load_workflow(RUNNER_TINY, ["sweep.rules=[weber]"])       # s_min 1.01, 1 mPa s
+    rep = st.preflight(wf.cases[0].scaled(), wf.cases[0].case_id)
+    assert next(f for f in rep.findings if f.check == "dt_viscous").verdict == st.OK
+
+
+@pytest.mark.engine
+def test_a_refused_viscous_damper_loses_atoms_in_the_engine(engine, tmp_path):
+    """The refusal is the engine's behaviour, not a guess: let through with
+    --allow-unstable, the 9.4x case is marked unstable by the runner."""
+    args = [str(RUNNER_TINY), "--set", "scene.liquid.viscosity=4",
+            "--set", "scene.liquid.min_separation_ratio=0.02", "--set", "sweep.rules=[weber]",
+            "--set", "scene.process.run_time=0.3", "--mesh-cache", str(tmp_path / "m")]
+    assert main(["check", *args[:-2]]) == 2
+    out = tmp_path / "visc"
+    main(["run", *args, "--out", str(out), "--allow-unstable", "--np", "1"])
+    import json
+    manifest = json.loads((out / "cg3-weber-r0" / "manifest.json").read_text())
+    assert manifest["status"] == "unstable", manifest.get("reason")
