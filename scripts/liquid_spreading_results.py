@@ -5,8 +5,9 @@ Reads the analysed study (its flow record holds each case's spreading series,
 ligwf.analysis.flow.spreading), writes series.csv (per case and frame), cases.csv (per case
 the spreading time), levels.csv (per level the rate ratio against CG1 with its interval,
 ligwf.inference.spreading), hypotheses.csv (each registered hypothesis, met or not, per
-level), a figure, and README.md from those tables; ``--check`` rebuilds the README from the
-committed tables and fails when it differs.
+level), a figure, and README.md. levels.csv and hypotheses.csv are derived from the
+committed cases.csv (a ResultsFolder's derived tables), so ``--check`` recomputes them and the
+README from the committed tables and fails when one differs.
 
     ligwf run workflows/liquid_spreading.yaml --out runs/liquid_spreading
     ligwf analyse runs/liquid_spreading
@@ -15,18 +16,19 @@ committed tables and fails when it differs.
 
 from __future__ import annotations
 
+import io
 import sys
 from pathlib import Path
 
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from results_readme import ROOT, csv_text, number, parser, write_or_check  # noqa: E402
+from ligwf.analysis.flow.spreading import DRY_FRACTION, SPREAD_LEVEL
+from ligwf.analysis.records.flow import FlowRecord
+from ligwf.api.results_folder import ResultsFolder, csv_text, number, results_command
+from ligwf.inference.spreading import case_times, level_rates
+from ligwf.study import layout
 
-from ligwf.analysis.flow.spreading import DRY_FRACTION, SPREAD_LEVEL  # noqa: E402
-from ligwf.analysis.records.flow import FlowRecord  # noqa: E402
-from ligwf.inference.spreading import case_times, level_rates  # noqa: E402
-from ligwf.study import layout  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 OUT = ROOT / "docs" / "results" / "liquid_spreading"
 COMMAND = "ligwf run workflows/liquid_spreading.yaml --out runs/liquid_spreading"
@@ -53,11 +55,13 @@ def hypotheses(levels: pd.DataFrame) -> pd.DataFrame:
         bound = " (a bound)" if r.is_bound else ""
         rows.append({"hypothesis": "H1 faster", "cg": r.cg, "met": bool(r.above_one),
                      "evidence": f"rate ratio {number(r.rate_ratio)} [{number(r.rate_ratio_low)}"
-                                 f", {number(r.rate_ratio_high)}]{bound}, lower end above 1"})
+                                 f", {number(r.rate_ratio_high)}]{bound}: lower end "
+                                 f"{'above' if r.above_one else 'not above'} 1"})
         rows.append({"hypothesis": "H2 n^2", "cg": r.cg, "met": bool(r.contains_expected),
                      "evidence": f"interval [{number(r.rate_ratio_low)}, "
                                  f"{number(r.rate_ratio_high)}] against n^2 = "
-                                 f"{r.expected_ratio:g}{bound}"})
+                                 f"{r.expected_ratio:g}: "
+                                 f"{'inside' if r.contains_expected else 'outside'}{bound}"})
     if len(levels):
         spread = float(levels.cg1_spread.iloc[0])
         rows.append({"hypothesis": "null CG1 vs CG1", "cg": 1.0, "met": bool(spread < NULL_SPREAD),
@@ -88,8 +92,37 @@ def figure(series: pd.DataFrame, path: Path) -> None:
     plt.close(fig)
 
 
-def readme(cases: pd.DataFrame, levels: pd.DataFrame, hyp: pd.DataFrame,
-           timing: pd.DataFrame) -> str:
+def findings(levels: pd.DataFrame, hyp: pd.DataFrame) -> str:
+    """The measured answer in words, every number read from the tables."""
+    if levels.empty:
+        return "No CG-n level was run against CG1."
+    faster = [f"CG{r.cg:g} {number(r.rate_ratio)} x [{number(r.rate_ratio_low)}, "
+              f"{number(r.rate_ratio_high)}]" for _, r in levels.iterrows()]
+    separated = [f"CG{r.cg:g}" for _, r in levels.iterrows() if r.above_one]
+    rejected = [f"CG{r.cg:g} ({r.expected_ratio:g})" for _, r in levels.iterrows()
+                if not r.contains_expected]
+    k = ", ".join(number(v, 2) for v in levels.exponent)
+    null = hyp[hyp.hypothesis == "null CG1 vs CG1"]
+    null_text = ("the CG1 seeds agree with one another (null met)" if len(null)
+                 and bool(null.met.iloc[0]) else "the CG1 seeds do not agree with one "
+                 "another (null not met: the ratios are not separated from seed spread)")
+    return (f"Placed liquid spread faster per revolution at CG-n than at CG1 in the point "
+            f"estimates ({'; '.join(faster)}, rate ratio [95 %]), and {null_text}. "
+            + (f"The interval lies above 1 at {', '.join(separated)} only. " if separated
+               else "No level's interval lies above 1 with 3 seeds a level: faster is not "
+                    "shown. ")
+            + (f"The n^2 walk estimate lies outside the interval at {', '.join(rejected)}; "
+               if rejected else "The n^2 walk estimate lies inside every interval; ")
+            + f"the measured exponents of n are {k} (point estimates; the walk estimate "
+            "is 2). The walk estimate assumed the same bridge-rupture rate per particle at "
+            "every level (washino moves liquid only at a rupture); why these runs do not "
+            "follow it is not measured here.")
+
+
+def readme(folder: ResultsFolder) -> str:
+    """README.md from the committed tables."""
+    cases, levels = folder.table("cases.csv"), folder.table("levels.csv")
+    hyp, timing = folder.table("hypotheses.csv"), folder.table("timing.csv")
     lines = ["# Liquid spreading across CG levels (issue 47 item 2)", "",
              "Registered before the runs: [criterion.md](criterion.md) (amendment 1 replaced a "
              "null that could not fail, before any result). Made by:", "", "```", COMMAND,
@@ -109,7 +142,8 @@ def readme(cases: pd.DataFrame, levels: pd.DataFrame, hyp: pd.DataFrame,
     for _, r in hyp.iterrows():
         lines.append(f"| {r.hypothesis} | {r.cg:g} | {'yes' if r.met else '**no**'} | "
                      f"{r.evidence} |")
-    lines += ["", "## Per level (against the 3 CG1 seeds)", "",
+    lines += ["", "## What it says", "", findings(levels, hyp), "",
+              "## Per level (against the 3 CG1 seeds)", "",
               "| CG | runs | spreading time [rev] (geometric mean) | CG1 [rev] | rate ratio "
               "[95 %] | exponent k [95 %] | n^2 |", "|---|---|---|---|---|---|---|"]
     for _, r in levels.iterrows():
@@ -148,31 +182,35 @@ def timing_table(study: Path) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def main() -> int:
-    args = parser(__doc__, "liquid-spreading").parse_args()
-    if args.check:
-        read = {n: pd.read_csv(OUT / f"{n}.csv") for n in ("cases", "levels", "hypotheses",
-                                                            "timing")}
-        return write_or_check(OUT, lambda: readme(read["cases"], read["levels"],
-                                                  read["hypotheses"], read["timing"]),
-                              True, "scripts/liquid_spreading_results.py")
+def derived(folder: ResultsFolder) -> dict[str, str]:
+    """levels.csv and hypotheses.csv, recomputed from the committed cases.csv."""
+    cases = folder.table("cases.csv")
+    levels = level_rates(cases)
+    return {"levels.csv": csv_text(levels),
+            "hypotheses.csv": csv_text(hypotheses(pd.read_csv(io.StringIO(csv_text(levels)))))}
+
+
+FOLDER = ResultsFolder(OUT, readme, "scripts/liquid_spreading_results.py "
+                                    "runs/liquid_spreading", derived)
+
+
+def make(args) -> ResultsFolder:
+    """Measure the study's series, case times and wall, then let the folder derive the rest."""
+    if args.study is None:
+        args.error("the study folder is required (or --check)")
     record = FlowRecord.read(args.study / layout.ANALYSIS_DIR / layout.FLOW_PROFILES)
     series = series_table(record)
     cases = case_times(record.cases.values()).sort_values(["cg", "replica"])
-    levels = level_rates(cases)
-    hyp = hypotheses(levels)
-    timing = timing_table(args.study)
     OUT.mkdir(parents=True, exist_ok=True)
-    for name, table in (("series", series), ("cases", cases), ("levels", levels),
-                        ("hypotheses", hyp), ("timing", timing)):
+    for name, table in (("series", series), ("cases", cases),
+                        ("timing", timing_table(args.study))):
         (OUT / f"{name}.csv").write_text(csv_text(table))
     figure(series, OUT / "spreading.png")
-    # the README from the tables as committed (rounded), so --check reproduces it
-    read = {n: pd.read_csv(OUT / f"{n}.csv") for n in ("cases", "levels", "hypotheses",
-                                                        "timing")}
-    return write_or_check(OUT, lambda: readme(read["cases"], read["levels"],
-                                              read["hypotheses"], read["timing"]),
-                          False, "scripts/liquid_spreading_results.py")
+    return FOLDER
+
+
+def main() -> int:
+    return results_command(__doc__, [FOLDER], make)
 
 
 if __name__ == "__main__":
