@@ -1,13 +1,18 @@
-"""docs/results/granule_screen/: phase 1 of the registered granule screen (issue 47 item 3,
-criterion.md committed before the runs): one seed of each condition scored on the four
-registered points, the best picked by the registered rule.
+"""docs/results/granule_screen/: the registered granule screen (issue 47 item 3,
+criterion.md committed before the runs). Phase 1: one seed of each condition scored on the
+four registered points, the best picked by the registered rule. Phase 2: the pick on five
+seeds, each beside its cohesionless twin and a uniform twin at the pick's mean liquid
+content, judged by the registered per-seed criteria (>= 4 of 5 seeds).
 
-Writes ``growth_rows.csv`` (every start frame of every run: held granules, survival,
+Writes ``growth_rows.csv`` (every start frame of every phase-1 run: held granules, survival,
 co-movement, the wall test; ligwf.analysis.granules.growth), ``conditions.csv`` (one row per
-condition: its measures, points and rank) and ``README.md`` from them; ``--check`` rebuilds
-the README from the committed tables and fails when it differs.
+condition: its measures, points and rank), and when phase 2 ran ``phase2_rows.csv`` (every
+start frame of its runs) and ``phase2_seeds.csv`` (one row per seed and null); the verdict
+``phase2_verdict.csv`` is derived from the seeds table, and README.md is rendered from the
+committed tables (a ResultsFolder: ``--check`` recomputes both and fails when one differs).
 
     bash scripts/granule_screen.sh runs            # runs/granule_screen/S1..S4
+    bash scripts/granule_screen_phase2.sh runs     # runs/granule_screen/P2 and P2U
     .venv/bin/python scripts/granule_screen_results.py runs/granule_screen
 """
 
@@ -21,11 +26,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from results_readme import ROOT, csv_text, number, parser, write_or_check  # noqa: E402
+from ligwf.analysis.granules.growth import GrowthSettings, hac_slope
+from ligwf.analysis.granules.growth_study import CRITERIA, Criteria, measure_case, seed_table
+from ligwf.api.results_folder import ResultsFolder, csv_text, number, results_command
 
-from ligwf.analysis.granules.growth import GrowthSettings, hac_slope  # noqa: E402
-from ligwf.analysis.granules.growth_study import Criteria, measure_case  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 OUT = ROOT / "docs" / "results" / "granule_screen"
 #: the registered settings (criterion.md): W = 1.3 s, start frames every 0.1 s from W
@@ -44,15 +49,18 @@ def case_folder(study: Path, name: str) -> Path | None:
     return found[0] if found else None
 
 
-def status_of(case: Path) -> tuple[str, float]:
+def status_of(case: Path) -> tuple[str, float, str]:
+    """(status, core seconds, the manifest's reason) of a run."""
     m = json.loads((case / "manifest.json").read_text())
-    return str(m.get("status")), float(m.get("core_seconds") or math.nan)
+    return (str(m.get("status")), float(m.get("core_seconds") or math.nan),
+            str(m.get("reason") or ""))
 
 
 def condition_row(name: str, rows: pd.DataFrame, flows: pd.DataFrame, status: str,
-                  core_s: float, criteria: Criteria = Criteria()) -> dict:
+                  core_s: float, reason: str = "", criteria: Criteria = Criteria()) -> dict:
     model, liquid = CONDITIONS[name]
     out = {"condition": name, "model": model, "liquid": liquid, "status": status,
+           "reason": "" if status == "done" else reason,
            "core_minutes": core_s / 60.0, "start_frames": len(rows)}
     if rows.empty:
         return {**out, **{p: False for p, _ in POINTS}, "wet_mass": False, "points": 0}
@@ -95,16 +103,9 @@ def ranked(table: pd.DataFrame) -> pd.DataFrame:
     return t
 
 
-def readme(cond: pd.DataFrame) -> str:
-    lines = ["# Granule screen, phase 1 (issue 47 item 3)", "",
-             "Registered before the runs: [criterion.md](criterion.md). Made by:", "", "```",
-             "bash scripts/granule_screen.sh runs",
-             ".venv/bin/python scripts/granule_screen_results.py runs/granule_screen", "```",
-             "", "Tables: `growth_rows.csv` (every start frame of every run), `conditions.csv` "
-             "(one row per condition, its registered points and rank). This README is written "
-             "from them by `scripts/granule_screen_results.py` and checked by "
-             "`tests/report/test_committed_granule_screen.py`.", "",
-             f"Held granules: bridges present through W = {SETTINGS.hold_time:g} s sampled "
+def phase1_lines(cond: pd.DataFrame) -> list[str]:
+    """The phase-1 sections of the README."""
+    lines = [f"Held granules: bridges present through W = {SETTINGS.hold_time:g} s sampled "
              f"every {SETTINGS.cadence:g} s; start frames every {SETTINGS.stride:g} s from "
              f"{SETTINGS.start_after:g} s; granules of >= {SETTINGS.min_particles} particles.",
              "", "## Points (one seed each; criterion.md's phase-1 pick)", "",
@@ -139,29 +140,208 @@ def readme(cond: pd.DataFrame) -> str:
               f"{best.liquid}), {int(best.points)} of {len(POINTS)} points. Phase 1 used "
               f"{total:.0f} core-minutes of the 480 budgeted for the item (cores x wall of "
               "each run, on a machine shared with other work).", ""]
-    return "\n".join(lines)
+    for _, r in cond[cond.status != "done"].iterrows():
+        lines += [f"{r.condition} did not finish ({r.status}: {r.reason}); the registered "
+                  "rule scores it 0.", ""]
+    return lines
 
 
-def main() -> int:
-    args = parser(__doc__, "granule-screen").parse_args()
-    if args.check:
-        return write_or_check(OUT, lambda: readme(pd.read_csv(OUT / "conditions.csv")), True,
-                              "scripts/granule_screen_results.py")
+
+#: phase 2 (criterion.md): the pick's study, its uniform twin, and the twin's content
+PHASE2, PHASE2_UNIFORM = "P2", "P2U"
+UNIFORM_CONTENT = 0.012
+SEEDS = 5
+BUDGET_CORE_MIN = 480.0
+#: the registered phase-2 pass (criteria 1-3 and 6) and the two reported beside it
+REGISTERED = ("pass_control", "pass_survival", "pass_growth", "pass_comovement")
+REPORTED = ("pass_no_spanning", "pass_not_wall")
+
+
+def phase2_measure(study: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame] | None:
+    """(every start frame of every phase-2 run, one row per run: status and core-minutes,
+    one row per registered seed: its measures, both nulls' and the criteria), or None when
+    phase 2 has not run. A uniform twin's case id gets the suffix ``_uniform``."""
+    if not (study / PHASE2).is_dir():
+        return None
+    all_rows, all_flows, runs = [], [], []
+    for folder, suffix in ((PHASE2, ""), (PHASE2_UNIFORM, "_uniform")):
+        for manifest in sorted((study / folder).glob("cg1-*/manifest.json")):
+            case = manifest.parent
+            status, core_s, reason = status_of(case)
+            case_id = case.name + suffix
+            runs.append({"case_id": case_id, "status": status,
+                         "reason": "" if status == "done" else reason,
+                         "core_minutes": core_s / 60.0})
+            if status != "done":
+                continue
+            rows, _, flows = measure_case(case, SETTINGS, cadences=(SETTINGS.cadence,))
+            rows["case_id"], flows["case_id"] = case_id, case_id
+            all_rows.append(rows)
+            all_flows.append(flows)
+    rows = pd.concat(all_rows) if all_rows else pd.DataFrame()
+    flows = pd.concat(all_flows) if all_flows else pd.DataFrame()
+    return rows, pd.DataFrame(runs), phase2_seeds(rows, flows)
+
+
+def phase2_seeds(rows: pd.DataFrame, flows: pd.DataFrame) -> pd.DataFrame:
+    """One row per registered seed r0..r4: the wet run against its cohesionless twin
+    (growth_study.seed_table) and against its uniform twin; control passes only when both
+    nulls hold <= 1/5 of the wet share_10. A seed whose wet run or a null is missing fails
+    every criterion (no evidence)."""
+    kw = dict(settings=SETTINGS, steady_after=SETTINGS.hold_time)
+    empty = rows.empty
+    dry = pd.DataFrame() if empty else seed_table(rows, flows, "cohesionless", **kw)
+    uni = pd.DataFrame() if empty else seed_table(rows, flows, "uniform", **kw)
+    out = []
+    for r in range(SEEDS):
+        seed = f"cg1-none-r{r}"
+        d = dry[dry.seed == seed] if len(dry) else dry
+        u = uni[uni.seed == seed] if len(uni) else uni
+        if d.empty or u.empty:
+            out.append({"seed": seed, "complete": False,
+                        **{c: False for c in REGISTERED + REPORTED}})
+            continue
+        row = d.iloc[0].to_dict()
+        urow = u.iloc[0]
+        row.update({"complete": True, "cohesionless_share_10": row.pop("control_share_10"),
+                    "uniform_share_10": urow.control_share_10,
+                    "uniform_survival": urow.control_survival,
+                    "uniform_spanning_frames": urow.control_spanning_frames,
+                    "uniform_angle_deg": urow.control_angle_deg,
+                    "pass_control_cohesionless": bool(row["pass_control"]),
+                    "pass_control_uniform": bool(urow.pass_control)})
+        row["pass_control"] = row["pass_control_cohesionless"] and row["pass_control_uniform"]
+        out.append(row)
+    return pd.DataFrame(out)
+
+
+def phase2_verdict(seeds: pd.DataFrame, criteria: Criteria = Criteria()) -> pd.DataFrame:
+    """One row per criterion: seeds passing of the registered five, whether it passes
+    (>= 4 of 5), and whether it is registered for the pass or reported beside it; a last
+    row: the screen finds growth (every registered criterion passes)."""
+    meaning = dict(CRITERIA)
+    meaning["pass_control"] = ("granules exist (share_10 >= 0.02) and each null (cohesionless "
+                               "twin, uniform twin) holds <= 1/5 of them")
+    rows = []
+    for col in REGISTERED + REPORTED:
+        k = int(seeds[col].astype(bool).sum())
+        rows.append({"criterion": col.removeprefix("pass_"), "meaning": meaning[col],
+                     "registered": col in REGISTERED, "seeds_pass": k, "seeds": SEEDS,
+                     "passes": k >= criteria.seeds_needed})
+    found = all(r["passes"] for r in rows if r["registered"])
+    rows.append({"criterion": "finds_growth", "meaning": "every registered criterion passes",
+                 "registered": True,
+                 "seeds_pass": int(seeds[list(REGISTERED)].astype(bool).all(axis=1).sum()),
+                 "seeds": SEEDS, "passes": found})
+    return pd.DataFrame(rows)
+
+
+def phase2_lines(folder: "ResultsFolder") -> list[str]:
+    """The phase-2 sections of the README (from the committed phase-2 tables)."""
+    if not folder.has("phase2_seeds.csv"):
+        return ["## Phase 2", "", "Not run yet.", ""]
+    seeds, runs = folder.table("phase2_seeds.csv"), folder.table("phase2_runs.csv")
+    verdict = folder.table("phase2_verdict.csv")
+    cond = folder.table("conditions.csv")
+    lines = ["## Phase 2: the pick on five seeds against two nulls", "",
+             f"The pick (S3, easo, placed nuclei) on seeds r0-r{SEEDS - 1} (phase 1's r0 is r0), "
+             f"each beside its cohesionless twin and a uniform twin at content "
+             f"{UNIFORM_CONTENT:g} (S3 r0's mean content at its first production frame, two "
+             "significant figures). A criterion passes in >= 4 of 5 seeds.", "",
+             "| criterion | registered | seeds passing | passes |", "|---|---|---|---|"]
+    for _, r in verdict.iterrows():
+        lines.append(f"| {r.criterion}: {r.meaning} | {'yes' if r.registered else 'reported'}"
+                     f" | {int(r.seeds_pass)} of {int(r.seeds)} | "
+                     f"{'yes' if r.passes else '**no**'} |")
+    lines += ["", "| seed | share_10 | cohesionless | uniform | slope [1/s] (95 %) | survival "
+              "| co-movement | spanning frames | wet share start / end | control | survival "
+              "| growth | co-movement |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    yn = lambda v: "yes" if bool(v) else "no"  # noqa: E731
+    for _, r in seeds.iterrows():
+        if not bool(r.complete):
+            lines.append(f"| {r.seed} | – | – | – | – | – | – | – | – | no | no | no | no |")
+            continue
+        lines.append(
+            f"| {r.seed} | {number(r.share_10)} | {number(r.cohesionless_share_10)} | "
+            f"{number(r.uniform_share_10)} | {number(r.slope_per_s)} [{number(r.slope_low)}, "
+            f"{number(r.slope_high)}] | {number(r.survival)} | {number(r.comove_ratio)} | "
+            f"{number(r.spanning_frames)} | {number(r.wet_share_start)} / "
+            f"{number(r.wet_share_end)} | {yn(r.pass_control)} | {yn(r.pass_survival)} | "
+            f"{yn(r.pass_growth)} | {yn(r.pass_comovement)} |")
+    used1, used2 = float(cond.core_minutes.sum()), float(runs.core_minutes.sum())
+    lines += ["", f"Phase 2 used {used2:.0f} core-minutes in {len(runs)} runs "
+              f"({int((runs.status == 'done').sum())} finished); with phase 1's {used1:.0f}, "
+              f"{used1 + used2:.0f} of the {BUDGET_CORE_MIN:g} budgeted.", ""]
+    for _, r in runs[runs.status != "done"].iterrows():
+        lines += [f"{r.case_id} did not finish ({r.status}: {r.reason}).", ""]
+    found = bool(verdict[verdict.criterion == "finds_growth"].passes.iloc[0])
+    failed = [r.criterion for _, r in verdict.iterrows()
+              if r.registered and r.criterion != "finds_growth" and not r.passes]
+    lines += ["**The screen " + ("finds growth**." if found else
+              "does not find growth**: " + ", ".join(failed) + " failed the registered "
+              "4-of-5 rule."), ""]
+    return lines
+
+
+def readme(folder: "ResultsFolder") -> str:
+    """README.md from the committed tables."""
+    cond = folder.table("conditions.csv")
+    tables = "`growth_rows.csv` (every start frame of every phase-1 run), `conditions.csv` " \
+             "(one row per condition, its registered points and rank)"
+    if folder.has("phase2_seeds.csv"):
+        tables += (", `phase2_rows.csv` (every start frame of every phase-2 run), "
+                   "`phase2_runs.csv` (each run's status and cores x wall), `phase2_seeds.csv` "
+                   "(one row per seed: its measures, both nulls', each criterion) and "
+                   "`phase2_verdict.csv` (derived from the seeds table)")
+    lines = ["# Granule screen (issue 47 item 3)", "",
+             "Registered before the runs: [criterion.md](criterion.md). Made by:", "", "```",
+             "bash scripts/granule_screen.sh runs",
+             "bash scripts/granule_screen_phase2.sh runs",
+             ".venv/bin/python scripts/granule_screen_results.py runs/granule_screen", "```",
+             "", f"Tables: {tables}. This README is written from them by "
+             "`scripts/granule_screen_results.py` and checked by "
+             "`tests/report/test_committed_granule_screen.py`.", "", "## Phase 1", ""]
+    return "\n".join(lines + phase1_lines(cond) + phase2_lines(folder))
+
+
+def derived(folder: "ResultsFolder") -> dict[str, str]:
+    """phase2_verdict.csv from the committed phase2_seeds.csv (when phase 2 ran)."""
+    if not folder.has("phase2_seeds.csv"):
+        return {}
+    return {"phase2_verdict.csv": csv_text(phase2_verdict(folder.table("phase2_seeds.csv")))}
+
+
+FOLDER = ResultsFolder(OUT, readme, "scripts/granule_screen_results.py runs/granule_screen",
+                       derived)
+
+
+def make(args) -> ResultsFolder:
+    """Measure phase 1's conditions (and phase 2 when it ran) into the folder's tables."""
+    if args.study is None:
+        args.error("the screen's folder is required (or --check)")
     all_rows, table = [], []
     for name in CONDITIONS:
         case = case_folder(args.study, name)
         if case is None:
             continue
-        status, core_s = status_of(case)
+        status, core_s, reason = status_of(case)
         rows, _, flows = measure_case(case, SETTINGS, cadences=(SETTINGS.cadence,))
         rows.insert(0, "condition", name)
         all_rows.append(rows)
-        table.append(condition_row(name, rows, flows, status, core_s))
+        table.append(condition_row(name, rows, flows, status, core_s, reason))
     OUT.mkdir(parents=True, exist_ok=True)
     (OUT / "growth_rows.csv").write_text(csv_text(pd.concat(all_rows)))
     (OUT / "conditions.csv").write_text(csv_text(ranked(pd.DataFrame(table))))
-    return write_or_check(OUT, lambda: readme(pd.read_csv(OUT / "conditions.csv")), False,
-                          "scripts/granule_screen_results.py")
+    phase2 = phase2_measure(args.study)
+    if phase2 is not None:
+        rows, runs, seeds = phase2
+        for name, t in (("phase2_rows", rows), ("phase2_runs", runs), ("phase2_seeds", seeds)):
+            (OUT / f"{name}.csv").write_text(csv_text(t))
+    return FOLDER
+
+
+def main() -> int:
+    return results_command(__doc__, [FOLDER], make)
 
 
 if __name__ == "__main__":
