@@ -51,6 +51,17 @@ DF_RULE_TEXT = {WELCH: "Welch-Satterthwaite degrees of freedom",
                           "the Behrens-Fisher distribution for unequal arms"}
 
 
+#: how the profile's bounds count its depth bins: as independent (the noncentral F's
+#: degrees of freedom from the bins' variances alone), or as correlated (the squared
+#: correlations between bins, measured on the runs' residuals, enter k_e and df_e). Real
+#: profiles share their seed errors between neighbouring bins (correlation 0.91-0.92,
+#: docs/results/profile_correlation): independent bins then count too many degrees of
+#: freedom and the upper bound covers too little (docs/results/verdict_rates)
+BINS_INDEPENDENT, BINS_CORRELATED = "independent", "correlated"
+BINS_RULE_TEXT = {BINS_INDEPENDENT: "depth bins counted as independent",
+                  BINS_CORRELATED: "depth bins' correlation measured on the runs' residuals"}
+
+
 @dataclass(frozen=True)
 class Estimate:
     """A value with its (1 - 2 alpha) interval, standard error and degrees of freedom;
@@ -222,7 +233,7 @@ class NormEstimate:
 
 
 def norm_estimate(runs, reference, alpha: float = ALPHA,
-                  add: tuple[int, int] = (0, 0)) -> NormEstimate:
+                  add: tuple[int, int] = (0, 0), bins: str = BINS_INDEPENDENT) -> NormEstimate:
     """Relative L2 distance between the mean profiles of two arms ((runs, bins) arrays),
     on the bins every run fills.
 
@@ -240,7 +251,10 @@ def norm_estimate(runs, reference, alpha: float = ALPHA,
     intervals it replaced: 1.00 everywhere, too wide to decide).
 
     ``add``: the bounds predicted with that many more replicas of (runs, reference), the
-    mean difference and the per-run variances as measured (what would decide it)."""
+    mean difference and the per-run variances as measured (what would decide it).
+    ``bins``: BINS_CORRELATED takes the bins' squared correlations (:func:`bin_correlation2`)
+    into k_e and df_e (sums over pairs of bins, not bins); BINS_INDEPENDENT counts them as
+    independent (the rule coverage.txt was measured with)."""
     x, y = np.asarray(runs, float), np.asarray(reference, float)
     if x.ndim != 2 or y.ndim != 2 or x.shape[1] != y.shape[1] or not len(x) or not len(y):
         return NormEstimate(math.nan, math.nan, math.nan, math.nan)
@@ -257,8 +271,32 @@ def norm_estimate(runs, reference, alpha: float = ALPHA,
     sx, sy = x.var(axis=0, ddof=1), y.var(axis=0, ddof=1)
     v = sx / nx + sy / ny
     value = math.sqrt(max(0.0, float(np.sum(d * d - v)))) / ref_norm
-    lo, hi = _noncentral_bounds(float(np.sum(d * d)), v, sx, sy, nx, ny, alpha)
+    rho2 = bin_correlation2(x, y) if bins == BINS_CORRELATED else None
+    lo, hi = _noncentral_bounds(float(np.sum(d * d)), v, sx, sy, nx, ny, alpha, rho2)
     return NormEstimate(value, math.sqrt(lo) / ref_norm, math.sqrt(hi) / ref_norm, raw)
+
+
+def bin_correlation2(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """The squared correlations between depth bins of two arms' runs ((runs, bins) each),
+    taken off the bias that noise alone gives them: each run's residual from its arm's
+    mean profile, scaled per arm and bin to unit variance, pooled over both arms
+    (m = R1 + R2 - 2 degrees of freedom); a sample correlation r of m degrees of freedom
+    has E[r^2] = 1/m between independent bins, so (r^2 - 1/m) / (1 - 1/m) is unbiased there
+    and 1 for bins that move together. Left unclipped (a sum over pairs stays unbiased);
+    the diagonal is 1. Bins with no variance correlate with nothing."""
+    parts = []
+    for a in (x, y):
+        res = a - a.mean(axis=0)
+        sd = res.std(axis=0, ddof=1)
+        parts.append(np.divide(res, sd, out=np.zeros_like(res), where=sd > 0))
+    res = np.vstack(parts)
+    m = len(x) + len(y) - 2
+    norms = np.sqrt(np.sum(res * res, axis=0))
+    outer = np.outer(norms, norms)
+    r = np.divide(res.T @ res, outer, out=np.zeros((res.shape[1],) * 2), where=outer > 0)
+    rho2 = (r * r - 1.0 / m) / (1.0 - 1.0 / m) if m > 1 else np.ones_like(r)
+    np.fill_diagonal(rho2, 1.0)
+    return rho2
 
 
 def noncentral_f_cdf(ratio: float, k: float, df: float, nc: float) -> float:
@@ -281,20 +319,33 @@ def noncentral_f_cdf(ratio: float, k: float, df: float, nc: float) -> float:
     return float(min(1.0, max(0.0, special.ndtr((ratio - mean) / math.sqrt(var)))))
 
 
-def _noncentral_shape(v: np.ndarray, sx: np.ndarray, sy: np.ndarray, nx: int, ny: int
-                      ) -> tuple[float, float, float]:
-    """(k_e, c, df_e) of the bins' squared differences (see :func:`norm_estimate`)."""
+def _noncentral_shape(v: np.ndarray, sx: np.ndarray, sy: np.ndarray, nx: int, ny: int,
+                      rho2: np.ndarray | None = None) -> tuple[float, float, float]:
+    """(k_e, c, df_e) of the bins' squared differences (see :func:`norm_estimate`);
+    ``rho2``: the bins' squared correlations (:func:`bin_correlation2`; None: independent),
+    which add the pairs' terms v_i v_j rho_ij^2 to sum v^2 and to the variance of sum v."""
     total = float(np.sum(v))
     df_k = np.array([welch_df(float(a), nx, float(b), ny) for a, b in zip(sx, sy)])
     df_k = np.where(np.isfinite(df_k) & (df_k > 0), df_k, 1.0)
     # sum v^2 from estimated variances: E[v_hat^2] = v^2 (1 + 2 / df), taken off, so that
     # the noise of a few replicas' variances does not pass for unequal bins
-    total2 = min(float(np.sum(v * v * df_k / (df_k + 2.0))), total * total)
+    diag2 = float(np.sum(v * v * df_k / (df_k + 2.0)))
+    diag_var = float(np.sum(v * v / df_k))
+    pairs2 = pairs_var = 0.0
+    if rho2 is not None and len(v) > 1:
+        off = np.array(rho2, float)
+        np.fill_diagonal(off, 0.0)
+        vv = np.outer(v, v)
+        pairs2 = float(np.sum(vv * off))
+        pairs_var = float(np.sum(vv * off / np.sqrt(np.outer(df_k, df_k))))
+    # pairs that look less correlated than independent bins (noise) never count fewer
+    # than the bins alone
+    total2 = min(diag2 + max(0.0, pairs2), total * total)
     k_e = min(total * total / total2, float(len(v)))
-    return k_e, total / k_e, total * total / float(np.sum(v * v / df_k))
+    return k_e, total / k_e, total * total / (diag_var + max(0.0, pairs_var))
 
 
-def norm_fail_p(runs, reference, budget: float) -> float:
+def norm_fail_p(runs, reference, budget: float, bins: str = BINS_INDEPENDENT) -> float:
     """The p-value of the profile's fail test (H0: true relative distance <= ``budget``):
     the chance, at a distance exactly on the budget, of a bins' F ratio at least the
     observed one (its lower bound exceeds the budget exactly when this is below alpha).
@@ -314,18 +365,20 @@ def norm_fail_p(runs, reference, budget: float) -> float:
     ss = float(np.sum(d * d))
     if not float(np.sum(v)) > 0:
         return 0.0 if math.sqrt(ss) / ref_norm > budget else 1.0
-    k_e, c, df_e = _noncentral_shape(v, sx, sy, len(x), len(y))
+    rho2 = bin_correlation2(x, y) if bins == BINS_CORRELATED else None
+    k_e, c, df_e = _noncentral_shape(v, sx, sy, len(x), len(y), rho2)
     nc = (budget * ref_norm) ** 2 / c
     return float(min(1.0, max(0.0, 1.0 - noncentral_f_cdf((ss / c) / k_e, k_e, df_e, nc))))
 
 
 def _noncentral_bounds(ss: float, v: np.ndarray, sx: np.ndarray, sy: np.ndarray, nx: int,
-                       ny: int, alpha: float) -> tuple[float, float]:
+                       ny: int, alpha: float, rho2: np.ndarray | None = None
+                       ) -> tuple[float, float]:
     """(lower, upper) confidence bounds of ||delta||^2 from the observed sum of squared
     bin differences ``ss`` and the bins' variances ``v`` (see :func:`norm_estimate`)."""
     if not float(np.sum(v)) > 0:            # no noise at all: the distance is known
         return ss, ss
-    k_e, c, df_e = _noncentral_shape(v, sx, sy, nx, ny)
+    k_e, c, df_e = _noncentral_shape(v, sx, sy, nx, ny, rho2)
     observed = (ss / c) / k_e               # ~ noncentral F(k_e, df_e, ||delta||^2 / c)
 
     def cdf(ratio: float, nc: float) -> float:

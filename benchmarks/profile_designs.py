@@ -1,0 +1,130 @@
+"""Error rates of the velocity profile's bounds when depth bins share their errors (issue 45
+item 2), the part of ``benchmarks/bench_coverage.py --profiles`` (its pass criteria are
+registered in ``docs/results/verdict_rates/README.md`` before the run).
+
+Real profiles share a seed's error between neighbouring depth bins: on the source drum's
+studies neighbouring bins correlate at 0.91-0.92, bins 4 apart at 0.60, 8 apart at about 0
+(``docs/results/profile_correlation/correlation.csv``). Here that is a triangular
+correlation 1 - k / W between bins k apart (the correlation of a moving sum of W independent
+series), W read from the committed table (:func:`kernel_width`), on 16 bins: both the
+replica offsets and the AR(1) frame noise of a run are moving sums over bins of independent
+series, so a run's window mean keeps the triangular correlation. Independent bins (W = 1)
+are measured beside it with the same designs.
+
+Each cell: ``trials`` studies of a CG-n arm and a CG1 arm (equal arms 2 / 3 / 4 / 6, and 6 vs
+2 and 24 vs 3), the CG-n profile shifted by 0.3 frame sd in its 4 top bins; the budget sits
+exactly on the true relative distance, so ``pass`` (upper bound <= budget) and ``fail``
+(lower bound > budget) are both wrong. Per rule of counting bins
+(:data:`ligwf.inference.equivalence.BINS_INDEPENDENT` / ``BINS_CORRELATED``): the upper
+bound's coverage, the wrong pass and the wrong fail.
+"""
+
+from __future__ import annotations
+
+import csv
+import itertools
+import math
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks.bench_coverage import ar1_runs
+from benchmarks.verdict_designs import lower_bound
+from ligwf.inference import equivalence as eq
+
+ALPHA = eq.ALPHA
+LOW, HIGH = 0.92, 0.99
+FRAMES, PHI = 50, 0.6
+BINS = 16
+SHIFT, SHIFTED_BINS = 0.3, 4
+DESIGNS = ((2, 2), (3, 3), (4, 4), (6, 6), (6, 2), (24, 3))
+OFFSETS = (0.0, 1.0, 3.0)
+CORRELATION = (Path(__file__).resolve().parents[1] / "docs" / "results" / "profile_correlation"
+               / "correlation.csv")
+RULES = (eq.BINS_CORRELATED, eq.BINS_INDEPENDENT)
+
+
+def kernel_width(path: Path = CORRELATION) -> int:
+    """W of the triangular correlation 1 - k / W that the measured profiles give: the mean
+    of k / (1 - r_k) over the committed lags k = 1, 2, 4 of every study (lag 8 is past the
+    kernel's reach, where 1 - k / W would be negative), rounded."""
+    widths = []
+    with path.open() as f:
+        for row in csv.DictReader(f):
+            for k in (1, 2, 4):
+                widths.append(k / (1.0 - float(row[f"mean_corr_lag{k}"])))
+    return int(round(float(np.mean(widths))))
+
+
+def profile_runs(rng, trials: int, runs: int, offset: float, width: int) -> np.ndarray:
+    """(trials, runs, BINS) window means of runs whose noise (AR(1) frames plus a replica
+    offset) is a moving sum of ``width`` independent series over bins: correlation
+    1 - k / width between bins k apart, unit frame sd."""
+    raw = ar1_runs(rng, trials, runs, FRAMES, PHI, offset, (BINS + width - 1,)).mean(axis=2)
+    c = np.concatenate([np.zeros(raw.shape[:-1] + (1,)), np.cumsum(raw, axis=-1)], axis=-1)
+    return (c[..., width:] - c[..., :-width]) / math.sqrt(width)
+
+
+def profile_cells(rng, trials: int, width: int) -> list[dict]:
+    """One row per (bins' correlation, design, offset) with each rule's coverage and errors;
+    both rules decide the same studies."""
+    shift = np.zeros(BINS)
+    shift[:SHIFTED_BINS] = SHIFT
+    out = []
+    for w, (nx, ny), offset in itertools.product((width, 1), DESIGNS, OFFSETS):
+        a = profile_runs(rng, trials, nx, offset, w) + 1.0 + shift
+        b = profile_runs(rng, trials, ny, offset, w) + 1.0
+        # the truth is relative to the reference's true mean profile (all ones)
+        truth = float(np.sqrt(np.sum(shift ** 2)) / math.sqrt(BINS))
+        row = {"bins": "correlated" if w > 1 else "independent", "design": f"{nx} vs {ny}",
+               "offset": offset}
+        for rule in RULES:
+            cover = wrong_pass = wrong_fail = 0
+            for i in range(trials):
+                e = eq.norm_estimate(a[i], b[i], ALPHA, bins=rule)
+                cover += e.hi >= truth
+                state = eq.norm_decision(e, truth)
+                wrong_pass += state == eq.PASS
+                wrong_fail += state == eq.FAIL
+            row[rule] = {"cover": cover / trials, "wrong pass": wrong_pass / trials,
+                         "wrong fail": wrong_fail / trials}
+        out.append(row)
+    return out
+
+
+def report(rng, trials: int) -> int:
+    """Print every cell and the registered checks; the number of checks that fail."""
+    width = kernel_width()
+    print(f"profile bounds with shared bin errors: {BINS} bins, triangular correlation "
+          f"1 - k / {width} (from {CORRELATION.relative_to(CORRELATION.parents[3])}), "
+          f"{trials} studies a cell, budget on the true distance")
+    print(f"{'bins':>11} {'design':>8} {'offset':>6} | rule correlated: {'cover':>6} "
+          f"{'w.pass':>7} {'w.fail':>7} | rule independent: {'cover':>6} {'w.pass':>7} "
+          f"{'w.fail':>7}")
+    cells = profile_cells(rng, trials, width)
+    for c in cells:
+        n, i = c[eq.BINS_CORRELATED], c[eq.BINS_INDEPENDENT]
+        print(f"{c['bins']:>11} {c['design']:>8} {c['offset']:6.1f} | {'':16} "
+              f"{n['cover']:6.3f} {n['wrong pass']:7.4f} {n['wrong fail']:7.4f} | "
+              f"{'':17} {i['cover']:6.3f} {i['wrong pass']:7.4f} {i['wrong fail']:7.4f}",
+              flush=True)
+    failed = 0
+    for bins, number in (("correlated", 1), ("independent", 3)):
+        rows = [c[eq.BINS_CORRELATED] for c in cells if c["bins"] == bins]
+        cover = [r["cover"] for r in rows]
+        inside = sum(LOW <= v <= HIGH for v in cover)
+        rates = [r[k] for r in rows for k in ("wrong pass", "wrong fail")]
+        above = sum(lower_bound(v, trials) > ALPHA for v in rates)
+        ok_cover, ok_rates = inside == len(cover), above == 0
+        print(f"check {number} ({bins} bins, rule correlated) coverage: {inside} of "
+              f"{len(cover)} cells in [{LOW}, {HIGH}] ({min(cover):.3f}-{max(cover):.3f}): "
+              f"{'holds' if ok_cover else 'FAILS'}")
+        print(f"check {number + 1} ({bins} bins, rule correlated) wrong pass and fail: at most "
+              f"{max(rates):.4f}; {above} of {len(rates)} shown above {ALPHA}: "
+              f"{'holds' if ok_rates else 'FAILS'}")
+        failed += (not ok_cover) + (not ok_rates)
+    old = [c[eq.BINS_INDEPENDENT]["cover"] for c in cells if c["bins"] == "correlated"]
+    print(f"beside (not a check): rule independent on correlated bins covers "
+          f"{min(old):.3f}-{max(old):.3f}")
+    print(f"summary: {4 - failed} of 4 registered checks hold")
+    return failed
