@@ -32,8 +32,11 @@ from helpers import ROOT  # noqa: E402
 
 WORKFLOW = ROOT / "tests" / "workflows" / "runner_tiny.yaml"
 # longer settling and production than the runner tests, so each phase can be hit on purpose
+# production long enough that a kill 0.5 s into it lands well before its end on a fast
+# machine too: at 0.5 s of simulated time a CI runner finished the last 3,900 steps between
+# the kill of ligwf and its watchdog, and the case ended one attempt early
 LONGER = ["--set", "sweep.rules=[weber]", "--set", "scene.process.settle_time=0.2",
-          "--set", "scene.process.run_time=0.5"]
+          "--set", "scene.process.run_time=2.0"]
 CASE = "cg3-weber-r0"
 pytestmark = [pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
 
