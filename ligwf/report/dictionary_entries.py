@@ -93,8 +93,10 @@ COMMON: tuple[tuple[str, ...], ...] = (
      "mean) of the rms speed over the steady frames"),
     ("kinetic_energy_mean", "J", "kinetic energy", "kinetic energy of the bed, mean over the "
      "steady window"),
-    ("flowing_layer_thickness_mean", "m", "flowing layer", "thickness of the flowing layer "
-     "(where the velocity profile changes sign), mean over the steady window", "mm"),
+    ("flowing_layer_thickness_mean", "m", "flowing layer", "mass-equivalent thickness of the "
+     "flowing layer (the grains above the depth where the velocity profile changes sign, "
+     "over the packing of the bed below it: no fitted surface in it, so the same layer reads "
+     "the same at every grain size), mean over the steady window", "mm"),
     ("flowing_layer_speed_mean", "m/s", "flowing-layer speed", "mean speed in the flowing layer"),
     # granules
     ("contacts", "count", "contacts", "particle-particle contacts and bridges in the contact "

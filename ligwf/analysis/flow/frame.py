@@ -14,8 +14,14 @@ is averaged out). Per frame:
   ``PROFILE_HALF_WIDTH`` x drum radius around the line (the same physical width at every
   CG level), their velocity along the downhill surface direction (positive in the flowing
   layer, negative where the bed turns with the drum), averaged in ``PROFILE_BINS`` bins.
-- flowing layer: from the surface down to where that velocity changes sign; its thickness
-  (m) and mean speed.
+- flowing layer: the grains above the first depth where that velocity changes sign (the
+  zero crossing interpolated between the bins' mean particle depths, not their centres: a
+  bin holding one or two rows of coarse grains has its mean depth off its centre); its
+  thickness (m) is mass-equivalent: the layer's grain volume in the band over the band's
+  width times the packing of the bed below the crossing (its grain volume over the band's
+  area from the crossing to the drum wall, the wall one grain radius in for centres), so
+  the fitted surface, whose height above the grains grows with their size, does not enter;
+  and their mean speed.
 - rigid-block fraction: share of particles whose velocity is within ``rigid_tolerance``
   x (omega R) of the drum's rigid rotation omega x r. A frame with more than 90 % of the
   bed co-rotating is a *rigid frame* (the bed is carried up as one block: slumping).
@@ -31,6 +37,7 @@ The report's flow metrics are registered in :mod:`ligwf.analysis.flow.registry`.
 
 from __future__ import annotations
 
+import math
 import warnings
 from dataclasses import asdict, dataclass, field
 
@@ -147,7 +154,12 @@ def frame_flow(frame: ParticleFrame, geo: DrumGeometry, rigid_tolerance: float =
         sums = np.bincount(idx, weights=down, minlength=PROFILE_BINS)
         cnt = np.bincount(idx, minlength=PROFILE_BINS)
         prof = np.where(cnt > 0, sums / np.maximum(cnt, 1), np.nan)
-        thickness, layer_speed = _flowing_layer(centres, prof, xi, down, depth)
+        mean_xi = np.where(cnt > 0, np.bincount(idx, weights=xi, minlength=PROFILE_BINS)
+                           / np.maximum(cnt, 1), np.nan)
+        band = _Band(PROFILE_HALF_WIDTH * geo.radius, geo.radius - float(np.mean(r)),
+                     surf.offset, depth)
+        thickness, layer_speed = _flowing_layer(mean_xi, prof, xi, down,
+                                                frame.volumes[near], band)
     return FrameFlow(step=frame.step, time=frame.time,
                      angle_of_repose=surf.angle_deg if surf else float("nan"),
                      com_angle=com_angle, rigid_fraction=rigid, rms_speed=rms,
@@ -156,10 +168,32 @@ def frame_flow(frame: ParticleFrame, geo: DrumGeometry, rigid_tolerance: float =
                      profile_s=centres, profile_v=prof)
 
 
-def _flowing_layer(centres, prof, xi, down, depth) -> tuple[float, float]:
-    """Thickness (m) and mean speed (m/s) of the layer above the first reversal of the
-    downhill velocity below the surface; nan when the profile does not reverse."""
-    filled = np.flatnonzero(np.isfinite(prof))
+@dataclass(frozen=True)
+class _Band:
+    """The profile's band in the surface's frame: half-width (m), the radius the grains'
+    centres reach (m), the surface's offset from the drum axis and the bed depth on the
+    centre line (m)."""
+
+    half_width: float
+    centre_radius: float
+    offset: float
+    depth: float
+
+    def area_below(self, level: float) -> float:
+        """Area (m^2) of the band between the height ``level`` (from the axis, along the
+        surface normal) and the circle the grains' centres reach."""
+        w, rc = self.half_width, self.centre_radius
+        if w >= rc:
+            return float("nan")
+        chord = w * math.sqrt(rc * rc - w * w) + rc * rc * math.asin(w / rc)
+        return 2.0 * w * level + chord
+
+
+def _flowing_layer(mean_xi, prof, xi, down, volumes, band: _Band) -> tuple[float, float]:
+    """Mass-equivalent thickness (m) and mean speed (m/s) of the layer above the first
+    reversal of the downhill velocity below the surface (module docstring); nan when the
+    profile does not reverse or no grain lies below the reversal."""
+    filled = np.flatnonzero(np.isfinite(prof) & np.isfinite(mean_xi))
     if len(filled) < 2 or prof[filled[0]] <= 0:
         return float("nan"), float("nan")
     below = filled[prof[filled] <= 0]
@@ -167,10 +201,16 @@ def _flowing_layer(centres, prof, xi, down, depth) -> tuple[float, float]:
         return float("nan"), float("nan")
     k = below[0]
     above = filled[filled < k][-1]
-    # linear zero crossing between the last flowing bin and the first reversed one
-    zero = centres[above] + (centres[k] - centres[above]) * prof[above] / (prof[above] - prof[k])
+    # linear zero crossing between the last flowing bin and the first reversed one, each at
+    # the mean depth of its particles
+    zero = mean_xi[above] + ((mean_xi[k] - mean_xi[above]) * prof[above]
+                             / (prof[above] - prof[k]))
     layer = xi < zero
-    return float(zero * depth), float(np.mean(np.abs(down[layer]))) if layer.any() else float("nan")
+    speed = float(np.mean(np.abs(down[layer]))) if layer.any() else float("nan")
+    packed = float(np.sum(volumes[~layer])) / band.area_below(band.offset - zero * band.depth)
+    if not packed > 0:
+        return float("nan"), speed
+    return float(np.sum(volumes[layer])) / (packed * 2.0 * band.half_width), speed
 
 
 @dataclass(frozen=True)

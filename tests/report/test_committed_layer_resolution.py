@@ -1,0 +1,33 @@
+"""docs/results/layer_resolution (issue 44 item 1): the README and levels.csv are what the
+committed per-run table gives (the script's --check), and what the README says of them."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pandas as pd
+
+from tests.helpers import ROOT
+
+HERE = ROOT / "docs" / "results" / "layer_resolution"
+
+
+def test_readme_and_levels_are_the_committed_runs():
+    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "layer_resolution.py"),
+                        "--check"], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def test_every_coarser_level_moves_less_from_the_finest_today():
+    lv = pd.read_csv(HERE / "levels.csv")
+    frames = pd.read_csv(HERE / "frames.csv")
+    assert set(lv.study) == {"liquid_spreading", "paper_scale_cg"}
+    assert (frames.frames > 0).all() and frames.today_mm.notna().all()
+    coarse = lv[lv.cg > lv.reference_cg]
+    assert len(coarse) == 4
+    assert (coarse.today_minus_finest_mm.abs() < coarse.former_minus_finest_mm.abs()).all()
+    # the former estimator read every coarser level thicker than its finest
+    assert (coarse.former_minus_finest_mm > 1.0).all()
+    text = " ".join((HERE / "README.md").read_text().split())
+    assert f"In {len(coarse)} of {len(coarse)} coarser levels" in text
