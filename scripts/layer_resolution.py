@@ -108,6 +108,9 @@ def levels(frames: pd.DataFrame) -> pd.DataFrame:
             out.append({"study": study, "cg": cg, "rule": rule, "runs": len(g),
                         "d_mm": g.d_mm.iloc[0], "reference_cg": float(finest.cg.iloc[0]),
                         "former_mm": g.former_mm.mean(), "today_mm": g.today_mm.mean(),
+                        # the null beside each difference: how far runs of one level spread
+                        "former_sd_mm": g.former_mm.std(ddof=1),
+                        "today_sd_mm": g.today_mm.std(ddof=1),
                         "former_minus_finest_mm": g.former_mm.mean() - ref_old,
                         "today_minus_finest_mm": g.today_mm.mean() - ref_new,
                         "moved_mm": g.today_mm.mean() - g.former_mm.mean()})
@@ -131,12 +134,15 @@ def readme(folder: ResultsFolder) -> str:
              "no surface in it). `levels.csv` is derived from it. Synthetic beds of one flow "
              "at 1-3 mm grains (`tests/analysis/flow/test_layer_resolution.py`) show why: the "
              "former read the surface's height above the grains into the layer.", "",
-             "| study | CG | rule | runs | d [mm] | former [mm] | today [mm] | moved [mm] | "
+             "The null beside each difference: the seed-to-seed standard deviation of the "
+             "runs of each level (3 seeds a level), under each estimator.", "",
+             "| study | CG | rule | runs | d [mm] | former [mm] (sd) | today [mm] (sd) | moved [mm] | "
              "former - finest [mm] | today - finest [mm] |",
              "|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in lv.iterrows():
         lines.append(f"| {r.study} | {r.cg:g} | {r.rule} | {int(r.runs)} | {number(r.d_mm)} | "
-                     f"{number(r.former_mm)} | {number(r.today_mm)} | {number(r.moved_mm, 2)} | "
+                     f"{number(r.former_mm)} ({number(r.former_sd_mm, 2)}) | "
+                     f"{number(r.today_mm)} ({number(r.today_sd_mm, 2)}) | {number(r.moved_mm, 2)} | "
                      f"{number(r.former_minus_finest_mm, 2)} | "
                      f"{number(r.today_minus_finest_mm, 2)} |")
     coarse = lv[lv.cg > lv.reference_cg]
