@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import errno
 import fcntl
+import hashlib
 import json
+import math
 import os
 import stat
 import tempfile
@@ -145,6 +147,28 @@ def atomic_write_text(path: Path, text: str) -> None:
 def atomic_write_json(path: Path, obj: Any) -> None:
     """Write ``obj`` as indented, key-sorted JSON to ``path`` atomically."""
     atomic_write_text(path, json.dumps(obj, indent=2, sort_keys=True) + "\n")
+
+
+def file_sha256(path: Path) -> str:
+    """SHA-256 of a file (hex), read in 1 MiB blocks: the one digest of a file's bytes
+    (case records, dump records, restart ids, the report's file record)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(1 << 20):
+            h.update(block)
+    return h.hexdigest()
+
+
+def json_safe(obj: Any) -> Any:
+    """``obj`` with every non-finite float replaced by None, through dicts, lists and
+    tuples (tuples become lists): what a JSON record stores, never NaN or Infinity."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    return obj
 
 
 def overwrite_in_place(path: Path, text: str) -> None:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ligwf.study import layout
-from ligwf.study.case import file_digest
+from ligwf.fsio import file_sha256
 
 def is_series_dir(path: Path) -> bool:
     """Whether ``path`` is a per-case granule series folder written by the analysis (it
@@ -61,7 +61,7 @@ class OutputSet:
         the set (the tables; the per-case series are not listed)."""
         if not self.stage.is_dir():
             return {}
-        return {p.name: [p.stat().st_size, file_digest(p)] for p in sorted(self.stage.iterdir())
+        return {p.name: [p.stat().st_size, file_sha256(p)] for p in sorted(self.stage.iterdir())
                 if p.is_file()}
 
     def commit(self, record_name: str, obsolete: tuple[str, ...] = ()) -> None:

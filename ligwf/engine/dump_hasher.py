@@ -23,7 +23,8 @@ import re
 import threading
 from pathlib import Path
 
-from ligwf.study.case import KnownDigests, file_digest, file_identity
+from ligwf.fsio import file_sha256
+from ligwf.study.case import KnownDigests, file_identity
 
 #: ``<series>_<step>.vtu`` / ``.vtr``: the dump file names LIGGGHTS writes into post/
 _DUMP = re.compile(r"^(?P<series>.+)_(?P<step>\d+)\.vt[ur]$")
@@ -72,7 +73,7 @@ def hash_if_unchanged(path: Path) -> tuple[tuple[int, int, int], str] | None:
     if before is None:
         return None
     try:
-        digest = file_digest(path)
+        digest = file_sha256(path)
     except OSError:
         return None
     return (before, digest) if file_identity(path) == before else None

@@ -21,7 +21,6 @@ written by this case under ligwf: it is never used.
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
 import time
@@ -29,7 +28,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ligwf.engine.liggghts import restart_step
-from ligwf.fsio import FolderNotWritable, atomic_write_json
+from ligwf.fsio import FolderNotWritable, atomic_write_json, file_sha256
 from ligwf.study.layout import FORCED_RESTART_RE, PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX
 
 #: a file the engine changed less than this many seconds ago may still be being written:
@@ -69,14 +68,6 @@ def restart_paths(case_dir: Path) -> list[Path]:
     return found
 
 
-def _digest(path: Path) -> str:
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        while block := fh.read(1 << 20):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _read(path: Path) -> dict | None:
     try:
         data = json.loads(sidecar(path).read_text())
@@ -110,7 +101,7 @@ def stamp(case_dir: Path, identity: CaseIdentity, attempt: int, since: float,
         if step is None:
             continue
         record = {**identity.to_dict(), "step": step, "attempt": int(attempt),
-                  "size": st.st_size, "mtime_ns": st.st_mtime_ns, "sha256": _digest(path)}
+                  "size": st.st_size, "mtime_ns": st.st_mtime_ns, "sha256": file_sha256(path)}
         try:
             atomic_write_json(sidecar(path), record)
         except (FolderNotWritable, OSError):
@@ -136,7 +127,7 @@ def why_not_own(path: Path, identity: CaseIdentity, max_step: int | None) -> str
         return "gone"
     if size != rec.get("size"):
         return f"{size} bytes, {rec.get('size')} when written (truncated or replaced)"
-    if _digest(path) != rec.get("sha256"):
+    if file_sha256(path) != rec.get("sha256"):
         return "content differs from what the engine wrote (SHA-256 mismatch)"
     step = restart_step(path)
     if step is None or step != rec.get("step"):

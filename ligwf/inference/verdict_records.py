@@ -13,21 +13,11 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf.inference.equivalence import ALPHA, WELCH
-from ligwf.fsio import atomic_write_json, atomic_write_text
+from ligwf.fsio import atomic_write_json, atomic_write_text, json_safe
 from ligwf.inference.registry import CriterionResult
 from ligwf.inference.verdict import ConditionVerdict, GroupVerdict, Verdict, decide, granule_gates
 from ligwf.scene.accept import AcceptSettings
 from ligwf.study import layout
-
-
-def _clean(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    return obj
 
 
 def verdict_rows(verdict: Verdict) -> pd.DataFrame:
@@ -57,8 +47,8 @@ def verdict_rows(verdict: Verdict) -> pd.DataFrame:
 
 def write_verdict(verdict: Verdict, out: Path) -> None:
     """``verdict.csv`` and ``verdict.json`` into the report folder ``out`` (atomically)."""
-    record = {"accept": verdict.accept, "statistics": _clean(verdict.statistics), "groups": [
-        {**_clean(asdict(g)), "conditions": [{**_clean(asdict(c)), "state": c.state,
+    record = {"accept": verdict.accept, "statistics": json_safe(verdict.statistics), "groups": [
+        {**json_safe(asdict(g)), "conditions": [{**json_safe(asdict(c)), "state": c.state,
                                               "name": c.name} for c in g.conditions]}
         for g in verdict.groups]}
     atomic_write_text(out / layout.VERDICT_TABLE, verdict_rows(verdict).to_csv(index=False))

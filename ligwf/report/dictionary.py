@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 from ligwf.inference.budget import criteria
+from ligwf.inference.field_errors import FIELD_ERRORS
 from ligwf.report.dictionary_entries import COMMON, OVERRIDES
 from ligwf.inference.spreading import LEVEL_COLUMNS as SPREADING_COLUMNS
 from ligwf.study import layout
@@ -96,8 +97,6 @@ POOLED = ("_mean", "_min", "_max", "_nan_pools")
 FLOW_METRICS = ("angle_of_repose", "angle_of_repose_std", "angle_error", "profile_error",
                 "rigid_frame_share", "rms_speed_rel_fluctuation", "flowing_layer_thickness_mean")
 GRANULE_METRICS = ("largest_cluster_fraction", "one_granule_frame_share")
-#: the flow-field errors the report adds (ligwf.inference.field_errors.FIELD_ERRORS)
-FIELD_ERRORS = ("field_error", "field_solid_error")
 #: the field criterion at each reported kernel width (field_errors.KERNEL_COLUMNS)
 FIELD_KERNEL_ERRORS = ("field_error_k1", "field_error_k2", "field_error_k4")
 #: the field criterion's noise pieces, from which its replica plan is made

@@ -6,11 +6,10 @@ analysis tables."""
 
 from __future__ import annotations
 
-import hashlib
 import json
 from pathlib import Path
 
-from ligwf.fsio import atomic_write_json
+from ligwf.fsio import atomic_write_json, file_sha256
 from ligwf.study.layout import REPORT_FILES_RECORD
 
 #: the record, in the report folder (never listed in itself)
@@ -19,11 +18,7 @@ DIGEST_RECORD = REPORT_FILES_RECORD
 
 def file_digest(path: Path) -> dict:
     """``{"size": bytes, "sha256": hex}`` of one file."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return {"size": path.stat().st_size, "sha256": h.hexdigest()}
+    return {"size": path.stat().st_size, "sha256": file_sha256(path)}
 
 
 def record_digests(report_dir: Path) -> None:

@@ -23,7 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ligwf.errors import ConfigError
-from ligwf.fsio import atomic_write_json
+from ligwf.fsio import atomic_write_json, file_sha256
 from ligwf.scene.model import Scene
 from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.scaling import scale
@@ -37,13 +37,6 @@ from ligwf.study.paths import check_case_id
 from ligwf.study.thermo_table import rows_from_csv, table_problem
 
 
-def file_digest(path: Path) -> str:
-    """SHA-256 of a file (hex), read in 1 MiB blocks."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        while block := fh.read(1 << 20):
-            h.update(block)
-    return h.hexdigest()
 
 
 def file_identity(path: Path) -> tuple[int, int, int] | None:
@@ -69,7 +62,7 @@ class KnownDigests:
         known = self.files.get(path.name)
         if known is not None and known[0] == file_identity(path):
             return known[1]
-        return file_digest(path)
+        return file_sha256(path)
 
 
 NO_DIGESTS = KnownDigests({})
@@ -93,7 +86,7 @@ class DumpRecord:
         size = path.stat().st_size
         if size != entry[0]:
             return f"{path}: {size} bytes, the run left {entry[0]} (truncated or replaced)"
-        if file_digest(path) != entry[1]:
+        if file_sha256(path) != entry[1]:
             return (f"{path}: content differs from the dump the run left (SHA-256 mismatch: "
                     "edited, corrupted or copied from another run)")
         return None
@@ -181,7 +174,7 @@ def _analysed_digest(record: Path) -> str:
         files = json.loads(record.read_text())["files"]
         kept = {k: v for k, v in files.items() if ANALYSED_DUMP_RE.match(k)}
     except (OSError, ValueError, KeyError, TypeError, AttributeError):
-        return file_digest(record)
+        return file_sha256(record)
     return hashlib.sha256(json.dumps(kept, sort_keys=True).encode()).hexdigest()
 
 

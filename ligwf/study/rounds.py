@@ -20,12 +20,11 @@ sequential study decides at that level from its first look on.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ligwf.errors import ConfigError
-from ligwf.fsio import atomic_write_json, try_lock
+from ligwf.fsio import atomic_write_json, json_safe, try_lock
 from ligwf.study.layout import ROUNDS_FILE, ROUNDS_LOCK
 
 #: the family error rate of a study's decisions
@@ -88,16 +87,6 @@ class Rounds:
                       self.every_level)
 
 
-def _clean(obj):
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    return obj
-
-
 #: how a record written before ``stop_kind`` existed words each kind of stop
 _STOP_WORDS = (("decided", DECIDED), ("no planned way", STUCK), ("the cap of", CAPPED))
 
@@ -146,7 +135,7 @@ def write_rounds(study_path: Path, rounds: Rounds) -> None:
            "over max_looks looks (each look at alpha / max_looks), Hsu's conservative "
            "degrees of freedom (min(R1, R2) - 1)",
            "max_core_hours": rounds.max_core_hours, "every_level": rounds.every_level,
-           "looks": [_clean(asdict(x)) for x in rounds.looks]}
+           "looks": [json_safe(asdict(x)) for x in rounds.looks]}
     atomic_write_json(Path(study_path) / ROUNDS_FILE, rec)
 
 

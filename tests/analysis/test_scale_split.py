@@ -19,7 +19,8 @@ from ligwf.analysis.parts import (AnalysisIncomplete, Share, check_count, check_
                                   parse_part, read_parts, write_part)
 from ligwf.analysis.runner import AnalysisShares
 from ligwf.errors import ConfigError, DumpReadError
-from ligwf.study.case import DumpRecord, file_digest
+from ligwf.fsio import file_sha256 as file_digest
+from ligwf.study.case import DumpRecord
 
 
 @pytest.mark.parametrize("text, index, count", [("0/1", 0, 1), ("3/8", 3, 8), (" 9 / 10 ", 9, 10)])

@@ -12,7 +12,8 @@ import os
 import time
 
 from ligwf.engine.dump_hasher import DumpHasher, complete_dumps
-from ligwf.study.case import NO_DIGESTS, file_digest
+from ligwf.fsio import file_sha256 as file_digest
+from ligwf.study.case import NO_DIGESTS
 
 
 def _dump(post, name: str, body: bytes = b"x" * 1000, whole: bool = True):

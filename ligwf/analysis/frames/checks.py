@@ -46,7 +46,8 @@ import numpy as np
 from ligwf.analysis.frames.dumps import (ContactFrame, FrameFiles, ParticleFrame, dump_files,
                                          read_particles)
 from ligwf.errors import ConfigError, DumpReadError
-from ligwf.study.case import CaseFolder, DumpRecord, file_digest
+from ligwf.fsio import file_sha256
+from ligwf.study.case import CaseFolder, DumpRecord
 
 #: Relative slack of the geometric checks (float32 positions, mesh facets vs circle).
 GEOMETRY_SLACK = 0.05
@@ -188,7 +189,7 @@ def _copy_of(prev: FrameFiles | None, part: Path, record: DumpRecord | None) -> 
         a, b = record.files.get(prev.particles.name), record.files.get(part.name)
         same = a is not None and b is not None and a[1] == b[1]
     else:
-        same = file_digest(prev.particles) == file_digest(part)
+        same = file_sha256(prev.particles) == file_sha256(part)
     return prev.step if same else None
 
 

@@ -15,7 +15,8 @@ from pathlib import Path
 
 from ligwf.analysis.frames.dumps import dump_files
 from ligwf.errors import ConfigError, LigwfError
-from ligwf.study.case import file_digest, folder_fingerprint
+from ligwf.fsio import file_sha256
+from ligwf.study.case import folder_fingerprint
 
 
 class StaleAnalysis(LigwfError):
@@ -71,7 +72,7 @@ def damaged_outputs(out_dir: Path, record: dict) -> list[str]:
         if size != entry[0]:
             bad.append(f"{name}: {size} bytes, the analysis wrote {entry[0]} (truncated or "
                        "replaced)")
-        elif file_digest(path) != entry[1]:
+        elif file_sha256(path) != entry[1]:
             bad.append(f"{name}: content differs from what the analysis wrote (edited)")
     return bad
 
