@@ -36,7 +36,8 @@ sys.path.insert(0, str(ROOT))
 
 from ligwf.engine.dump_hasher import _DUMP  # noqa: E402
 from ligwf.study import case as case_module  # noqa: E402
-from ligwf.study.case import CaseFolder, file_digest  # noqa: E402
+from ligwf.fsio import file_sha256 as file_digest  # noqa: E402
+from ligwf.study.case import CaseFolder  # noqa: E402
 from ligwf.study.manifest import DONE  # noqa: E402
 
 
@@ -75,7 +76,7 @@ def run_case(workflow: Path, sets: list[str]) -> None:
 
     timed: list[tuple[float, float]] = []
     hashed: list[int] = []
-    original, digest = CaseFolder.write_manifest, case_module.file_digest
+    original, digest = CaseFolder.write_manifest, case_module.file_sha256
 
     def counting(path):
         hashed[-1] += 1
@@ -85,12 +86,12 @@ def run_case(workflow: Path, sets: list[str]) -> None:
         if manifest.status != DONE:
             return original(self, manifest, digests)
         hashed.append(0)
-        case_module.file_digest = counting
+        case_module.file_sha256 = counting
         w, c = time.perf_counter(), time.process_time()
         try:
             original(self, manifest, digests)
         finally:
-            case_module.file_digest = digest
+            case_module.file_sha256 = digest
         timed.append((time.perf_counter() - w, time.process_time() - c))
 
     CaseFolder.write_manifest = timing

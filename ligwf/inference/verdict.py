@@ -32,7 +32,6 @@ answer without a rerun. Written by :mod:`ligwf.inference.verdict_records`, shown
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 
@@ -47,7 +46,7 @@ from ligwf.inference.deciding import too_short_note
 from ligwf.inference.extrapolated import extrapolated_criteria
 from ligwf.inference.verdict_statistics import statistics_record
 from ligwf.scene.accept import AcceptSettings
-from ligwf.scene.workflow import CONTROL_KEY
+from ligwf.study.group import SweepGroup
 
 #: condition states
 MEETS, FAILS = "meets the budget", "fails"
@@ -101,11 +100,7 @@ class Verdict:
 
 def is_control_group(group: str) -> bool:
     """A group of control twins (its swept values hold the control key)."""
-    try:
-        varied = json.loads(group)
-    except (TypeError, ValueError):
-        return False
-    return isinstance(varied, dict) and CONTROL_KEY in varied
+    return SweepGroup.parse(group).control is not None
 
 
 # ------------------------------------------------------------------ groups and the sentence

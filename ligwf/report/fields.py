@@ -19,7 +19,6 @@ difference should be found. The report shows what it measured and asserts nothin
 
 from __future__ import annotations
 
-import json
 import math
 import zipfile
 from pathlib import Path
@@ -40,9 +39,9 @@ from ligwf.analysis.records.provenance import StaleAnalysis
 from ligwf.fsio import atomic_write_text
 from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.inference.uncertainty import mark
-from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study import layout
 from ligwf.study.case import group_label
+from ligwf.study.group import SweepGroup
 from ligwf.study.study import Study
 
 #: what each field error is called in the report
@@ -169,14 +168,8 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
 def _wet_group(group: str) -> str | None:
     """The sweep group of the wet cases a cohesionless twin's group controls (None for a
     group that is not a cohesionless control)."""
-    try:
-        varied = json.loads(group)
-    except (TypeError, ValueError):
-        return None
-    if not isinstance(varied, dict) or varied.get(CONTROL_KEY) != COHESIONLESS:
-        return None
-    varied.pop(CONTROL_KEY)
-    return json.dumps(varied, sort_keys=True) if varied else "{}"
+    parsed = SweepGroup.parse(group)
+    return parsed.wet.text if parsed.control == COHESIONLESS else None
 
 
 def twin_cases(cases: pd.DataFrame) -> dict[str, list[str]]:

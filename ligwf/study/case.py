@@ -29,6 +29,7 @@ from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.scaling import scale
 from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.extension import extension_steps
+from ligwf.study.group import SweepGroup
 from ligwf.study.layout import (ANALYSED_DUMP_RE, DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME,
                                 POST_DIR, SCENE_FILE, SCREEN_FILE, THERMO_FILE)
 from ligwf.study.made_from import edit_summary, record_edits
@@ -191,31 +192,15 @@ def granules_absent(scaled: ScaledScene) -> str | None:
 
 def group_of(varied: dict[str, Any]) -> str:
     """The sweep group of a case: its swept scene values as canonical JSON (cases of one
-    group are compared with the CG1 cases of the same group)."""
-    return json.dumps(varied, sort_keys=True)
-
-
-#: the readable name of a group with no swept scene value
-ALL_CASES = "all cases"
+    group are compared with the CG1 cases of the same group; :class:`SweepGroup`)."""
+    return SweepGroup.of(varied).text
 
 
 def group_label(group: str) -> str:
-    """The sweep group as a reader names it: ``all cases`` (nothing swept), the swept
-    values as ``key=value`` (``process.rotation.rpm=20``), and a control twin's group as
-    ``cohesionless control`` (``cohesionless control, process.rotation.rpm=20``); text
-    that is not a group record is returned as it is."""
-    try:
-        varied = json.loads(group)
-    except (TypeError, ValueError):
-        return str(group)
-    if not isinstance(varied, dict):
-        return str(group)
-    control = varied.pop(CONTROL_KEY, None)
-    parts = [f"{key}={value:g}" if isinstance(value, float) else f"{key}={value}"
-             for key, value in varied.items()]
-    if control is not None:
-        return ", ".join([f"{control} control", *parts])
-    return ", ".join(parts) or ALL_CASES
+    """The sweep group as a reader names it (:attr:`ligwf.study.group.SweepGroup.label`):
+    ``all cases``, ``key=value``, ``cohesionless control, key=value``; text that is not a
+    group record is returned as it is."""
+    return SweepGroup.parse(group).label
 
 
 @dataclass(frozen=True)

@@ -105,7 +105,7 @@ def test_each_dump_is_hashed_once_per_analysis_and_again_when_changed(tmp_path, 
         calls.append(path)
         return file_digest(path)
 
-    monkeypatch.setattr(case_module, "file_digest", counting)
+    monkeypatch.setattr(case_module, "file_sha256", counting)
     ff = FrameFiles(10, dump, None)
     plan.check_record(ff)
     plan.check_record(ff)

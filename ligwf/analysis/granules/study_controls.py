@@ -13,15 +13,14 @@ pre-registered criteria (:mod:`ligwf.analysis.granules.control_verdict`). The ta
 
 from __future__ import annotations
 
-import json
 
 import pandas as pd
 
 from ligwf.analysis.granules.control_run import DEFAULT_CANDIDATES, control_rows, load_series, summarise
 from ligwf.analysis.granules.control_verdict import verdict
 from ligwf.scene.settings import AnalysisSettings
-from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.case import CaseFolder
+from ligwf.study.group import SweepGroup
 
 #: the ``varied`` value (under CONTROL_KEY) of a cohesionless twin
 COHESIONLESS = "cohesionless"
@@ -29,24 +28,19 @@ COHESIONLESS = "cohesionless"
 FLOW_MATCHED = "flow_matched"
 
 
-def _varied(case: CaseFolder) -> dict:
-    return json.loads(case.group)
-
-
 def control_pairs(cases: list[CaseFolder]) -> list[tuple[CaseFolder, CaseFolder]]:
     """(wet case, its twin) for every control twin (cohesionless or flow-matched) whose wet
     case is among ``cases``, in case order."""
     wet = {}
     for c in cases:
-        v = _varied(c)
-        if CONTROL_KEY not in v:
-            wet[(json.dumps(v, sort_keys=True), c.cg, c.rule, c.replica)] = c
+        group = SweepGroup.parse(c.group)
+        if group.control is None:
+            wet[(group.text, c.cg, c.rule, c.replica)] = c
     out = []
     for c in cases:
-        v = _varied(c)
-        if v.get(CONTROL_KEY) in (COHESIONLESS, FLOW_MATCHED):
-            v.pop(CONTROL_KEY)
-            w = wet.get((json.dumps(v, sort_keys=True), c.cg, c.rule, c.replica))
+        group = SweepGroup.parse(c.group)
+        if group.control in (COHESIONLESS, FLOW_MATCHED):
+            w = wet.get((group.wet.text, c.cg, c.rule, c.replica))
             if w is not None:
                 out.append((w, c))
     return out
@@ -72,7 +66,7 @@ def study_controls(cases: list[CaseFolder], definition: AnalysisSettings,
         t0 = (steady_from or {}).get(wet.case_id, 0.5)
         sw = summarise(control_rows(load_series(wet.path), cands, steady_from=t0))
         st = summarise(control_rows(load_series(twin.path), cands, steady_from=t0))
-        kind = _varied(twin).get(CONTROL_KEY, COHESIONLESS)
+        kind = SweepGroup.parse(twin.group).control or COHESIONLESS
         for (_, w), (_, t) in zip(sw.iterrows(), st.iterrows()):
             ok, sentence = verdict(w.to_dict(), t.to_dict(), w["definition"], kind)
             row = {"case_id": wet.case_id, "twin_id": twin.case_id, "definition": w["definition"],
