@@ -87,11 +87,11 @@ def profile_plan(x: np.ndarray, y: np.ndarray, tolerance: float, alpha: float,
     """The fewest replicas added to each arm (the same number, the profile's noise is both
     arms') whose predicted bounds would decide the profile criterion."""
     out: dict = {}
-    width = eq.norm_estimate(x, y, alpha)
+    width = eq.norm_estimate(x, y, alpha, bins=eq.PROFILE_BINS)
     width = width.hi - width.lo
     hours = lambda k: k * (costs[0] + costs[1]) / 3600.0   # noqa: E731
     for k in range(1, sampling.MOST_REPLICAS - max(len(x), len(y)) + 1):
-        p = eq.norm_estimate(x, y, alpha, add=(k, k))
+        p = eq.norm_estimate(x, y, alpha, add=(k, k), bins=eq.PROFILE_BINS)
         if not p.has_interval:
             break
         if not out.get("round_by") and p.hi - p.lo <= 0.5 * width:

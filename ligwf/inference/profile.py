@@ -43,7 +43,8 @@ def decide_profile(spec: Criterion, tolerance: float, level: LevelData) -> Decis
         xa = ya = np.array([])
     costs = (replica_cost(level.runs, level.noise), replica_cost(level.ref_runs, level.noise))
     r = profile_result(spec, tolerance, xa, ya, level.alpha, costs)
-    p = eq.norm_fail_p(xa, ya, tolerance) if r.assessed and math.isfinite(r.lo) else math.nan
+    p = (eq.norm_fail_p(xa, ya, tolerance, eq.PROFILE_BINS)
+         if r.assessed and math.isfinite(r.lo) else math.nan)
     return Decision(r, p)
 
 
@@ -53,7 +54,7 @@ def profile_result(spec: Criterion, tolerance: float, x: np.ndarray, y: np.ndarr
     """The noise-corrected distance and its bounds against the tolerance (``costs``:
     core-seconds of a replica of each arm, for what would decide it)."""
     base = spec.base(tolerance)
-    e = eq.norm_estimate(x, y, alpha)
+    e = eq.norm_estimate(x, y, alpha, bins=eq.PROFILE_BINS)
     if not math.isfinite(e.value):
         return CriterionResult(**base, state=NOT_MEASURED, note="not measured: no profiles")
     state = eq.norm_decision(e, tolerance)

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 
-from ligwf.inference.equivalence import DF_RULE_TEXT, FAIL_SIDES
+from ligwf.inference.equivalence import BINS_RULE_TEXT, DF_RULE_TEXT, FAIL_SIDES, PROFILE_BINS
 
 #: the family rule and the fail test of this version, in words
 FAMILY = ("Holm's step-down over the fail tests of every criterion the level was tested on, "
@@ -25,7 +25,8 @@ def statistics_record(alpha: float, df_rule: str) -> dict:
     """The verdict's statistics as plain values (what ``verdict.json`` stores)."""
     return {"alpha": alpha, "interval_level": 1.0 - 2.0 * alpha, "bound_level": 1.0 - alpha,
             "df_rule": df_rule, "df_text": DF_RULE_TEXT.get(df_rule, df_rule),
-            "fail_test": FAIL_TEST[FAIL_SIDES], "family": FAMILY}
+            "fail_test": FAIL_TEST[FAIL_SIDES], "family": FAMILY,
+            "profile_bins": PROFILE_BINS, "profile_bins_text": BINS_RULE_TEXT[PROFILE_BINS]}
 
 
 def _pct(x: float) -> str:
@@ -47,7 +48,9 @@ def method_text(stats: dict) -> str:
             f"{stats['fail_test']}, rejects at {_pct(a)}; a share whose runs all read 0 in "
             f"an arm is bounded over its runs (rule of three) instead. The velocity profile "
             f"is the distance of the mean profiles less the noise of both arms, with "
-            f"one-sided {_pct(stats['bound_level'])} noncentral-F bounds. A level meets the "
+            f"one-sided {_pct(stats['bound_level'])} noncentral-F bounds"
+            + (f" ({stats['profile_bins_text']})" if stats.get("profile_bins_text") else "")
+            + ". A level meets the "
             f"budget when every criterion it was assessed on passes, and fails when one "
             f"fails after {stats['family']}.")
 

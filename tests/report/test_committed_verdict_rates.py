@@ -146,3 +146,30 @@ def test_third_run_numbers_are_its_file():
                           ("check cheapest level disclosed: at most ([\\d.]+)",
                            "meets in at most {} of studies")):
         assert quoted.format(re.search(label, text).group(1)) in README, label
+
+
+def test_profile_bins_run_is_what_the_readme_says():
+    """profiles.txt (bench_coverage --profiles, registered before it): the registered
+    command, its four check lines as the README reports them, and the numbers quoted."""
+    text = (HERE / "profiles.txt").read_text()
+    registered = re.search(r"^    (nice -n 19 .*--profiles.*) > docs/results/verdict_rates/"
+                           r"profiles.txt$", (HERE / "README.md").read_text(), re.M).group(1)
+    assert text.splitlines()[0].startswith("# " + registered)
+    rows = [line.split() for line in text.splitlines() if "|" in line and " vs " in line]
+    assert len(rows) == 36
+    cells = {(r[0], r[1] + " vs " + r[3], float(r[4])): [float(v) for v in
+             (r[6], r[7], r[8], r[10], r[11], r[12])] for r in rows}
+    corr = [v for k, v in cells.items() if k[0] == "correlated"]
+    two = [v for k, v in cells.items() if k[0] == "correlated" and k[1] == "2 vs 2"]
+    rest = [v for k, v in cells.items() if k[0] == "correlated" and k[1] != "2 vs 2"]
+    indep = [v for k, v in cells.items() if k[0] == "independent"]
+    assert (min(v[0] for v in two), max(v[0] for v in two)) == (0.907, 0.914)
+    assert (min(v[0] for v in rest), max(v[0] for v in rest)) == (0.968, 0.994)
+    assert max(v[2] for v in rest) == 0.065 and max(v[1] for v in rest) <= 0.032
+    assert (min(v[3] for v in corr), max(v[3] for v in corr)) == (0.662, 0.759)
+    assert (min(v[0] for v in indep), max(v[0] for v in indep)) == (0.951, 0.983)
+    assert max(max(v[1], v[2]) for v in indep) == 0.0488
+    checks = re.findall(r"^check (\d) .*: (holds|FAILS)$", text, re.M)
+    assert checks == [("1", "FAILS"), ("2", "FAILS"), ("3", "holds"), ("4", "holds")]
+    assert "summary: 2 of 4 registered checks hold" in text
+    assert "**2 of 4 registered checks hold.**" in README
