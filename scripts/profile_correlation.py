@@ -157,8 +157,9 @@ def readme(table: pd.DataFrame) -> str:
                  + "), so bounds whose degrees of freedom count bins as independent are too "
                  "narrow." if len(below) else "independence between bins is not rejected "
                  "on these data.")
-              + " `benchmarks/bench_coverage.py`'s correlated-bin noise is to be sized from "
-              "this table.", ""]
+              + " `benchmarks/bench_coverage.py --profiles` sizes its correlated-bin noise "
+              "from this table (`benchmarks/profile_designs.py`; its result: "
+              "[verdict_rates](../verdict_rates/README.md), `profiles.txt`).", ""]
     return "\n".join(lines)
 
 
