@@ -56,6 +56,21 @@ GRANULATING_BOND = 3.0
 #: the map's runs had min_separation_ratio 1.01 (lubrication off)
 MAP_MIN_SEPARATION_RATIO = 1.01
 
+#: what the registered granule screen found with lubrication on (docs/results/granule_screen,
+#: phase 1, one seed a condition; tests/scene/test_regime.py reads these against its
+#: conditions.csv): the placed-nuclei pick's mean survival and co-movement ratio, its
+#: beads wet at the start and at the end
+SCREEN_SURVIVAL, SCREEN_COMOVEMENT = 0.30, 0.59
+SCREEN_WET_START, SCREEN_WET_END = 0.06, 1.0
+SCREEN_FINDING = (
+    "with lubrication on, the registered granule screen (docs/results/granule_screen: CG1, "
+    "2 mm beads, liquid content 0.2, 0.1 Pa s, s_min 0.02, 30 revolutions, one seed a "
+    "condition, phase 1) found no granules that pass its criteria: uniformly wet beds (washino, easo) bound into "
+    "one mass spanning the slice, and placed wet nuclei (easo) spread their liquid from "
+    f"{SCREEN_WET_START:.0%} to {SCREEN_WET_END:.0%} of the beads while their held granules "
+    f"neither survived (mean survival {SCREEN_SURVIVAL:.2f} < 0.5) nor moved together "
+    f"(co-movement {SCREEN_COMOVEMENT:.2f} > 0.5); washino with placed nuclei went unstable")
+
 
 def bridge_gap_ratio(s, radius: float) -> float:
     """x_0: where the engine's bridge between two particles of ``radius`` (m) at the case's
@@ -103,7 +118,7 @@ def granulation_warning(numbers: dict[str, float]) -> str:
     unmapped = "" if s_min >= 1.0 else (
         f" (min_separation_ratio = {s_min:g} switches the engine's lubrication on; the map "
         f"was measured with it off, {MAP_MIN_SEPARATION_RATIO:g}: its verdict there is an "
-        "extrapolation)")
+        f"extrapolation; {SCREEN_FINDING})")
     if st <= GRANULATING_ST_V and bo >= GRANULATING_BOND:
         return (f"St_v = {st:.3g}, Bo_g = {bo:.3g} is the regime map's closest point to "
                 "granulation (docs/results/granule_definitions.md): granules held for 1 s beat "

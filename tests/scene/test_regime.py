@@ -170,3 +170,29 @@ def test_dry_bed_has_no_bridge_numbers():
     n = regime_numbers(case.scaled())
     assert n["stokes_viscous"] == math.inf and n["bond_granular"] == 0.0
     assert n["viscous_path_integral"] == 0.0
+
+
+def test_lubrication_warning_quotes_the_screen_as_committed(capsys):
+    """The screen's finding in the warning (issue 47 item 4) is what the committed table
+    says: the pick's survival and co-movement, its wet share at start and end, and the
+    uniform conditions bound into one slice-spanning mass."""
+    import pandas as pd
+
+    from ligwf.scene import regime
+    from tests.helpers import ROOT
+
+    cond = pd.read_csv(ROOT / "docs" / "results" / "granule_screen" / "conditions.csv")
+    cond = cond.set_index("condition")
+    pick = cond[cond["rank"] == 1].iloc[0]
+    assert pick.name == "S3" and pick.liquid == "placed nuclei" and pick.model == "easo"
+    assert round(pick.survival, 2) == regime.SCREEN_SURVIVAL
+    assert round(pick.comove_ratio, 2) == regime.SCREEN_COMOVEMENT
+    assert round(pick.wet_share_start, 2) == regime.SCREEN_WET_START
+    assert round(pick.wet_share_end, 2) == regime.SCREEN_WET_END
+    for name in ("S2", "S4"):
+        assert cond.loc[name, "wet_mass"] and cond.loc[name, "spanning_frames"] == 1.0
+    assert cond.loc["S1", "status"] == "unstable"
+    assert main(["check", str(GRANULES), "--set", "scene.liquid.viscosity=0.1",
+                 "--set", "scene.liquid.surface_tension=0.072",
+                 "--set", "scene.liquid.min_separation_ratio=0.02"]) == 0
+    assert "found no granules that pass its criteria" in " ".join(capsys.readouterr().err.split())
