@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import sys
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -163,24 +165,31 @@ def phase2_measure(study: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFram
     phase 2 has not run. A uniform twin's case id gets the suffix ``_uniform``."""
     if not (study / PHASE2).is_dir():
         return None
-    all_rows, all_flows, runs = [], [], []
+    all_rows, all_flows, runs, done = [], [], [], []
     for folder, suffix in ((PHASE2, ""), (PHASE2_UNIFORM, "_uniform")):
         for manifest in sorted((study / folder).glob("cg1-*/manifest.json")):
             case = manifest.parent
             status, core_s, reason = status_of(case)
-            case_id = case.name + suffix
-            runs.append({"case_id": case_id, "status": status,
+            runs.append({"case_id": case.name + suffix, "status": status,
                          "reason": "" if status == "done" else reason,
                          "core_minutes": core_s / 60.0})
-            if status != "done":
-                continue
-            rows, _, flows = measure_case(case, SETTINGS, cadences=(SETTINGS.cadence,))
-            rows["case_id"], flows["case_id"] = case_id, case_id
-            all_rows.append(rows)
-            all_flows.append(flows)
+            if status == "done":
+                done.append((case, case.name + suffix))
+    # the cases are independent: two at a time (the machine's cores), in case order
+    with ProcessPoolExecutor(max_workers=min(2, os.cpu_count() or 1)) as pool:
+        measured = list(pool.map(_measure, [case for case, _ in done]))
+    for (_, case_id), (rows, flows) in zip(done, measured):
+        rows["case_id"], flows["case_id"] = case_id, case_id
+        all_rows.append(rows)
+        all_flows.append(flows)
     rows = pd.concat(all_rows) if all_rows else pd.DataFrame()
     flows = pd.concat(all_flows) if all_flows else pd.DataFrame()
     return rows, pd.DataFrame(runs), phase2_seeds(rows, flows)
+
+
+def _measure(case: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
+    rows, _, flows = measure_case(case, SETTINGS, cadences=(SETTINGS.cadence,))
+    return rows, flows
 
 
 def phase2_seeds(rows: pd.DataFrame, flows: pd.DataFrame) -> pd.DataFrame:
@@ -320,7 +329,7 @@ def make(args) -> ResultsFolder:
     if args.study is None:
         args.error("the screen's folder is required (or --check)")
     all_rows, table = [], []
-    for name in CONDITIONS:
+    for name in () if args.phase2_only else CONDITIONS:
         case = case_folder(args.study, name)
         if case is None:
             continue
@@ -330,8 +339,9 @@ def make(args) -> ResultsFolder:
         all_rows.append(rows)
         table.append(condition_row(name, rows, flows, status, core_s, reason))
     OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "growth_rows.csv").write_text(csv_text(pd.concat(all_rows)))
-    (OUT / "conditions.csv").write_text(csv_text(ranked(pd.DataFrame(table))))
+    if table:
+        (OUT / "growth_rows.csv").write_text(csv_text(pd.concat(all_rows)))
+        (OUT / "conditions.csv").write_text(csv_text(ranked(pd.DataFrame(table))))
     phase2 = phase2_measure(args.study)
     if phase2 is not None:
         rows, runs, seeds = phase2
@@ -340,8 +350,13 @@ def make(args) -> ResultsFolder:
     return FOLDER
 
 
+def arguments(ap) -> None:
+    ap.add_argument("--phase2-only", action="store_true",
+                    help="keep the committed phase-1 tables; measure phase 2 only")
+
+
 def main() -> int:
-    return results_command(__doc__, [FOLDER], make)
+    return results_command(__doc__, [FOLDER], make, arguments=arguments)
 
 
 if __name__ == "__main__":
