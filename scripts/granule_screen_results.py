@@ -145,7 +145,32 @@ def phase1_lines(cond: pd.DataFrame) -> list[str]:
     for _, r in cond[cond.status != "done"].iterrows():
         lines += [f"{r.condition} did not finish ({r.status}: {r.reason}); the registered "
                   "rule scores it 0.", ""]
-    return lines
+    lines += ["Which ingredient failed, per condition (from the table above):", ""]
+    lines += [f"- {r.condition} ({r.model}, {r.liquid}): {ingredient(r)}"
+              for _, r in cond.iterrows()]
+    return lines + [""]
+
+
+def ingredient(r) -> str:
+    """What a condition's phase-1 row says failed: no run, one wet mass, no granules,
+    granules that broke, granules that did not grow, or none of these."""
+    if r.status != "done":
+        return "the run did not reach its end (" + str(r.status) + ")"
+    wet = (f"; its beads wet went from {number(r.wet_share_start, 2)} to "
+           f"{number(r.wet_share_end, 2)}")
+    if bool(r.wet_mass):
+        return (f"no granule population: the held bridges bound the bed into one mass "
+                f"spanning the slice in {number(r.spanning_frames, 2)} of start frames "
+                f"(largest {int(r.largest)} beads){wet}")
+    if not bool(r.exists):
+        return f"no granules formed (share_10 {number(r.share_10, 2)}){wet}"
+    if not (bool(r.survives) and bool(r.comoves)):
+        grew = " while share_10 grew" if bool(r.grows) else ""
+        return (f"granules formed and broke{grew}: survival {number(r.survival, 2)}, "
+                f"co-movement {number(r.comove_ratio, 2)}{wet}")
+    if not bool(r.grows):
+        return f"granules formed and survived but did not grow{wet}"
+    return f"granules formed, survived, moved together and grew{wet}"
 
 
 
