@@ -31,3 +31,12 @@ def test_every_coarser_level_moves_less_from_the_finest_today():
     assert (coarse.former_minus_finest_mm > 1.0).all()
     text = " ".join((HERE / "README.md").read_text().split())
     assert f"In {len(coarse)} of {len(coarse)} coarser levels" in text
+
+
+def test_the_scaling_guide_quotes_the_committed_range():
+    from ligwf.api.results_folder import number
+    lv = pd.read_csv(HERE / "levels.csv")
+    coarse = lv[lv.cg > lv.reference_cg].former_minus_finest_mm
+    quoted = f"{number(coarse.min(), 2)}-{number(coarse.max(), 2)} mm thicker"
+    guide = " ".join((ROOT / "docs" / "guide" / "scaling.md").read_text().split())
+    assert quoted in guide, quoted
