@@ -75,3 +75,12 @@ def test_missing_engine_fails_in_ci(folder):
     assert proc.returncode != 0 and "1 error" in proc.stdout, proc.stdout
     assert "CI=true and the engine is missing" in proc.stdout
     assert "/nonexistent/liggghts" in proc.stdout
+
+
+@pytest.mark.slow
+def test_the_list_of_slow_tests_is_current():
+    """docs/slow_tests.md says what each test outside the fast lane is for; it is pytest's
+    own collection of them (scripts/slow_tests.py --check collects again, ~20 s: slow)."""
+    r = subprocess.run([sys.executable, str(ROOT / "scripts" / "slow_tests.py"), "--check"],
+                       capture_output=True, text=True, cwd=ROOT)
+    assert r.returncode == 0, r.stderr
