@@ -281,7 +281,11 @@ def phase2_lines(folder: "ResultsFolder") -> list[str]:
              f"The pick (S3, easo, placed nuclei) on seeds r0-r{SEEDS - 1} (phase 1's r0 is r0), "
              f"each beside its cohesionless twin and a uniform twin at content "
              f"{UNIFORM_CONTENT:g} (S3 r0's mean content at its first production frame, two "
-             "significant figures). A criterion passes in >= 4 of 5 seeds.", "",
+             "significant figures). A criterion passes in >= 4 of 5 seeds. Run by "
+             "`bash scripts/granule_screen_phase2.sh runs`, with the uniform twins (P2U) "
+             "started early beside it by the same `ligwf run` line with `--cores 1` (to fill "
+             "a core the pairs left idle; a case runs in one process only, each case locks "
+             "its folder).", "",
              "| criterion | registered | seeds passing | passes |", "|---|---|---|---|"]
     for _, r in verdict.iterrows():
         lines.append(f"| {r.criterion}: {r.meaning} | {'yes' if r.registered else 'reported'}"

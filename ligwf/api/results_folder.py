@@ -96,11 +96,21 @@ class ResultsFolder:
         """What differs from what the committed tables give, one line each naming the
         command that remakes it: each derived table, then the README (empty: nothing)."""
         problems = []
-        for name, text in ({} if self.derived is None else self.derived(self)).items():
+        try:
+            derived = {} if self.derived is None else self.derived(self)
+        except (OSError, KeyError, AttributeError, ValueError, pd.errors.ParserError) as exc:
+            return [f"{self.path}: its committed tables cannot be read ({type(exc).__name__}: "
+                    f"{exc}): run {self.remake}"]
+        for name, text in derived.items():
             if not self.has(name) or (self.path / name).read_text() != text:
                 problems.append(f"{self.path / name} differs from what the committed tables "
                                 f"give: run {self.remake}")
-        body = self.text()
+        try:
+            body = self.text()
+        except (OSError, KeyError, AttributeError, ValueError, pd.errors.ParserError) as exc:
+            # a stale committed table (a column the README reads is missing): one line
+            return problems + [f"{self.readme} cannot be written from the committed tables "
+                               f"({type(exc).__name__}: {exc}): run {self.remake}"]
         if body is not None and (not self.readme.is_file() or self.readme.read_text() != body):
             problems.append(f"{self.readme} differs from its tables: run {self.remake}")
         return problems

@@ -61,6 +61,22 @@ def test_written_readme_checks_and_a_changed_table_does_not(folder):
     assert "differs from its tables" in problem and "scripts/make_t.py STUDY" in problem
 
 
+def test_a_stale_table_is_one_line_not_a_traceback(folder):
+    """A committed table that lost a column its README reads (or that does not parse) is
+    named in one line with the command that remakes it."""
+    def by_column(f: ResultsFolder) -> str:
+        return f"{f.table('t.csv').x.sum():g}\n"
+
+    stale = ResultsFolder(folder.path, by_column, "scripts/make_t.py STUDY", doubled)
+    stale.write()
+    (folder.path / "t.csv").write_text("y\n1\n")          # the column x is gone
+    problems = stale.check()
+    assert any("cannot be written from the committed tables" in p for p in problems)
+    assert all("scripts/make_t.py STUDY" in p for p in problems)
+    (folder.path / "t.csv").write_text('x\n"unterminated\n')
+    assert all("scripts/make_t.py STUDY" in p for p in stale.check())
+
+
 def doubled(folder: ResultsFolder) -> dict[str, str]:
     return {"d.csv": csv_text(folder.table("t.csv") * 2)}
 
