@@ -318,7 +318,38 @@ def phase2_lines(folder: "ResultsFolder") -> list[str]:
     lines += ["**The screen " + ("finds growth**." if found else
               "does not find growth**: " + ", ".join(failed) + " failed the registered "
               "4-of-5 rule."), ""]
+    if not found:
+        lines += ["## What the engine lacks for growth here", "",
+                  *lacks(seeds[seeds.complete.astype(bool)], failed), ""]
     return lines
+
+
+def lacks(seeds: pd.DataFrame, failed: list[str]) -> list[str]:
+    """Per failed registered criterion, the ingredient it measures and the seeds' numbers
+    (means over the complete seeds), as README bullets."""
+    if seeds.empty:
+        return ["- No seed has its wet run and both nulls: nothing is measured."]
+    mean = lambda col: number(pd.to_numeric(seeds[col], errors="coerce").mean(), 2)  # noqa: E731
+    said = {
+        "control": f"- **Placement and cohesion make no difference to the held share**: the "
+                   f"wet beds hold share_10 {mean('share_10')}, the uniform twins at the same "
+                   f"mean content {mean('uniform_share_10')}, the cohesionless twins "
+                   f"{mean('cohesionless_share_10')} (a null must hold <= 1/5 of the wet "
+                   "bed's).",
+        "survival": f"- **Held granules do not survive**: mean survival {mean('survival')} "
+                    "(< 0.5: most member pairs are apart a quarter revolution after their "
+                    "window).",
+        "growth": f"- **The held share does not grow**: slope {mean('slope_per_s')} /s, its "
+                  "95 % interval's lower end not above 0 in most seeds.",
+        "comovement": f"- **Members do not move together**: co-movement ratio "
+                      f"{mean('comove_ratio')} (> 0.5: they separate about as fast as "
+                      "non-members at the same distance).",
+    }
+    out = [said[c] for c in failed if c in said]
+    out.append(f"- Liquid leaves the nuclei: the wet share of the beads goes from "
+               f"{mean('wet_share_start')} to {mean('wet_share_end')} over the run (the "
+               "engine pools and splits a bridge's liquid at every rupture).")
+    return out
 
 
 def readme(folder: "ResultsFolder") -> str:

@@ -104,3 +104,15 @@ def test_the_phase2_rule_fails_a_seed_without_its_null():
     r0 = seeds.set_index("seed").loc["cg1-none-r0"]
     assert r0.complete and r0.pass_control_cohesionless and not r0.pass_control_uniform
     assert not r0.pass_control and np.isclose(r0.uniform_share_10, r0.share_10)
+
+
+def test_what_the_engine_lacks_names_each_failed_criterion_with_its_numbers():
+    seeds = pd.DataFrame([{"seed": f"cg1-none-r{r}", "complete": True, "share_10": 0.3,
+                           "uniform_share_10": 0.25, "cohesionless_share_10": 0.0,
+                           "survival": 0.3, "slope_per_s": 0.002, "comove_ratio": 0.6,
+                           "wet_share_start": 0.06, "wet_share_end": 1.0} for r in range(5)])
+    text = "\n".join(gs.lacks(seeds, ["control", "survival", "comovement"]))
+    assert "uniform twins at the same mean content 0.25" in text
+    assert "mean survival 0.3" in text and "co-movement ratio 0.6" in text
+    assert "does not grow" not in text and "from 0.06 to 1" in text
+    assert gs.lacks(seeds.iloc[0:0], ["survival"])[0].startswith("- No seed")
