@@ -415,8 +415,8 @@ def arguments(ap) -> None:
                     help="keep the committed phase-1 tables; measure phase 2 only")
 
 
-def main() -> int:
-    return results_command(__doc__, [FOLDER], make, arguments=arguments)
+def main(argv=None) -> int:
+    return results_command(__doc__, [FOLDER], make, argv, arguments)
 
 
 if __name__ == "__main__":

@@ -173,5 +173,9 @@ def arguments(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--frames", type=int, default=40, help="frames a case at most")
 
 
+def main(argv=None) -> int:
+    return results_command(__doc__, [FOLDER], make, argv, arguments)
+
+
 if __name__ == "__main__":
-    sys.exit(results_command(__doc__, [FOLDER], make, arguments=arguments))
+    sys.exit(main())

@@ -209,8 +209,8 @@ def make(args) -> ResultsFolder:
     return FOLDER
 
 
-def main() -> int:
-    return results_command(__doc__, [FOLDER], make)
+def main(argv=None) -> int:
+    return results_command(__doc__, [FOLDER], make, argv)
 
 
 if __name__ == "__main__":
