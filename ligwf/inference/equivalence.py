@@ -62,7 +62,9 @@ BINS_RULE_TEXT = {BINS_INDEPENDENT: "depth bins counted as independent",
                   BINS_CORRELATED: "the depth bins' correlation measured on the runs' "
                                    "residuals; on bins correlated like real profiles the "
                                    "upper bound covers 0.91 with 2 runs an arm and "
-                                   "0.97-0.99 with 3-24, the fail test errs up to 0.065: "
+                                   "0.97-0.99 with 3-24, the fail test errs up to 0.065, "
+                                   "so a profile is decided only on 6 runs of both arms "
+                                   "together or more: "
                                    "docs/results/verdict_rates/profiles.txt"}
 #: the verdict's rule (the benchmark's default stays independent, so coverage.txt reproduces)
 PROFILE_BINS = BINS_CORRELATED

@@ -19,6 +19,13 @@ from ligwf.inference.registry import (NOT_MEASURED, Criterion, CriterionResult, 
                                       LevelData)
 
 
+#: the fewest runs of both arms together a profile decision is made on: the bins'
+#: correlation is estimated from R1 + R2 - 2 residual degrees of freedom, and at 2 and 2 runs
+#: the bounds covered 0.907-0.914 on correlated bins (3 and 3: 0.968-0.979;
+#: docs/results/verdict_rates/profiles.txt)
+MIN_PROFILE_RUNS = 6
+
+
 def replica_cost(runs, noise) -> float:
     """Mean core-seconds of a new replica of an arm (nan without a noise table)."""
     if noise is None or noise.empty or runs is None or REPLICA_COST not in noise:
@@ -60,13 +67,21 @@ def profile_result(spec: Criterion, tolerance: float, x: np.ndarray, y: np.ndarr
     state = eq.norm_decision(e, tolerance)
     decide = {}
     note = f"raw distance {e.raw:.3g} before the noise of both arms is taken off"
+    too_few = e.has_interval and len(x) + len(y) < MIN_PROFILE_RUNS
+    if too_few:
+        # too few runs to count the bins' correlation: the bounds are shown, not decided on
+        state = UNDECIDED
     if state == UNDECIDED and e.has_interval and spec.plan is not None:
         decide = spec.plan(x, y, tolerance, alpha, costs)
         r = CriterionResult(**base, state=state, **decide)
         how = decide_text(r) or (f"over {sampling.MOST_REPLICAS} replicas of both arms "
                                  "would be needed")
-        note = (f"raw distance {e.raw:.3g}; the bounds [{e.lo:.3g}, {e.hi:.3g}] "
-                f"straddle the budget; {how}")
+        why = (f"{len(x)} and {len(y)} runs: a profile is decided on at least "
+               f"{MIN_PROFILE_RUNS} runs of both arms together (at 2 and 2 its bounds "
+               "covered 0.91 on correlated bins: docs/results/verdict_rates, profiles.txt)"
+               if too_few else "straddle the budget")
+        note = (f"raw distance {e.raw:.3g}; the bounds [{e.lo:.3g}, {e.hi:.3g}]"
+                f"{'; ' if too_few else ' '}{why}; {how}")
     if not e.has_interval:
         note = "an arm has one run: no variance, no bounds (run at least 2 replicas)"
     return CriterionResult(**base, state=state, value=e.value, lo=e.lo, hi=e.hi, bound=e.hi,

@@ -73,3 +73,23 @@ def test_the_verdict_uses_the_correlated_rule_and_says_so():
     stats = statistics_record(0.05, eq.WELCH_BF)
     assert eq.PROFILE_BINS == eq.BINS_CORRELATED == stats["profile_bins"]
     assert "correlation measured on the runs' residuals" in method_text(stats)
+
+
+def test_a_profile_is_decided_on_six_runs_of_both_arms_at_least():
+    """At 2 and 2 runs the correlated bins' bounds covered 0.91 (profiles.txt): there the
+    criterion shows its bounds and stays undecided, naming why; at 3 and 3 the same close
+    profiles pass."""
+    from ligwf.inference.budget import criteria
+    from ligwf.inference.profile import MIN_PROFILE_RUNS, profile_result
+
+    spec = next(c for c in criteria() if c.name == "profile_error")
+    rng = np.random.default_rng(5)
+    base = np.linspace(1.0, -0.5, 16)
+    for runs, want in ((2, eq.UNDECIDED), (3, eq.PASS)):
+        x = base + 0.002 * rng.standard_normal((runs, 16))
+        y = base + 0.002 * rng.standard_normal((runs, 16))
+        r = profile_result(spec, 0.1, x, y, eq.ALPHA)
+        assert r.state == want, (runs, r.state, r.note)
+        assert math.isfinite(r.hi) and r.hi < 0.1
+        if want == eq.UNDECIDED:
+            assert f"at least {MIN_PROFILE_RUNS} runs" in r.note
