@@ -56,20 +56,22 @@ GRANULATING_BOND = 3.0
 #: the map's runs had min_separation_ratio 1.01 (lubrication off)
 MAP_MIN_SEPARATION_RATIO = 1.01
 
-#: what the registered granule screen found with lubrication on (docs/results/granule_screen,
-#: phase 1, one seed a condition; tests/scene/test_regime.py reads these against its
-#: conditions.csv): the placed-nuclei pick's mean survival and co-movement ratio, its
-#: beads wet at the start and at the end
+#: what the registered granule screen found with lubrication on (docs/results/granule_screen;
+#: tests/scene/test_regime.py reads these against its committed tables): phase 2's five
+#: seeds of the pick (easo, placed nuclei) -- mean survival and co-movement ratio, the wet
+#: beds' held share and their uniform twins' -- and the beads wet at the start and the end
 SCREEN_SURVIVAL, SCREEN_COMOVEMENT = 0.30, 0.59
+SCREEN_SHARE, SCREEN_UNIFORM_SHARE = 0.32, 0.40
 SCREEN_WET_START, SCREEN_WET_END = 0.06, 1.0
 SCREEN_FINDING = (
     "with lubrication on, the registered granule screen (docs/results/granule_screen: CG1, "
-    "2 mm beads, liquid content 0.2, 0.1 Pa s, s_min 0.02, 30 revolutions, one seed a "
-    "condition, phase 1) found no granules that pass its criteria: uniformly wet beds (washino, easo) bound into "
-    "one mass spanning the slice, and placed wet nuclei (easo) spread their liquid from "
-    f"{SCREEN_WET_START:.0%} to {SCREEN_WET_END:.0%} of the beads while their held granules "
+    "2 mm beads, liquid content 0.2, 0.1 Pa s, s_min 0.02, 30 revolutions) found no growth: "
+    "uniformly wet beds (washino, easo) bound into one mass spanning the slice; placed wet "
+    f"nuclei (easo, 5 seeds) spread their liquid from {SCREEN_WET_START:.0%} to "
+    f"{SCREEN_WET_END:.0%} of the beads, their held granules (share {SCREEN_SHARE:.2f}) "
     f"neither survived (mean survival {SCREEN_SURVIVAL:.2f} < 0.5) nor moved together "
-    f"(co-movement {SCREEN_COMOVEMENT:.2f} > 0.5); washino with placed nuclei went unstable")
+    f"(co-movement {SCREEN_COMOVEMENT:.2f} > 0.5), and the same liquid spread uniformly held "
+    f"more ({SCREEN_UNIFORM_SHARE:.2f}); washino with placed nuclei went unstable")
 
 
 def bridge_gap_ratio(s, radius: float) -> float:

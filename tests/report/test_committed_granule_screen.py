@@ -109,7 +109,9 @@ def test_what_the_engine_lacks_names_each_failed_criterion_with_its_numbers():
                            "survival": 0.3, "slope_per_s": 0.002, "comove_ratio": 0.6,
                            "wet_share_start": 0.06, "wet_share_end": 1.0} for r in range(5)])
     text = "\n".join(gs.lacks(seeds, ["control", "survival", "comovement"]))
-    assert "uniform twins at the same mean content 0.25" in text
+    assert "**placement makes no difference**: the uniform twins at the same mean content " \
+        "hold share_10 0.25 (5 of 5 seeds" in text
+    assert "the cohesionless twins hold 0 (within 1/5 in every seed)" in text
     assert "mean survival 0.3" in text and "co-movement ratio 0.6" in text
     assert "does not grow" not in text and "from 0.06 to 1" in text
     assert gs.lacks(seeds.iloc[0:0], ["survival"])[0].startswith("- No seed")
