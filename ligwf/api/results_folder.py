@@ -59,6 +59,10 @@ def csv_text(table: pd.DataFrame) -> str:
     return table.to_csv(index=False, float_format="%.6g")
 
 
+#: what reading a stale or damaged committed table raises (a column gone, a bad CSV)
+_UNREADABLE = (OSError, KeyError, AttributeError, ValueError, pd.errors.ParserError)
+
+
 @dataclass(frozen=True)
 class ResultsFolder:
     """One committed results folder: ``path``; ``render(folder) -> text``, its README from
@@ -98,7 +102,7 @@ class ResultsFolder:
         problems = []
         try:
             derived = {} if self.derived is None else self.derived(self)
-        except (OSError, KeyError, AttributeError, ValueError, pd.errors.ParserError) as exc:
+        except _UNREADABLE as exc:
             return [f"{self.path}: its committed tables cannot be read ({type(exc).__name__}: "
                     f"{exc}): run {self.remake}"]
         for name, text in derived.items():
@@ -107,7 +111,7 @@ class ResultsFolder:
                                 f"give: run {self.remake}")
         try:
             body = self.text()
-        except (OSError, KeyError, AttributeError, ValueError, pd.errors.ParserError) as exc:
+        except _UNREADABLE as exc:
             # a stale committed table (a column the README reads is missing): one line
             return problems + [f"{self.readme} cannot be written from the committed tables "
                                f"({type(exc).__name__}: {exc}): run {self.remake}"]

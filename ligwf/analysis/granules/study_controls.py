@@ -13,7 +13,6 @@ pre-registered criteria (:mod:`ligwf.analysis.granules.control_verdict`). The ta
 
 from __future__ import annotations
 
-
 import pandas as pd
 
 from ligwf.analysis.granules.control_run import DEFAULT_CANDIDATES, control_rows, load_series, summarise
