@@ -21,7 +21,7 @@ import argparse
 from pathlib import Path
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
-                              add_workflow_args, console,
+                              add_workflow_args, console, number_in,
                               folder_to_write, plan_table, prepare_from_args,
                               print_warning, rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
@@ -36,11 +36,17 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     prepared = prepare_from_args(args)
     settings = run_settings(args.np, args.ensemble, args.cores, args.retry_unstable,
                             args.templates)
-    run = start_run(prepared, args.out, settings, args.mesh_cache, args.replace)
+    run = start_run(prepared, args.out, settings, args.mesh_cache, args.replace,
+                    getattr(args, "extend_production", 0.0))
     title = (f"rank plan for {settings.cores} core(s) ({settings.cores_source})"
              if settings.planned else "ranks as asked (--np / --ensemble)")
     console.print(plan_table(run.schedule, title))
     console.print(run.identity.describe(), highlight=False, soft_wrap=True)
+    for c in run.study.cases:
+        if c.extension_steps:
+            console.print(f"{c.path.name}: production {c.extension_steps * c.scaled.numerics.dt:.3g} s "
+                          f"longer than rendered (to step {c.scaled.numerics.run_steps})",
+                          highlight=False, soft_wrap=True)
     for line in elsewhere(run.study.cases, settings.retry_unstable):
         console.print(line, highlight=False, soft_wrap=True)
     for line in skipped_restarts(run.study.cases, settings.retry_unstable):
@@ -138,6 +144,11 @@ def add_run_args(p: argparse.ArgumentParser) -> None:
                    help="also re-run cases found unstable before")
     add_mesh_cache(p)
     add_replace_arg(p)
+    p.add_argument("--extend-production", type=number_in(0, 1e4, "s"), default=0.0,
+                   metavar="S", help="every case's production S seconds longer than the "
+                   "workflow's run_time, done cases continued from their restarts (the fix "
+                   "the verdict names for runs too short to show a steady state); repeating "
+                   "it changes nothing")
 
 
 def register(subparsers) -> None:

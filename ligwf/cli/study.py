@@ -25,6 +25,7 @@ from ligwf.cli.common import (add_workflow_args, console, grouped_warnings, numb
 from ligwf.cli.report import add_snapshots, print_report
 from ligwf.cli.run import add_run_args, run_with_progress, start_from_args
 from ligwf.engine.progress import RichMonitor, summary_table
+from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess
 from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, until_decided
 from ligwf.local import LocalExecutor, run_settings
@@ -71,6 +72,10 @@ def show_look(look: Look, rounds: Rounds) -> None:
 
 
 def cmd_until_decided(args: argparse.Namespace) -> int:
+    if args.extend_production:
+        raise ConfigError(f"--extend-production = {args.extend_production:g}: not with "
+                          "--until-decided (its rounds choose the production); run "
+                          "'ligwf study' without it first")
     if is_study_folder(args.workflow):
         prepared = prepare_study_folder(args.workflow, args.overrides, args.templates,
                                         args.allow_unstable)

@@ -29,6 +29,7 @@ from ligwf.local import LocalExecutor, RunSettings, cases_to_run, study_schedule
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.scheduler import Executor
 from ligwf.study.case import CaseFolder
+from ligwf.study.extension import extend_production
 from ligwf.study.layout import OUTPUT_DIRS
 from ligwf.study.paths import check_inside
 from ligwf.study.study import Study
@@ -84,13 +85,17 @@ class StudyRun:
 
 
 def start_run(prepared: Prepared, out: Path, settings: RunSettings,
-              mesh_cache: Path | None = None, replace: bool = False) -> StudyRun:
+              mesh_cache: Path | None = None, replace: bool = False,
+              extend_seconds: float = 0.0) -> StudyRun:
     """Write a prepared study (the pre-flight is behind it) and schedule the cases that
     are not finished. The site's engine is found first (executable, its library, version,
     the MPI launcher): one that is missing or cannot be loaded is refused before anything
-    is written."""
+    is written. ``extend_seconds``: every case's production that much longer than rendered
+    (:func:`~ligwf.study.extension.extend_production`; done cases are continued)."""
     engine, identity = site_engine()
     study = write(prepared, out, mesh_cache, replace)    # refuses another study's folder
+    if extend_seconds > 0 and extend_production(study.cases, extend_seconds):
+        study = Study.open(out)                          # the cases with their extensions
     return scheduled(study, LocalExecutor(settings, engine), identity)
 
 

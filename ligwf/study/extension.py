@@ -15,6 +15,7 @@ table and one frame series.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 from ligwf.errors import ConfigError
@@ -44,3 +45,21 @@ def write_extension(path: Path, base_run_steps: int, run_steps: int, dt: float) 
     atomic_write_json(Path(path) / EXTENSION_FILE, {
         "base_run_steps": int(base_run_steps), "run_steps": int(run_steps),
         "added_seconds": (int(run_steps) - int(base_run_steps)) * dt})
+
+
+def extend_production(cases, seconds: float) -> list[str]:
+    """Give every case of ``cases`` (:class:`~ligwf.study.case.CaseFolder`) a production
+    ``seconds`` longer than rendered (``ligwf run --extend-production``: the fix the verdict
+    names for runs too short to show a steady state). A case already extended as far or
+    further (by an earlier call or a round) is left as it is, so repeating the call changes
+    nothing; a done case is continued from its restarts by the next run, not re-run. One
+    line per case extended."""
+    lines = []
+    for case in cases:
+        rendered = case.rendered_scaled.numerics
+        target = rendered.run_steps + math.ceil(seconds / rendered.dt)
+        if target > case.scaled.numerics.run_steps:
+            write_extension(case.path, rendered.run_steps, target, rendered.dt)
+            lines.append(f"{case.path.name}: production extended to step {target} "
+                         f"(+{(target - rendered.run_steps) * rendered.dt:.3g} s)")
+    return lines
