@@ -45,7 +45,7 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     for c in run.study.cases:
         if c.extension_steps:
             console.print(f"{c.path.name}: production {c.extension_steps * c.scaled.numerics.dt:.3g} s "
-                          f"longer than rendered (to step {c.scaled.numerics.run_steps})",
+                          f"longer than rendered ({c.scaled.numerics.run_steps} production steps)",
                           highlight=False, soft_wrap=True)
     for line in elsewhere(run.study.cases, settings.retry_unstable):
         console.print(line, highlight=False, soft_wrap=True)

@@ -60,6 +60,6 @@ def extend_production(cases, seconds: float) -> list[str]:
         target = rendered.run_steps + math.ceil(seconds / rendered.dt)
         if target > case.scaled.numerics.run_steps:
             write_extension(case.path, rendered.run_steps, target, rendered.dt)
-            lines.append(f"{case.path.name}: production extended to step {target} "
+            lines.append(f"{case.path.name}: production extended to {target} steps "
                          f"(+{(target - rendered.run_steps) * rendered.dt:.3g} s)")
     return lines
