@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import pandas as pd
 
 from ligwf.inference import equivalence as eq
-from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
+from ligwf.study.condition import REFERENCE_CG, Condition
 from ligwf.inference.equivalence import FAIL, PASS, UNDECIDED
 from ligwf.inference.criteria import condition_criteria
 from ligwf.inference.registry import CriterionResult, Gate, band

@@ -29,14 +29,12 @@ record and the report).
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
-from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
 from ligwf.inference.equivalence import UNDECIDED
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess, report_study
@@ -48,11 +46,13 @@ from ligwf.inference.verdict import FAILS, MEETS, Verdict, is_control_group
 from ligwf.inference.verdict_records import read_verdict
 from ligwf.scheduler import Executor
 from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_override
-from ligwf.study.case import CaseFolder, group_of
+from ligwf.study.case import group_of
+from ligwf.study.condition import Arm, Condition
 from ligwf.study.extension import write_extension
 from ligwf.study.ownership import check_own_folder
-from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Look,
-                                Rounds, read_rounds, write_rounds)
+from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Action,
+                                AddReplicas, ExtendProduction, Look, Rounds, read_rounds,
+                                write_rounds)
 from ligwf.study.study import Study
 
 
@@ -107,23 +107,21 @@ def prepare_study_folder(path: Path, overrides=(), template_dirs=(),
 # ---------------------------------------------------------------- what the rounds added
 def added_cases(prepared: Prepared, rounds: Rounds) -> Prepared:
     """The prepared study with the replicas earlier rounds added (rendered in memory, in
-    the order they were added, indices after the workflow's own cases)."""
-    wanted = [(a["group"], float(a["cg"]), a["rule"], int(r)) for x in rounds.looks
-              for a in x.actions if a["kind"] == REPLICAS for r in a["replicas"]]
+    the order they were added, indices after the workflow's own cases). The added cases
+    are the workflow's own expansion with more replicas at their CG levels
+    (:meth:`~ligwf.scene.workflow.Workflow.with_replicas`), so each is the case the
+    workflow would have had with that many replicas (its seeds, its scene); control
+    twins are not added."""
+    wanted = [(a.condition, r) for x in rounds.looks for a in x.actions
+              if isinstance(a, AddReplicas) for r in a.replicas]
     if not wanted:
         return prepared
-    raw = copy.deepcopy(prepared.workflow.raw)
-    sweep = raw.setdefault("sweep", {})
-    levels = [float(c) for c in sweep.get("cg_levels", [1])]
-    base = sweep.get("replicas", 1)
-    counts = {c: (base if isinstance(base, int) else int(base.get(c, base.get(int(c), 1)) if
-                                                          isinstance(base, dict) else 1))
-              for c in levels}
-    for _, cg, _, rep in wanted:
-        counts[cg] = max(counts.get(cg, 1), rep + 1)
-    sweep["replicas"] = {(int(c) if c == int(c) else c): n for c, n in counts.items()}
-    by_key = {(group_of(dict(c.varied)), c.cg, c.rule.value, c.replica): c
-              for c in expand(raw).cases if CONTROL_KEY not in dict(c.varied)}
+    counts: dict[float, int] = {}
+    for condition, replica in wanted:
+        counts[condition.cg] = max(counts.get(condition.cg, 0), replica + 1)
+    more = prepared.workflow.with_replicas(counts)
+    by_key = {(Condition(group_of(dict(c.varied)), c.cg, c.rule.value), c.replica): c
+              for c in more.cases if CONTROL_KEY not in dict(c.varied)}
     have = {rc.case.case_id for rc in prepared.rendered}
     rendered = list(prepared.rendered)
     for key in wanted:
@@ -140,16 +138,15 @@ def apply_extensions(study: Study, rounds: Rounds) -> None:
     """Write every production extension the looks asked for (a case's newest target
     step wins; written only where it differs, so a repeat changes nothing)."""
     target: dict[str, int] = {}
-    new: dict[tuple, int] = {}
+    new: dict[tuple[Condition, int], int] = {}
     for x in rounds.looks:
         for a in x.actions:
-            for cid, steps in a.get("run_steps", {}).items():
-                target[cid] = int(steps)
-            for rep in a.get("replicas", ()):
-                new[(a["group"], float(a["cg"]), a["rule"], int(rep))] = int(a["each_run_steps"])
+            if isinstance(a, ExtendProduction):
+                target.update(a.run_steps)
+            else:
+                new.update(((a.condition, rep), a.each_run_steps) for rep in a.replicas)
     for case in study.cases:
-        steps = target.get(case.case_id, new.get((case.group, case.cg, case.rule,
-                                                  case.replica)))
+        steps = target.get(case.case_id, new.get((Condition.of(case), case.replica)))
         if steps is not None and steps != case.scaled.numerics.run_steps:
             base = case.rendered_scaled.numerics.run_steps
             write_extension(case.path, base, max(steps, base), case.scaled.numerics.dt)
@@ -173,56 +170,46 @@ def _criteria_rows(verdict: Verdict) -> tuple[dict, ...]:
                  if r.assessed)
 
 
-def _arm_cases(study: Study, group: str, cg: float, rule: str) -> list[CaseFolder]:
-    return [c for c in study.cases if c.group == group and c.cg == cg
-            and (cg == REFERENCE_CG or c.rule == rule)]
-
-
-def _needs(criteria, group: str, cg: float, rule: str,
-           needs: dict[tuple, list[float]]) -> None:
-    """Add to ``needs`` (per arm ``(group, cg, rule)``: [seconds of production more per
-    run, replicas more]) what one condition's undecided ``criteria`` ask for; an arm shared
-    by several conditions (their CG1 runs) gets the most any of them asks, not the sum."""
-    keys = {"CG-n": (group, cg, rule), "CG1": (group, REFERENCE_CG, "none")}
+def _needs(criteria, condition: Condition, needs: dict[Condition, list[float]]) -> None:
+    """Add to ``needs`` (per arm, named by the condition whose runs it is: [seconds of
+    production more per run, replicas more]) what the undecided ``criteria`` of
+    ``condition`` ask for; an arm shared by several conditions (their CG1 runs) gets the
+    most any of them asks, not the sum."""
     for r in criteria:
-        for arm, key in keys.items():
-            if arm not in r.round_arm.split(" and "):
-                continue
-            need = needs.setdefault(key, [0.0, 0])
+        for arm in Arm.named_in(r.round_arm):
+            need = needs.setdefault(condition.side(arm), [0.0, 0])
             if r.round_by == EXTEND:
                 need[0] = max(need[0], r.round_amount)
             elif r.round_by == REPLICAS:
-                amount = r.round_amount if arm == "CG-n" else r.round_amount_cg1
+                amount = r.round_amount if arm == Arm.CG_N else r.round_amount_cg1
                 need[1] = max(need[1], int(amount) if math.isfinite(amount) else 0)
 
 
-def _actions(study: Study, needs: dict[tuple, list[float]]) -> tuple[list[dict], float]:
+def _actions(study: Study, needs: dict[Condition, list[float]]) -> tuple[list[Action], float]:
     """The round's actions on each arm ``needs`` names (longer production on its runs,
     then new replicas as long as them) and their planned core-hours (the planner's rates
     calibrated by the arm's own runs,
     :func:`~ligwf.inference.planning.calibration`)."""
-    actions, hours = [], 0.0
-    for (group, cg, rule), (extend, add) in needs.items():
-        cases = _arm_cases(study, group, cg, rule)
+    actions: list[Action] = []
+    hours = 0.0
+    for condition, (extend, add) in needs.items():
+        cases = [c for c in study.cases if condition.covers(c)]
         if not cases:
             continue
         rate = calibration(cases)
-        arm = "CG1" if cg == REFERENCE_CG else "CG-n"
         steps_now = max(c.scaled.numerics.run_steps for c in cases)
         if extend > 0:
             more = math.ceil(extend / cases[0].scaled.numerics.dt)
-            run_steps = {c.case_id: steps_now + more for c in cases}
-            actions.append({"kind": EXTEND, "arm": arm, "seconds": extend,
-                            "case_ids": [c.case_id for c in cases], "run_steps": run_steps})
+            actions.append(ExtendProduction(
+                condition.arm, extend, tuple(c.case_id for c in cases),
+                {c.case_id: steps_now + more for c in cases}))
             hours += rate * sum(run_costs(c.scaled)[1] * extend for c in cases) / 3600.0
             steps_now += more
         if add > 0:
             first = max(c.replica for c in cases) + 1
-            reps = list(range(first, first + add))
             # new replicas run as long as the arm's runs (extended ones included)
-            actions.append({"kind": REPLICAS, "arm": arm, "group": group, "cg": cg,
-                            "rule": rule, "replicas": reps, "each_run_steps": steps_now,
-                            "condition": Condition(group, cg, rule).name})
+            actions.append(AddReplicas(condition, tuple(range(first, first + add)),
+                                       steps_now))
             scaled = cases[0].scaled.with_run_steps(steps_now)
             hours += rate * add * run_costs(scaled)[0] / 3600.0
     return actions, hours
@@ -254,7 +241,7 @@ def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Lo
             stuck += [f"{c.name} {r.label}: {r.note}" for r in undecided if not r.round_by]
             stuck += [] if undecided else [f"{c.name}: no criterion of the budget assessed"]
             if planned:
-                _needs(planned, g.group, c.cg, c.rule, needs)
+                _needs(planned, Condition(g.group, c.cg, c.rule), needs)
                 targets.append(c.name)
     actions, hours = _actions(study, needs)
     if not targets:

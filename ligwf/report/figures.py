@@ -24,7 +24,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from ligwf.analysis.records.conditions import REFERENCE_CG, Condition
+from ligwf.study.condition import REFERENCE_CG, Condition
 from ligwf.fsio import atomic_write_bytes
 from ligwf.study.case import group_label
 

@@ -6,24 +6,23 @@ study of one look."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from ligwf.report.sections import Figure, Section, figure_markdown
 from ligwf.study import layout
-from ligwf.study.rounds import EXTEND, Look, Rounds
+from ligwf.study.rounds import Action, ExtendProduction, Look, Rounds
 
 TITLE = "Rounds (sequential study)"
 ANCHOR = "rounds"
 
 
-def action_text(action: dict) -> str:
+def action_text(action: Action) -> str:
     """One action of a round in words."""
-    if action.get("kind") == EXTEND:
-        return (f"{action.get('seconds', math.nan):.3g} s more production on "
-                f"{', '.join(action.get('case_ids', ()))}")
-    reps = action.get("replicas", ())
-    return (f"{len(reps)} new replica(s) of {action.get('condition', '?')} "
+    if isinstance(action, ExtendProduction):
+        return (f"{action.seconds:.3g} s more production on "
+                f"{', '.join(action.case_ids)}")
+    reps = action.replicas
+    return (f"{len(reps)} new replica(s) of {action.condition.name} "
             f"(replica {', '.join(str(r) for r in reps)}: new seeds)")
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.records.conditions import REFERENCE_CG
+from ligwf.study.condition import REFERENCE_CG
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.metrics import CASE_TABLE, CONDITION_TABLE, GRANULE_METRICS
 from ligwf.report.dictionary import gsd_note, header, shown_value

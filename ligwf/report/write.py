@@ -18,7 +18,7 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf import __version__
-from ligwf.analysis.records.conditions import REFERENCE_CG
+from ligwf.study.condition import REFERENCE_CG
 from ligwf.inference.equivalence import HSU, WELCH_BF
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import LOWER_LIMIT

@@ -22,12 +22,13 @@ A CG1 case is the same under every rule, so it is run once (rule ``none``).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import itertools
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, Mapping, Sequence
 
 from pydantic import Field, TypeAdapter, ValidationError
 
@@ -98,12 +99,35 @@ class Case:
 
 @dataclass(frozen=True)
 class Workflow:
+    """A validated workflow: ``raw``, the mapping as written (what the study record
+    stores), and what it expands to: its cases, from the typed ``sweep`` over the
+    ``scene_lists`` (swept scene fields and their values) and the ``base_scene``."""
+
     name: str
     description: str
     raw: dict[str, Any]
     cases: tuple[Case, ...]
     analysis: AnalysisSettings = AnalysisSettings()
     accept: AcceptSettings = AcceptSettings()
+    sweep: Sweep = Sweep()
+    scene_lists: tuple[tuple[str, tuple[Any, ...]], ...] = ()
+    base_scene: Mapping[str, Any] = field(default_factory=dict, repr=False)
+
+    def with_replicas(self, replicas: Mapping[float, int]) -> "Workflow":
+        """The workflow with ``replicas[cg]`` replicas at those CG levels where that is
+        more than it has (levels it does not run are ignored): the same expansion with
+        more seeds, so every case it had comes back with its id, scene and seed, and a
+        new replica is the case a workflow written with that many would have had. ``raw``
+        stays the workflow as written (a sequential study's rounds add replicas to the
+        study, not to its workflow); the limits of :data:`MAX_REPLICAS` and
+        :data:`MAX_CASES` hold as for a written sweep."""
+        counts = {cg: max(self.sweep.replicas_for(cg), int(replicas.get(cg, 0)))
+                  for cg in self.sweep.cg_levels}
+        sweep = self.sweep.model_copy(update={"replicas": counts})
+        _check_replicas(sweep)
+        _check_count(sweep, self.scene_lists)
+        return dataclasses.replace(self, sweep=sweep, cases=_cases(
+            dict(self.base_scene), sweep, self.scene_lists))
 
 
 # ---------------------------------------------------------------------------------------
@@ -204,24 +228,32 @@ def _split_sweep(sweep_raw: dict[str, Any]) -> tuple[Sweep, list[tuple[str, list
     for where, cg in levels + [(f"sweep.per_cg.{cg:g}", cg) for cg in sweep.per_cg]:
         if cg < 1:
             raise ConfigError(f"{where} = {cg:g}: CG level is < 1 (allowed range [1, inf))")
+    _check_replicas(sweep)
+    stray = sorted(set(sweep.per_cg) - set(sweep.cg_levels))
+    if stray:
+        raise ConfigError(f"sweep.per_cg: CG level {stray[0]:g} is not in sweep.cg_levels "
+                          f"{[float(c) for c in sweep.cg_levels]} (its settings would never "
+                          "be used)")
+    _check_count(sweep, varied)
+    return sweep, varied
+
+
+def _check_replicas(sweep: Sweep) -> None:
     reps = ([(f"sweep.replicas.{cg:g}", n) for cg, n in sweep.replicas.items()]
             if isinstance(sweep.replicas, dict) else [("sweep.replicas", sweep.replicas)])
     for where, n in reps:
         if not 1 <= n <= MAX_REPLICAS:
             raise ConfigError(f"{where} = {n}: allowed range [1, {MAX_REPLICAS}] "
                               "replicas per CG level")
-    stray = sorted(set(sweep.per_cg) - set(sweep.cg_levels))
-    if stray:
-        raise ConfigError(f"sweep.per_cg: CG level {stray[0]:g} is not in sweep.cg_levels "
-                          f"{[float(c) for c in sweep.cg_levels]} (its settings would never "
-                          "be used)")
+
+
+def _check_count(sweep: Sweep, varied) -> None:
     count = math.prod(len(v) for _, v in varied) * sum(
         (1 if cg == 1 else len(set(sweep.rules))) * sweep.replicas_for(cg)
         for cg in set(sweep.cg_levels))
     if count > MAX_CASES:
         raise ConfigError(f"sweep expands to {count:,} cases (replicas x rules x CG levels x "
                           f"scene lists); allowed at most {MAX_CASES:,} per study: split it")
-    return sweep, varied
 
 
 #: longest case folder name (file systems allow 255 bytes; the study path comes on top)
@@ -339,6 +371,18 @@ def expand(raw: dict[str, Any]) -> Workflow:
         raise ConfigError(f"sweep.control_cg_levels: CG level {stray[0]:g} is not in "
                           f"sweep.cg_levels {[float(c) for c in sweep.cg_levels]}")
 
+    return Workflow(name=name, description=str(raw.get("description", "")), raw=raw,
+                    cases=_cases(base_scene, sweep, varied), analysis=analysis,
+                    accept=accept, sweep=sweep, scene_lists=tuple(
+                        (path, tuple(values)) for path, values in varied),
+                    base_scene=base_scene)
+
+
+def _cases(base_scene: dict[str, Any], sweep: Sweep,
+           varied: Sequence[tuple[str, Sequence[Any]]]) -> tuple[Case, ...]:
+    """The cases of a validated sweep over the (validated) base scene, in the study's
+    order: per combination of the swept scene values, per CG level, rule and replica,
+    each followed by its control twins."""
     cases: list[Case] = []
     combos = itertools.product(*[vals for _, vals in varied]) if varied else [()]
     seen: set[tuple] = set()
@@ -373,8 +417,7 @@ def expand(raw: dict[str, Any]) -> Workflow:
                                               float(cg), rule,
                                               rep, values + ((CONTROL_KEY, control),)))
     _unique_case_ids(cases)
-    return Workflow(name=name, description=str(raw.get("description", "")), raw=raw,
-                    cases=tuple(cases), analysis=analysis, accept=accept)
+    return tuple(cases)
 
 
 #: the ``varied`` entry that marks a control twin (its own comparison group)

@@ -4,8 +4,9 @@ One JSON file in the study folder (:data:`~ligwf.study.layout.ROUNDS_FILE`), wri
 read only here. It holds the plan fixed at the first look (at most ``max_looks`` looks,
 the family ``alpha``, the core-hour cap) and, per look, the verdict's criteria as they
 stood (value, interval, state), the condition the next round works on, what it adds
-(production extended on named runs to a named step, or new replicas of a condition) and,
-on the last look, why the study stopped.
+(its actions, typed: :class:`ExtendProduction`, production extended on named runs to a
+named step, and :class:`AddReplicas`, new replicas of an arm; each writes and reads its
+own JSON) and, on the last look, why the study stopped.
 
 Repeated looks are paid for by **Bonferroni alpha spending**: every look tests at
 ``alpha / max_looks`` (:attr:`Rounds.alpha_per_look`), so the chance that any look of the
@@ -20,11 +21,13 @@ sequential study decides at that level from its first look on.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
+from typing import Any, ClassVar, Mapping, Union
 
 from ligwf.errors import ConfigError
 from ligwf.fsio import atomic_write_json, json_safe, try_lock
+from ligwf.study.condition import Arm, Condition
 from ligwf.study.layout import ROUNDS_FILE, ROUNDS_LOCK
 
 #: the family error rate of a study's decisions
@@ -40,6 +43,71 @@ DECIDED, STUCK, LOOKS_SPENT, CAPPED = "decided", "stuck", "looks spent", "capped
 
 
 @dataclass(frozen=True)
+class ExtendProduction:
+    """A round's longer production on the runs of one arm: ``seconds`` more each, every
+    case of ``case_ids`` (in the study's order) continued to its step in ``run_steps``
+    (a target step, so applying it again changes nothing)."""
+
+    kind: ClassVar[str] = EXTEND
+    arm: Arm
+    seconds: float
+    case_ids: tuple[str, ...]
+    run_steps: Mapping[str, int]
+
+    def to_json(self) -> dict[str, Any]:
+        """The action as the rounds record stores it."""
+        return {"kind": self.kind, "arm": self.arm.value, "seconds": self.seconds,
+                "case_ids": list(self.case_ids), "run_steps": dict(self.run_steps)}
+
+    @classmethod
+    def from_json(cls, rec: Mapping[str, Any]) -> "ExtendProduction":
+        seconds = rec["seconds"]
+        return cls(Arm(rec["arm"]), float("nan") if seconds is None else float(seconds),
+                   tuple(str(c) for c in rec["case_ids"]),
+                   {str(c): int(n) for c, n in rec["run_steps"].items()})
+
+
+@dataclass(frozen=True)
+class AddReplicas:
+    """A round's new replicas of one arm: the runs of ``condition`` (for the CG1 arm, the
+    reference condition of its sweep group) numbered ``replicas`` (new case folders with
+    new seeds), each with ``each_run_steps`` production steps (as long as the arm's runs,
+    extended ones included)."""
+
+    kind: ClassVar[str] = REPLICAS
+    condition: Condition
+    replicas: tuple[int, ...]
+    each_run_steps: int
+
+    @property
+    def arm(self) -> Arm:
+        return self.condition.arm
+
+    def to_json(self) -> dict[str, Any]:
+        """The action as the rounds record stores it (the condition's fields and name)."""
+        c = self.condition
+        return {"kind": self.kind, "arm": self.arm.value, "group": c.group, "cg": c.cg,
+                "rule": c.rule, "replicas": list(self.replicas),
+                "each_run_steps": self.each_run_steps, "condition": c.name}
+
+    @classmethod
+    def from_json(cls, rec: Mapping[str, Any]) -> "AddReplicas":
+        return cls(Condition(str(rec["group"]), float(rec["cg"]), str(rec["rule"])),
+                   tuple(int(r) for r in rec["replicas"]), int(rec["each_run_steps"]))
+
+
+#: what a round does: longer production on an arm's runs, or new replicas of an arm
+Action = Union[ExtendProduction, AddReplicas]
+_ACTIONS: dict[str, type] = {EXTEND: ExtendProduction, REPLICAS: AddReplicas}
+
+
+def read_action(rec: Mapping[str, Any]) -> Action:
+    """An action as the rounds record stores it (:meth:`ExtendProduction.to_json`,
+    :meth:`AddReplicas.to_json`); KeyError for an unknown kind."""
+    return _ACTIONS[rec["kind"]].from_json(rec)
+
+
+@dataclass(frozen=True)
 class Look:
     """One look: its number (1-based), the level it decided at, the core-hours the study's
     runs had cost by then (from the manifests), the criteria of every condition
@@ -52,7 +120,7 @@ class Look:
     core_hours: float
     criteria: tuple[dict, ...] = ()
     target: str = ""
-    actions: tuple[dict, ...] = ()
+    actions: tuple[Action, ...] = ()
     planned_core_hours: float = 0.0
     stop: str = ""
     stop_kind: str = ""
@@ -115,7 +183,7 @@ def read_rounds(study_path: Path) -> Rounds:
     try:
         looks = tuple(Look(int(x["number"]), float(x["alpha"]), float(x["core_hours"]),
                            tuple(x.get("criteria", ())), str(x.get("target", "")),
-                           tuple(x.get("actions", ())),
+                           tuple(read_action(a) for a in x.get("actions", ())),
                            float(x.get("planned_core_hours") or 0.0), str(x.get("stop", "")),
                            str(x.get("stop_kind", "")) or _legacy_kind(str(x.get("stop", ""))))
                       for x in rec.get("looks", ()))
@@ -128,6 +196,13 @@ def read_rounds(study_path: Path) -> Rounds:
                           f"({type(exc).__name__}: {exc})") from None
 
 
+def _look_json(look: Look) -> dict[str, Any]:
+    """A look as the record stores it (its actions through their own ``to_json``)."""
+    rec = {f.name: getattr(look, f.name) for f in fields(look)}
+    rec["actions"] = [a.to_json() for a in look.actions]
+    return json_safe(rec)
+
+
 def write_rounds(study_path: Path, rounds: Rounds) -> None:
     """Write the record atomically (a kill leaves the old one or the new one)."""
     rec = {"max_looks": rounds.max_looks, "alpha": rounds.alpha,
@@ -135,7 +210,7 @@ def write_rounds(study_path: Path, rounds: Rounds) -> None:
            "over max_looks looks (each look at alpha / max_looks), Hsu's conservative "
            "degrees of freedom (min(R1, R2) - 1)",
            "max_core_hours": rounds.max_core_hours, "every_level": rounds.every_level,
-           "looks": [json_safe(asdict(x)) for x in rounds.looks]}
+           "looks": [_look_json(x) for x in rounds.looks]}
     atomic_write_json(Path(study_path) / ROUNDS_FILE, rec)
 
 

@@ -18,8 +18,10 @@ from ligwf.pipeline.rounds import (RoundPlan, added_cases, apply_extensions, pla
 from ligwf.inference.registry import CriterionResult
 from ligwf.inference.verdict import ConditionVerdict, GroupVerdict, Verdict
 from ligwf.study.case import CaseFolder
-from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Look,
-                                Rounds, read_rounds, write_rounds)
+from ligwf.study.condition import Arm, Condition
+from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK,
+                                AddReplicas, ExtendProduction, Look, Rounds, read_rounds,
+                                write_rounds)
 from ligwf.study.study import Study
 
 from helpers import ROOT
@@ -51,9 +53,10 @@ def test_an_undecided_extension_becomes_the_next_round(study):
     assert not look.stop and look.target == "cg1.5-weber" and look.alpha == pytest.approx(0.05 / 3)
     (act,) = look.actions
     dt = s.cases[2].scaled.numerics.dt
-    assert act["kind"] == EXTEND and act["case_ids"] == ["cg1.5-weber-r0", "cg1.5-weber-r1"]
+    assert isinstance(act, ExtendProduction) and act.arm == Arm.CG_N
+    assert act.case_ids == ("cg1.5-weber-r0", "cg1.5-weber-r1")
     want = s.cases[2].scaled.numerics.run_steps + math.ceil(0.05 / dt)
-    assert act["run_steps"] == {"cg1.5-weber-r0": want, "cg1.5-weber-r1": want}
+    assert act.run_steps == {"cg1.5-weber-r0": want, "cg1.5-weber-r1": want}
     assert look.planned_core_hours > 0
     # applied: the case runs longer, its scene (and hash) is the rendered one
     rounds = rounds.with_look(look)
@@ -72,9 +75,10 @@ def test_replicas_are_new_cases_with_new_seeds_after_the_workflows(study, tmp_pa
     look = plan_look(verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n and CG1",
                                    round_amount=2, round_amount_cg1=1)), s,
                      start_rounds(s.path, RoundPlan(3, None)), 1)
-    kinds = {(a["kind"], a["arm"]): a for a in look.actions}
-    assert kinds[(REPLICAS, "CG-n")]["replicas"] == [2, 3]
-    assert kinds[(REPLICAS, "CG1")]["replicas"] == [2]
+    kinds = {(type(a), a.arm): a for a in look.actions}
+    assert kinds[(AddReplicas, Arm.CG_N)].replicas == (2, 3)
+    assert kinds[(AddReplicas, Arm.CG1)].replicas == (2,)
+    assert kinds[(AddReplicas, Arm.CG1)].condition == Condition("{}", 1.0, "none")
     more = added_cases(prepared, Rounds(3, looks=(look,)))
     new = more.rendered[len(prepared.rendered):]
     assert [rc.case.case_id for rc in new] == ["cg1.5-weber-r2", "cg1.5-weber-r3", "cg1-none-r2"]
@@ -168,8 +172,8 @@ def test_every_level_works_on_each_level_and_a_shared_cg1_arm_gets_the_most_aske
     assert cheapest.target == "cg1.5-bond"
     every = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None, every_level=True)), 1)
     assert every.target == "cg1.5-weber, cg1.5-bond"
-    reps = {a["condition"]: a["replicas"] for a in every.actions if a["kind"] == REPLICAS}
-    assert reps == {"cg1": [2, 3], "cg1.5-bond": [2]}
+    reps = {a.condition.name: a.replicas for a in every.actions if isinstance(a, AddReplicas)}
+    assert reps == {"cg1": (2, 3), "cg1.5-bond": (2,)}
     assert read_rounds(s.path).every_level is True
 
 
@@ -178,7 +182,7 @@ def test_an_unplanned_criterion_does_not_hold_back_the_planned_ones(study):
     v = verdict(angle("undecided", round_by=REPLICAS, round_arm="CG-n", round_amount=1),
                 dataclasses.replace(angle("undecided"), name="rigid_share"))
     look = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None)), 1)
-    assert not look.stop and [a["replicas"] for a in look.actions] == [[2]]
+    assert not look.stop and [a.replicas for a in look.actions] == [(2,)]
 
 
 def test_a_stuck_look_is_taken_again_by_the_next_call(study):
@@ -208,3 +212,42 @@ def test_round_costs_are_calibrated_by_the_arms_fastest_run(study):
     s = Study.open(s.path)
     calibrated = plan_look(v, s, start_rounds(s.path, RoundPlan(3, None)), 1)
     assert calibrated.planned_core_hours == pytest.approx(3.0 * plain)
+
+
+def test_added_replicas_are_the_cases_of_a_workflow_written_with_them(tmp_path):
+    """The rounds add replicas through the typed workflow (Workflow.with_replicas), never
+    by editing its YAML: each added case renders byte for byte as the same case of the
+    workflow written with that many replicas (swept scene values, per-level settings,
+    two rules, control twins around them), and the prepared workflow is left as written."""
+    import copy
+
+    import yaml
+    from ligwf.pipeline.prepare import render_case
+    from ligwf.scene.workflow import expand
+    from ligwf.study.case import group_of
+    raw = yaml.safe_load(WORKFLOW.read_text())
+    raw["sweep"].update({"rules": ["weber", "bond"], "replicas": {1: 2, 1.5: 1},
+                         "scene.process.rotation.rpm": [20, 30],
+                         "per_cg": {1.5: {"process.run_time": 0.4}},
+                         "controls": ["cohesionless"]})
+    path = tmp_path / "rich.yaml"
+    path.write_text(yaml.safe_dump(raw))
+    prepared = prepare_workflow(path)
+    group = group_of({"process.rotation.rpm": 30})
+    look = Look(1, 0.05, 0.0, actions=(
+        AddReplicas(Condition(group, 1.5, "bond"), (1, 2), 100),
+        AddReplicas(Condition(group, 1.0, "none"), (2,), 100)))
+    more = added_cases(prepared, Rounds(3, looks=(look,)))
+    new = more.rendered[len(prepared.rendered):]
+    assert [rc.case.case_id for rc in new] == ["cg1.5-bond-r1_rpm-30", "cg1.5-bond-r2_rpm-30",
+                                               "cg1-none-r2_rpm-30"]
+    assert [rc.case.index for rc in new] == list(range(len(prepared.rendered), len(more.rendered)))
+    assert more.workflow is prepared.workflow and more.workflow.raw == raw
+    written = copy.deepcopy(raw)
+    written["sweep"]["replicas"] = {1: 3, 1.5: 3}
+    same = {c.case_id: c for c in expand(written).cases}
+    for rc in new:
+        ref = render_case(same[rc.case.case_id])
+        assert (rc.files, rc.mesh_text, rc.scene_hash) == (ref.files, ref.mesh_text,
+                                                           ref.scene_hash)
+    assert added_cases(more, Rounds(3, looks=(look,))).rendered == more.rendered   # idempotent

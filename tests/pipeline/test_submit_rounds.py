@@ -17,7 +17,8 @@ from ligwf.pipeline.submit_rounds import (INCOMPLETE, ROUND_DUE, RUNNING, Follow
 from ligwf.slurm.jobs import append_record, read_record
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite
-from ligwf.study.rounds import Look, Rounds, read_rounds, write_rounds
+from ligwf.study.condition import Condition
+from ligwf.study.rounds import AddReplicas, Look, Rounds, read_rounds, write_rounds
 
 from helpers import ROOT
 
@@ -116,8 +117,7 @@ def test_a_look_whose_round_was_never_submitted_gets_a_follow_up_job_once(tmp_pa
     look, no array; again while that job is queued: nothing."""
     out = _round_one(tmp_path, monkeypatch)
     write_rounds(out, Rounds(2, looks=(Look(1, 0.025, 0.01, target="cg1.5-weber", actions=(
-        {"kind": "replicas", "group": "", "cg": 1.5, "rule": "weber", "replicas": [2],
-         "each_run_steps": 100, "condition": "cg1.5-weber"},)),)))
+        AddReplicas(Condition("{}", 1.5, "weber"), (2,), 100),)),)))
     slurm = Slurm("")
     p = progress(out, SlurmScheduler(SITE, slurm))
     assert (p.state, p.round, p.looks) == (ROUND_DUE, 2, 1)

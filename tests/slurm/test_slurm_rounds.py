@@ -27,7 +27,7 @@ from ligwf.slurm.parse import task_records
 from ligwf.study.case import CaseFolder
 from ligwf.study.layout import FIGURE_ROUNDS, FIGURES_DIR
 from ligwf.study.manifest import read_manifest
-from ligwf.study.rounds import EXTEND, REPLICAS, read_rounds
+from ligwf.study.rounds import AddReplicas, ExtendProduction, read_rounds
 from ligwf.study.study import Study
 from ligwf.study.thermo_table import rows_from_csv
 
@@ -164,9 +164,10 @@ def test_until_decided_runs_each_round_as_a_dependent_array(slurm_cluster, tmp_p
                      for i in s["indices"]) for r in (1, 2)}
     assert ran[1] == sorted(ids[:4])
     look1 = rounds.looks[0]
-    extended = sorted(cid for a in look1.actions if a["kind"] == EXTEND for cid in a["case_ids"])
-    added = sorted(f"cg{a['cg']:g}-{a['rule']}-r{r}" for a in look1.actions
-                   if a["kind"] == REPLICAS for r in a["replicas"])
+    extended = sorted(cid for a in look1.actions if isinstance(a, ExtendProduction)
+                      for cid in a.case_ids)
+    added = sorted(f"cg{a.condition.cg:g}-{a.condition.rule}-r{r}" for a in look1.actions
+                   if isinstance(a, AddReplicas) for r in a.replicas)
     assert look1.actions and ran[2] == sorted(extended + added), (ran, look1.actions)
     assert len(ids) == 4 + len(added)
 

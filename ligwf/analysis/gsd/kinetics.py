@@ -26,7 +26,8 @@ from ligwf.analysis.gsd import bins as gsdmod
 from ligwf.analysis.granules.case import GranuleAnalysis, RunFacts
 from ligwf.analysis.granules.definitions import variants
 from ligwf.analysis.frames.dumps import FrameFiles
-from ligwf.analysis.records.conditions import REFERENCE_CG, CaseLike, Condition
+from ligwf.analysis.records.conditions import CaseLike
+from ligwf.study.condition import REFERENCE_CG, Condition
 from ligwf.scene.settings import AnalysisSettings
 
 #: Per-frame quantities (see :func:`ligwf.analysis.gsd.bins.frame_stats`)

@@ -19,7 +19,8 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis.gsd import bins as gsdmod
-from ligwf.analysis.records.conditions import CaseLike, Condition, Conditions
+from ligwf.analysis.records.conditions import CaseLike, Conditions
+from ligwf.study.condition import Condition
 # the GSD errors name their limit: ligwf.analysis.records.gsd
 from ligwf.analysis.records.gsd import GSD_ERRORS, LOWER_LIMIT
 from ligwf.scene.settings import AnalysisSettings

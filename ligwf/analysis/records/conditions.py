@@ -1,12 +1,13 @@
-"""Conditions and their CG1 reference: one definition for the analysis and the report.
+"""The conditions of a set of cases and their CG1 references: one grouping for the analysis
+and the report.
 
-A condition is what replicas are pooled over: a sweep group, a CG level and a rule. A
-CG-n condition is compared with the CG1 cases of its own sweep group (its reference);
-the CG1 conditions are the references themselves (their errors against CG1 are the noise
-floor). :class:`Conditions` holds the conditions of a set of cases and answers "which
-condition is this case in" and "which cases is it compared with" -- the GSD, pooling,
-kinetics and sensitivity stages and the report's errors, intervals and noise floors all
-ask it instead of testing ``cg == 1`` themselves.
+A condition (:class:`ligwf.study.condition.Condition`) is what replicas are pooled over: a
+sweep group, a CG level and a rule. A CG-n condition is compared with the CG1 cases of its
+own sweep group (its reference); the CG1 conditions are the references themselves (their
+errors against CG1 are the noise floor). :class:`Conditions` holds the conditions of a
+set of cases and answers "which condition is this case in" and "which cases is it
+compared with" -- the GSD, pooling, kinetics and sensitivity stages and the report's
+errors, intervals and noise floors all ask it instead of testing ``cg == 1`` themselves.
 """
 
 from __future__ import annotations
@@ -14,10 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Iterable, Protocol
 
-from ligwf.study.case import group_label
-
-#: the CG level every other level is compared with
-REFERENCE_CG = 1.0
+from ligwf.study.condition import Condition
 
 
 class CaseLike(Protocol):
@@ -28,36 +26,6 @@ class CaseLike(Protocol):
     rule: str
     replica: int
     group: str
-
-
-@dataclass(frozen=True)
-class Condition:
-    """Cases pooled together: same sweep group, CG level and rule (replicas together)."""
-
-    group: str
-    cg: float
-    rule: str
-
-    @classmethod
-    def of(cls, case) -> "Condition":
-        return cls(case.group, case.cg, case.rule)
-
-    @property
-    def is_reference(self) -> bool:
-        """A CG1 condition: what the other levels of its group are compared with."""
-        return self.cg == REFERENCE_CG
-
-    @property
-    def name(self) -> str:
-        """``cg2-weber``; with a sweep group its readable name (``cg1 cohesionless
-        control``, ``cg2-weber process.rotation.rpm=20``: :func:`ligwf.study.case.group_label`)."""
-        tag = f"cg{self.cg:g}" + ("" if self.is_reference else f"-{self.rule}")
-        return tag if self.group in ("{}", "") else f"{tag} {group_label(self.group)}"
-
-    @property
-    def key(self) -> tuple[str, float, str]:
-        """Sort key: group, CG level, rule."""
-        return self.group, self.cg, self.rule
 
 
 @dataclass(frozen=True)
