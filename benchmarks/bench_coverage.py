@@ -29,6 +29,7 @@ Every coverage cell must lie in [0.92, 0.99]; the summary line says how many do.
 
 ``--profiles`` measures the profile's bounds when depth bins share their errors, sized from
 real profiles (:mod:`benchmarks.profile_designs`, registered in docs/results/verdict_rates/).
+``--profiles-2`` measures the profile's simulated fail test (the second registered run).
 ``--designs`` measures instead the designs users run under the verdict's single-look rules
 (unequal arms, all-zero shares, a level's family of criteria, the cheapest of several
 levels: :mod:`benchmarks.verdict_designs`, registered in docs/results/verdict_rates/); the
@@ -264,6 +265,9 @@ def main(argv=None) -> int:
     ap.add_argument("--profiles", action="store_true",
                     help="only the profile's bounds with correlated depth bins "
                          "(benchmarks/profile_designs.py; docs/results/verdict_rates)")
+    ap.add_argument("--profiles-2", action="store_true",
+                    help="only the profile's simulated fail test beside the correlated rule "
+                         "(benchmarks/profile_designs.py report_2; docs/results/verdict_rates)")
     ap.add_argument("--level-trials", type=int, default=2000,
                     help="studies a cell of the family and levels designs (--designs)")
     ap.add_argument("--recheck", type=int, default=0, metavar="N",
@@ -271,6 +275,9 @@ def main(argv=None) -> int:
                     "fresh null studies (Welch's and Hsu's df)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
+    if args.profiles_2:
+        from benchmarks.profile_designs import report_2
+        return 1 if report_2(rng, args.trials) else 0
     if args.profiles:
         from benchmarks.profile_designs import report as profile_report
         return 1 if profile_report(rng, args.trials) else 0

@@ -42,6 +42,11 @@ OFFSETS = (0.0, 1.0, 3.0)
 CORRELATION = (Path(__file__).resolve().parents[1] / "docs" / "results" / "profile_correlation"
                / "correlation.csv")
 RULES = (eq.BINS_CORRELATED, eq.BINS_INDEPENDENT)
+#: the second run's rules (profiles_2.txt): the rule checked first, the first run's beside
+RULES_2 = (eq.BINS_SIMULATED, eq.BINS_CORRELATED)
+#: the second run counts a design in its checks from this many runs of both arms together
+#: (the verdict decides a profile from there: ligwf.inference.profile.MIN_PROFILE_RUNS)
+COUNTED_FROM = 6
 
 
 def kernel_width(path: Path = CORRELATION) -> int:
@@ -65,7 +70,7 @@ def profile_runs(rng, trials: int, runs: int, offset: float, width: int) -> np.n
     return (c[..., width:] - c[..., :-width]) / math.sqrt(width)
 
 
-def profile_cells(rng, trials: int, width: int) -> list[dict]:
+def profile_cells(rng, trials: int, width: int, rules: tuple[str, ...] = RULES) -> list[dict]:
     """One row per (bins' correlation, design, offset) with each rule's coverage and errors;
     both rules decide the same studies."""
     shift = np.zeros(BINS)
@@ -78,7 +83,7 @@ def profile_cells(rng, trials: int, width: int) -> list[dict]:
         truth = float(np.sqrt(np.sum(shift ** 2)) / math.sqrt(BINS))
         row = {"bins": "correlated" if w > 1 else "independent", "design": f"{nx} vs {ny}",
                "offset": offset}
-        for rule in RULES:
+        for rule in rules:
             cover = wrong_pass = wrong_fail = 0
             for i in range(trials):
                 e = eq.norm_estimate(a[i], b[i], ALPHA, bins=rule)
@@ -126,5 +131,61 @@ def report(rng, trials: int) -> int:
     old = [c[eq.BINS_INDEPENDENT]["cover"] for c in cells if c["bins"] == "correlated"]
     print(f"beside (not a check): rule independent on correlated bins covers "
           f"{min(old):.3f}-{max(old):.3f}")
+    print(f"summary: {4 - failed} of 4 registered checks hold")
+    return failed
+
+
+def report_2(rng, trials: int) -> int:
+    """The second profile run (registered in docs/results/verdict_rates/README.md before it):
+    the simulated fail test (:data:`RULES_2`, first) beside the first run's correlated rule,
+    on the same designs and draws; checks over designs of at least :data:`COUNTED_FROM` runs
+    of both arms together (2 vs 2 printed, not counted). The number of checks that fail."""
+    width = kernel_width()
+    new, old = RULES_2
+    print(f"profile bounds with shared bin errors: {BINS} bins, triangular correlation "
+          f"1 - k / {width} (from {CORRELATION.relative_to(CORRELATION.parents[3])}), "
+          f"{trials} studies a cell, budget on the true distance")
+    print(f"{'bins':>11} {'design':>8} {'offset':>6} | rule simulated:  {'cover':>6} "
+          f"{'w.pass':>7} {'w.fail':>7} | rule correlated:  {'cover':>6} {'w.pass':>7} "
+          f"{'w.fail':>7}")
+    cells = profile_cells(rng, trials, width, RULES_2)
+    for c in cells:
+        n, i = c[new], c[old]
+        print(f"{c['bins']:>11} {c['design']:>8} {c['offset']:6.1f} | {'':16} "
+              f"{n['cover']:6.3f} {n['wrong pass']:7.4f} {n['wrong fail']:7.4f} | "
+              f"{'':16} {i['cover']:6.3f} {i['wrong pass']:7.4f} {i['wrong fail']:7.4f}",
+              flush=True)
+
+    def counted(c: dict) -> bool:
+        return sum(int(r) for r in c["design"].split(" vs ")) >= COUNTED_FROM
+
+    failed = 0
+    for bins, number in (("correlated", 1), ("independent", 3)):
+        rows = [c[new] for c in cells if c["bins"] == bins and counted(c)]
+        cover = [r["cover"] for r in rows]
+        inside = sum(LOW <= v <= HIGH for v in cover)
+        rates = [r[k] for r in rows for k in ("wrong pass", "wrong fail")]
+        above = sum(lower_bound(v, trials) > ALPHA for v in rates)
+        ok_cover, ok_rates = inside == len(cover), above == 0
+        print(f"check {number} ({bins} bins, rule simulated, designs of >= {COUNTED_FROM} "
+              f"runs) coverage: {inside} of {len(cover)} cells in [{LOW}, {HIGH}] "
+              f"({min(cover):.3f}-{max(cover):.3f}): {'holds' if ok_cover else 'FAILS'}")
+        print(f"check {number + 1} ({bins} bins, rule simulated, designs of >= "
+              f"{COUNTED_FROM} runs) wrong pass and fail: at most {max(rates):.4f} (pass "
+              f"{max(r['wrong pass'] for r in rows):.4f}, fail "
+              f"{max(r['wrong fail'] for r in rows):.4f}); {above} of {len(rates)} shown "
+              f"above {ALPHA}: {'holds' if ok_rates else 'FAILS'}")
+        failed += (not ok_cover) + (not ok_rates)
+    for bins in ("correlated", "independent"):
+        two = [c[new] for c in cells if c["bins"] == bins and not counted(c)]
+        print(f"beside (not a check): {bins} bins, 2 vs 2 (never decided): cover "
+              f"{min(r['cover'] for r in two):.3f}-{max(r['cover'] for r in two):.3f}, wrong "
+              f"pass at most {max(r['wrong pass'] for r in two):.4f}, wrong fail at most "
+              f"{max(r['wrong fail'] for r in two):.4f}")
+    rows = [c[old] for c in cells if c["bins"] == "correlated" and counted(c)]
+    print(f"beside (not a check): rule correlated on correlated bins, designs of >= "
+          f"{COUNTED_FROM} runs: wrong fail at most {max(r['wrong fail'] for r in rows):.4f}, "
+          f"{sum(lower_bound(r['wrong fail'], trials) > ALPHA for r in rows)} of {len(rows)} "
+          f"shown above {ALPHA}")
     print(f"summary: {4 - failed} of 4 registered checks hold")
     return failed
