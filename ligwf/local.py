@@ -19,6 +19,7 @@ resumes them), as ``scancel`` does to an array task.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import subprocess
@@ -32,8 +33,8 @@ from typing import Callable, ClassVar, Iterable, Sequence
 from ligwf.engine.cores import machine_cores
 from ligwf.engine.ensemble import run_ensemble
 from ligwf.engine.launch import Monitor, run_case, take_over
-from ligwf.engine.plan import Phase, Schedule, case_load, override_schedule, plan_study
-from ligwf.engine.resume import SKIP, plan_case
+from ligwf.engine.plan import CaseLoad, Phase, Schedule, case_load, override_schedule, plan_study
+from ligwf.engine.resume import RESUME, SKIP, plan_case
 from ligwf.engine.site import EngineConfig
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -112,10 +113,22 @@ def cases_to_run(cases: Iterable[CaseFolder], retry_unstable: bool = False) -> l
 def study_schedule(cases: Sequence[CaseFolder], settings: RunSettings) -> Schedule:
     """What a run does with ``cases`` (pass :func:`cases_to_run`): the planned schedule,
     or the one ``--np`` / ``--ensemble`` ask for."""
-    loads = [case_load(c.path.name, c.scaled) for c in cases]
+    loads = [_remaining(case_load(c.path.name, c.scaled), c, settings.retry_unstable)
+             for c in cases]
     if settings.planned:
         return plan_study(loads, settings.cores)
     return override_schedule(loads, settings.nprocs or 1, settings.ensemble, settings.cores)
+
+
+def _remaining(load: CaseLoad, case: CaseFolder, retry_unstable: bool) -> CaseLoad:
+    """The load of what is left of a case: a killed or extended case continues from its
+    newest own restart (:func:`~ligwf.engine.resume.plan_case`), so the planner prices
+    the steps after that restart, not the whole run again."""
+    plan = plan_case(case, retry_unstable)
+    if plan.action != RESUME or plan.restart is None:
+        return load
+    left = load.steps - plan.restart.step
+    return dataclasses.replace(load, steps=left) if 0 < left < load.steps else load
 
 
 @dataclass(frozen=True)

@@ -94,3 +94,22 @@ def test_a_hole_left_by_a_full_disk_says_where_the_case_resumes_or_that_it_start
                                  complete_upto=2500, total_steps=case.scaled.total_steps))
     plan = plan_case(case)
     assert plan.action == RESUME and plan.restart.step == 2000 and plan.skipped == ()
+
+
+def test_the_planner_prices_what_is_left_of_a_resumed_case_not_the_whole_run(tmp_path):
+    """An extended or killed case continues from its restart: the rank plan's estimate
+    counts the steps after it (before, a 4.5 s extension of the source drum was planned as
+    27 min, the whole runs again)."""
+    from ligwf.local import RunSettings, study_schedule
+
+    _, case = killed_case(tmp_path, steps_done=3000)
+    fresh = study_schedule([case], RunSettings(nprocs=1)).cases[0]
+    restart = case.path / "restart" / "restart_a.liggghts"
+    restart.write_bytes(restart_header(2000))
+    stamp(case.path, CaseIdentity.of(case), 1, 0.0)
+    assert plan_case(case).action == RESUME
+    left = study_schedule([case], RunSettings(nprocs=1)).cases[0]
+    total = case.scaled.total_steps
+    assert fresh.particle_steps == case.scaled.particles.count * total
+    assert left.particle_steps == case.scaled.particles.count * (total - 2000)
+    assert left.estimated_seconds < fresh.estimated_seconds
