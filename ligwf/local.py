@@ -34,12 +34,13 @@ from ligwf.engine.cores import machine_cores
 from ligwf.engine.ensemble import run_ensemble
 from ligwf.engine.launch import Monitor, run_case, take_over
 from ligwf.engine.plan import CaseLoad, Phase, Schedule, case_load, override_schedule, plan_study
-from ligwf.engine.resume import RESUME, SKIP, plan_case
+from ligwf.eligibility import eligible
+from ligwf.engine.resume import plan_case
 from ligwf.engine.site import EngineConfig
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
-from ligwf.study.manifest import (DONE, MISSING, RUNNING, case_busy, case_lock,
-                                  effective_status, runner_alive)
+from ligwf.study.manifest import (MISSING, RUNNING, case_busy, case_lock, effective_status,
+                                  runner_alive)
 from ligwf.study.study import Study
 
 #: Seconds between looks at cases another runner holds.
@@ -99,20 +100,9 @@ def run_settings(nprocs: int | None = None, ensemble: int = 0, cores: int | None
                        template_dirs=tuple(template_dirs), cores=count, cores_source=source)
 
 
-def all_done(cases: Iterable[CaseFolder]) -> bool:
-    """Whether every case's manifest says done."""
-    return all((m := c.manifest()) is not None and m.status == DONE for c in cases)
-
-
-def cases_to_run(cases: Iterable[CaseFolder], retry_unstable: bool = False) -> list[CaseFolder]:
-    """The cases a runner would start or resume now (not done, not unstable unless
-    ``retry_unstable``, not held by a live runner)."""
-    return [c for c in cases if plan_case(c, retry_unstable).action != SKIP]
-
-
 def study_schedule(cases: Sequence[CaseFolder], settings: RunSettings) -> Schedule:
-    """What a run does with ``cases`` (pass :func:`cases_to_run`): the planned schedule,
-    or the one ``--np`` / ``--ensemble`` ask for."""
+    """What a run does with ``cases`` (pass :attr:`ligwf.eligibility.Eligible.to_run`): the
+    planned schedule, or the one ``--np`` / ``--ensemble`` ask for."""
     loads = [_remaining(case_load(c.path.name, c.scaled), c, settings.retry_unstable)
              for c in cases]
     if settings.planned:
@@ -125,7 +115,7 @@ def _remaining(load: CaseLoad, case: CaseFolder, retry_unstable: bool) -> CaseLo
     newest own restart (:func:`~ligwf.engine.resume.plan_case`), so the planner prices
     the steps after that restart, not the whole run again."""
     plan = plan_case(case, retry_unstable)
-    if plan.action != RESUME or plan.restart is None:
+    if plan.restart is None:
         return load
     left = load.steps - plan.restart.step
     return dataclasses.replace(load, steps=left) if 0 < left < load.steps else load
@@ -194,7 +184,7 @@ class LocalExecutor:
             run_ensemble(study.path, list(cases), settings.ensemble, settings.nprocs or 1,
                          engine, retry_unstable=settings.retry_unstable, stop=stop,
                          monitor=monitor)
-            return all_done(cases)
+            return eligible(cases).settled
 
         def one(case: CaseFolder, nprocs: int) -> None:
             run_case(case, nprocs, engine, monitor, stop, settings.retry_unstable,
@@ -202,7 +192,8 @@ class LocalExecutor:
 
         ranks: dict[str, int] = {}
         if settings.planned:
-            schedule = study_schedule(cases_to_run(cases, settings.retry_unstable), settings)
+            schedule = study_schedule(eligible(cases, settings.retry_unstable).to_run,
+                                      settings)
             # every case's ranks (a case taken over below may not be in this runner's phases)
             ranks = {c.name: c.ranks for c in study_schedule(cases, settings).cases}
             by_name = {c.path.name: c for c in cases}
@@ -232,7 +223,7 @@ class LocalExecutor:
             for case in [c for c in busy if not case_busy(c.path)]:
                 one(case, ranks.get(case.path.name, default))
             busy = [c for c in cases if case_busy(c.path)]
-        return all_done(cases)
+        return eligible(cases).settled
 
     def ensemble_phase(self, study: Study, members: list[CaseFolder], phase: Phase,
                         label: str, engine: EngineConfig, monitor: Monitor | None,

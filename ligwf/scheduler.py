@@ -29,6 +29,10 @@ schedulers, and a :class:`Scheduler` implements them:
   tasks get the scheduler's signal, so the runner writes forced restarts and marks the
   case ``killed``; a resubmit resumes it).
 
+Which cases a resubmit runs again is not the scheduler's to say: it is what
+:func:`ligwf.eligibility.eligible` says of the case folders, with the cases whose task the
+scheduler still has queued or running held.
+
 The case's outcome is always its manifest: the scheduler only says whether a task is still
 queued or running. The Slurm implementation is :class:`ligwf.slurm.scheduler.SlurmScheduler`;
 the pipeline (:mod:`ligwf.pipeline.submit`) chains preparation, rank plan and scheduler.
@@ -40,12 +44,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
 from typing import Iterable, Mapping, Protocol, Sequence, runtime_checkable
-
-from ligwf.study.manifest import FAILED, KILLED, MISSING, RUNNING, UNSTABLE
-
-#: Manifest states worth running again: the runner resumes killed cases from their restart.
-#: ``unstable`` is left out by default: the same input and seed would fail the same way.
-RETRY_STATES = frozenset({FAILED, KILLED, RUNNING, MISSING})
 
 
 class CaseView(Protocol):
@@ -71,21 +69,15 @@ class StudyStatus(Protocol):
     scheduler_error: str | None
 
 
-def cases_to_resubmit(cases: Iterable[CaseView], include_unstable: bool = False) -> list[int]:
-    """Indices of cases that are not done and not queued: missing, failed, killed, stale.
-
-    A manifest still saying ``running`` while the scheduler no longer runs the task means the
-    task died without the runner finishing its manifest (e.g. SIGKILL at the time limit).
-    """
-    retry = set(RETRY_STATES)
-    if include_unstable:
-        retry.add(UNSTABLE)
-    return sorted(c.index for c in cases if not c.queued and c.manifest in retry)
-
-
 def active_tasks(cases: Iterable[CaseView]) -> list[CaseView]:
     """Cases whose latest task is still pending or running."""
     return [c for c in cases if c.queued]
+
+
+def queued_tasks(status: StudyStatus) -> dict[int, str]:
+    """Case index -> the task still holding it (pending or running), for
+    :func:`ligwf.eligibility.eligible`."""
+    return {c.index: c.job or "?" for c in status.cases if c.queued}
 
 
 @runtime_checkable

@@ -91,7 +91,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("analysis", ("ligwf.analysis",)),
     ("inference", ("ligwf.inference",)),
     ("report", ("ligwf.report",)),
-    ("executors", ("ligwf.scheduler", "ligwf.local", "ligwf.slurm")),
+    ("executors", ("ligwf.eligibility", "ligwf.scheduler", "ligwf.local", "ligwf.slurm")),
     ("pipeline", ("ligwf.pipeline",)),
     ("cli", ("ligwf.cli", "ligwf.__main__")),
     ("api", ("ligwf.api",)),

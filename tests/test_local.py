@@ -11,7 +11,8 @@ import pytest
 import ligwf.local as local
 from ligwf.engine.site import EngineConfig
 from ligwf.pipeline.prepare import prepare_workflow, write
-from ligwf.local import LocalExecutor, RunSettings, cases_to_run, study_schedule
+from ligwf.eligibility import eligible
+from ligwf.local import LocalExecutor, RunSettings, study_schedule
 from ligwf.pipeline.run import run_study
 from ligwf.study.manifest import case_lock
 
@@ -91,7 +92,8 @@ def test_ensemble_override_keeps_its_old_meaning(tmp_path, launches):
 def test_a_planned_ensemble_leaves_out_the_cases_another_runner_holds(tmp_path, launches):
     study = make_study(tmp_path, SMALL)
     held = study.cases[0]
-    phase = study_schedule(cases_to_run(study.cases), RunSettings(nprocs=None, cores=2)).phases[0]
+    phase = study_schedule(eligible(study.cases).to_run,
+                           RunSettings(nprocs=None, cores=2)).phases[0]
     members = [c for c in study.cases]
     with case_lock(held.path) as mine:
         assert mine

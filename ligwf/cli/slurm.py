@@ -18,8 +18,10 @@ particles, steps, ranks and what bound them, nodes, the estimated wall time agai
 ``--dry-run`` prints the plan, what it assumed about the site (MPI launcher, cores per node,
 partition limits: :mod:`ligwf.slurm.assumptions`), the scripts and the sbatch commands and
 writes nothing.
-``status`` joins the runner's manifests with squeue/scontrol; ``resubmit`` submits new
-arrays with exactly the cases that are missing, failed or killed (a planned submission is
+``status`` joins the runner's manifests with squeue/scontrol and says what each case needs
+next (:func:`ligwf.eligibility.eligible`) and whether the analysis is due; ``resubmit``
+submits new arrays with exactly the cases that need running -- missing, failed, killed,
+re-rendered, or done with their production extended since (a planned submission is
 planned again); ``cancel`` scancels the study's queued and running jobs (the runners write
 forced restarts, so ``resubmit`` resumes them). The chain is :mod:`ligwf.pipeline.submit`
 over :class:`ligwf.slurm.scheduler.SlurmScheduler`; this module parses and prints.
@@ -47,6 +49,7 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
 from ligwf.cli.slurm_rounds import (add_next_round_parser, add_until_decided_args,
                                     dry_run_note, follow_up_of, next_round, print_submitted,
                                     resubmit_rounds, submit_until_decided)
+from ligwf.eligibility import EXTEND, analysis_due, eligible
 from ligwf.engine.plan import RankPlan
 from ligwf.engine.progress import shown_reason
 from ligwf.engine.site import EngineConfig
@@ -60,7 +63,9 @@ from ligwf.pipeline.submit_rounds import is_sequential
 from ligwf.slurm.jobs import PlannedJob, read_record, recorded_site, study_status
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
+from ligwf.scheduler import queued_tasks
 from ligwf.study.ownership import other_study
+from ligwf.study.study import Study
 
 
 def add_site_args(p: argparse.ArgumentParser) -> None:
@@ -196,17 +201,26 @@ def cmd_submit(args: argparse.Namespace) -> int:
 
 
 def status_table(study_dir: Path) -> tuple[Table, dict]:
+    """Each case's manifest, its latest task and what it needs next
+    (:func:`ligwf.eligibility.eligible`, what a resubmit runs: unknown while Slurm cannot
+    be asked), and why the analysis is due (None: it holds)."""
     st = study_status(study_dir, tolerant=True)
+    study = Study.open(study_dir)
+    needs = ({} if st.scheduler_error else
+             {t.case.index: t.need.value for t in eligible(study.cases,
+                                                           queued=queued_tasks(st)).tasks})
     table = Table(title=f"{study_dir}")
-    for col in ("index", "case", "manifest", "slurm task", "slurm state", "reason"):
+    for col in ("index", "case", "manifest", "next", "slurm task", "slurm state", "reason"):
         table.add_column(col)
     counts: dict[str, int] = {}
     for c in st.cases:
         counts[c.manifest] = counts.get(c.manifest, 0) + 1
-        table.add_row(str(c.index), c.case_id, c.manifest, c.job or "-", c.slurm_state or "-",
+        table.add_row(str(c.index), c.case_id, c.manifest, needs.get(c.index, "?"),
+                      c.job or "-", c.slurm_state or "-",
                       shown_reason(c.manifest, c.reason)[:60])
-    data = {"cases": [asdict(c) for c in st.cases], "jobs": st.jobs, "counts": counts,
-            "scheduler_error": st.scheduler_error}
+    data = {"cases": [{**asdict(c), "next": needs.get(c.index)} for c in st.cases],
+            "jobs": st.jobs, "counts": counts, "scheduler_error": st.scheduler_error,
+            "analysis_due": analysis_due(study)}
     return table, data
 
 
@@ -224,6 +238,9 @@ def cmd_status(args: argparse.Namespace) -> int:
             console.print(f"{job['kind']} job {job['job_id']} (after {job.get('after')}): "
                           f"{job.get('state') or 'finished/forgotten by Slurm'}")
     console.print(", ".join(f"{n} {s}" for s, n in sorted(data["counts"].items())))
+    console.print(f"analysis due: {data['analysis_due']}" if data["analysis_due"]
+                  else "analysis: holds for the study (its record, cases, dumps, settings)",
+                  highlight=False, soft_wrap=True)
     return 0
 
 
@@ -249,7 +266,9 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
         console.print("nothing to resubmit: every case is done, unstable or still queued")
         return 0
     console.print(f"resubmitting {len(again.indices)} case(s): "
-                  + ", ".join(f"{c.index} {c.case_id} ({c.manifest})"
+                  + ", ".join(f"{c.index} {c.case_id} ({c.manifest}"
+                              + (", production extended)" if again.needs.of(c.index).need
+                                 is EXTEND else ")")
                               for c in again.cases if c.index in again.indices))
     if args.dry_run:
         print(scheduler.dry_run_text(list(again.jobs)))
@@ -301,7 +320,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.set_defaults(func=cmd_status)
 
     p = sub.add_parser("resubmit", help="submit a new array with exactly the cases that are "
-                                        "missing, failed or killed")
+                                        "missing, failed, killed or extended")
     p.add_argument("study_dir", type=Path, help="study folder")
     p.add_argument("--include-unstable", action="store_true",
                    help="also rerun cases the health checks marked unstable")

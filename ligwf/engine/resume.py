@@ -39,7 +39,7 @@ from ligwf.study.case import CaseFolder
 from ligwf.study.layout import (ENGINE_LOG, FORCED_RESTART_RE, INPUT_NAME, MANIFEST_FILE,
                                 OUTPUT_DIRS, PERIODIC_RESTARTS, RESTART_SIDECAR_SUFFIX,
                                 RESUME_INPUT, SCREEN_FILE, SCREEN_LOG_RE, THERMO_FILE, screen_log)
-from ligwf.study.manifest import DONE, FAILED, RUNNING, UNSTABLE, effective_status
+from ligwf.study.manifest import DONE, FAILED, RUNNING, UNSTABLE, Manifest, effective_status
 
 
 class Action(StrEnum):
@@ -149,37 +149,66 @@ def discard_restart(case_dir: Path, restart: RestartFile) -> None:
         p.rename(p.with_name(p.name + ".corrupt"))
 
 
-def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
-    """What to do with a case folder now (see the module docstring)."""
+@dataclass(frozen=True)
+class Standing:
+    """Where a case stands against its postcondition (a ``done`` manifest of its scene, run
+    to its end step, extension included), read from its folder alone: ``why`` says what it
+    still needs, ``reason`` says so in words, ``manifest`` is the one read (None: not run).
+    No restart file is opened: :func:`plan_case` picks the restart of a case that needs
+    one."""
+
+    why: Why
+    reason: str
+    manifest: Manifest | None = None
+
+
+def standing(case: CaseFolder, retry_unstable: bool = False) -> Standing:
+    """The one rule of what a case still needs (see the module docstring), from its
+    manifest, scene hash and production extension."""
     m = case.manifest()
     if m is None:
-        return NextAttempt(FRESH, "not run yet", why=Why.NOT_RUN)
+        return Standing(Why.NOT_RUN, "not run yet")
     if m.scene_hash != case.scene_hash:
-        return NextAttempt(FRESH, "scene changed since the last run", why=Why.SCENE_CHANGED)
+        return Standing(Why.SCENE_CHANGED, "scene changed since the last run", m)
     status = effective_status(m)
     if status == DONE and m.steps_done < case.scaled.total_steps and case.extension_steps:
-        return _extension_plan(case, m.steps_done)
+        return Standing(Why.EXTENDED, f"production extended to step {case.scaled.total_steps} "
+                        f"(done at {m.steps_done})", m)
     if status == DONE:
-        return NextAttempt(SKIP, DONE, why=Why.DONE)
+        return Standing(Why.DONE, DONE, m)
     if status == UNSTABLE and not retry_unstable:
-        return NextAttempt(SKIP, f"unstable: {m.reason}", why=Why.UNSTABLE)
+        return Standing(Why.UNSTABLE, f"unstable: {m.reason}", m)
     if status in (FAILED, UNSTABLE):
-        return NextAttempt(FRESH, f"re-run after {status}: {m.reason}", why=Why.RERUN)
+        return Standing(Why.RERUN, f"re-run after {status}: {m.reason}", m)
     if status == RUNNING:
-        return NextAttempt(SKIP, f"running in process {m.pid} on {m.host}", why=Why.HELD)
+        return Standing(Why.HELD, f"running in process {m.pid} on {m.host}", m)
+    return Standing(Why.KILLED, f"killed at step {m.steps_done}", m)
+
+
+def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
+    """What to do with a case folder now: its :func:`standing`, and for a killed or
+    extended case the restart it continues from (see the module docstring)."""
+    now = standing(case, retry_unstable)
+    m = now.manifest
+    if now.why is Why.EXTENDED:
+        return _extension_plan(case, m.steps_done)
+    if now.why is not Why.KILLED:
+        action = {Why.NOT_RUN: FRESH, Why.SCENE_CHANGED: FRESH, Why.RERUN: FRESH}.get(
+            now.why, SKIP)
+        return NextAttempt(action, now.reason, why=now.why)
     limit = m.steps_done + case.scaled.numerics.thermo_every
     if m.complete_upto is not None:
         limit = min(limit, m.complete_upto)
     restarts, refused = own_restarts(case, limit)
     ignored = f" (ignored {'; '.join(refused)})" if refused else ""
     if restarts:
-        return _with_skipped(NextAttempt(RESUME, f"killed at step {m.steps_done}; resume from "
+        return _with_skipped(NextAttempt(RESUME, f"{now.reason}; resume from "
                                          f"{restarts[0].path}{ignored}", restarts[0],
                                          why=Why.KILLED), refused)
     none = (f"no restart file of its own at or before step {limit} (its record is whole up "
             "to there)" if m.complete_upto is not None and m.complete_upto < m.steps_done
             else "before any restart file of its own was written")
-    return _with_skipped(NextAttempt(FRESH, f"killed at step {m.steps_done} {none}{ignored}: runs "
+    return _with_skipped(NextAttempt(FRESH, f"{now.reason} {none}{ignored}: runs "
                               "again from step 0", why=Why.KILLED), refused)
 
 

@@ -25,7 +25,8 @@ from ligwf.engine.launch import Monitor
 from ligwf.engine.plan import Schedule, plan_study
 from ligwf.engine.site import EngineConfig, EngineIdentity
 from ligwf.errors import ConfigError, LigwfError
-from ligwf.local import LocalExecutor, RunSettings, cases_to_run, study_schedule
+from ligwf.eligibility import eligible
+from ligwf.local import LocalExecutor, RunSettings, study_schedule
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.scheduler import Executor
 from ligwf.study.case import CaseFolder
@@ -102,7 +103,7 @@ def start_run(prepared: Prepared, out: Path, settings: RunSettings,
 def scheduled(study: Study, executor: LocalExecutor, identity: EngineIdentity) -> StudyRun:
     """A written study with the schedule of its cases still to run on ``executor``."""
     settings = executor.settings
-    schedule = study_schedule(cases_to_run(study.cases, settings.retry_unstable), settings)
+    schedule = study_schedule(eligible(study.cases, settings.retry_unstable).to_run, settings)
     return StudyRun(study, schedule, executor, identity)
 
 

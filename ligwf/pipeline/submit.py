@@ -22,8 +22,9 @@ from ligwf.engine.plan import Schedule, allocation_schedule, case_load
 from ligwf.errors import SubmitError
 from ligwf.pipeline.post import POSTPROCESS_COMMANDS
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
+from ligwf.eligibility import Eligible, eligible
 from ligwf.scheduler import (BatchJob, CaseView, JobRound, Scheduler, active_tasks,
-                             cases_to_resubmit)
+                             queued_tasks)
 from ligwf.study.study import Study
 
 
@@ -105,6 +106,7 @@ class Resubmission:
     indices: tuple[int, ...]          # the ones to run again
     busy: tuple[CaseView, ...]         # still queued or running: left alone
     jobs: tuple[BatchJob, ...]
+    needs: Eligible                    # what each case needs (why it runs again or not)
 
     def submit(self, scheduler: Scheduler) -> list[dict]:
         return scheduler.submit(self.study_dir, self.jobs)
@@ -113,13 +115,16 @@ class Resubmission:
 def plan_resubmission(study_dir: Path, scheduler: Scheduler, include_unstable: bool,
                       cores: int | None, planned: bool, recorded_cores: int | None = None,
                       analysis: bool = True, analysis_tasks: int = 1) -> Resubmission:
-    """The cases that are missing, failed or killed (``include_unstable``: unstable too)
-    and not queued, with their scripts. ``planned``: a planned submission is planned
-    again, on ``cores`` or else the cores it was planned on (``recorded_cores``);
-    otherwise every case gets the site's fixed task count."""
+    """The cases :func:`~ligwf.eligibility.eligible` says must run (missing, failed,
+    killed, their scene changed, or done with their production extended since;
+    ``include_unstable``: unstable too) and whose task is not queued, with their scripts.
+    ``planned``: a planned submission is planned again, on ``cores`` or else the cores it
+    was planned on (``recorded_cores``); otherwise every case gets the site's fixed task
+    count."""
     study = Study.open(study_dir)
     st = scheduler.status(study_dir)
-    indices = cases_to_resubmit(st.cases, include_unstable)
+    needs = eligible(study.cases, include_unstable, queued_tasks(st))
+    indices = list(needs.indices)
     busy = active_tasks(st.cases)
     jobs: Sequence[BatchJob] = ()
     plan_cores = cores if cores is not None else recorded_cores
@@ -128,7 +133,7 @@ def plan_resubmission(study_dir: Path, scheduler: Scheduler, include_unstable: b
         jobs = rerun_jobs(study, scheduler, indices, plan_cores, planned, steps,
                           analysis_tasks)
     return Resubmission(Path(study_dir), tuple(st.cases), tuple(indices), tuple(busy),
-                        tuple(jobs))
+                        tuple(jobs), needs)
 
 
 def rerun_jobs(study: Study, scheduler: Scheduler, indices: Sequence[int], cores: int | None,

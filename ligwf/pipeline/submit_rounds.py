@@ -9,22 +9,23 @@ analyses and reports the study and takes the look
 (:func:`~ligwf.pipeline.rounds.take_look`: written into the rounds record first); if the
 study goes on it writes the next round's case folders and extensions exactly as the local
 loop does (:func:`~ligwf.pipeline.rounds.write_round`) and submits the cases that must run
-(:func:`~ligwf.local.cases_to_run`: new replicas and extended done cases -- an
-extended done case still reads ``done`` in its manifest, so the scheduler's resubmit rule
-would skip it) with another follow-up job of the same kind; once it stops, the final
-report.
+(:func:`~ligwf.eligibility.eligible`: new replicas and extended done cases, whose
+manifest still reads ``done``; the same rule ``ligwf slurm resubmit`` and a local run
+follow) with another follow-up job of the same kind; once it stops, the final report.
 
 Where the study stands (:func:`progress`) is read from two records, never guessed: the
 rounds record (k looks taken) and the scheduler's submission record, where every job
 names the round it runs (``study_round``; r the latest):
 
 * the last look stopped it: :data:`STOPPED` (only the final report remains, written
-  once: :func:`final_report_written`);
+  once: :func:`~ligwf.eligibility.report_due`);
 * r <= k: round k + 1 is :data:`ROUND_DUE` (written and submitted, tagged k + 1);
 * r = k + 1 and a case still queued: :data:`RUNNING`;
-* r = k + 1 and a case not done (failed, killed, unstable, or its task never ran):
-  :data:`INCOMPLETE`, no look (``ligwf slurm resubmit`` runs them again with a follow-up);
-* r = k + 1 and every case done: the :data:`LOOK_DUE`.
+* r = k + 1 and a case not done (failed, killed, unstable, extended, or its task never
+  ran): :data:`INCOMPLETE`, no look (``ligwf slurm resubmit`` runs them again with a
+  follow-up);
+* r = k + 1 and every case done (:attr:`~ligwf.eligibility.Eligible.settled`): the
+  :data:`LOOK_DUE`.
 
 So a call after a kill, at any point, finds the state the last one left and completes it:
 a look is taken only while it is due (then k = r and it is not due again) and a round is
@@ -46,10 +47,10 @@ from ligwf.errors import ConfigError
 from ligwf.pipeline.post import report_study
 from ligwf.pipeline.prepare import Prepared
 from ligwf.pipeline.rounds import take_look, write_round
-from ligwf.local import LocalExecutor, all_done, cases_to_run
+from ligwf.eligibility import eligible, report_due
+from ligwf.local import LocalExecutor
 from ligwf.pipeline.submit import rerun_jobs
-from ligwf.scheduler import Scheduler
-from ligwf.study.layout import REPORT_FILES_RECORD, ROUNDS_FILE
+from ligwf.scheduler import Scheduler, queued_tasks
 from ligwf.study.rounds import Look, Rounds, read_rounds, rounds_lock
 from ligwf.study.study import Study
 
@@ -150,14 +151,11 @@ def progress(study_dir: Path, scheduler: Scheduler, retry_unstable: bool = False
                           f"look {r - 1}; was the rounds record replaced?")
     if r <= k:
         return Progress(ROUND_DUE, k, k + 1, follow_ups=follow)
-    study = Study.open(study_dir)
-    to_run = {c.index for c in cases_to_run(study.cases, retry_unstable)}
-    queued = tuple(c.job or "?" for c in st.cases if c.queued)
-    unfinished = tuple(c.index for c in st.cases if not c.queued and c.index in to_run)
-    not_done = tuple(c.case_id for c in study.cases
-                     if c.index in to_run or not all_done([c]))
+    needs = eligible(Study.open(study_dir).cases, retry_unstable, queued_tasks(st))
+    queued = tuple(t.queued for t in needs.tasks if t.queued is not None)
+    not_done = tuple(t.case.case_id for t in needs.not_done)
     state = RUNNING if queued else INCOMPLETE if not_done else LOOK_DUE
-    return Progress(state, k, r, queued, unfinished, not_done, follow)
+    return Progress(state, k, r, queued, needs.indices, not_done, follow)
 
 
 @dataclass(frozen=True)
@@ -231,9 +229,8 @@ def _submit_round(out: Path, scheduler: Scheduler, how: FollowUp,
     """Write round ``p.round`` (what the looks added) and submit its cases with a
     follow-up job; None when none must run and the caller takes the look itself."""
     study = write_round(prepared(), out, read_rounds(out), how.mesh_cache)
-    queued = {c.index for c in scheduler.status(out).cases if c.queued}
-    indices = [c.index for c in cases_to_run(study.cases, how.retry_unstable)
-               if c.index not in queued]
+    indices = eligible(study.cases, how.retry_unstable,
+                       queued_tasks(scheduler.status(out))).indices
     if not indices and take_looks:
         return None
     entries = _submit(study, scheduler, how, indices, p.round)
@@ -243,23 +240,12 @@ def _submit_round(out: Path, scheduler: Scheduler, how: FollowUp,
                  tuple(indices), f"round {p.round} submitted: {what}")
 
 
-def final_report_written(out: Path) -> bool:
-    """Whether the report was written after the last look (the record of its files is
-    newer than the rounds record; the look's own report comes before the look is
-    written): a repeat of the follow-up command on a stopped study then leaves it."""
-    try:
-        written = (Study.open(out).report_dir / REPORT_FILES_RECORD).stat().st_mtime_ns
-        return written > (Path(out) / ROUNDS_FILE).stat().st_mtime_ns
-    except FileNotFoundError:
-        return False
-
-
 def _settle(out: Path, scheduler: Scheduler, how: FollowUp, p: Progress, take_looks: bool,
             looks: tuple[Look, ...]) -> Moved:
     """The states a call ends in: the final report of a stopped study, or what a
     login-node call submits to keep the study going, or nothing with the reason."""
     if p.state == STOPPED:
-        if take_looks and not final_report_written(out):
+        if take_looks and report_due(Study.open(out)):
             report_study(out, snapshots=how.snapshots)
         return Moved(p, looks, note=f"stopped at look {p.looks}: {p.stop}")
     names = ", ".join(p.not_done[:6]) + (" ..." if len(p.not_done) > 6 else "")

@@ -14,7 +14,7 @@ from typing import Callable, ClassVar, Sequence
 
 from ligwf.engine.plan import allocation_schedule, case_load
 from ligwf.errors import SubmitError
-from ligwf.local import all_done
+from ligwf.eligibility import eligible
 from ligwf.scheduler import JobRound
 from ligwf.slurm.jobs import (PlannedJob, Runner, StudyStatus, dry_run_text, next_round,
                               plan_analysis_array, plan_jobs, read_record, recorded_plan,
@@ -71,7 +71,7 @@ class SlurmScheduler:
         self.submit(study.path, jobs)
         self._wait(study.path, stop,
                    lambda st: any(c.queued for c in st.cases if c.index in indices))
-        return all_done(cases)
+        return eligible(cases).settled
 
     def _wait(self, study_dir: Path, stop: threading.Event,
               pending: Callable[[StudyStatus], bool]) -> bool:

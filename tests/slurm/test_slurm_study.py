@@ -1,4 +1,5 @@
-"""Submission planning, resubmit selection and the CLI paths that need no scheduler."""
+"""Submission planning and the CLI paths that need no scheduler (which cases a resubmit
+selects: tests/test_eligibility.py)."""
 
 from __future__ import annotations
 
@@ -11,9 +12,8 @@ from pathlib import Path
 import pytest
 
 from ligwf.errors import ConfigError
-from ligwf.scheduler import cases_to_resubmit
 from ligwf.scheduler import JobRound
-from ligwf.slurm.jobs import (CaseStatus, append_record, dry_run_text, job_name, next_round,
+from ligwf.slurm.jobs import (append_record, dry_run_text, job_name, next_round,
                               plan_jobs, read_record, recorded_plan, recorded_site, submit_jobs)
 from ligwf.slurm.site import SlurmSite
 
@@ -22,21 +22,6 @@ from helpers import DRUM
 HERE = Path(__file__).resolve().parent
 WORKFLOW = HERE / "tiny_drum.yaml"
 LIGWF = str(Path(sys.executable).parent / "ligwf")
-
-
-def case(i: int, manifest: str, state: str | None = None) -> CaseStatus:
-    return CaseStatus(i, f"c{i}", manifest, job=f"7_{i}", slurm_state=state)
-
-
-def test_resubmit_picks_missing_failed_killed_and_stale_only():
-    cases = [case(0, "done", "COMPLETED"), case(1, "failed", "FAILED"),
-             case(2, "killed", "CANCELLED"), case(3, "missing", None),
-             case(4, "running", None),          # task gone, manifest never finished: stale
-             case(5, "unstable", "COMPLETED"),
-             case(6, "missing", "PENDING"),     # still queued: not again
-             case(7, "running", "RUNNING")]
-    assert cases_to_resubmit(cases) == [1, 2, 3, 4]
-    assert cases_to_resubmit(cases, include_unstable=True) == [1, 2, 3, 4, 5]
 
 
 def test_plan_has_array_of_exact_indices_and_dependent_analysis(tmp_path):
