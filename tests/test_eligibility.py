@@ -127,3 +127,15 @@ def test_the_analysis_and_the_report_are_due_until_their_records_hold(study):
     (study / ROUNDS_FILE).write_text("{}")          # a look taken since: the report is due
     os.utime(written, ns=(2, 2))
     assert report_due(s)
+
+
+def test_slurm_status_shows_each_case_need_beside_its_manifest(study, monkeypatch):
+    import ligwf.cli.slurm as cli_slurm
+    from ligwf.slurm.jobs import study_status
+
+    monkeypatch.setattr(cli_slurm, "study_status", lambda path, tolerant: study_status(
+        path, idle_slurm, tolerant=tolerant))
+    _, data = cli_slurm.status_table(study)
+    assert [(c["manifest"], c["next"]) for c in data["cases"]] == [
+        ("done", "done"), ("done", "extend"), ("killed", "resume"), ("missing", "fresh")]
+    assert data["analysis_due"] == "not analysed yet"

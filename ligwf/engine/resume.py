@@ -54,8 +54,8 @@ SKIP, FRESH, RESUME = Action.SKIP, Action.FRESH, Action.RESUME
 
 
 class Why(StrEnum):
-    """Why :func:`plan_case` chose its action: callers branch on this, never on the
-    reason's words (which are for people)."""
+    """What a case needs (:func:`standing`) and so why :func:`plan_case` chose its action:
+    callers branch on this, never on the reason's words (which are for people)."""
 
     NOT_RUN = "not_run"                   # no manifest yet
     SCENE_CHANGED = "scene_changed"       # the manifest is of another scene
@@ -185,6 +185,11 @@ def standing(case: CaseFolder, retry_unstable: bool = False) -> Standing:
     return Standing(Why.KILLED, f"killed at step {m.steps_done}", m)
 
 
+#: the action of a case that continues from no restart (killed and extended ones pick one)
+_NO_RESTART_ACTION = {Why.NOT_RUN: FRESH, Why.SCENE_CHANGED: FRESH, Why.RERUN: FRESH,
+                      Why.DONE: SKIP, Why.UNSTABLE: SKIP, Why.HELD: SKIP}
+
+
 def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
     """What to do with a case folder now: its :func:`standing`, and for a killed or
     extended case the restart it continues from (see the module docstring)."""
@@ -193,9 +198,7 @@ def plan_case(case: CaseFolder, retry_unstable: bool = False) -> NextAttempt:
     if now.why is Why.EXTENDED:
         return _extension_plan(case, m.steps_done)
     if now.why is not Why.KILLED:
-        action = {Why.NOT_RUN: FRESH, Why.SCENE_CHANGED: FRESH, Why.RERUN: FRESH}.get(
-            now.why, SKIP)
-        return NextAttempt(action, now.reason, why=now.why)
+        return NextAttempt(_NO_RESTART_ACTION[now.why], now.reason, why=now.why)
     limit = m.steps_done + case.scaled.numerics.thermo_every
     if m.complete_upto is not None:
         limit = min(limit, m.complete_upto)
