@@ -84,6 +84,11 @@ def derived(folder: ResultsFolder) -> dict[str, str]:
 
 
 FOLDER = ResultsFolder(OUT, None, "scripts/paper_scale_results.py RUNS", derived)
+#: the same studies' tables after their first 1.5 revolutions of production, before
+#: `--extend-production 4.5` (as committed in 4edc574; claims.csv recomputes from them too)
+FIRST = ResultsFolder(OUT / "first_windows", None,
+                      "scripts/paper_scale_results.py RUNS (before --extend-production)",
+                      derived)
 
 
 def make(args) -> ResultsFolder:
@@ -95,7 +100,7 @@ def make(args) -> ResultsFolder:
 
 
 def main(argv=None) -> int:
-    return results_command(__doc__, [FOLDER], make, argv)
+    return results_command(__doc__, [FOLDER, FIRST], make, argv)
 
 
 if __name__ == "__main__":
