@@ -1,6 +1,9 @@
 """The velocity-profile criterion: the noise-corrected relative L2 distance between the
-arms' mean profiles, decided by its noncentral-F bounds (:func:`ligwf.inference.equivalence.norm_estimate`);
-its fail test's p-value enters Holm's family whether it decides or not. What would decide it:
+arms' mean profiles, decided by its bounds (:func:`ligwf.inference.equivalence.norm_estimate`
+under :data:`~ligwf.inference.equivalence.PROFILE_BINS`: the upper bound from the noncentral
+F with the depth bins' correlation counted, the lower bound and the fail test from the F
+ratio's null simulated under the runs' own covariance of bins); its fail test's p-value
+enters Holm's family whether it decides or not. What would decide it:
 :func:`ligwf.inference.deciding.profile_plan` (the same number more replicas of both arms).
 """
 

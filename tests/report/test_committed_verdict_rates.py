@@ -173,3 +173,37 @@ def test_profile_bins_run_is_what_the_readme_says():
     assert checks == [("1", "FAILS"), ("2", "FAILS"), ("3", "holds"), ("4", "holds")]
     assert "summary: 2 of 4 registered checks hold" in text
     assert "**2 of 4 registered checks hold.**" in README
+
+
+def test_simulated_fail_test_run_is_what_the_readme_says():
+    """profiles_2.txt (bench_coverage --profiles-2, registered before it): the registered
+    command on its first line, the check lines recomputed from its cells (designs of >= 6
+    runs counted, a rate shown above 0.05 by its lower 95 % Clopper-Pearson bound) and the
+    numbers the README quotes."""
+    text = (HERE / "profiles_2.txt").read_text()
+    registered = re.search(r"^    (nice -n 19 .*--profiles-2.*) > docs/results/verdict_rates/"
+                           r"profiles_2\.txt$", (HERE / "README.md").read_text(), re.M).group(1)
+    assert text.splitlines()[0].startswith("# " + registered + " ")
+    rows = [line.split() for line in text.splitlines() if "|" in line and " vs " in line]
+    assert len(rows) == 36
+    cells = {(r[0], int(r[1]) + int(r[3]), r[1] + " vs " + r[3], float(r[4])):
+             [float(v) for v in (r[6], r[7], r[8], r[10], r[11], r[12])] for r in rows}
+    holds = []
+    for bins in ("correlated", "independent"):
+        counted = [v for k, v in cells.items() if k[0] == bins and k[1] >= 6]
+        assert len(counted) == 15
+        cover = [1.0 - v[1] for v in counted]          # the printed cover is rounded
+        holds.append(all(0.92 <= c <= 0.99 for c in cover))
+        holds.append(not any(_lower(r, 4000) > 0.05 for v in counted for r in v[1:3]))
+    assert holds == [False, True, True, True]
+    checks = re.findall(r"^check (\d) .*: (holds|FAILS)$", text, re.M)
+    assert checks == [(str(i + 1), "holds" if h else "FAILS") for i, h in enumerate(holds)]
+    assert "summary: 3 of 4 registered checks hold" in text
+    assert "**3 of 4 registered checks hold.**" in README
+    corr = [v for k, v in cells.items() if k[0] == "correlated" and k[1] >= 6]
+    indep = [v for k, v in cells.items() if k[0] == "independent" and k[1] >= 6]
+    assert f"at most {max(v[2] for v in corr):.4f} (6 vs 2, offset 1)" in README
+    assert f"Wrong pass at most {max(v[1] for v in corr):.4f}" in README
+    assert f"wrongly up to {max(v[5] for v in corr):.4f} (3 vs 3, offset 3" in README
+    assert "(0.970-0.997)" in README and f"({min(v[0] for v in indep):.3f}-" in README
+    assert f"{max(v[1] for v in indep):.4f} (pass) and {max(v[2] for v in indep):.4f}" in README
