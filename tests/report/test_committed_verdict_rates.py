@@ -207,3 +207,21 @@ def test_simulated_fail_test_run_is_what_the_readme_says():
     assert f"wrongly up to {max(v[5] for v in corr):.4f} (3 vs 3, offset 3" in README
     assert "(0.970-0.997)" in README and f"({min(v[0] for v in indep):.3f}-" in README
     assert f"{max(v[1] for v in indep):.4f} (pass) and {max(v[2] for v in indep):.4f}" in README
+
+
+def test_the_analysis_guide_quotes_both_profile_runs():
+    """docs/guide/analysis.md's profile sentence: the old rule's worst wrong fail on
+    correlated bins at 3 runs an arm or more (profiles.txt), the simulated test's
+    (profiles_2.txt check 2) and its upper bound's largest coverage (check 1)."""
+    import re
+    guide = " ".join((ROOT / "docs" / "guide" / "analysis.md").read_text().split())
+    old = (HERE / "profiles.txt").read_text().splitlines()
+    rows = [line.split() for line in old if line.startswith(" correlated")
+            and line.split()[1] != "2"]
+    worst_old = max(float(r[8]) for r in rows)       # rule correlated: cover, pass, fail
+    new = (HERE / "profiles_2.txt").read_text()
+    fail = float(re.search(r"check 2 .*?fail ([\d.]+)\)", new).group(1))
+    cover = re.search(r"check 1 .*?\(([\d.]+)-([\d.]+)\)", new).group(2)
+    assert (f"failed wrongly in up to {100 * worst_old:.1f} % of correlated studies, the "
+            f"simulated test in at most {100 * fail:.1f} %") in guide
+    assert f"over-covers there, up to {cover}," in guide
