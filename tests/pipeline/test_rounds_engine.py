@@ -1,7 +1,8 @@
 """Sequential studies on the real engine (tests/workflows/rounds_tiny.yaml: a CG1 bed of
 ~490 particles and its We-CG1.5 twin of ~140, two seeds each, seconds a run).
 
-* A production extension continues a done case from its own restart: one manifest (two
+* A production extension (``ligwf run --extend-production``, the user's path to the
+  rounds' extension record) continues a done case from its own restart: one manifest (two
   attempts, the second from a restart), one thermo table without gap or repeat up to the
   new end, the frames of the new production beside the old ones, the scene hash as
   rendered, the case usable.
@@ -12,6 +13,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import signal
 import subprocess
@@ -22,7 +24,6 @@ from pathlib import Path
 import pytest
 
 from ligwf.study.case import CaseFolder
-from ligwf.study.extension import write_extension
 from ligwf.study.manifest import read_manifest
 from ligwf.study.rounds import read_rounds
 from ligwf.study.thermo_table import rows_from_csv
@@ -62,13 +63,15 @@ def test_an_extension_continues_the_done_case_from_its_restart(tmp_path, engine)
     case_dir = out / "cg1.5-weber-r0"
     before = CaseFolder.open(case_dir)
     first = read_manifest(case_dir)
-    more = round(0.1 / before.scaled.numerics.dt)
-    write_extension(case_dir, before.scaled.numerics.run_steps, before.scaled.numerics.run_steps + more,
-                    before.scaled.numerics.dt)
+    more = math.ceil(0.1 / before.scaled.numerics.dt)
+    # the user's path (the fix the verdict names for runs too short): the same command
+    # with --extend-production writes the extension record and continues the done case
     r = subprocess.run(ligwf_cmd("run", str(WORKFLOW), "--out", str(out), "--set",
-                                 "sweep.cg_levels=[1.5]", "--set", "sweep.replicas=1"),
+                                 "sweep.cg_levels=[1.5]", "--set", "sweep.replicas=1",
+                                 "--extend-production", "0.1"),
                        capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
+    assert "cg1.5-weber-r0: production 0.1 s longer than rendered" in r.stdout
     after = CaseFolder.open(case_dir)
     m = read_manifest(case_dir)
     assert after.scene_hash == before.scene_hash == m.scene_hash
