@@ -1,9 +1,10 @@
 """docs/results/extrapolation/: the size relation over every committed study and the
 extrapolated CG1 reference checked where CG1 exists (issue 44 items 3 and 5).
 
-Reads only committed case tables (and, given RUNS, the new drums' analysed study folders in
-it, through open_study); writes size_relation.csv (one row per study, rule and CG level: the angle's excess over
-CG1 against x = (n - 1) d / D), size_fit.csv (the Weber slope through the origin that
+Reads only committed case tables (and, given RUNS, the new drums' analysed study folders
+in it, through open_study, whose case and extrapolation tables it copies here); writes
+size_relation.csv (one row per study, rule and CG level: the angle's excess over CG1
+against x = (n - 1) d / D), size_fit.csv (the Weber slope through the origin that
 ``ligwf/inference/size_relation.py`` carries as constants), validation.csv (per (drum,
 rule) pair: the extrapolated 95 % interval, the form's checks, the measured CG1 mean) and
 size_relation.png. ``--check`` recomputes the tables from the committed case tables and
@@ -49,11 +50,15 @@ PAIRS = (
     ("ladder cap_80min", "ladder/cap_80min", 0.001 / 0.05),
     ("we_vs_bo", "we_vs_bo", 0.001 / 0.05),
 )
-#: the new drums of criterion.md (run folders, analysed as amendments 3 and 4 say: each
-#: case's own strips, in the hard-linked copy): (name, study folder, d / D)
+#: the new drums of criterion.md (run folders, analysed as amendments 3-5 say: each case's
+#: own strips; the demo drum in its hard-linked copy): (name, study folder, d / D, the
+#: prefix its copied report tables (cases, extrapolation) carry here)
 NEW_PAIRS = (
-    ("demo drum CG1.5-2.5", "extrapolation_demo_drum_perlevel", 0.002 / 0.05),
+    ("demo drum CG1.5-2.5", "extrapolation_demo_drum_perlevel", 0.002 / 0.05, "demo_drum_"),
+    ("new drum CG1.5-2.5", "extrapolation_new_drum", 0.0025 / 0.07, "new_drum_"),
 )
+#: the report tables of each new drum's study copied here
+NEW_COPIED = (layout.CASES_REPORT, layout.EXTRAPOLATION_REPORT)
 COLUMN = "angle_of_repose"
 
 
@@ -114,7 +119,7 @@ def validation(runs: Path | None) -> pd.DataFrame:
     for name, folder, ratio in PAIRS:
         cases = committed_cases(folder)
         rows += [pair_row(name, cases, rule, ratio) for rule in ("weber", "bond")]
-    for name, folder, ratio in NEW_PAIRS:
+    for name, folder, ratio, _ in NEW_PAIRS:
         if runs is not None and (runs / folder).is_dir():
             cases = open_study(runs / folder).cases
             rows += [pair_row(name, cases, rule, ratio) for rule in ("weber", "bond")]
@@ -169,6 +174,9 @@ def make(args) -> ResultsFolder:
     """With RUNS, the new drums' validation rows from their study folders; the figure."""
     if args.study is not None:
         (OUT / VALIDATION).write_text(csv_text(validation(args.study)))
+        for _, folder, _, prefix in NEW_PAIRS:
+            if (args.study / folder).is_dir():
+                FOLDER.copy_report(args.study / folder, NEW_COPIED, prefix=prefix)
     if not args.no_figure:
         rows = size_rows()
         figure(rows, size_fit(rows), OUT / FIGURE)

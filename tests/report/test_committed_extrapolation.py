@@ -79,26 +79,57 @@ def test_committed_pairs_counts(rule, word):
                 in README)
 
 
+NEW = {"demo drum CG1.5-2.5": "demo drum", "new drum CG1.5-2.5": "new drum"}
+
+
 def test_new_drum_pairs_and_registered_criteria():
     v = pd.read_csv(HERE / "validation.csv")
-    new = v[v["pair"] == "demo drum CG1.5-2.5"].set_index("rule")
-    assert list(new["levels"]) == ["1.5 2 2.5"] * 2
-    for rule, inside in (("weber", "yes"), ("bond", "**no**")):
-        r = new.loc[rule]
-        assert (f"| demo drum, {rule.capitalize()} | {r['form']} ({r['lack_of_fit_p']:.2f}) | "
-                f"{r['extrapolated']:.2f} [{r['lo']:.2f}, {r['hi']:.2f}] | "
-                f"{r['cg1_mean']:.2f} | {inside} |") in README
+    new = v[v["pair"].isin(NEW)]
+    assert len(new) == 4 and set(new["levels"]) == {"1.5 2 2.5"}
+    for _, r in new.iterrows():
+        inside = "yes" if r["inside"] else "**no**"
+        assert (f"| {NEW[r['pair']]}, {r['rule'].capitalize()} | {r['form']} "
+                f"({r['lack_of_fit_p']:.2f}) | {r['extrapolated']:.2f} [{r['lo']:.2f}, "
+                f"{r['hi']:.2f}] | {r['cg1_mean']:.2f} | {inside} |") in README
     checked = new[new["form"] == "checked"]
     k, n = int(checked["inside"].sum()), len(checked)
     assert f"in **{k} of {n}** pairs that pass the checks" in README
     assert k / n < 0.9 and "(registered >= 90 %): **not met**" in README
-    weber = new.loc["weber"]
-    assert weber["form"] == "checked" and "(**1 of 1**): **met**" in README
-    assert weber["half_width"] > 1.0
-    assert f"half-width is **{weber['half_width']:.2f}** deg" in README
+    assert (new[new["rule"] == "bond"]["inside"] == False).all()      # noqa: E712
+    for _, r in new[new["rule"] == "bond"].iterrows():
+        assert f"{r['extrapolated'] - r['cg1_mean']:.1f} deg" in README
+    weber = new[new["rule"] == "weber"].set_index("pair")
+    assert (weber["form"] == "checked").all() and "(**2 of 2**): **met**" in README
+    demo, fresh = weber.loc["demo drum CG1.5-2.5"], weber.loc["new drum CG1.5-2.5"]
+    assert demo["half_width"] > 1.0 >= fresh["half_width"]
+    assert (f"half-width is **{demo['half_width']:.2f}** deg on the demo drum and "
+            f"**{fresh['half_width']:.2f}** on the new one") in README
+    assert "**not met**, 1 of 2" in README
     pooled = v[v["rule"] == "weber"]
-    assert f"inside in {int(pooled['inside'].sum())} of {len(pooled)} pairs, Bond's in " \
-           f"{int(v[v['rule'] == 'bond']['inside'].sum())} of 4" in README
+    bond = v[v["rule"] == "bond"]
+    assert (f"inside in {int(pooled['inside'].sum())} of {len(pooled)} pairs, Bond's in "
+            f"{int(bond['inside'].sum())} of {len(bond)}") in README
+
+
+def test_new_drum_report_tables_and_the_size_relation_printed_before_its_runs():
+    e = pd.read_csv(HERE / "new_drum_extrapolation.csv")
+    row = e[(e["rule"] == "weber - bond") & (e["column"] == "angle_of_repose")].iloc[0]
+    assert row["hi"] < 0                                   # past the check's edge
+    assert (f"on the new drum by {row['extrapolated']:.2f} [{row['lo']:.2f}, "
+            f"{row['hi']:.2f}] deg") in README
+    cases = pd.read_csv(HERE / "new_drum_cases.csv")
+    spread = cases[cases["rule"] == "weber"].groupby("cg")["angle_of_repose"].std()
+    assert f"(up to {spread.max():.1f} deg at CG{spread.idxmax():g})" in README
+    rows = [r for r in sr.excess_rows(cases, "new drum", 0.0025 / 0.07) if r["rule"] == "weber"]
+    expected = ", ".join(f"{sr.SLOPE_DEG * r['x']:.1f} [{sr.SLOPE_DEG_LO * r['x']:.1f}, "
+                         f"{sr.SLOPE_DEG_HI * r['x']:.1f}]" for r in rows)
+    assert expected.replace(", 5.3", " and 5.3") in README
+    measured = ", ".join(f"{r['excess_deg']:.2f}" for r in rows)
+    assert f"Measured: {measured.replace(', 5.', ' and 5.')} deg" in README
+    inside = [sr.SLOPE_DEG_LO * r["x"] <= r["excess_deg"] <= sr.SLOPE_DEG_HI * r["x"]
+              for r in rows]
+    assert inside == [True, False, True]
+    assert "inside at CG1.5 and CG2.5, above the interval at CG2" in README
 
 
 def test_demo_drum_report_tables_are_the_readme():
@@ -106,7 +137,8 @@ def test_demo_drum_report_tables_are_the_readme():
     row = e[(e["rule"] == "weber - bond") & (e["column"] == "angle_of_repose")].iloc[0]
     assert f"by {row['extrapolated']:.2f} [{row['lo']:.2f}, {row['hi']:.2f}] deg" in README
     bond = e[(e["rule"] == "bond") & (e["column"] == "angle_of_repose")].iloc[0]
-    assert f"misses CG1 by {bond['extrapolated'] - bond['cg1_measured']:.1f} deg" in README
+    assert (f"miss CG1, by {bond['extrapolated'] - bond['cg1_measured']:.1f} deg on the demo "
+            "drum") in README
     cases = pd.read_csv(HERE / "demo_drum_cases.csv")
     spread = cases[cases["rule"] == "weber"].groupby("cg")["angle_of_repose"].std()
     assert f"(up to {spread.max():.1f} deg between seeds at CG{spread.idxmax():g})" in README
@@ -120,3 +152,20 @@ def test_new_weber_rows_beside_the_fit():
     assert ", ".join(f"{r['x']:.2f}" for r in rows).replace(", 0.06", " and 0.06") in README
     want = ", ".join(f"{sr.SLOPE_DEG * r['x']:.2f}" for r in rows)
     assert want.replace(", 5", " and 5") in README
+
+
+def test_the_scaling_guide_quotes_the_new_drums():
+    guide = " ".join((ROOT / "docs" / "guide" / "scaling.md").read_text().split())
+    v = pd.read_csv(HERE / "validation.csv")
+    new = v[v["pair"].isin(NEW)].set_index(["pair", "rule"])
+    order = list(NEW)
+    weber = [new.loc[(p, "weber")] for p in order]
+    bond = [new.loc[(p, "bond")] for p in order]
+    assert all(r["inside"] for r in weber) and not any(r["inside"] for r in bond)
+    assert "Weber's measured CG1 lay inside its interval on both" in guide
+    assert ("half-widths " + " and ".join(f"{r['half_width']:.2f}" for r in weber)
+            + " deg: the registered 1 deg held on one") in guide
+    assert sum(r["half_width"] <= 1 for r in weber) == 1
+    assert all(r["form"] == "checked" for r in bond)
+    assert ("missed CG1 on both (by " + " and ".join(
+        f"{r['extrapolated'] - r['cg1_mean']:.1f}" for r in bond) + " deg)") in guide
