@@ -99,4 +99,23 @@ def extrapolation_section(table: pd.DataFrame, ratio: float,
             f"{_num(r['observed_order'], '.2g')} | {_num(r['cg1_measured'])} | {inside} |")
     if table.empty:
         lines = lines[:1]
-    return [Section("Extrapolated CG1", "extrapolated-cg1", "\n".join(lines + expected))]
+    return [Section("Extrapolated CG1", "extrapolated-cg1",
+                    "\n".join(lines + rules_disagree(table) + expected))]
+
+
+def rules_disagree(table: pd.DataFrame) -> list[str]:
+    """A sentence for each criterion whose two rules' extrapolated CG1 values differ (the
+    ``weber - bond`` rows whose interval excludes 0): both rules target one CG1, so at
+    least one of them does not extrapolate there, even where each line passes its check."""
+    if table.empty or "rule" not in table:
+        return []
+    out = []
+    for _, r in table[table["rule"] == "weber - bond"].iterrows():
+        if pd.isna(r["lo"]) or pd.isna(r["hi"]) or r["lo"] <= 0 <= r["hi"]:
+            continue
+        out.append(f"- {r['column']} ({r['group']}): Weber's and Bond's extrapolated CG1 "
+                   f"values differ by {_num(r['extrapolated'])} [{_num(r['lo'])}, "
+                   f"{_num(r['hi'])}] (weber - bond): both rules target the same CG1, so at "
+                   "least one of them does not extrapolate here, whatever its line's check "
+                   "says")
+    return [""] + out if out else []
