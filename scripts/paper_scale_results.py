@@ -89,6 +89,11 @@ FOLDER = ResultsFolder(OUT, None, "scripts/paper_scale_results.py RUNS", derived
 FIRST = ResultsFolder(OUT / "first_windows", None,
                       "scripts/paper_scale_results.py RUNS (before --extend-production)",
                       derived)
+#: after `--extend-production 4.5` (3 revolutions; as committed in 674d44a), before the
+#: Weber study's `--extend-production 13.5` (its Bond twin was not extended again)
+THIRD = ResultsFolder(OUT / "three_revolutions", None,
+                      "scripts/paper_scale_results.py RUNS (after --extend-production 4.5)",
+                      derived)
 
 
 def make(args) -> ResultsFolder:
@@ -100,7 +105,7 @@ def make(args) -> ResultsFolder:
 
 
 def main(argv=None) -> int:
-    return results_command(__doc__, [FOLDER, FIRST], make, argv)
+    return results_command(__doc__, [FOLDER, THIRD, FIRST], make, argv)
 
 
 if __name__ == "__main__":

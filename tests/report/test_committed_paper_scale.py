@@ -1,10 +1,12 @@
 """docs/results/paper_scale: claims.csv recomputes from the committed case tables, in the
-folder and in first_windows/ (scripts/paper_scale_results.py --check), and the README's
-numbers are those of the committed report tables (the verdict against the extrapolated
-CG1, the extrapolation, the cases; after the extension and, where it says what changed,
-before it)."""
+folder, three_revolutions/ and first_windows/ (scripts/paper_scale_results.py --check),
+and the README's numbers are those of the committed report tables (the verdict against the
+extrapolated CG1, the extrapolation, the cases; after 6 revolutions and, where it says what
+the extensions changed, after 3 and 1.5)."""
 
 from __future__ import annotations
+
+import re
 
 import pandas as pd
 
@@ -17,6 +19,11 @@ from tests.helpers import ROOT
 
 HERE = ROOT / "docs" / "results" / "paper_scale"
 FIRST = HERE / "first_windows"
+THIRD = HERE / "three_revolutions"
+#: the Weber study's tables at each production length, as the README's table names them
+STAGES = (("1.5 revolutions (`first_windows/`)", FIRST),
+          ("3 revolutions (`three_revolutions/`)", THIRD),
+          ("6 revolutions (this folder)", HERE))
 README = " ".join((HERE / "README.md").read_text().split())
 
 
@@ -52,45 +59,64 @@ def test_verdict_rows_are_the_readme():
     spread = f"{-angle['value'].max():.1f}-{-angle['value'].min():.1f} deg"
     assert f"they lie {spread} *shallower*" in README
     guide = " ".join((ROOT / "docs" / "guide" / "scaling.md").read_text().split())
-    assert f"level, {spread} below the extrapolated CG1 over 3 revolutions" in guide
+    assert f"level, {spread} below the extrapolated CG1 over 6 revolutions" in guide
     rigid = v[v["criterion"] == "rigid_share"]
     assert (rigid["state"] == "undecided").all()
     cases = pd.read_csv(HERE / "weber_cases.csv")
     assert (cases["rigid_frame_share"] == 0).all()      # "no run at any level turns as a block"
     layer = v[v["criterion"] == "flowing_layer"].sort_values("cg")
-    assert list(layer["state"]) == ["pass", "pass", "pass"]
-    r = layer.iloc[0]
-    assert f"{r['value']:.3f} [{r['lo']:.3f}, {r['hi']:.4f}]" in README
+    assert (layer["state"] == "not assessed").all()
+    e = pd.read_csv(HERE / "weber_extrapolation.csv").set_index("column")
+    lof = e.loc["flowing_layer_thickness_mean"]
+    assert lof["form"] == "rejected" and lof["lack_of_fit_p"] < 0.05
+    assert all(f"lack of fit p = {lof['lack_of_fit_p']:.3f}" in n for n in layer["note"])
+    thick = cases.groupby("cg")["flowing_layer_thickness_mean"].mean()
+    assert (" / ".join(f"{1000 * t:.1f}" for t in thick)
+            + f" mm) fails the lack-of-fit check (p = {lof['lack_of_fit_p']:.3f})") in README
+    third = pd.read_csv(THIRD / "weber_verdict.csv").query("criterion == 'flowing_layer'")
+    assert (third["state"] == "pass").all() and "(at 3 revolutions it passed)" in README
     norms = v[v["criterion"].isin(["profile_error", "field_error", "gsd_error"])]
     assert (norms["state"] == "not assessed").all()
 
 
-def test_steady_windows_after_the_extension_and_what_it_changed():
+def _capped(folder) -> int:
+    """Runs whose steady window starts at its cap, as the verdict printed them."""
+    text = (folder / "weber_summary.md").read_text()
+    return sum(int(k) for k in re.findall(
+        r"^- cg\d+-weber: runs too short to show a steady state: the steady window of "
+        r"(\d+) of 3 CG-n runs", text, re.M))
+
+
+def test_steady_windows_and_what_the_extensions_changed():
     v = _verdict().drop_duplicates("cg").set_index("cg")
     short = v["too_short_note"].fillna("")
-    assert "2 of 3 CG-n runs" in short[4.0] and "1 of 3 CG-n runs" in short[8.0]
-    assert short[6.0] == "" and "9 s more production" in short[4.0]
-    assert "2 of 3 CG4 runs and 1 of 3 CG8 runs still" in README
-    summary = (FIRST / "weber_summary.md").read_text()     # the first verdict printed it
-    assert all(f"- cg{n}-weber: runs too short to show a steady state: the steady window of "
-               "3 of 3 CG-n runs starts at its 50 % cap" in summary for n in (4, 6, 8))
-    assert "Then every run's window started at its cap; now 3 of 9 do" in README
-    assert not v.loc[6.0, "too_short"] and v.loc[4.0, "too_short"] and v.loc[8.0, "too_short"]
-    fa = pd.read_csv(FIRST / "weber_verdict.csv")
-    fa = fa[fa["criterion"] == "angle_deg"].sort_values("cg")
-    assert (fa["state"] == "fail").all()
-    assert "from " + " / ".join(f"{x:.2f}" for x in fa["value"]) + " deg to " + " / ".join(
-        f"{x:.2f}" for x in _verdict().query("criterion == 'angle_deg'").sort_values("cg")["value"]
-    ) + " deg" in README
-    fe = pd.read_csv(FIRST / "weber_extrapolation.csv").iloc[0]
-    assert f"moved from {fe['extrapolated']:.1f} [{fe['lo']:.1f}, {fe['hi']:.1f}]" in README
+    assert short[4.0] == "" and short[8.0] == "" and "1 of 3 CG-n runs" in short[6.0]
+    assert "18 s more production" in short[6.0]
+    assert "1 of 9 runs (one CG6 run) still starts" in README
+    rows = []
+    for name, folder in STAGES:
+        e = pd.read_csv(folder / "weber_extrapolation.csv").iloc[0]
+        a = pd.read_csv(folder / "weber_verdict.csv").query("criterion == 'angle_deg'")
+        assert (a["state"] == "fail").all()
+        rows.append(f"| {name} | {e['extrapolated']:.1f} [{e['lo']:.1f}, {e['hi']:.1f}] | "
+                    + " | ".join(f"{x:.2f}" for x in a.sort_values("cg")["value"])
+                    + f" | {_capped(folder)} of 9 |")
+    assert "\n".join(rows) in (HERE / "README.md").read_text()
+    assert [_capped(f) for _, f in STAGES] == [9, 3, 1]
+    drop = (pd.read_csv(FIRST / "weber_extrapolation.csv").iloc[0]["extrapolated"]
+            - pd.read_csv(HERE / "weber_extrapolation.csv").iloc[0]["extrapolated"])
+    assert f"the extrapolated CG1 angle fell by {drop:.1f} deg" in README
     fr = pd.read_csv(FIRST / "weber_verdict.csv").query("criterion == 'rigid_share'")
     assert (fr["state"] == "pass").all()
     fc = pd.read_csv(FIRST / "weber_cases.csv")
     hit = fc[fc["rigid_frame_share"] > 0]
     assert list(hit["cg"]) == [6.0] and f"({hit['rigid_frame_share'].iloc[0]:.3f} of them)" in README
+    for folder in (HERE, THIRD):
+        assert (pd.read_csv(folder / "weber_cases.csv")["rigid_frame_share"] == 0).all()
     bond = pd.read_csv(HERE / "bond_cases.csv")
     assert bond["steady_fraction"].max() < 0.035 and "at 3 % of the run" in README
+    for name in ("bond_cases.csv", "bond_verdict.csv", "bond_extrapolation.csv"):
+        assert (HERE / name).read_bytes() == (THIRD / name).read_bytes()   # not extended again
 
 
 def test_speedups_and_expected_excess():
@@ -123,8 +149,9 @@ def test_timing_is_the_recorded_one():
     assert f"{first_cluster} for the first 1.5 revolutions" in README
     we = float(re.search(r"^([\d.]+) s wall extension weber", text, re.M).group(1))
     bo = float(re.search(r"^([\d.]+) s wall extension bond", text, re.M).group(1))
-    assert f"and {we:,.0f} s for the Weber extension" in README
-    assert f"--extend-production 4.5 --no-snapshots`, {bo:,.0f} s;" in README
+    we2 = float(re.search(r"^([\d.]+) s wall extension weber 2", text, re.M).group(1))
+    assert f"{we:,.0f} s for the first extension and {we2:,.0f} s for the second" in README
+    assert f"--extend-production 4.5 --no-snapshots`, {bo:,.0f} s: 3 revolutions" in README
 
 
 def _claim(metric: str, cg: float) -> pd.Series:
