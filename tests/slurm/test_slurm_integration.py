@@ -137,7 +137,18 @@ def test_array_analysis_cancel_and_resubmit(slurm_cluster, tmp_path, env):
         _logs(study_b)
     for victim in (2, 3):  # cancelled in settle / production: resumed from a restart
         m = Study.open(study_b).case(victim).manifest()
-        assert len(m.attempts) == 2 and m.attempts[1].from_step > 0, m.attempts
+        assert len(m.attempts) == 2, m.attempts
+        if m.attempts[1].from_step == 0:
+            # the one exception, said in the manifest: a SIGTERM that lands one step past a
+            # thermo row the attempt did not record leaves its forced restart past the
+            # recorded progress; resuming there would leave a gap in the thermo table, so it
+            # is refused and the case runs again (seen once in CI, 2026-12-07: forced
+            # restart at step 10371, progress recorded to 10200 + one thermo interval)
+            skipped = [i["message"] for i in m.issues if i["kind"] == "restart_skipped"]
+            assert skipped and all("restart_forced_liggghts_" in x and "past the case's "
+                                   "recorded progress" in x for x in skipped), (m.attempts, skipped)
+        else:
+            assert m.attempts[1].from_step > 0
     # (the fill runs as short `run` commands: a SIGTERM that lands between two of them ends
     # LIGGGHTS without a forced restart, and the case then re-runs from step 0)
     # nothing left to resubmit
