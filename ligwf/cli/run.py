@@ -37,7 +37,7 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
     settings = run_settings(args.np, args.ensemble, args.cores, args.retry_unstable,
                             args.templates)
     run = start_run(prepared, args.out, settings, args.mesh_cache, args.replace,
-                    getattr(args, "extend_production", 0.0))
+                    args.extend_production)
     title = (f"rank plan for {settings.cores} core(s) ({settings.cores_source})"
              if settings.planned else "ranks as asked (--np / --ensemble)")
     console.print(plan_table(run.schedule, title))

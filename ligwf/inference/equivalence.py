@@ -30,7 +30,7 @@ import numpy as np
 from scipy import optimize, special, stats
 
 from ligwf.inference import behrens_fisher
-from ligwf.inference.profile_null import simulated_null
+from ligwf.inference.profile_null import sample_correlation, simulated_null
 
 #: a decision's error rate per side (the two one-sided tests each at ALPHA: a 90 % interval)
 ALPHA = 0.05
@@ -318,16 +318,8 @@ def bin_correlation2(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     has E[r^2] = 1/m between independent bins, so (r^2 - 1/m) / (1 - 1/m) is unbiased there
     and 1 for bins that move together. Left unclipped (a sum over pairs stays unbiased);
     the diagonal is 1. Bins with no variance correlate with nothing."""
-    parts = []
-    for a in (x, y):
-        res = a - a.mean(axis=0)
-        sd = res.std(axis=0, ddof=1)
-        parts.append(np.divide(res, sd, out=np.zeros_like(res), where=sd > 0))
-    res = np.vstack(parts)
+    r = sample_correlation(x, y)
     m = len(x) + len(y) - 2
-    norms = np.sqrt(np.sum(res * res, axis=0))
-    outer = np.outer(norms, norms)
-    r = np.divide(res.T @ res, outer, out=np.zeros((res.shape[1],) * 2), where=outer > 0)
     rho2 = (r * r - 1.0 / m) / (1.0 - 1.0 / m) if m > 1 else np.ones_like(r)
     np.fill_diagonal(rho2, 1.0)
     return rho2

@@ -25,8 +25,8 @@ SIMULATED_DRAWS, SIMULATED_SEED = 2000, 20261207
 
 def sample_correlation(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """The depth bins' sample correlation matrix from the runs' residuals pooled over both
-    arms (each scaled per arm and bin to unit variance, as
-    :func:`ligwf.inference.equivalence.bin_correlation2`); of
+    arms (each scaled per arm and bin to unit variance; the noise-corrected squares of
+    :func:`ligwf.inference.equivalence.bin_correlation2` start from it); of
     rank at most R1 + R2 - 2, so its eigenvalues spread more than the truth's (fewer
     effective bins: a heavier upper tail, the conservative side of a fail test)."""
     parts = []
