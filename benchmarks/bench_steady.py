@@ -31,9 +31,12 @@ Registered before the first run (2026-12-06 03:30 UTC):
     .venv/bin/python benchmarks/bench_steady.py            # ~1 min
 
 The planner's extension rule (``--extension``, :func:`extension_check`; its hypotheses
-H-ext1-3 registered in docs/results/steady/README.md on 2026-12-07 before their run):
+H-ext1-3 registered in docs/results/steady/README.md on 2026-12-07 before their run; the
+first run checked the first rule, a capped run's truncation taken as half its production,
+the second the rule of :data:`~ligwf.analysis.records.steady_window.CAPPED_TRUNCATION`):
 
-    .venv/bin/python -m benchmarks.bench_steady --extension --trials 20000 --seed 20261208
+    .venv/bin/python -m benchmarks.bench_steady --extension --trials 20000 --seed 20261208 --capped-truncation 0.5
+    .venv/bin/python -m benchmarks.bench_steady --extension --trials 20000 --seed 20261209
 """
 
 from __future__ import annotations
@@ -47,7 +50,8 @@ import numpy as np
 
 from benchmarks.bench_prediction import ar1_mean_variance
 from ligwf.analysis.flow.steady import auto_fraction, mser_index
-from ligwf.analysis.records.steady_window import TARGET_SHARE, at_cap, least_extension
+from ligwf.analysis.records.steady_window import (CAPPED_TRUNCATION, TARGET_SHARE, at_cap,
+                                                  least_extension)
 
 CAP_SHARE = 0.45        # a start at or after this fraction of production counts as capped
 STARTUP_SDS, STARTUP_TAU = 5.0, 4.0
@@ -87,12 +91,12 @@ def cell(rng, trials: int, frames: int, phi: float, oscillation: float, startup:
 
 
 def extension_check(rng, trials: int, frames: int = 80, phi: float = 0.5,
-                    tau: float = 16.0) -> dict:
+                    tau: float = 16.0, capped_truncation: float = CAPPED_TRUNCATION) -> dict:
     """The planner's extension rule (``--extension``): runs of ``frames`` frames whose
     start-up (5 sds, relaxing with ``tau`` frames: settled to 0.1 sd only after ~4 tau)
     outlasts half of them, so ``auto`` starts their window at the cap; each capped run is
-    continued by :func:`least_extension` (production >= 4 x the truncation) and analysed
-    again. Returned: the share capped before, the number of extended (capped) runs, the
+    continued by :func:`least_extension` (production >= 4 x the truncation, a capped run's
+    truncation taken as ``capped_truncation`` of its production) and analysed again. Returned: the share capped before, the number of extended (capped) runs, the
     share of them still capped after, the median truncation after (fraction of the new
     production; the rule aims at <= TARGET_SHARE), the share of them truncated later than
     TARGET_SHARE, and the bias of the window mean after, in standard errors."""
@@ -109,7 +113,7 @@ def extension_check(rng, trials: int, frames: int = 80, phi: float = 0.5,
         before.append(at_cap(f))
         if not at_cap(f):
             continue
-        n = frames + int(math.ceil(least_extension(f, float(frames))))
+        n = frames + int(math.ceil(least_extension(f, float(frames), capped_truncation)))
         g = auto_fraction(np.arange(n, dtype=float), [s[:n] for s in sig], 0.0, float(n))
         after.append(at_cap(g))
         share.append(g)
@@ -130,12 +134,15 @@ EXT_MEDIAN = TARGET_SHARE   # H-ext2: median truncation after, fraction of the n
 EXT_BIAS = 0.25             # H-ext3: |window-mean bias| after, standard errors
 
 
-def extension_main(rng, trials: int) -> None:
+def extension_main(rng, trials: int, capped_truncation: float = CAPPED_TRUNCATION) -> None:
     """The extension check's table and its registered hypotheses (phi 0.5 cells; the phi 0.8
-    cells are reported beside, without a criterion)."""
+    cells are reported beside, without a criterion). The first run's rule (a capped run's
+    truncation taken as 0.5 of production) prints the header it printed then."""
+    taken = ("" if capped_truncation == 0.5 else
+             f", a capped run's truncation taken as {capped_truncation:g} of its production")
     print(f"extension rule: 80 frames of production, {trials} trials a cell; capped = start "
           f">= {CAP_SHARE:.0%} of production; each capped run extended by least_extension "
-          f"(production >= {1 / TARGET_SHARE:g} x the truncation) and analysed again; "
+          f"(production >= {1 / TARGET_SHARE:g} x the truncation{taken}) and analysed again; "
           f"median and late (share > {TARGET_SHARE:g}) of the truncation after, in the new "
           "production; bias = mean (window mean - level) / se")
     print(f"{'phi':>4} {'tau':>4} | {'trials':>6} {'capped':>6} | {'extended':>8} "
@@ -143,7 +150,8 @@ def extension_main(rng, trials: int) -> None:
     cells = []
     for phi in (0.5, 0.8):
         for tau in (12.0, 16.0, 24.0):
-            c = extension_check(rng, trials, phi=phi, tau=tau)
+            c = extension_check(rng, trials, phi=phi, tau=tau,
+                                capped_truncation=capped_truncation)
             cells.append(c)
             print(f"{phi:4.1f} {tau:4.0f} | {c['trials']:6d} {c['before']:6.3f} | "
                   f"{c['extended']:8d} {c['after']:6.3f} {c['median']:6.4f} {c['late']:6.3f} "
@@ -167,10 +175,13 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=20261206)
     ap.add_argument("--extension", action="store_true",
                     help="check the planner's extension rule instead (extension_check)")
+    ap.add_argument("--capped-truncation", type=float, default=CAPPED_TRUNCATION,
+                    help="with --extension: the truncation taken for a capped run, as a "
+                         "fraction of its production (0.5: the first rule's)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
     if args.extension:
-        extension_main(rng, args.trials)
+        extension_main(rng, args.trials, args.capped_truncation)
         return 0
     print(f"steady-window start: {args.trials} trials a cell; capped = start >= "
           f"{CAP_SHARE:.0%} of production; bias = mean (window mean - level) / se")
