@@ -191,6 +191,7 @@ def too_short_note(runs, ref_runs, noise) -> str:
             f"starts at its {100 * steady.CAP:.0f} % cap (steady_after: auto found no steady "
             f"start in the first half); what would fix it: {' and '.join(fixes)} (the "
             f"planner's rule: production >= {1 / steady.TARGET_SHARE:g} x the truncation, so "
-            f"the window starts by {100 * steady.TARGET_SHARE:.0f} % of it): 'ligwf study "
+            f"the window starts by {100 * steady.TARGET_SHARE:.0f} % of it; a capped run's "
+            f"truncation taken as {steady.CAPPED_TRUNCATION:g} of its production): 'ligwf study "
             "WORKFLOW --out STUDY --extend-production S' continues every run from its "
             "restarts and analyses again, which tests the start again")

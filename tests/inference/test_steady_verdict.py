@@ -30,10 +30,16 @@ def test_the_cap_and_the_least_extension_rule():
     # production >= 4 x the truncation: a window at 40 % of 2 s needs 3.2 s, 1.2 s more
     assert steady.least_extension(0.40, 2.0) == pytest.approx(1.2)
     assert steady.least_extension(0.20, 2.0) == 0.0          # already by a quarter
-    # at the cap the truncation is only known to be >= half: production at least doubles
-    assert steady.least_extension(0.47, 2.0) == pytest.approx(2.0)
+    # at the cap the truncation is only known to lie in [1/2, 1] of production: the middle,
+    # 3/4, is taken, so production at least triples (the first rule, 1/2, doubled it)
+    assert steady.least_extension(0.47, 2.0) == pytest.approx(4.0)
+    assert steady.least_extension(0.47, 2.0, capped_truncation=0.5) == pytest.approx(2.0)
     after = 2.0 + steady.least_extension(0.47, 2.0)
-    assert 0.5 * 2.0 / after <= steady.TARGET_SHARE          # the truncation seen is a quarter
+    assert 0.75 * 2.0 / after <= steady.TARGET_SHARE         # the truncation taken is a quarter
+    assert 0.5 * 2.0 / after < steady.TARGET_SHARE           # the one seen, less
+    # a window measured past the middle of the capped range is sized by what was measured
+    assert steady.least_extension(0.47, 2.0, capped_truncation=0.4) == pytest.approx(
+        0.47 * 2.0 / steady.TARGET_SHARE - 2.0)
 
 
 def noise(cases: pd.DataFrame, capped: set[str], production: float = 2.0) -> pd.DataFrame:
@@ -60,7 +66,7 @@ def test_a_level_whose_windows_start_at_the_cap_is_flagged_with_what_fixes_it(tm
     short = {c.name: c.too_short for c in v.groups[0].conditions}
     assert "2 of 3 CG-n runs and 1 of 3 CG1 runs" in short["cg2-weber"]
     assert "starts at its 50 % cap" in short["cg2-weber"]
-    assert "2 s more production on each of those CG-n runs" in short["cg2-weber"]
+    assert "4 s more production on each of those CG-n runs" in short["cg2-weber"]
     assert "production >= 4 x the truncation" in short["cg2-weber"]
     # cg3's own runs start in time, but it shares the capped CG1 run
     assert "1 of 3 CG1 runs" in short["cg3-weber"] and "CG-n" not in short["cg3-weber"]

@@ -95,12 +95,13 @@ def test_the_new_rule_and_the_long_check_numbers_are_their_files():
 EXT_REGISTERED = {"still_capped": 0.05, "median": 0.25, "bias": 0.25}
 
 
-def _extension_rows() -> tuple[list[dict], str]:
-    """The cells of the committed ``bench_steady --extension`` run, and the file's text."""
-    text = (HERE / "bench_steady_extension.txt").read_text()
+def _extension_rows(name: str = "bench_steady_extension.txt", seed: int = 20261208
+                    ) -> tuple[list[dict], str]:
+    """The cells of a committed ``bench_steady --extension`` run, and the file's text."""
+    text = (HERE / name).read_text()
     first = text.splitlines()[0]
     assert first.startswith("# ") and "bench_steady --extension" in first
-    assert "--trials 20000 --seed 20261208" in first
+    assert f"--trials 20000 --seed {seed}" in first
     rows = []
     for line in text.splitlines():
         m = re.match(r"^\s*([\d.]+)\s+(\d+) \|\s+(\d+)\s+([\d.]+) \|\s+(\d+)\s+([\d.]+)\s+"
@@ -162,3 +163,43 @@ def test_the_extension_rule_numbers_are_their_file():
     assert float(tau24["late"]) > 0.5 and "most start later than a quarter" in text
     failing = [r["tau"] for r in reg if float(r["median"]) > EXT_REGISTERED["median"]]
     assert failing == [24] and "**H-ext2 is not met** (tau 24)" in text
+
+
+def test_the_tripling_rule_numbers_are_their_file():
+    """The second registered run (README: registered at a929c29, before its run): the rule
+    the planner uses now, a capped run's truncation taken as 3/4 of its production."""
+    from ligwf.analysis.records import steady_window
+
+    assert steady_window.CAPPED_TRUNCATION == 0.75
+    rows, verdicts = _extension_rows("bench_steady_extension_2.txt", 20261209)
+    assert "a capped run's truncation taken as 0.75 of its production" in verdicts
+    text = " ".join((HERE / "README.md").read_text().split())
+    assert "registered in README.md at a929c29" in verdicts.splitlines()[0]
+    reg = [r for r in rows if r["phi"] == 0.5]
+    beside = [r for r in rows if r["phi"] == 0.8]
+
+    def span(cells, key, fmt=".3f"):
+        values = sorted(float(r[key]) for r in cells)
+        return f"{values[0]:{fmt}}-{values[-1]:{fmt}}"
+
+    def each(key):
+        return ", ".join(r[key] for r in reg[:-1]) + f" and {reg[-1][key]}"
+
+    met = {
+        "H-ext1": all(float(r["after"]) <= EXT_REGISTERED["still_capped"] for r in reg),
+        "H-ext2": all(float(r["median"]) <= EXT_REGISTERED["median"] for r in reg),
+        "H-ext3": all(abs(float(r["bias"])) <= EXT_REGISTERED["bias"] for r in reg),
+    }
+    for h, ok in met.items():
+        assert re.search(rf"^{h} .*: {'met' if ok else 'not met'}$", verdicts, re.M)
+        assert f"**{h} is {'met' if ok else 'not met'} by the tripling rule**" in text
+    section = text[text.index("`bench_steady_extension_2.txt`"):]
+    assert f"starts at the cap in {span(reg, 'before')} of runs" in section
+    assert (f"extended ({min(r['extended'] for r in reg)}-{max(r['extended'] for r in reg)} "
+            f"a cell), the window still starts at the cap in {each('after')}") in section
+    assert f"is {each('median')} of the new production" in section
+    assert f"later than 0.25 in {each('late')} of the extended runs" in section
+    bias = sorted(float(r["bias"]) for r in reg)
+    assert f"off by {bias[0]:.2f} to {bias[-1]:.2f} standard errors" in section
+    assert (f"still at the cap after the extension {span(beside, 'after')}, median truncation "
+            f"{span(beside, 'median', '.4f')}") in section
