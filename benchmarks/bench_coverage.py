@@ -183,12 +183,14 @@ def _synth_arm(runs: list, price: float) -> "sp.Arm":
 
 
 def sequential_study(rng, R: int, frames: int, phi: float, offset: float, delta: float,
-                     budget: float = 1.0, looks: int = 3) -> str:
+                     budget: float = 1.0, looks: int = 3, fail_sides: int = 1) -> str:
     """The whole sequential procedure of ``ligwf study --until-decided`` on one synthetic
     comparison (true CG-n - CG1 = ``delta``): up to ``looks`` looks, each two one-sided
     tests at alpha / looks (Bonferroni spending); after an undecided look the cheapest
     option of :func:`ligwf.inference.sampling.cheapest` that halves the half-width
-    is done (runs continued or replicas added, new seeds). Returns the final state."""
+    is done (runs continued or replicas added, new seeds). Returns the final state.
+    ``fail_sides``: 1, the one-sided fail test coverage.txt was registered with; 2, the
+    verdict's two-sided fail test since issue 45 (docs/results/verdict_rates)."""
     from ligwf.inference import sampling as sp
     alpha = ALPHA / looks
     arms = [[SynthRun(rng, frames, phi, offset, delta) for _ in range(R)],
@@ -197,9 +199,9 @@ def sequential_study(rng, R: int, frames: int, phi: float, offset: float, delta:
     for look in range(1, looks + 1):
         x, y = _synth_arm(arms[0], 1.0), _synth_arm(arms[1], CG1_PRICE)
         e = difference_estimate(x.values, y.values, alpha, HSU)
-        # the rule coverage.txt was registered with: a fail when the interval lies wholly
-        # outside (one-sided fail p); the two-sided rule is measured by --designs
-        state = equivalence(e, budget, alpha, fail_sides=1).state
+        # fail_sides 1: the rule coverage.txt was registered with (a fail when the interval
+        # lies wholly outside, one-sided fail p); 2: the verdict's since issue 45
+        state = equivalence(e, budget, alpha, fail_sides=fail_sides).state
         if state != "undecided" or look == looks:
             return state
         # the round's rule (ligwf.pipeline.rounds): the cheapest way to halve the half-width
@@ -220,14 +222,14 @@ def sequential_study(rng, R: int, frames: int, phi: float, offset: float, delta:
     return state
 
 
-def sequential_cells(rng, trials: int, looks: int = 3) -> list[dict]:
+def sequential_cells(rng, trials: int, looks: int = 3, fail_sides: int = 1) -> list[dict]:
     """Wrong final decisions of the sequential procedure on null studies: a pass when the
     truth sits on the budget (delta = budget), a fail when it sits on the budget or at 0."""
     out = []
     for R, frames, phi, offset in itertools.product((2, 3), (20, 100), (0.3, 0.8), (0.0, 1.0)):
-        on = [sequential_study(rng, R, frames, phi, offset, 1.0, 1.0, looks)
+        on = [sequential_study(rng, R, frames, phi, offset, 1.0, 1.0, looks, fail_sides)
               for _ in range(trials)]
-        zero = [sequential_study(rng, R, frames, phi, offset, 0.0, 1.0, looks)
+        zero = [sequential_study(rng, R, frames, phi, offset, 0.0, 1.0, looks, fail_sides)
                 for _ in range(trials)]
         out.append({"R": R, "frames": frames, "phi": phi, "offset": offset,
                     "wrong pass": on.count("pass") / trials,
@@ -256,6 +258,9 @@ def main(argv=None) -> int:
     ap.add_argument("--looks", type=int, default=3, help="looks of the sequential procedure")
     ap.add_argument("--sequential-only", action="store_true",
                     help="only the sequential procedure (skip the interval cells)")
+    ap.add_argument("--fail-sides", type=int, default=1, choices=(1, 2),
+                    help="the sequential procedure's fail test: 1, one-sided (the ladder's "
+                         "coverage.txt); 2, two-sided (the verdict's since issue 45)")
     ap.add_argument("--designs", action="store_true",
                     help="only the designs users run (docs/results/verdict_rates)")
     ap.add_argument("--df-rule", default="welch if equal arms, else hsu",
@@ -311,9 +316,10 @@ def main(argv=None) -> int:
     print(f"summary: {inside} of {total} coverage cells in [{LOW}, {HIGH}]")
     if args.recheck and rows:
         recheck_wrong_pass(rng, rows, args.recheck)
-    seq = sequential_cells(rng, args.sequential_trials, args.looks)
+    seq = sequential_cells(rng, args.sequential_trials, args.looks, args.fail_sides)
     print(f"sequential (--until-decided): at most {args.looks} looks at alpha "
-          f"{ALPHA}/{args.looks} each, {args.sequential_trials} null studies a cell")
+          f"{ALPHA}/{args.looks} each, {args.sequential_trials} null studies a cell"
+          + (", two-sided fail test" if args.fail_sides == 2 else ""))
     print(f"{'R':>2} {'frames':>6} {'phi':>4} {'offset':>6} | {'wrong pass':>10} "
           f"{'wrong fail':>10} | {'decided at 0':>12}")
     for c in seq:
@@ -322,6 +328,13 @@ def main(argv=None) -> int:
               flush=True)
     worst = max(max(c["wrong pass"], c["wrong fail"]) for c in seq)
     print(f"sequential: final decisions wrong at most {worst:.3f} of the time (must be <= 0.05)")
+    if args.fail_sides == 2:
+        from benchmarks.verdict_designs import lower_bound
+        shown = max(lower_bound(max(c["wrong pass"], c["wrong fail"]), args.sequential_trials)
+                    for c in seq)
+        print(f"check sequential (two-sided fail test: no cell's wrong pass or wrong fail shown "
+              f"above {ALPHA}): {'holds' if shown <= ALPHA else 'FAILS'} (largest lower 95 % "
+              f"bound {shown:.4f})")
     if args.old:
         for R, frames, phi, offset in itertools.product((2, 3), (50,), (0.6,), (0.0, 2.0)):
             print(f"old bootstrap interval R={R} frames={frames} phi={phi} offset={offset}: "
