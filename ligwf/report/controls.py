@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.records.renamed import current_names
+from ligwf.analysis.records.controls import read_controls
 from ligwf.study import layout
 
 #: (column, header) of the control table; each is shown as "wet / twin"
@@ -27,17 +27,6 @@ NO_CONTROL = ("This study ran no cohesionless control (`sweep.controls: [cohesio
               "wetted bed had no granules that beat that control under any definition: read "
               "the granule sizes, GSD errors and size limits below as properties of the "
               "definition, not as findings about granulation.")
-
-
-def read_controls(analysis_dir: Path) -> pd.DataFrame | None:
-    """The controls table, or None when the study has no twins (or no analysis); one
-    written by the previous release is read with its current column names
-    (:func:`~ligwf.analysis.records.renamed.current_names`)."""
-    path = Path(analysis_dir) / layout.CONTROLS_TABLE
-    if not path.is_file() or path.stat().st_size == 0:
-        return None
-    table = current_names(pd.read_csv(path), layout.CONTROLS_TABLE, str(path))
-    return table if len(table) else None
 
 
 def _cell(r, col: str) -> str:

@@ -1,37 +1,17 @@
-"""The extrapolated CG1 reference in a study's report: its inputs read from the case
-folders (the drum's d / D, the planner's CG1 cost per level), ``extrapolation.csv`` and
-the report section that shows it (the extrapolated CG1 beside the measured one where CG1
-ran, the form's checks, the two rules' disagreement)."""
+"""The extrapolated CG1 reference in a study's report: the section that shows
+``extrapolation.csv`` (written by :func:`ligwf.inference.decide.decide_study`): the
+extrapolated CG1 beside the measured one where CG1 ran, the form's checks, the two rules'
+disagreement, and the size relation's expected excess per Weber level."""
 
 from __future__ import annotations
 
-import json
 import math
 
 import pandas as pd
 
-from ligwf.inference.reference import ANGLE_COLUMN, planned_cg1_speedup, size_ratio
+from ligwf.inference.reference import ANGLE_COLUMN
 from ligwf.inference.size_relation import expected_excess
 from ligwf.report.sections import Section
-from ligwf.study import layout
-from ligwf.study.study import Study
-
-
-def extrapolation_inputs(study: Study) -> tuple[float, dict]:
-    """(d / D of the study's drum, (group, cg, rule) -> the planner's CG1 cost over the
-    level's): read from the usable cases' scene records (nan / empty without one)."""
-    ratio, speedups = math.nan, {}
-    for case in study.usable_cases()[0]:
-        try:
-            scene = json.loads((case.path / layout.SCENE_FILE).read_text())["scene"]
-        except (OSError, ValueError, KeyError):
-            continue
-        if not math.isfinite(ratio):
-            ratio = size_ratio(scene)
-        key = (case.group, float(case.cg), str(case.rule))
-        if case.cg > 1.0 and key not in speedups:
-            speedups[key] = planned_cg1_speedup(scene, case.cg, case.rule)
-    return ratio, speedups
 
 
 def _num(v, fmt: str = ".3g") -> str:

@@ -19,7 +19,6 @@ import pandas as pd
 
 from ligwf import __version__
 from ligwf.study.condition import REFERENCE_CG
-from ligwf.inference.equivalence import HSU, WELCH_BF
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import LOWER_LIMIT
 from ligwf.analysis.records.analysis_record import AnalysisRecord
@@ -27,7 +26,7 @@ from ligwf.analysis.records.provenance import StaleAnalysis, changed_dumps
 from ligwf.errors import LigwfError
 from ligwf.fsio import atomic_write_text
 from ligwf.report import figures as figs
-from ligwf.report.controls import controls_markdown, read_controls
+from ligwf.report.controls import controls_markdown
 from ligwf.report.fields import fields_report
 from ligwf.report.forest import forest, forest_rows
 from ligwf.report.granule_figures import granule_figures
@@ -40,15 +39,12 @@ from ligwf.report.sections import (Figure, Section, figure_section, ordered, ren
 from ligwf.report.table_sections import (markdown_tables, noise_markdown, paraview_markdown,
                                          pooling_markdown, stability_markdown, steady_line)
 from ligwf.report.tables import build_tables
-from ligwf.inference.budget import signed_columns
-from ligwf.report.extrapolation_report import extrapolation_inputs, extrapolation_section
+from ligwf.report.extrapolation_report import extrapolation_section
 from ligwf.report.scale_section import scale_section
 from ligwf.report.spreading_section import spreading_section, spreading_tables
-from ligwf.inference.reference import extrapolation_rows
-from ligwf.inference.planning import noise_table
 from ligwf.report.rounds import rounds_sections
 from ligwf.inference.verdict import Verdict
-from ligwf.inference.verdict_records import study_verdict, write_verdict
+from ligwf.inference.decide import decide_study
 from ligwf.report.verdict_text import verdict_section
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -90,15 +86,8 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
-    ratio, speedups = extrapolation_inputs(study)
-    verdict = study_verdict(cases, conditions, study.accept, read_controls(study.analysis_dir),
-                            {cid: c.profile_v_mean for cid, c in flow.cases.items()},
-                            noise_table(study.usable_cases()[0], flow, signed_columns()),
-                            *sequential_level(read_rounds(study.path)), size_ratio=ratio,
-                            speedups=speedups)
-    write_verdict(verdict, out)
-    extrapolated = extrapolation_rows(cases, signed_columns(), ratio)
-    atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
+    decided = decide_study(study, flow, cases, conditions, out)
+    verdict, extrapolated, ratio = decided.verdict, decided.extrapolated, decided.size_ratio
     spread_cases, spread_levels = spreading_tables(flow)     # no rows without placed liquid
     atomic_write_text(out / layout.SPREADING_REPORT, spread_levels.to_csv(index=False))
     figures = report_figures(study, flow, cases, conditions, out, snapshots, verdict)
@@ -148,14 +137,6 @@ def report_sections(study: Study, flow: FlowRecord, cases: pd.DataFrame,
              *split_markdown(stability_markdown(study.usable_cases()[0])),
              *split_markdown(paraview_markdown(figures.paraview))]
     return ordered(parts)
-
-
-def sequential_level(rounds) -> tuple[float, str]:
-    """(alpha, df rule) of each test: a sequential study's looks test at alpha / looks with
-    Hsu's conservative degrees of freedom (:mod:`ligwf.study.rounds`); a single look Welch's
-    for equal arms and the Behrens-Fisher distribution for unequal ones (Welch is liberal
-    there, Hsu's far too wide: docs/results/verdict_rates)."""
-    return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH_BF)
 
 
 def verdict_sections(verdict: Verdict | None, figure: Figure | None = None) -> list[Section]:

@@ -26,7 +26,7 @@ from ligwf.inference import behrens_fisher
 from ligwf.inference import equivalence as eq
 from ligwf.inference.field_errors import FIELD_NOISE_COLUMNS, LayerNoise
 from ligwf.inference.shares import share_bounds, share_test
-from ligwf.report.write import sequential_level
+from ligwf.inference.decide import look_level
 from ligwf.study.rounds import read_rounds
 from tests.helpers import ROOT
 from tests.inference.test_verdict import CG1, crit, runs, verdict
@@ -162,7 +162,7 @@ def test_unequal_arms_leave_welch_where_it_passes_wrongly():
 def test_a_single_look_report_decides_with_behrens_fisher_for_unequal_arms():
     class OneLook:
         alpha_per_look, max_looks = 0.05, 1
-    assert sequential_level(OneLook()) == (0.05, eq.WELCH_BF)
+    assert look_level(OneLook()) == (0.05, eq.WELCH_BF)
 
 
 def test_behrens_fisher_is_its_distribution():

@@ -13,7 +13,8 @@ from ligwf.analysis.records.flow import CaseFlow
 from ligwf.analysis.records.renamed import RENAMED, current_names
 from ligwf.api.tables import read_table
 from ligwf.report import dictionary
-from ligwf.report.controls import controls_markdown, read_controls
+from ligwf.analysis.records.controls import read_controls
+from ligwf.report.controls import controls_markdown
 from ligwf.study import layout
 
 RESULTS = ROOT / "docs" / "results"

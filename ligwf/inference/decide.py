@@ -1,0 +1,87 @@
+"""A study decided: the verdict record and the extrapolated CG1 table, computed once from
+the analysis' values and the report's case and condition tables, and written into the
+report folder before anything is rendered.
+
+This is the one place a study's statistics are decided: the report
+(:func:`ligwf.report.write.write_report`) renders what :func:`decide_study` returns and
+wrote, and the API (:func:`ligwf.api.open_study`) reads the same record back
+(:func:`~ligwf.inference.verdict_records.read_verdict`). What it reads besides the tables:
+the granule controls (:mod:`ligwf.analysis.records.controls`), the runs' noise and prices
+(:func:`~ligwf.inference.planning.noise_table`), the level each test is run at (a sequential
+study's looks: :func:`look_level`), and the drum's size ratio and the planner's CG1 speedup
+per level (:func:`extrapolation_inputs`) for a sweep judged against an extrapolated CG1.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from ligwf.analysis.records.controls import read_controls
+from ligwf.analysis.records.flow import FlowRecord
+from ligwf.fsio import atomic_write_text
+from ligwf.inference.budget import signed_columns
+from ligwf.inference.equivalence import HSU, WELCH_BF
+from ligwf.inference.planning import noise_table
+from ligwf.inference.reference import extrapolation_rows, planned_cg1_speedup, size_ratio
+from ligwf.inference.verdict import Verdict
+from ligwf.inference.verdict_records import study_verdict, write_verdict
+from ligwf.study import layout
+from ligwf.study.rounds import Rounds, read_rounds
+from ligwf.study.study import Study
+
+
+@dataclass(frozen=True)
+class Decided:
+    """What :func:`decide_study` wrote: the verdict (its record ``verdict.json`` /
+    ``verdict.csv``), the extrapolated CG1 rows (``extrapolation.csv``) and the drum's
+    d / D they were computed with (nan without a scene record)."""
+
+    verdict: Verdict
+    extrapolated: pd.DataFrame
+    size_ratio: float
+
+
+def look_level(rounds: Rounds) -> tuple[float, str]:
+    """(alpha, df rule) of each test: a sequential study's looks test at alpha / looks with
+    Hsu's conservative degrees of freedom (:mod:`ligwf.study.rounds`); a single look Welch's
+    for equal arms and the Behrens-Fisher distribution for unequal ones (Welch is liberal
+    there, Hsu's far too wide: docs/results/verdict_rates)."""
+    return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH_BF)
+
+
+def extrapolation_inputs(study: Study) -> tuple[float, dict]:
+    """(d / D of the study's drum, (group, cg, rule) -> the planner's CG1 cost over the
+    level's): read from the usable cases' scene records (nan / empty without one)."""
+    ratio, speedups = math.nan, {}
+    for case in study.usable_cases()[0]:
+        try:
+            scene = json.loads((case.path / layout.SCENE_FILE).read_text())["scene"]
+        except (OSError, ValueError, KeyError):
+            continue
+        if not math.isfinite(ratio):
+            ratio = size_ratio(scene)
+        key = (case.group, float(case.cg), str(case.rule))
+        if case.cg > 1.0 and key not in speedups:
+            speedups[key] = planned_cg1_speedup(scene, case.cg, case.rule)
+    return ratio, speedups
+
+
+def decide_study(study: Study, flow: FlowRecord, cases: pd.DataFrame,
+                 conditions: pd.DataFrame, out: Path) -> Decided:
+    """Decide ``study`` from its analysis (``flow``) and its report tables (``cases``,
+    ``conditions``) and write the verdict record and ``extrapolation.csv`` into ``out``."""
+    ratio, speedups = extrapolation_inputs(study)
+    verdict = study_verdict(cases, conditions, study.accept, read_controls(study.analysis_dir),
+                            {cid: c.profile_v_mean for cid, c in flow.cases.items()},
+                            noise_table(study.usable_cases()[0], flow, signed_columns()),
+                            *look_level(read_rounds(study.path)), size_ratio=ratio,
+                            speedups=speedups)
+    write_verdict(verdict, out)
+    extrapolated = extrapolation_rows(cases, signed_columns(), ratio)
+    atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
+    return Decided(verdict, extrapolated, ratio)
