@@ -65,8 +65,9 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, null: pd.DataFrame,
     lines = ["# The demo study's report (`make demo`)", "",
              "Made by `make demo` (the study: `" + COMMAND + "`), then "
              "`scripts/demo_results.py runs/demo` copied the report folder's tables "
-             "(`verdict.csv` / `verdict.json`, `cases.csv`, `conditions.csv`, "
-             "`noise_floor.csv`, `fields_null_check.csv`), `summary.md`, `index.html` (open "
+             f"(`{layout.VERDICT_TABLE}` / `{layout.VERDICT_RECORD}`, `{layout.CASES_REPORT}`, "
+             f"`{layout.CONDITIONS_REPORT}`, `{layout.NOISE_FLOOR_REPORT}`, "
+             f"`{layout.FIELD_NULL_REPORT}`), `{layout.SUMMARY_REPORT}`, `{layout.HTML_REPORT}` (open "
              "it in a browser: verdict first) and `figures/`, and wrote this README from "
              "them (checked by `tests/report/test_committed_demo.py`). The ParaView series "
              "are not committed.", "",

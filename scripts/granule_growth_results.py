@@ -100,10 +100,10 @@ def readme(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame, cases: pd.
         "",
         "Pre-registration (committed before the runs): [criterion.md](criterion.md). Made by:",
         "", "```", COMMAND, "```", "",
-        "Tables: `seeds.csv` (one row per wet seed beside its cohesionless twin, every measure and "
-        "criterion), `controls_verdict.csv` (k of n seeds per criterion), `growth_rows.csv` "
-        "(every start frame), `cadence.csv` (held share at three window cadences), `flow.csv` "
-        "(angle of repose per frame), `cases.csv` (the runs). This README is written from them by "
+        f"Tables: `{SEEDS}` (one row per wet seed beside its cohesionless twin, every measure and "
+        f"criterion), `{SEED_VERDICT}` (k of n seeds per criterion), `{GROWTH_ROWS}` "
+        f"(every start frame), `{CADENCE}` (held share at three window cadences), `{FRAME_FLOW}` "
+        f"(angle of repose per frame), `{RUNS}` (the runs). This README is written from them by "
         "`scripts/granule_growth_results.py` and checked against them by "
         "`tests/report/test_committed_granule_growth.py`.",
         "",

@@ -25,84 +25,37 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
-from ligwf.analysis.granules.growth import GrowthSettings, hac_slope
-from ligwf.analysis.granules.growth_study import CRITERIA, Criteria, measure_case, seed_table
+from ligwf.analysis.granules.growth_study import measure_case
+from ligwf.analysis.granules.screen import (POINTS, REGISTERED, SEEDS, SETTINGS, condition_row,
+                                            phase2_seeds, phase2_verdict, ranked)
 from ligwf.api.results_folder import ResultsFolder, csv_text, number, results_command
+from ligwf.study import layout
 
 ROOT = Path(__file__).resolve().parents[1]
 
 OUT = ROOT / "docs" / "results" / "granule_screen"
-#: the registered settings (criterion.md): W = 1.3 s, start frames every 0.1 s from W
-SETTINGS = GrowthSettings(hold_time=1.3, cadence=0.05, stride=0.1, start_after=1.3)
+#: the tables this script measures (named here, once); the verdict is derived from the seeds
+GROWTH_ROWS, CONDITIONS_TABLE = "growth_rows.csv", "conditions.csv"
+PHASE2_ROWS, PHASE2_RUNS, PHASE2_SEEDS = "phase2_rows.csv", "phase2_runs.csv", "phase2_seeds.csv"
+PHASE2_VERDICT = "phase2_verdict.csv"
+#: phase 1's conditions (criterion.md): (liquid model, how the liquid is placed)
 CONDITIONS = {"S1": ("washino", "placed nuclei"), "S2": ("washino", "uniform"),
               "S3": ("easo", "placed nuclei"), "S4": ("easo", "uniform")}
-LAST_REVOLUTIONS = 10.0
-POINTS = (("exists", "share_10 >= 0.02"), ("survives", "mean survival >= 0.5"),
-          ("grows", "share_10 slope's 95 % interval above 0"),
-          ("comoves", "mean co-movement ratio <= 0.5"))
 
 
 def case_folder(study: Path, name: str) -> Path | None:
     """The one case folder of condition ``name`` (its seed r0), or None when not run."""
-    found = sorted(p.parent for p in (study / name).glob("cg1-*/manifest.json"))
+    found = sorted(p.parent for p in (study / name).glob(f"cg1-*/{layout.MANIFEST_FILE}"))
     return found[0] if found else None
 
 
 def status_of(case: Path) -> tuple[str, float, str]:
     """(status, core seconds, the manifest's reason) of a run."""
-    m = json.loads((case / "manifest.json").read_text())
+    m = json.loads((case / layout.MANIFEST_FILE).read_text())
     return (str(m.get("status")), float(m.get("core_seconds") or math.nan),
             str(m.get("reason") or ""))
-
-
-def condition_row(name: str, rows: pd.DataFrame, flows: pd.DataFrame, status: str,
-                  core_s: float, reason: str = "", criteria: Criteria = Criteria()) -> dict:
-    model, liquid = CONDITIONS[name]
-    out = {"condition": name, "model": model, "liquid": liquid, "status": status,
-           "reason": "" if status == "done" else reason,
-           "core_minutes": core_s / 60.0, "start_frames": len(rows)}
-    if rows.empty:
-        return {**out, **{p: False for p, _ in POINTS}, "wet_mass": False, "points": 0}
-    lag = int(round(SETTINGS.hold_time / SETTINGS.stride)) + 1
-    slope = hac_slope(rows["time"].to_numpy(), rows["share_10"].to_numpy(), lag)
-    last = rows[rows.revolutions >= rows.revolutions.max() - LAST_REVOLUTIONS]
-    out.update({
-        "share_10": rows.share_10.mean(), "share_10_last": last.share_10.mean(),
-        "share_10_first_rev": rows[rows.revolutions < rows.revolutions.min() + 1.0].share_10.mean(),
-        "d50_particles": rows.d50_particles.mean(), "largest": int(rows.largest.max()),
-        "survival": rows.survival.mean(), "comove_ratio": rows.comove_ratio.mean(),
-        "slope_per_s": slope.slope, "slope_low": slope.low, "slope_high": slope.high,
-        "spanning_frames": rows.spanning.astype(float).mean(),
-        "wall_share": rows.wall_share.mean(), "bed_wall_share": rows.bed_wall_share.mean(),
-        "wet_share_start": float(flows.sort_values("time").wet_share.iloc[0]),
-        "wet_share_end": float(flows.sort_values("time").wet_share.iloc[-1]),
-        "angle_deg": flows[flows.time >= SETTINGS.hold_time].angle_of_repose.mean(),
-        "revolutions": float(rows.revolutions.max())})
-    ok = status == "done"
-    out["exists"] = bool(ok and out["share_10"] >= criteria.min_share)
-    out["survives"] = bool(ok and np.isfinite(out["survival"])
-                           and out["survival"] >= criteria.survival)
-    out["grows"] = bool(ok and np.isfinite(out["slope_low"]) and out["slope_low"] > 0.0)
-    out["comoves"] = bool(ok and np.isfinite(out["comove_ratio"])
-                          and out["comove_ratio"] <= criteria.comove_ratio)
-    # amendment 1: a bed bound into one wet mass that spans the slice is not granules
-    out["wet_mass"] = bool(out["spanning_frames"] > criteria.spanning_frames)
-    out["points"] = 0 if out["wet_mass"] else int(sum(out[p] for p, _ in POINTS))
-    return out
-
-
-def ranked(table: pd.DataFrame) -> pd.DataFrame:
-    """The registered pick: most points, ties to the larger share_10 over the last 10
-    revolutions."""
-    t = table.copy()
-    t["share_10_last"] = t.get("share_10_last", pd.Series(np.nan, index=t.index))
-    t = t.sort_values(["points", "share_10_last"], ascending=[False, False],
-                      na_position="last").reset_index(drop=True)
-    t["rank"] = np.arange(1, len(t) + 1)
-    return t
 
 
 def phase1_lines(cond: pd.DataFrame) -> list[str]:
@@ -173,15 +126,10 @@ def ingredient(r) -> str:
     return f"granules formed, survived, moved together and grew{wet}"
 
 
-
 #: phase 2 (criterion.md): the pick's study, its uniform twin, and the twin's content
 PHASE2, PHASE2_UNIFORM = "P2", "P2U"
 UNIFORM_CONTENT = 0.012
-SEEDS = 5
 BUDGET_CORE_MIN = 480.0
-#: the registered phase-2 pass (criteria 1-3 and 6) and the two reported beside it
-REGISTERED = ("pass_control", "pass_survival", "pass_growth", "pass_comovement")
-REPORTED = ("pass_no_spanning", "pass_not_wall")
 
 
 def phase2_measure(study: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame] | None:
@@ -192,7 +140,7 @@ def phase2_measure(study: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFram
         return None
     all_rows, all_flows, runs, done = [], [], [], []
     for folder, suffix in ((PHASE2, ""), (PHASE2_UNIFORM, "_uniform")):
-        for manifest in sorted((study / folder).glob("cg1-*/manifest.json")):
+        for manifest in sorted((study / folder).glob(f"cg1-*/{layout.MANIFEST_FILE}")):
             case = manifest.parent
             status, core_s, reason = status_of(case)
             runs.append({"case_id": case.name + suffix, "status": status,
@@ -217,66 +165,13 @@ def _measure(case: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
     return rows, flows
 
 
-def phase2_seeds(rows: pd.DataFrame, flows: pd.DataFrame) -> pd.DataFrame:
-    """One row per registered seed r0..r4: the wet run against its cohesionless twin
-    (growth_study.seed_table) and against its uniform twin; control passes only when both
-    nulls hold <= 1/5 of the wet share_10. A seed whose wet run or a null is missing fails
-    every criterion (no evidence)."""
-    kw = dict(settings=SETTINGS, steady_after=SETTINGS.hold_time)
-    empty = rows.empty
-    dry = pd.DataFrame() if empty else seed_table(rows, flows, "cohesionless", **kw)
-    uni = pd.DataFrame() if empty else seed_table(rows, flows, "uniform", **kw)
-    out = []
-    for r in range(SEEDS):
-        seed = f"cg1-none-r{r}"
-        d = dry[dry.seed == seed] if len(dry) else dry
-        u = uni[uni.seed == seed] if len(uni) else uni
-        if d.empty or u.empty:
-            out.append({"seed": seed, "complete": False,
-                        **{c: False for c in REGISTERED + REPORTED}})
-            continue
-        row = d.iloc[0].to_dict()
-        urow = u.iloc[0]
-        row.update({"complete": True, "cohesionless_share_10": row.pop("control_share_10"),
-                    "uniform_share_10": urow.control_share_10,
-                    "uniform_survival": urow.control_survival,
-                    "uniform_spanning_frames": urow.control_spanning_frames,
-                    "uniform_angle_deg": urow.control_angle_deg,
-                    "pass_control_cohesionless": bool(row["pass_control"]),
-                    "pass_control_uniform": bool(urow.pass_control)})
-        row["pass_control"] = row["pass_control_cohesionless"] and row["pass_control_uniform"]
-        out.append(row)
-    return pd.DataFrame(out)
-
-
-def phase2_verdict(seeds: pd.DataFrame, criteria: Criteria = Criteria()) -> pd.DataFrame:
-    """One row per criterion: seeds passing of the registered five, whether it passes
-    (>= 4 of 5), and whether it is registered for the pass or reported beside it; a last
-    row: the screen finds growth (every registered criterion passes)."""
-    meaning = dict(CRITERIA)
-    meaning["pass_control"] = ("granules exist (share_10 >= 0.02) and each null (cohesionless "
-                               "twin, uniform twin) holds <= 1/5 of them")
-    rows = []
-    for col in REGISTERED + REPORTED:
-        k = int(seeds[col].astype(bool).sum())
-        rows.append({"criterion": col.removeprefix("pass_"), "meaning": meaning[col],
-                     "registered": col in REGISTERED, "seeds_pass": k, "seeds": SEEDS,
-                     "passes": k >= criteria.seeds_needed})
-    found = all(r["passes"] for r in rows if r["registered"])
-    rows.append({"criterion": "finds_growth", "meaning": "every registered criterion passes",
-                 "registered": True,
-                 "seeds_pass": int(seeds[list(REGISTERED)].astype(bool).all(axis=1).sum()),
-                 "seeds": SEEDS, "passes": found})
-    return pd.DataFrame(rows)
-
-
 def phase2_lines(folder: "ResultsFolder") -> list[str]:
     """The phase-2 sections of the README (from the committed phase-2 tables)."""
-    if not folder.has("phase2_seeds.csv"):
+    if not folder.has(PHASE2_SEEDS):
         return ["## Phase 2", "", "Not run yet.", ""]
-    seeds, runs = folder.table("phase2_seeds.csv"), folder.table("phase2_runs.csv")
-    verdict = folder.table("phase2_verdict.csv")
-    cond = folder.table("conditions.csv")
+    seeds, runs = folder.table(PHASE2_SEEDS), folder.table(PHASE2_RUNS)
+    verdict = folder.table(PHASE2_VERDICT)
+    cond = folder.table(CONDITIONS_TABLE)
     lines = ["## Phase 2: the pick on five seeds against two nulls", "",
              f"The pick (S3, easo, placed nuclei) on seeds r0-r{SEEDS - 1} (phase 1's r0 is r0), "
              f"each beside its cohesionless twin and a uniform twin at content "
@@ -367,14 +262,14 @@ def lacks(seeds: pd.DataFrame, failed: list[str]) -> list[str]:
 
 def readme(folder: "ResultsFolder") -> str:
     """README.md from the committed tables."""
-    cond = folder.table("conditions.csv")
-    tables = "`growth_rows.csv` (every start frame of every phase-1 run), `conditions.csv` " \
-             "(one row per condition, its registered points and rank)"
-    if folder.has("phase2_seeds.csv"):
-        tables += (", `phase2_rows.csv` (every start frame of every phase-2 run), "
-                   "`phase2_runs.csv` (each run's status and cores x wall), `phase2_seeds.csv` "
+    cond = folder.table(CONDITIONS_TABLE)
+    tables = (f"`{GROWTH_ROWS}` (every start frame of every phase-1 run), `{CONDITIONS_TABLE}` "
+              "(one row per condition, its registered points and rank)")
+    if folder.has(PHASE2_SEEDS):
+        tables += (f", `{PHASE2_ROWS}` (every start frame of every phase-2 run), "
+                   f"`{PHASE2_RUNS}` (each run's status and cores x wall), `{PHASE2_SEEDS}` "
                    "(one row per seed: its measures, both nulls', each criterion) and "
-                   "`phase2_verdict.csv` (derived from the seeds table)")
+                   f"`{PHASE2_VERDICT}` (derived from the seeds table)")
     lines = ["# Granule screen (issue 47 item 3)", "",
              "Registered before the runs: [criterion.md](criterion.md). Made by:", "", "```",
              "bash scripts/granule_screen.sh runs",
@@ -388,9 +283,9 @@ def readme(folder: "ResultsFolder") -> str:
 
 def derived(folder: "ResultsFolder") -> dict[str, str]:
     """phase2_verdict.csv from the committed phase2_seeds.csv (when phase 2 ran)."""
-    if not folder.has("phase2_seeds.csv"):
+    if not folder.has(PHASE2_SEEDS):
         return {}
-    return {"phase2_verdict.csv": csv_text(phase2_verdict(folder.table("phase2_seeds.csv")))}
+    return {PHASE2_VERDICT: csv_text(phase2_verdict(folder.table(PHASE2_SEEDS)))}
 
 
 FOLDER = ResultsFolder(OUT, readme, "scripts/granule_screen_results.py runs/granule_screen",
@@ -410,16 +305,16 @@ def make(args) -> ResultsFolder:
         rows, _, flows = measure_case(case, SETTINGS, cadences=(SETTINGS.cadence,))
         rows.insert(0, "condition", name)
         all_rows.append(rows)
-        table.append(condition_row(name, rows, flows, status, core_s, reason))
+        table.append(condition_row(name, *CONDITIONS[name], rows, flows, status, core_s, reason))
     OUT.mkdir(parents=True, exist_ok=True)
     if table:
-        (OUT / "growth_rows.csv").write_text(csv_text(pd.concat(all_rows)))
-        (OUT / "conditions.csv").write_text(csv_text(ranked(pd.DataFrame(table))))
+        (OUT / GROWTH_ROWS).write_text(csv_text(pd.concat(all_rows)))
+        (OUT / CONDITIONS_TABLE).write_text(csv_text(ranked(pd.DataFrame(table))))
     phase2 = phase2_measure(args.study)
     if phase2 is not None:
         rows, runs, seeds = phase2
-        for name, t in (("phase2_rows", rows), ("phase2_runs", runs), ("phase2_seeds", seeds)):
-            (OUT / f"{name}.csv").write_text(csv_text(t))
+        for name, t in ((PHASE2_ROWS, rows), (PHASE2_RUNS, runs), (PHASE2_SEEDS, seeds)):
+            (OUT / name).write_text(csv_text(t))
     return FOLDER
 
 

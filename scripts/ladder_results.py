@@ -160,8 +160,9 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
              "",
              "```", *ladder.commands, remake, "```",
              "",
-             "Tables: `verdict.csv` (one row per CG level, rule and criterion), `cases.csv` "
-             "(one row per run), `conditions.csv`, the report's `summary.md`. This README is "
+             f"Tables: `{layout.VERDICT_TABLE}` (one row per CG level, rule and criterion), "
+             f"`{layout.CASES_REPORT}` (one row per run), `{layout.CONDITIONS_REPORT}`, the "
+             f"report's `{layout.SUMMARY_REPORT}`. This README is "
              "written from them by `scripts/ladder_results.py` and checked against them by "
              "`tests/report/test_committed_ladder.py`.",
              "",
@@ -285,7 +286,7 @@ def repeat_lines(cases: pd.DataFrame, repeated: pd.DataFrame) -> list[str]:
                        for _, r in both[~same].iterrows())
     return [f"- The same seeds as the continuation (the engine is deterministic): "
             f"{int(same.sum())} of {len(both)} runs that both studies have give the same angle of repose to "
-            "every digit of cases.csv" + (f"; not: {differ}." if differ else ".")]
+            f"every digit of {layout.CASES_REPORT}" + (f"; not: {differ}." if differ else ".")]
 
 
 def arguments(ap) -> None:

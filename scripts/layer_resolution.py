@@ -37,6 +37,8 @@ from ligwf.study.case import CaseFolder
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "docs" / "results" / "layer_resolution"
+#: the table this script measures and the one derived from it (named here, once)
+FRAMES, LEVELS = "frames.csv", "levels.csv"
 
 
 def former_thickness(frame, geo: fl.DrumGeometry) -> float:
@@ -118,20 +120,20 @@ def levels(frames: pd.DataFrame) -> pd.DataFrame:
 
 
 def derived(folder: ResultsFolder) -> dict[str, str]:
-    return {"levels.csv": csv_text(levels(folder.table("frames.csv")))}
+    return {LEVELS: csv_text(levels(folder.table(FRAMES)))}
 
 
 def readme(folder: ResultsFolder) -> str:
-    lv = folder.table("levels.csv")
+    lv = folder.table(LEVELS)
     lines = ["# The flowing layer on real frames, former and today's estimator (issue 44 "
              "item 1)", "", "Made by:", "", "```",
              ".venv/bin/python scripts/layer_resolution.py " + " ".join(
                  f"runs/{s}" for s in dict.fromkeys(lv.study)), "```", "",
-             "`frames.csv`: per run, the mean thickness over its steady frames (the analysis' "
+             f"`{FRAMES}`: per run, the mean thickness over its steady frames (the analysis' "
              "window, at most 40 evenly spaced frames) under the former estimator (from the "
              "fitted surface to the velocity's zero crossing between bin centres) and "
              "today's (the crossing at the bins' mean depths, the thickness mass-equivalent: "
-             "no surface in it). `levels.csv` is derived from it. Synthetic beds of one flow "
+             f"no surface in it). `{LEVELS}` is derived from it. Synthetic beds of one flow "
              "at 1-3 mm grains (`tests/analysis/flow/test_layer_resolution.py`) show why: the "
              "former read the surface's height above the grains into the layer.", "",
              "The null beside each difference: the seed-to-seed standard deviation of the "
@@ -164,7 +166,7 @@ def make(args) -> ResultsFolder:
         args.error("at least one analysed study folder is required (or --check)")
     rows = [r for s in [args.study, *args.more] for r in case_rows(s, args.frames)]
     OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "frames.csv").write_text(csv_text(pd.DataFrame(rows)))
+    (OUT / FRAMES).write_text(csv_text(pd.DataFrame(rows)))
     return FOLDER
 
 

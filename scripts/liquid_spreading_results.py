@@ -34,6 +34,9 @@ OUT = ROOT / "docs" / "results" / "liquid_spreading"
 COMMAND = "ligwf run workflows/liquid_spreading.yaml --out runs/liquid_spreading"
 #: the registered null: the largest CG1 seed-to-seed ratio of spreading times stays below it
 NULL_SPREAD = 2.0
+#: the tables this script measures, then the two derived from them (named here, once)
+SERIES, CASES, TIMING = "series.csv", "cases.csv", "timing.csv"
+LEVELS, HYPOTHESES = "levels.csv", "hypotheses.csv"
 
 
 def series_table(record: FlowRecord) -> pd.DataFrame:
@@ -121,17 +124,17 @@ def findings(levels: pd.DataFrame, hyp: pd.DataFrame) -> str:
 
 def readme(folder: ResultsFolder) -> str:
     """README.md from the committed tables."""
-    cases, levels = folder.table("cases.csv"), folder.table("levels.csv")
-    hyp, timing = folder.table("hypotheses.csv"), folder.table("timing.csv")
+    cases, levels = folder.table(CASES), folder.table(LEVELS)
+    hyp, timing = folder.table(HYPOTHESES), folder.table(TIMING)
     lines = ["# Liquid spreading across CG levels (issue 47 item 2)", "",
              "Registered before the runs: [criterion.md](criterion.md) (amendment 1 replaced a "
              "null that could not fail, before any result). Made by:", "", "```", COMMAND,
              "ligwf analyse runs/liquid_spreading",
              ".venv/bin/python scripts/liquid_spreading_results.py runs/liquid_spreading",
              "```", "",
-             "Tables: `series.csv` (per case and production frame), `cases.csv` (per case the "
-             "spreading time), `levels.csv` (per level the rate against CG1), `hypotheses.csv` "
-             "(each registered hypothesis), `timing.csv` (the runs' wall, on a machine shared "
+             f"Tables: `{SERIES}` (per case and production frame), `{CASES}` (per case the "
+             f"spreading time), `{LEVELS}` (per level the rate against CG1), `{HYPOTHESES}` "
+             f"(each registered hypothesis), `{TIMING}` (the runs' wall, on a machine shared "
              "with other work: not a benchmark). This README is written from them by "
              "`scripts/liquid_spreading_results.py` and checked against them by "
              "`tests/report/test_committed_liquid_spreading.py`.", "",
@@ -184,10 +187,10 @@ def timing_table(study: Path) -> pd.DataFrame:
 
 def derived(folder: ResultsFolder) -> dict[str, str]:
     """levels.csv and hypotheses.csv, recomputed from the committed cases.csv."""
-    cases = folder.table("cases.csv")
+    cases = folder.table(CASES)
     levels = level_rates(cases)
-    return {"levels.csv": csv_text(levels),
-            "hypotheses.csv": csv_text(hypotheses(pd.read_csv(io.StringIO(csv_text(levels)))))}
+    return {LEVELS: csv_text(levels),
+            HYPOTHESES: csv_text(hypotheses(pd.read_csv(io.StringIO(csv_text(levels)))))}
 
 
 FOLDER = ResultsFolder(OUT, readme, "scripts/liquid_spreading_results.py "
@@ -202,9 +205,8 @@ def make(args) -> ResultsFolder:
     series = series_table(record)
     cases = case_times(record.cases.values()).sort_values(["cg", "replica"])
     OUT.mkdir(parents=True, exist_ok=True)
-    for name, table in (("series", series), ("cases", cases),
-                        ("timing", timing_table(args.study))):
-        (OUT / f"{name}.csv").write_text(csv_text(table))
+    for name, table in ((SERIES, series), (CASES, cases), (TIMING, timing_table(args.study))):
+        (OUT / name).write_text(csv_text(table))
     figure(series, OUT / "spreading.png")
     return FOLDER
 

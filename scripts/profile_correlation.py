@@ -16,6 +16,7 @@ rebuilds the README from the committed table.
 
 from __future__ import annotations
 
+import argparse
 import json
 import sys
 from pathlib import Path
@@ -23,10 +24,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from results_readme import ROOT, csv_text, number, write_or_check  # noqa: E402
+from ligwf.api.results_folder import ResultsFolder, check_all, csv_text, number
+from ligwf.study import layout
 
-OUT = ROOT / "docs" / "results" / "profile_correlation"
+OUT = Path(__file__).resolve().parents[1] / "docs" / "results" / "profile_correlation"
+#: the table this script measures (named here, once)
+CORRELATION = "correlation.csv"
 LAGS = (1, 2, 4, 8)
 
 
@@ -130,7 +133,7 @@ def readme(table: pd.DataFrame) -> str:
              "runs/paper_scale_cg_bond", "```", "",
              "The source drum's studies (docs/results/paper_scale): We-CG4/6/8 and Bo-CG4/6, "
              "3 seeds each, 16 depth bins.", "",
-             "Table: `correlation.csv` (one row per study). This README is written from it by "
+             f"Table: `{CORRELATION}` (one row per study). This README is written from it by "
              "`scripts/profile_correlation.py` and checked by "
              "`tests/report/test_committed_profile_correlation.py`.", "",
              "The null beside each row: the same design (conditions, seeds, bins) with "
@@ -163,22 +166,34 @@ def readme(table: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def main() -> int:
-    args = sys.argv[1:]
-    if args == ["--check"]:
-        return write_or_check(OUT, lambda: readme(pd.read_csv(OUT / "correlation.csv")), True,
-                              "scripts/profile_correlation.py")
+FOLDER = ResultsFolder(OUT, lambda folder: readme(folder.table(CORRELATION)),
+                       "scripts/profile_correlation.py STUDY...")
+
+
+def main(argv=None) -> int:
+    """``STUDY...`` measures the studies' table and writes the README; ``--check`` renders
+    the README from the committed table and fails (1) when it differs."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("studies", nargs="*", type=Path, help="the analysed studies")
+    ap.add_argument("--check", action="store_true",
+                    help="only check that the committed README is what its table gives")
+    args = ap.parse_args(argv)
+    if args.check:
+        problems = check_all([FOLDER])
+        for problem in problems:
+            print(problem, file=sys.stderr)
+        return 1 if problems else 0
     rows = []
-    for s in args:
-        record = json.loads((Path(s) / "analysis" / "flow_profiles.json").read_text())
+    for study in args.studies:
+        record = json.loads((study / layout.ANALYSIS_DIR / layout.FLOW_PROFILES).read_text())
         if residuals(record)[1] == 0:
-            print(f"{s}: no condition with two seeds' profiles, left out", file=sys.stderr)
+            print(f"{study}: no condition with two seeds' profiles, left out", file=sys.stderr)
             continue
-        rows.append(correlation_row(Path(s).name, record))
+        rows.append(correlation_row(study.name, record))
     OUT.mkdir(parents=True, exist_ok=True)
-    (OUT / "correlation.csv").write_text(csv_text(pd.DataFrame(rows)))
-    return write_or_check(OUT, lambda: readme(pd.read_csv(OUT / "correlation.csv")), False,
-                          "scripts/profile_correlation.py")
+    (OUT / CORRELATION).write_text(csv_text(pd.DataFrame(rows)))
+    print(FOLDER.write())
+    return 0
 
 
 if __name__ == "__main__":

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from ligwf.analysis.granules import screen
 from ligwf.analysis.granules.growth import hac_slope
 from tests.helpers import ROOT
 
@@ -23,7 +24,7 @@ def test_readme_and_verdict_are_the_committed_tables():
 
 
 def test_phase1_points_and_pick_read_from_the_measures():
-    cond = pd.read_csv(HERE / "conditions.csv")
+    cond = pd.read_csv(HERE / gs.CONDITIONS_TABLE)
     assert sorted(cond.condition) == ["S1", "S2", "S3", "S4"]
     for _, r in cond.iterrows():
         done = r.status == "done"
@@ -42,10 +43,17 @@ def test_phase1_points_and_pick_read_from_the_measures():
     assert f"**{best.condition}**" in (HERE / "README.md").read_text()
 
 
+def test_phase1_rank_is_the_registered_rule_on_the_committed_rows():
+    cond = pd.read_csv(HERE / gs.CONDITIONS_TABLE)
+    again = screen.ranked(cond.drop(columns="rank").sample(frac=1.0, random_state=1))
+    assert list(again["condition"]) == list(cond["condition"])
+    assert list(again["rank"]) == list(cond["rank"]) == [1, 2, 3, 4]
+
+
 def test_phase1_slope_is_its_rows():
-    rows = pd.read_csv(HERE / "growth_rows.csv")
-    cond = pd.read_csv(HERE / "conditions.csv").set_index("condition")
-    lag = int(round(gs.SETTINGS.hold_time / gs.SETTINGS.stride)) + 1
+    rows = pd.read_csv(HERE / gs.GROWTH_ROWS)
+    cond = pd.read_csv(HERE / gs.CONDITIONS_TABLE).set_index("condition")
+    lag = int(round(screen.SETTINGS.hold_time / screen.SETTINGS.stride)) + 1
     for name, g in rows.groupby("condition"):
         fit = hac_slope(g["time"].to_numpy(), g["share_10"].to_numpy(), lag)
         assert fit.slope == pytest.approx(cond.loc[name, "slope_per_s"], rel=1e-4, abs=1e-9)
@@ -53,12 +61,12 @@ def test_phase1_slope_is_its_rows():
 
 
 def test_phase2_verdict_counts_its_seeds():
-    if not (HERE / "phase2_seeds.csv").is_file():
+    if not (HERE / gs.PHASE2_SEEDS).is_file():
         assert "Not run yet." in (HERE / "README.md").read_text()
         return
-    seeds = pd.read_csv(HERE / "phase2_seeds.csv")
-    verdict = pd.read_csv(HERE / "phase2_verdict.csv").set_index("criterion")
-    assert len(seeds) == gs.SEEDS
+    seeds = pd.read_csv(HERE / gs.PHASE2_SEEDS)
+    verdict = pd.read_csv(HERE / gs.PHASE2_VERDICT).set_index("criterion")
+    assert len(seeds) == screen.SEEDS
     for _, s in seeds[seeds.complete].iterrows():
         ratio = 0.2 * s.share_10
         assert s.pass_control == bool(s.share_10 >= 0.02 and s.cohesionless_share_10 <= ratio
@@ -66,12 +74,12 @@ def test_phase2_verdict_counts_its_seeds():
         assert s.pass_survival == bool(s.survival >= 0.5)
         assert s.pass_growth == bool(s.slope_low > 0)
         assert s.pass_comovement == bool(s.comove_ratio <= 0.5)
-    for col in gs.REGISTERED + gs.REPORTED:
+    for col in screen.REGISTERED + screen.REPORTED:
         k = int(seeds[col].sum())
         name = col.removeprefix("pass_")
         assert verdict.loc[name, "seeds_pass"] == k
         assert bool(verdict.loc[name, "passes"]) == (k >= 4)
-    found = all(verdict.loc[c.removeprefix("pass_"), "passes"] for c in gs.REGISTERED)
+    found = all(verdict.loc[c.removeprefix("pass_"), "passes"] for c in screen.REGISTERED)
     assert bool(verdict.loc["finds_growth", "passes"]) == found
     text = (HERE / "README.md").read_text()
     assert ("**The screen finds growth**" in text) == found
@@ -79,7 +87,7 @@ def test_phase2_verdict_counts_its_seeds():
 
 def test_the_phase2_rule_fails_a_seed_without_its_null():
     """A seed whose uniform twin is missing is not evidence: it fails every criterion."""
-    rows = pd.read_csv(HERE / "growth_rows.csv")
+    rows = pd.read_csv(HERE / gs.GROWTH_ROWS)
     s3 = rows[rows.condition == "S3"].drop(columns="condition").copy()
     s3["case_id"] = "cg1-none-r0"
     twin = s3.copy()
@@ -88,16 +96,16 @@ def test_the_phase2_rule_fails_a_seed_without_its_null():
     flows = pd.DataFrame({"case_id": ["cg1-none-r0", "cg1-none-r0_cohesionless"] * 2,
                           "time": [1.0, 1.0, 2.0, 2.0], "angle_of_repose": 40.0,
                           "rigid_fraction": 0.0, "wet_share": [0.05, 0.0, 1.0, 0.0]})
-    seeds = gs.phase2_seeds(pd.concat([s3, twin]), flows)
-    assert len(seeds) == gs.SEEDS and not seeds.complete.any()
-    verdict = gs.phase2_verdict(seeds).set_index("criterion")
+    seeds = screen.phase2_seeds(pd.concat([s3, twin]), flows)
+    assert len(seeds) == screen.SEEDS and not seeds.complete.any()
+    verdict = screen.phase2_verdict(seeds).set_index("criterion")
     assert not verdict.passes.any() and (verdict.seeds_pass == 0).all()
     # with both nulls present the control criterion is judged on each of them
     uni = s3.copy()
     uni["case_id"] = "cg1-none-r0_uniform"
     flows2 = pd.concat([flows, flows[flows.case_id == "cg1-none-r0_cohesionless"]
                         .assign(case_id="cg1-none-r0_uniform")])
-    seeds = gs.phase2_seeds(pd.concat([s3, twin, uni]), flows2)
+    seeds = screen.phase2_seeds(pd.concat([s3, twin, uni]), flows2)
     r0 = seeds.set_index("seed").loc["cg1-none-r0"]
     assert r0.complete and r0.pass_control_cohesionless and not r0.pass_control_uniform
     assert not r0.pass_control and np.isclose(r0.uniform_share_10, r0.share_10)
@@ -115,3 +123,25 @@ def test_what_the_engine_lacks_names_each_failed_criterion_with_its_numbers():
     assert "mean survival 0.3" in text and "co-movement ratio 0.6" in text
     assert "does not grow" not in text and "from 0.06 to 1" in text
     assert gs.lacks(seeds.iloc[0:0], ["survival"])[0].startswith("- No seed")
+
+
+def test_phase1_rows_are_what_the_screen_makes_of_the_committed_growth_rows():
+    """screen.condition_row on each condition's committed start frames gives its committed
+    measures and points (the frame flows are not committed: a stand-in gives the
+    liquid's columns, which are not compared)."""
+    rows = pd.read_csv(HERE / gs.GROWTH_ROWS)
+    cond = pd.read_csv(HERE / gs.CONDITIONS_TABLE).set_index("condition")
+    flows = pd.DataFrame({"time": [0.0, 2.0], "wet_share": [1.0, 0.5],
+                          "angle_of_repose": [40.0, 40.0]})
+    compared = ["share_10", "share_10_last", "share_10_first_rev", "d50_particles", "largest",
+                "survival", "comove_ratio", "slope_per_s", "slope_low", "slope_high",
+                "spanning_frames", "wall_share", "bed_wall_share", "revolutions"]
+    for name, g in rows.groupby("condition"):
+        c = cond.loc[name]
+        row = screen.condition_row(name, c.model, c.liquid, g.drop(columns="condition"), flows,
+                                   c.status, 60.0 * c.core_minutes, str(c.reason))
+        assert row["start_frames"] == c.start_frames
+        for col in compared:
+            assert row[col] == pytest.approx(c[col], rel=1e-4, abs=1e-9, nan_ok=True), (name, col)
+        for col in ("exists", "survives", "grows", "comoves", "wet_mass", "points"):
+            assert row[col] == c[col], (name, col)

@@ -23,7 +23,7 @@ def test_readme_is_its_table():
 
 
 def test_measured_bins_are_below_their_null():
-    t = pd.read_csv(HERE / "correlation.csv")
+    t = pd.read_csv(HERE / pc.CORRELATION)
     assert len(t) == 2 and (t.effective_bins < t.null_effective_bins_low).all()
     assert (t.mean_corr_lag1 > 0.8).all() and (t.null_mean_corr_lag1.abs() < 0.05).all()
 

@@ -63,7 +63,11 @@ def kinetics_summary(kin: pd.DataFrame, settings: AnalysisSettings) -> pd.DataFr
         return pd.DataFrame()
     rng = np.random.default_rng(settings.seed)
     out = []
-    for (name, group, cg, rule), d in kin.groupby(["condition", "group", "cg", "rule"], sort=True):
+    conditions = {Condition(group, float(cg), rule) for group, cg, rule
+                  in kin[["group", "cg", "rule"]].itertuples(index=False)}
+    for condition in sorted(conditions, key=lambda c: (c.name, *c.key)):
+        d = kin[(kin["group"] == condition.group) & (kin["cg"] == condition.cg)
+                & (kin["rule"] == condition.rule)]
         times = np.sort(d["time"].unique())
         for t in times:
             at = d[d["time"] == t]
@@ -74,8 +78,8 @@ def kinetics_summary(kin: pd.DataFrame, settings: AnalysisSettings) -> pd.DataFr
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)
                 mean = np.nanmean(vals, axis=0)
-            row = {"condition": name, "group": group, "cg": cg, "rule": rule, "time": t,
-                   "replicas": len(at)}
+            row = {"condition": condition.name, "group": condition.group, "cg": condition.cg,
+                   "rule": condition.rule, "time": t, "replicas": len(at)}
             for k, q in enumerate(QUANTITIES):
                 row.update({q: mean[k], f"{q}_lo": lo[k], f"{q}_hi": hi[k]})
             out.append(row)
