@@ -48,7 +48,7 @@ from ligwf.pipeline.post import report_study
 from ligwf.pipeline.prepare import Prepared
 from ligwf.pipeline.rounds import take_look, write_round
 from ligwf.eligibility import eligible, report_due
-from ligwf.local import LocalExecutor
+from ligwf.executors import LOCAL, build_executor
 from ligwf.pipeline.submit import rerun_jobs
 from ligwf.scheduler import Scheduler, queued_tasks
 from ligwf.study.rounds import Look, Rounds, read_rounds, rounds_lock
@@ -205,7 +205,7 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
                 time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
                 continue
             if take_looks and p.state == LOOK_DUE:
-                rounds = take_look(out, read_rounds(out), LocalExecutor())
+                rounds = take_look(out, read_rounds(out), build_executor(LOCAL))
                 looks.append(rounds.looks[-1])
                 if show is not None:
                     show(rounds.looks[-1], rounds)
@@ -213,7 +213,7 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
             if p.state == ROUND_DUE and prepared is not None:
                 moved = _submit_round(out, scheduler, how, prepared, p, take_looks)
                 if moved is None:           # nothing to run: look again at once
-                    rounds = take_look(out, read_rounds(out), LocalExecutor())
+                    rounds = take_look(out, read_rounds(out), build_executor(LOCAL))
                     looks.append(rounds.looks[-1])
                     if show is not None:
                         show(rounds.looks[-1], rounds)
