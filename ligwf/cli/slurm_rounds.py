@@ -22,9 +22,10 @@ from ligwf.cli.common import console, grouped_warnings, print_warning
 from ligwf.cli.report import add_snapshots, print_report, show_look
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import Prepared
-from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, start_rounds
-from ligwf.pipeline.submit_rounds import (INCOMPLETE, NEXT_ROUND, STOPPED, FollowUp, Moved,
-                                          keep_going, progress, recorded_steps)
+from ligwf.pipeline.rounds import (INCOMPLETE, STOPPED, RoundPlan, prepare_study_folder,
+                                   start_rounds)
+from ligwf.pipeline.submit_rounds import (NEXT_ROUND, FollowUp, Moved, keep_going, progress,
+                                          recorded_steps)
 from ligwf.scheduler import Scheduler
 from ligwf.study.layout import REPORT_DIR
 from ligwf.study.rounds import read_rounds

@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Sequence
 
 from ligwf.engine.launch import Monitor
-from ligwf.engine.plan import Schedule, plan_study
+from ligwf.engine.plan import Schedule, allocation_schedule, case_load, plan_study
 from ligwf.engine.site import EngineConfig, EngineIdentity
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.eligibility import eligible
@@ -101,10 +101,18 @@ def start_run(prepared: Prepared, out: Path, settings: RunSettings,
     return scheduled(study, build_executor(LOCAL, settings), identity)
 
 
-def scheduled(study: Study, executor: LocalExecutor, identity: EngineIdentity) -> StudyRun:
-    """A written study with the schedule of its cases still to run on ``executor``."""
-    settings = executor.settings
-    schedule = study_schedule(eligible(study.cases, settings.retry_unstable).to_run, settings)
+def scheduled(study: Study, executor: Executor, identity: EngineIdentity) -> StudyRun:
+    """A written study with the schedule of its cases still to run on ``executor``: this
+    machine's (:func:`~ligwf.local.study_schedule`, its phases), or on any other executor
+    one allocation per case (:func:`~ligwf.engine.plan.allocation_schedule`, what a
+    scheduler's ``run_cases`` submits)."""
+    if isinstance(executor, LocalExecutor):
+        settings = executor.settings
+        schedule = study_schedule(eligible(study.cases, settings.retry_unstable).to_run,
+                                  settings)
+    else:
+        schedule = allocation_schedule([case_load(c.path.name, c.scaled)
+                                        for c in eligible(study.cases).to_run])
     return StudyRun(study, schedule, executor, identity)
 
 
