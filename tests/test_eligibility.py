@@ -13,7 +13,8 @@ from ligwf.eligibility import (DONE, EXTEND, FRESH, HELD, RESUME, UNSTABLE, anal
                                eligible, report_due)
 from ligwf.pipeline.prepare import prepare_workflow, write
 from ligwf.pipeline.submit import plan_resubmission
-from ligwf.pipeline.submit_rounds import INCOMPLETE, LOOK_DUE, progress
+from ligwf.pipeline.rounds import INCOMPLETE, LOOK_DUE
+from ligwf.pipeline.submit_rounds import progress
 from ligwf.slurm.jobs import append_record
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite

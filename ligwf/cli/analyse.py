@@ -7,10 +7,12 @@ The options here only say how the analysis runs.
 
 Runs serially, or frame-parallel under MPI: ``mpirun -np P ligwf analyse RUN_DIR`` gives
 each of the P ranks a contiguous share of the (case, frame) tasks; the outputs are
-identical to the serial run. For big studies, ``--slurm N`` submits the same shares as a
-Slurm array of N tasks (each ``--part K/N``, one partial output each) and a job that
-merges them (``--merge N``) into the same tables; a task that failed is named by the
-merge, with the command that re-runs it.
+identical to the serial run. ``--tasks N`` splits the study's analysis into N shares
+(each ``--part K/N``, one partial output each) merged (``--merge N``) into the same
+tables, on the executor ``--executor`` names: locally N processes side by side, merged
+here; on Slurm (``--executor slurm``, also spelt ``--slurm N``) an array of N tasks and a
+job that merges them, and the command returns once they are submitted. A share that
+failed is named by the merge, with the command that re-runs it.
 """
 
 from __future__ import annotations
@@ -19,9 +21,10 @@ import argparse
 import sys
 from pathlib import Path
 
-from ligwf.cli.common import folder_to_write
+from ligwf.cli.common import folder_to_write, stop_on_signals
+from ligwf.cli.executors import SUBMIT_ANALYSIS, add_executor_arg
 from ligwf.errors import ConfigError, LigwfError
-from ligwf.study import layout
+from ligwf.executors import LOCAL
 
 
 def register(subparsers) -> None:
@@ -39,18 +42,25 @@ def register(subparsers) -> None:
                    help="add Louvain communities (bridge-force weighted) to the .vtu files")
     p.add_argument("--no-manifest-check", action="store_true",
                    help="analyse cases without a `done` manifest too (e.g. run by hand)")
+    add_executor_arg(p, "the shares of --tasks")
+    p.add_argument("--tasks", type=int, metavar="N", default=1,
+                   help="split the study's analysis into N shares run side by side and merged "
+                   "into the same tables (default 1)")
     split = p.add_mutually_exclusive_group()
     split.add_argument("--slurm", type=int, metavar="N", default=None,
-                       help="submit the analysis as a Slurm array of N tasks and a merge job")
+                       help="= --executor slurm --tasks N: submit the analysis as a Slurm array "
+                       "of N tasks and a merge job")
     split.add_argument("--part", metavar="K/N", default=None,
-                       help="compute share K of N and write it as a partial output (an array "
-                            "task of --slurm; needs --token)")
+                       help="compute share K of N and write it as a partial output (one share "
+                            "of --tasks; needs --token)")
     split.add_argument("--merge", type=int, metavar="N", default=None,
                        help="merge the N partial outputs of --token into the outputs")
     p.add_argument("--token", default=None,
-                   help="the split analysis' token (--slurm prints it; --part / --merge)")
+                   help="the split analysis' token (a batch scheduler's --tasks prints it; "
+                   "--part / --merge)")
     p.add_argument("--dry-run", action="store_true",
-                   help="with --slurm: print the scripts and sbatch commands, submit nothing")
+                   help="on a batch scheduler: print the scripts and submit commands, submit "
+                   "nothing")
     p.set_defaults(func=cmd_analyse)
 
 
@@ -62,10 +72,15 @@ def cmd_analyse(args: argparse.Namespace) -> int:
     options = AnalysisOptions(implementation="reference" if args.reference else "fast",
                               write_vtu=not args.no_vtu, louvain=args.louvain,
                               require_manifest=not args.no_manifest_check)
-    if args.slurm is not None or args.part is not None or args.merge is not None:
+    if args.slurm is not None:          # the old spelling of --executor slurm --tasks N
+        args.executor, args.tasks = "slurm", args.slurm
+    if args.part is not None or args.merge is not None:
         return cmd_split(args, options)
+    if args.executor != LOCAL or args.tasks != 1:
+        return cmd_shares(args)
     if args.token is not None or args.dry_run:
-        raise ConfigError("--token and --dry-run belong to --slurm / --part / --merge")
+        raise ConfigError("--token and --dry-run belong to --tasks on a batch scheduler / "
+                          "--part / --merge")
     comm = mpi_comm()
     try:
         record = analyse_study(args.run_dir, args.out, options, comm)
@@ -88,19 +103,50 @@ def cmd_analyse(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_shares(args: argparse.Namespace) -> int:
+    """``--tasks N`` on ``--executor``: a batch scheduler submits the shares and their merge
+    job (:data:`~ligwf.cli.executors.SUBMIT_ANALYSIS`); locally the local executor runs
+    them side by side and merges them here."""
+    from ligwf.analysis import parts
+    from ligwf.executors import build_executor, executor_kind
+    from ligwf.pipeline.run import Interrupted
+    from ligwf.study.study import Study
+
+    name = executor_kind(args.executor).name
+    count = parts.check_count(args.tasks, "--tasks")
+    if args.out is not None or args.reference or args.no_vtu or args.louvain \
+            or args.no_manifest_check:
+        raise ConfigError(f"--executor {name} --tasks {count} runs the study's own analysis "
+                          "into its analysis folder: --out, --reference, --no-vtu, --louvain "
+                          "and --no-manifest-check are for one local process")
+    if args.token is not None:
+        raise ConfigError("--token: --tasks makes its own token")
+    if name != LOCAL:
+        return SUBMIT_ANALYSIS[name](args, count)
+    if args.dry_run:
+        raise ConfigError("--dry-run: the local executor runs the shares now (a batch "
+                          "scheduler's --executor shows what it would submit)")
+    study = Study.open(args.run_dir)
+    with stop_on_signals() as stop:
+        record = build_executor(LOCAL).analyse(study, count, stop)
+    if record is None:
+        raise Interrupted(getattr(stop, "signum", None))
+    print_record(record, study.analysis_dir)
+    return 0
+
+
 def cmd_split(args: argparse.Namespace, options) -> int:
-    """``--slurm N`` (submit), ``--part K/N`` (one array task), ``--merge N``."""
+    """``--part K/N`` (one share), ``--merge N``."""
     from ligwf.analysis import parts
     from ligwf.analysis.runner import analyse_part, merge_parts
     from ligwf.local import end_with_parent
     from ligwf.study.study import Study
 
-    if args.slurm is not None:
-        if args.token is not None:
-            raise ConfigError("--token: --slurm makes its own token")
-        return submit_split(args, parts.check_count(args.slurm))
+    if args.executor != LOCAL or args.tasks != 1:
+        raise ConfigError(f"--{'part' if args.part else 'merge'}: one share or the merge, "
+                          "here; not with --executor / --tasks (they run the shares)")
     if args.dry_run:
-        raise ConfigError("--dry-run belongs to --slurm")
+        raise ConfigError("--dry-run belongs to --tasks on a batch scheduler")
     if args.token is None:
         raise ConfigError(f"--{'part' if args.part else 'merge'} needs --token (the token "
                           "`ligwf analyse --slurm` printed)")
@@ -114,33 +160,6 @@ def cmd_split(args: argparse.Namespace, options) -> int:
     count = parts.check_count(args.merge, "--merge")
     record = merge_parts(args.run_dir, token, count, args.out, options)
     print_record(record, args.out or Study.open(args.run_dir).analysis_dir)
-    return 0
-
-
-def submit_split(args: argparse.Namespace, count: int) -> int:
-    """Plan (and unless ``--dry-run`` submit) the analysis array and its merge job."""
-    from ligwf.analysis.outputs import new_token
-    from ligwf.slurm.scheduler import SlurmScheduler
-    from ligwf.slurm.site import load_slurm_site
-    from ligwf.study.study import Study
-
-    if args.out is not None or args.reference or args.no_vtu or args.louvain \
-            or args.no_manifest_check:
-        raise ConfigError("--slurm runs the study's own analysis into its analysis folder: "
-                          "--out, --reference, --no-vtu, --louvain and --no-manifest-check "
-                          "are for a local run")
-    study = Study.open(args.run_dir)
-    token = new_token()
-    scheduler = SlurmScheduler(load_slurm_site())
-    planned = scheduler.plan_analysis(study.path, study.path.name, count, token)
-    if args.dry_run:
-        print(scheduler.dry_run_text(planned))
-        return 0
-    scheduler.require()
-    entries = scheduler.submit(study.path, planned)
-    array, merge = entries[0]["job_id"], entries[-1]["job_id"]
-    print(f"submitted analysis array {array} ({count} task(s)) and merge job {merge} "
-          f"(token {token}); logs in {study.path / layout.SLURM_LOG_DIR}")
     return 0
 
 

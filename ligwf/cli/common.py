@@ -147,6 +147,31 @@ def add_workflow_args(p: argparse.ArgumentParser) -> None:
                    help="run/write cases the pre-flight stability check refuses (experts)")
 
 
+def add_until_decided_args(p: argparse.ArgumentParser) -> None:
+    """``--until-decided``, ``--max-looks``, ``--max-core-hours``, ``--every-level``: a
+    sequential study, on any executor (``ligwf study``, ``ligwf slurm submit``)."""
+    from functools import partial
+
+    from ligwf.study.rounds import DEFAULT_LOOKS
+
+    p.add_argument("--until-decided", action="store_true",
+                   help="go on in rounds (longer production or more replicas, the cheapest "
+                   "that decides) until the cheapest level that can still pass is decided; "
+                   "locally WORKFLOW may be a study folder; on a scheduler each round is a "
+                   "dependent array whose follow-up job ('ligwf slurm next-round') takes the "
+                   "look and submits the next round")
+    p.add_argument("--max-looks", type=partial(positive_int, unit="looks"),
+                   default=DEFAULT_LOOKS, help="with --until-decided: looks at most (each "
+                   f"tests at 0.05 / looks; default {DEFAULT_LOOKS})")
+    p.add_argument("--max-core-hours", type=number_in(1e-6, 1e9, "core-h"), default=None,
+                   metavar="H", help="with --until-decided: stop before a round would take "
+                   "the study's runs past H core-hours")
+    p.add_argument("--every-level", action="store_true",
+                   help="with --until-decided: the rounds work on the undecided criteria of "
+                   "every CG level (a ladder: each level's error decided), not only on the "
+                   "cheapest level that can still pass")
+
+
 def add_replace_arg(p: argparse.ArgumentParser) -> None:
     p.add_argument("--replace", action="store_true",
                    help="write over another study in --out (refused without it: another "

@@ -25,7 +25,8 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
                               folder_to_write, plan_table, prepare_from_args,
                               print_warning, rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
-from ligwf.local import LocalExecutor, run_settings
+from ligwf.executors import LOCAL, build_executor
+from ligwf.local import run_settings
 from ligwf.pipeline.run import StudyRun, run_case_of, start_run
 from ligwf.study.study import Study
 
@@ -108,7 +109,7 @@ def cmd_status(args: argparse.Namespace) -> int:
     for case in study.cases:             # an edited record: its results are not used
         if (why := case.record_problem(check_hash=False)) is not None:
             print_warning(f"{case.case_id}: {why}")
-    held = [c for c in LocalExecutor().status(args.study).cases if c.queued]
+    held = [c for c in build_executor(LOCAL).status(args.study).cases if c.queued]
     for runner in sorted({c.job for c in held}):
         names = [c.case_id for c in held if c.job == runner]
         console.print(f"running in ligwf process {runner}: {', '.join(names)}",
@@ -119,7 +120,7 @@ def cmd_status(args: argparse.Namespace) -> int:
 def cmd_cancel(args: argparse.Namespace) -> int:
     """SIGTERM the live runners of a study on this machine (the local executor's cancel)."""
     Study.open(args.study)          # a folder that is no study: one line, nothing sent
-    sent = LocalExecutor().cancel(args.study)
+    sent = build_executor(LOCAL).cancel(args.study)
     if not sent:
         console.print(f"{args.study}: no live ligwf runner on this machine holds a case",
                       highlight=False)
@@ -130,8 +131,9 @@ def cmd_cancel(args: argparse.Namespace) -> int:
     return 0
 
 
-def add_run_args(p: argparse.ArgumentParser) -> None:
-    """The options of the run stage (``run`` and ``study``)."""
+def add_run_args(p: argparse.ArgumentParser, cores_help: str | None = None) -> None:
+    """The options of the run stage (``run`` and ``study``; ``cores_help``: what
+    ``--cores`` means there)."""
     p.add_argument("--out", type=folder_to_write, required=True, help="study folder")
     p.add_argument("--np", type=rank_count, default=None,
                    help="MPI ranks for every case, one case after the other (default: the "
@@ -139,7 +141,7 @@ def add_run_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ensemble", type=rank_count, default=0, metavar="P",
                    help="run all cases in ONE mpirun -np P, P/np cases at a time (np "
                    "default 1; overrides the rank plan)")
-    add_cores_arg(p)
+    add_cores_arg(p, cores_help)
     p.add_argument("--retry-unstable", action="store_true",
                    help="also re-run cases found unstable before")
     add_mesh_cache(p)

@@ -32,10 +32,9 @@ from __future__ import annotations
 import argparse
 import json
 import shlex
-from dataclasses import asdict, fields
+from dataclasses import asdict
 from functools import partial
 from pathlib import Path
-from typing import Any
 
 from rich.console import Group
 from rich.markup import escape
@@ -43,12 +42,13 @@ from rich.table import Table
 from rich.text import Text
 
 from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
-                              add_workflow_args, case_table,
+                              add_until_decided_args, add_workflow_args, case_table,
                               console, duration, err_console, folder_to_write, positive_int,
                               prepare_from_args, print_warning, rank_count)
-from ligwf.cli.slurm_rounds import (add_next_round_parser, add_until_decided_args,
-                                    dry_run_note, follow_up_of, next_round, print_submitted,
-                                    resubmit_rounds, submit_until_decided)
+from ligwf.cli.report import add_snapshots
+from ligwf.cli.slurm_rounds import (add_next_round_parser, dry_run_note, follow_up_of,
+                                    next_round, print_submitted, resubmit_rounds,
+                                    submit_until_decided)
 from ligwf.eligibility import EXTEND, analysis_due, eligible
 from ligwf.engine.plan import RankPlan
 from ligwf.engine.progress import shown_reason
@@ -60,22 +60,30 @@ from ligwf.slurm.assumptions import site_assumptions
 from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
                                 plan_rows, slab_note, slurm_time_seconds)
 from ligwf.pipeline.submit_rounds import is_sequential
-from ligwf.slurm.jobs import PlannedJob, read_record, recorded_site, study_status
-from ligwf.slurm.scheduler import SlurmScheduler
+from ligwf.executors import build_executor, executor_kind, study_executor
+from ligwf.slurm.jobs import PlannedJob, read_record, study_status
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
 from ligwf.scheduler import queued_tasks
+from ligwf.study import layout
 from ligwf.study.ownership import other_study
 from ligwf.study.study import Study
 
 
-def add_site_args(p: argparse.ArgumentParser) -> None:
+#: this module's executor in the registry (:mod:`ligwf.executors`)
+SLURM = "slurm"
+
+
+def add_site_args(p: argparse.ArgumentParser, cores: bool = True) -> None:
+    """The Slurm site options (``cores``: with ``--cores``, which ``ligwf study`` has of
+    its own)."""
     p.add_argument("--partition", help="Slurm partition (default: site setting)")
     p.add_argument("--account", help="Slurm account (default: site setting)")
     p.add_argument("--time", help="wall time per case, e.g. 02:00:00 (default: site setting)")
     p.add_argument("--ntasks", type=rank_count,
                    help="MPI ranks for every case (default: site setting, else the rank plan)")
-    add_cores_arg(p, "most ranks the rank plan gives one case, e.g. a node's cores "
-                  "(default: no limit besides the slab rule and particles per rank)")
+    if cores:
+        add_cores_arg(p, "most ranks the rank plan gives one case, e.g. a node's cores "
+                      "(default: no limit besides the slab rule and particles per rank)")
     p.add_argument("--cores-per-node", type=partial(positive_int, unit="cores"), metavar="N",
                    help="cores of one node: a planned case asks for ceil(ranks / N) nodes "
                    "(default: site setting, else unknown and Slurm places the ranks)")
@@ -86,7 +94,7 @@ def add_site_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--analysis-tasks", type=positive_int, default=1, metavar="N",
                    help="split the analysis over an array of N tasks after the cases, merged "
                    "by a job that then writes the report: the tables of one analysis job "
-                   "(default 1: one job; for big studies, see 'ligwf analyse --slurm')")
+                   "(default 1: one job; for big studies, see 'ligwf analyse --executor slurm')")
     p.add_argument("--dry-run", action="store_true",
                    help="print the scripts and sbatch commands; submit and write nothing")
 
@@ -95,12 +103,6 @@ def site_from_args(args: argparse.Namespace, base: SlurmSite) -> SlurmSite:
     return base.with_overrides(partition=args.partition, account=args.account, time=args.time,
                                ntasks=args.ntasks, max_concurrent=args.max_concurrent,
                                cores_per_node=args.cores_per_node)
-
-
-def _site_from_record(values: dict[str, Any]) -> SlurmSite:
-    names = {f.name for f in fields(SlurmSite)}
-    return SlurmSite(**{k: tuple(v) if isinstance(v, list) else v
-                        for k, v in values.items() if k in names})
 
 
 def _warn(lines: list[str]) -> None:
@@ -159,10 +161,12 @@ def slurm_plan_table(rows: tuple[PlanRow, ...], title: str, time: str | None,
 
 
 def cmd_submit(args: argparse.Namespace) -> int:
+    """``ligwf study --executor slurm`` (``ligwf slurm submit``): write the study and submit
+    it (round 1 of a study ``--until-decided``), or with ``--dry-run`` show what would be."""
     prepared = prepare_from_args(args)      # pre-flight before anything is written
     wf, rendered = prepared.workflow, prepared.rendered
     site = site_from_args(args, load_slurm_site())
-    scheduler = SlurmScheduler(site)
+    scheduler = build_executor(SLURM, site)
     fixed = args.ntasks is not None or ntasks_configured()   # every case on site.ntasks ranks
     rounds = follow_up_of(args, not fixed, args.cores)      # None: no --until-decided
     submission = plan_submission(prepared, args.out.resolve(), scheduler, args.cores,
@@ -197,6 +201,27 @@ def cmd_submit(args: argparse.Namespace) -> int:
     if rounds:      # the rounds record first, then round 1 (or what an earlier study asks)
         return submit_until_decided(args, prepared, submission.out, scheduler, rounds)
     print_submitted(submission.submit(scheduler))
+    return 0
+
+
+def submit_analysis(args: argparse.Namespace, count: int) -> int:
+    """``ligwf analyse STUDY --executor slurm --tasks N`` (``--slurm N``): plan (and unless
+    ``--dry-run`` submit) the analysis array of ``count`` shares and its merge job; returns
+    once they are submitted (the token and the logs printed)."""
+    from ligwf.analysis.outputs import new_token
+
+    study = Study.open(args.run_dir)
+    token = new_token()
+    scheduler = build_executor(SLURM)
+    planned = scheduler.plan_analysis(study.path, study.path.name, count, token)
+    if args.dry_run:
+        print(scheduler.dry_run_text(planned))
+        return 0
+    scheduler.require()
+    entries = scheduler.submit(study.path, planned)
+    array, merge = entries[0]["job_id"], entries[-1]["job_id"]
+    print(f"submitted analysis array {array} ({count} task(s)) and merge job {merge} "
+          f"(token {token}); logs in {study.path / layout.SLURM_LOG_DIR}")
     return 0
 
 
@@ -246,9 +271,8 @@ def cmd_status(args: argparse.Namespace) -> int:
 
 def cmd_resubmit(args: argparse.Namespace) -> int:
     study_dir: Path = args.study_dir.resolve()
-    recorded = recorded_site(study_dir)
-    base = _site_from_record(recorded) if recorded else load_slurm_site()
-    scheduler = SlurmScheduler(site_from_args(args, base))
+    base = executor_kind(SLURM).recorded(study_dir)
+    scheduler = build_executor(SLURM, site_from_args(args, base))
     # a planned submission is planned again (same core limit unless --cores says otherwise)
     plan = scheduler.recorded_plan(study_dir) if args.ntasks is None else None
     if is_sequential(read_record(study_dir)):
@@ -279,17 +303,14 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
 
 def cmd_next_round(args: argparse.Namespace) -> int:
     study_dir: Path = args.study_dir.resolve()
-    recorded = recorded_site(study_dir)
-    scheduler = SlurmScheduler(_site_from_record(recorded) if recorded else load_slurm_site())
+    scheduler = study_executor(SLURM, study_dir)
     plan = scheduler.recorded_plan(study_dir)
     return next_round(args, study_dir, scheduler, plan is not None, (plan or {}).get("cores"))
 
 
 def cmd_cancel(args: argparse.Namespace) -> int:
     study_dir: Path = args.study_dir.resolve()
-    recorded = recorded_site(study_dir)
-    scheduler = SlurmScheduler(_site_from_record(recorded) if recorded else load_slurm_site())
-    ids = scheduler.cancel(study_dir)
+    ids = study_executor(SLURM, study_dir).cancel(study_dir)
     if not ids:
         console.print("nothing to cancel: no job of this study is queued or running")
         return 0
@@ -312,7 +333,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     add_replace_arg(p)
     add_site_args(p)
     add_until_decided_args(p)
-    p.set_defaults(func=cmd_submit)
+    add_snapshots(p)
+    p.set_defaults(func=cmd_submit, executor=SLURM)    # = ligwf study --executor slurm
 
     p = sub.add_parser("status", help="cases with their manifest and Slurm state")
     p.add_argument("study_dir", type=Path, help="study folder")

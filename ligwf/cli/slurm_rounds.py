@@ -16,45 +16,23 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-from functools import partial
 from pathlib import Path
 
-from ligwf.cli.common import (console, grouped_warnings, number_in, positive_int,
-                              print_warning)
-from ligwf.cli.report import add_snapshots, print_report
-from ligwf.cli.study import show_look
+from ligwf.cli.common import console, grouped_warnings, print_warning
+from ligwf.cli.report import add_snapshots, print_report, show_look
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import Prepared
-from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, start_rounds
-from ligwf.pipeline.submit_rounds import (INCOMPLETE, NEXT_ROUND, STOPPED, FollowUp, Moved,
-                                          keep_going, progress, recorded_steps)
+from ligwf.pipeline.rounds import (INCOMPLETE, STOPPED, RoundPlan, prepare_study_folder,
+                                   start_rounds)
+from ligwf.pipeline.submit_rounds import (NEXT_ROUND, FollowUp, Moved, keep_going, progress,
+                                          recorded_steps)
 from ligwf.scheduler import Scheduler
 from ligwf.study.layout import REPORT_DIR
-from ligwf.study.rounds import DEFAULT_LOOKS, read_rounds
+from ligwf.study.rounds import read_rounds
 
 #: how long a follow-up job waits for case tasks Slurm still shows (a task that has just
 #: ended may still be completing), seconds
 SETTLE_SECONDS = 60.0
-
-
-def add_until_decided_args(p: argparse.ArgumentParser) -> None:
-    """``--until-decided``, ``--max-looks``, ``--max-core-hours``, ``--every-level``,
-    ``--no-snapshots``."""
-    p.add_argument("--until-decided", action="store_true",
-                   help="a sequential study (as 'ligwf study --until-decided'): each round a "
-                   "dependent array whose follow-up job ('ligwf slurm next-round') takes the "
-                   "look and submits the next round")
-    p.add_argument("--max-looks", type=partial(positive_int, unit="looks"),
-                   default=DEFAULT_LOOKS, help="with --until-decided: looks at most (each "
-                   f"tests at 0.05 / looks; default {DEFAULT_LOOKS})")
-    p.add_argument("--max-core-hours", type=number_in(1e-6, 1e9, "core-h"), default=None,
-                   metavar="H", help="with --until-decided: stop before a round would take "
-                   "the study's runs past H core-hours")
-    p.add_argument("--every-level", action="store_true",
-                   help="with --until-decided: the rounds work on the undecided criteria of "
-                   "every CG level, not only on the cheapest level that can still pass")
-    p.add_argument("--no-snapshots", action="store_true", help="with --until-decided: the "
-                   "final report without the pyvista snapshots (the slowest figures)")
 
 
 def add_next_round_parser(sub, add_mesh_cache) -> argparse.ArgumentParser:

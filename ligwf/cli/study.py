@@ -8,34 +8,38 @@ failed (they are listed, not used). With ``--until-decided`` it goes on in round
 (:mod:`ligwf.pipeline.rounds`): after each look it extends the runs or adds the replicas
 that decide the cheapest level that can still pass, until it is decided, the looks
 (``--max-looks``) are spent or the cap (``--max-core-hours``) is reached; WORKFLOW may
-then also be a study folder (its stored workflow is used). The chain is
-:mod:`ligwf.pipeline`; this module parses and prints.
+then also be a study folder (its stored workflow is used). ``--executor`` picks what runs
+it (:mod:`ligwf.executors`): ``local`` (the default) runs it here and now; a batch
+scheduler (``--executor slurm``, also spelt ``ligwf slurm submit``) writes the study and
+submits it with its post-processing, or its first round and the follow-up job that takes
+each look, and returns. The chain is :mod:`ligwf.pipeline`; this module parses and prints.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
-from functools import partial
 
-from rich.table import Table
-
-from ligwf.cli.common import (add_workflow_args, console, grouped_warnings, number_in,
-                              positive_int, prepare_from_args, print_warning, stop_on_signals)
-from ligwf.cli.report import add_snapshots, print_report
+from ligwf.cli.common import (add_until_decided_args, add_workflow_args, console,
+                              grouped_warnings, prepare_from_args, print_warning,
+                              stop_on_signals)
+from ligwf.cli.executors import SUBMIT_STUDY, add_executor_arg, checked_executor
+from ligwf.cli.report import add_snapshots, print_report, show_look
+from ligwf.cli.slurm import add_site_args
 from ligwf.cli.run import add_run_args, run_with_progress, start_from_args
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess
 from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, until_decided
-from ligwf.local import LocalExecutor, run_settings
+from ligwf.executors import LOCAL, build_executor
+from ligwf.local import run_settings
 from ligwf.pipeline.run import StudyRun
-from ligwf.report.rounds import look_line
 from ligwf.study.layout import REPORT_DIR, is_study_folder
-from ligwf.study.rounds import Look, Rounds
 
 
 def cmd_study(args: argparse.Namespace) -> int:
+    name = checked_executor(args)       # before anything is read or written
+    if name != LOCAL:
+        return SUBMIT_STUDY[name](args)
     if args.until_decided:
         return cmd_until_decided(args)
     run = start_from_args(args)
@@ -43,32 +47,6 @@ def cmd_study(args: argparse.Namespace) -> int:
     _, out = postprocess(run.study.path, run.executor, snapshots=not args.no_snapshots)
     print_report(run.study.path, out)
     return 0 if done else 1
-
-
-def show_look(look: Look, rounds: Rounds) -> None:
-    """A look on the terminal: every interval against its budget, the half-width beside
-    the previous look's (the intervals shrinking), then what the next round does."""
-    before = {(c["condition"], c["criterion"]): c for x in rounds.looks
-              if x.number == look.number - 1 for c in x.criteria}
-    table = Table(title=f"look {look.number} of at most {rounds.max_looks}", box=None)
-    for col in ("condition", "criterion", "state", "value [interval]", "half-width",
-                "previous", "budget"):
-        table.add_column(col)
-    for c in look.criteria:
-        lo, hi = c.get("lo"), c.get("hi")
-        half = 0.5 * (hi - lo) if lo is not None and hi is not None and math.isfinite(lo) \
-            and math.isfinite(hi) else math.nan
-        p = before.get((c["condition"], c["criterion"]))
-        prev = (0.5 * (p["hi"] - p["lo"]) if p and p.get("lo") is not None
-                and p.get("hi") is not None else math.nan)
-        band = (f"{c['value']:.3g} [{lo:.3g}, {hi:.3g}]" if math.isfinite(half)
-                else f"{c.get('value', math.nan):.3g}")
-        table.add_row(c["condition"], c["label"], c["state"], band,
-                      f"{half:.3g}" if math.isfinite(half) else "–",
-                      f"{prev:.3g}" if math.isfinite(prev) else "–",
-                      f"{c.get('budget', math.nan):.3g}")
-    console.print(table)
-    console.print(look_line(look), highlight=False, soft_wrap=True)
 
 
 def cmd_until_decided(args: argparse.Namespace) -> int:
@@ -93,7 +71,7 @@ def cmd_until_decided(args: argparse.Namespace) -> int:
         console.print(summary_table(run.study.cases, f"{run.study.name}: {args.out}"))
         return done
 
-    rounds = until_decided(prepared, args.out, LocalExecutor(settings),
+    rounds = until_decided(prepared, args.out, build_executor(LOCAL, settings),
                            RoundPlan(args.max_looks, args.max_core_hours, args.every_level),
                            run_round,
                            show_look, args.mesh_cache, snapshots=not args.no_snapshots,
@@ -110,20 +88,13 @@ def register(subparsers) -> None:
     """Add ``study``."""
     p = subparsers.add_parser("study", help="run + analyse + report a workflow in one command")
     add_workflow_args(p)
-    add_run_args(p)
+    add_executor_arg(p, "the cases and the post-processing")
+    add_run_args(p, cores_help="local: cores the rank plan fills (default: the tasks of the "
+                 "Slurm allocation this runs in, else the CPUs this process may use); on a "
+                 "scheduler: most ranks the rank plan gives one case (default: no limit "
+                 "besides the slab rule and particles per rank)")
     add_snapshots(p)
-    p.add_argument("--until-decided", action="store_true",
-                   help="go on in rounds (longer production or more replicas, the cheapest "
-                   "that decides) until the cheapest level that can still pass is decided; "
-                   "WORKFLOW may be a study folder")
-    p.add_argument("--max-looks", type=partial(positive_int, unit="looks"), default=3,
-                   help="with --until-decided: looks at most (each tests at 0.05 / looks; "
-                   "default 3)")
-    p.add_argument("--max-core-hours", type=number_in(1e-6, 1e9, "core-h"), default=None,
-                   metavar="H", help="with --until-decided: stop before a round would take "
-                   "the study's runs past H core-hours")
-    p.add_argument("--every-level", action="store_true",
-                   help="with --until-decided: the rounds work on the undecided criteria of "
-                   "every CG level (a ladder: each level's error decided), not only on the "
-                   "cheapest level that can still pass")
+    add_until_decided_args(p)
+    add_site_args(p.add_argument_group("with --executor slurm (as 'ligwf slurm submit')"),
+                  cores=False)
     p.set_defaults(func=cmd_study)

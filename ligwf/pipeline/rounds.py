@@ -23,6 +23,14 @@ runs (:mod:`ligwf.engine.resume`) and looks again: nothing lost, repeated or mix
 continued case keeps its manifest, thermo table and frame series
 (:mod:`ligwf.study.extension`); a new replica is a new case folder with its own seeds.
 
+Where a sequential study stands is decided once, for every executor (:func:`stand`), from
+the rounds record, the round the executor was handed and what each case needs
+(:func:`ligwf.eligibility.eligible`): stopped, a round due, running, incomplete, a look
+due. The loop here (:func:`until_decided`, on any :class:`~ligwf.scheduler.Executor` that
+runs cases to their end) does what that says and asks again until the study stops; on a
+batch scheduler the follow-up job (:mod:`ligwf.pipeline.submit_rounds`) asks once, does
+it, and submits the next round with another follow-up job.
+
 Repeated looks: every look tests at alpha / max_looks (Bonferroni spending, stated in the
 record and the report).
 """
@@ -32,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from enum import StrEnum
 from pathlib import Path
 from typing import Callable
 
@@ -39,7 +48,7 @@ from ligwf.inference.equivalence import UNDECIDED
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
-from ligwf.local import LocalExecutor
+from ligwf.eligibility import HELD, Eligible, eligible
 from ligwf.pipeline.run import StudyRun, scheduled, site_engine
 from ligwf.inference.planning import calibration, run_costs
 from ligwf.inference.verdict import FAILS, MEETS, Verdict, is_control_group
@@ -266,26 +275,71 @@ def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Lo
 
 
 # ---------------------------------------------------------------- the loop
-def until_decided(prepared: Prepared, out: Path, executor: LocalExecutor, plan: RoundPlan,
+class Stand(StrEnum):
+    """Where a sequential study stands (:func:`stand`; the value is the word shown)."""
+
+    STOPPED = "stopped"             # the last look stopped it: only the final report remains
+    ROUND_DUE = "round due"         # the round the last look asked for is not handed out yet
+    RUNNING = "running"             # a case of the round is held (a live runner, a queued task)
+    INCOMPLETE = "incomplete"       # a case of the round is not done and nobody holds it
+    LOOK_DUE = "look due"           # every case of the round is done
+
+
+STOPPED, ROUND_DUE, RUNNING, INCOMPLETE, LOOK_DUE = (
+    Stand.STOPPED, Stand.ROUND_DUE, Stand.RUNNING, Stand.INCOMPLETE, Stand.LOOK_DUE)
+
+
+def stand(rounds: Rounds, handed: int, needs: Eligible, where: Path) -> Stand:
+    """Where the sequential study in ``where`` stands, the one decision every executor's
+    loop acts on: ``rounds`` (k looks taken), ``handed`` the latest round its executor was
+    given (written locally; submitted on a scheduler: the round its jobs name) and
+    ``needs`` what each case of that round needs. Stopped by the last look; round k + 1
+    due while ``handed`` <= k; else running while a case is held, incomplete while one is
+    not done, the look due once all are. A round handed out before the look that asked
+    for it is refused (another rounds record was put in place)."""
+    k = len(rounds.looks)
+    if rounds.stopped:
+        return STOPPED
+    if handed > k + 1:
+        raise ConfigError(f"{where}: the executor's record names round {handed}, the rounds "
+                          f"record {k} look(s): round {handed} cannot have been submitted "
+                          f"before look {handed - 1}; was the rounds record replaced?")
+    if handed <= k:
+        return ROUND_DUE
+    if any(t.need is HELD for t in needs.tasks):
+        return RUNNING
+    return INCOMPLETE if needs.not_done else LOOK_DUE
+
+
+def until_decided(prepared: Prepared, out: Path, executor: Executor, plan: RoundPlan,
                   run_round: Callable[[StudyRun], bool], show: Callable[[Look, Rounds], None],
                   mesh_cache: Path | None = None, snapshots: bool = True,
                   replace: bool = False) -> Rounds:
     """Run, analyse and judge the study in rounds until it decides (module docstring), its
-    cases and analysis on ``executor``; ``run_round`` runs a scheduled round (the CLI's
-    progress display), ``show`` prints a look. Returns the rounds record; stops early (no
-    look recorded) when a case did not finish (the same command resumes it). Another study
-    in ``out`` is refused before the rounds record is touched, unless ``replace``."""
+    cases and analysis on ``executor`` (one that runs them to their end: this machine, or a
+    scheduler that waits); ``run_round`` runs the due cases of a round (the CLI's progress
+    display), ``show`` prints a look. Each turn acts on :func:`stand`: a due round is
+    written (:func:`write_round`), a round whose cases are not done is run, a due look is
+    taken (:func:`take_look`), until the study stops (then the final report). Returns the
+    rounds record; stops early (no look recorded) when a case did not finish (the same
+    command resumes it). Another study in ``out`` is refused before the rounds record is
+    touched, unless ``replace``."""
     check_own_folder(out, prepared.workflow.name, prepared.workflow.raw,
                      [rc.case.case_id for rc in prepared.rendered], (), replace)
     rounds = start_rounds(out, plan)
-    while not rounds.stopped:
-        _, identity = site_engine()             # refused before anything is written
-        study = write_round(prepared, out, rounds, mesh_cache, replace)
-        run = scheduled(study, executor, identity)
-        if not run_round(run):
-            return rounds
-        rounds = take_look(out, rounds, executor)
-        show(rounds.looks[-1], rounds)
+    handed = len(rounds.looks)      # each call writes its round first (idempotent)
+    identity = None
+    while (now := stand(rounds, handed, eligible(Study.open(out).cases)
+                        if handed > len(rounds.looks) else Eligible(()), out)) != STOPPED:
+        if now == ROUND_DUE:
+            _, identity = site_engine()             # refused before anything is written
+            write_round(prepared, out, rounds, mesh_cache, replace)
+            handed = len(rounds.looks) + 1
+        elif now == LOOK_DUE:
+            rounds = take_look(out, rounds, executor)
+            show(rounds.looks[-1], rounds)
+        elif not run_round(scheduled(Study.open(out), executor, identity)):
+            return rounds                           # RUNNING elsewhere, or INCOMPLETE
     report_study(out, snapshots=snapshots)
     return rounds
 

@@ -22,10 +22,11 @@ from pathlib import Path
 from typing import Sequence
 
 from ligwf.engine.launch import Monitor
-from ligwf.engine.plan import Schedule, plan_study
+from ligwf.engine.plan import Schedule, allocation_schedule, case_load, plan_study
 from ligwf.engine.site import EngineConfig, EngineIdentity
 from ligwf.errors import ConfigError, LigwfError
 from ligwf.eligibility import eligible
+from ligwf.executors import LOCAL, build_executor
 from ligwf.local import LocalExecutor, RunSettings, study_schedule
 from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.scheduler import Executor
@@ -93,17 +94,25 @@ def start_run(prepared: Prepared, out: Path, settings: RunSettings,
     the MPI launcher): one that is missing or cannot be loaded is refused before anything
     is written. ``extend_seconds``: every case's production that much longer than rendered
     (:func:`~ligwf.study.extension.extend_production`; done cases are continued)."""
-    engine, identity = site_engine()
+    _, identity = site_engine()
     study = write(prepared, out, mesh_cache, replace)    # refuses another study's folder
     if extend_seconds > 0 and extend_production(study.cases, extend_seconds):
         study = Study.open(out)                          # the cases with their extensions
-    return scheduled(study, LocalExecutor(settings, engine), identity)
+    return scheduled(study, build_executor(LOCAL, settings), identity)
 
 
-def scheduled(study: Study, executor: LocalExecutor, identity: EngineIdentity) -> StudyRun:
-    """A written study with the schedule of its cases still to run on ``executor``."""
-    settings = executor.settings
-    schedule = study_schedule(eligible(study.cases, settings.retry_unstable).to_run, settings)
+def scheduled(study: Study, executor: Executor, identity: EngineIdentity) -> StudyRun:
+    """A written study with the schedule of its cases still to run on ``executor``: this
+    machine's (:func:`~ligwf.local.study_schedule`, its phases), or on any other executor
+    one allocation per case (:func:`~ligwf.engine.plan.allocation_schedule`, what a
+    scheduler's ``run_cases`` submits)."""
+    if isinstance(executor, LocalExecutor):
+        settings = executor.settings
+        schedule = study_schedule(eligible(study.cases, settings.retry_unstable).to_run,
+                                  settings)
+    else:
+        schedule = allocation_schedule([case_load(c.path.name, c.scaled)
+                                        for c in eligible(study.cases).to_run])
     return StudyRun(study, schedule, executor, identity)
 
 
@@ -127,8 +136,8 @@ def run_case_of(study: Study, case: CaseFolder, nprocs: int | None = None,
     if (why := case.record_problem(check_hash=False)) is not None:
         raise ConfigError(f"{case.path}: not run: {why}")
     ranks = nprocs or int(os.environ.get("SLURM_NTASKS", "1"))
-    engine, _ = site_engine()       # refused before the case is locked or touched
-    executor = LocalExecutor(RunSettings(nprocs=ranks, retry_unstable=retry_unstable), engine)
+    site_engine()                   # refused before the case is locked or touched
+    executor = build_executor(LOCAL, RunSettings(nprocs=ranks, retry_unstable=retry_unstable))
     return run_study(study, [case], executor, monitor, stop)
 
 

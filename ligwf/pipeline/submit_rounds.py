@@ -15,12 +15,14 @@ follow) with another follow-up job of the same kind; once it stops, the final re
 
 Where the study stands (:func:`progress`) is read from two records, never guessed: the
 rounds record (k looks taken) and the scheduler's submission record, where every job
-names the round it runs (``study_round``; r the latest):
+names the round it runs (``study_round``; r the latest, the round handed to the
+scheduler); the decision is :func:`ligwf.pipeline.rounds.stand`, the same as the local
+loop's:
 
 * the last look stopped it: :data:`STOPPED` (only the final report remains, written
   once: :func:`~ligwf.eligibility.report_due`);
 * r <= k: round k + 1 is :data:`ROUND_DUE` (written and submitted, tagged k + 1);
-* r = k + 1 and a case still queued: :data:`RUNNING`;
+* r = k + 1 and a case still queued (or held by a live runner): :data:`RUNNING`;
 * r = k + 1 and a case not done (failed, killed, unstable, extended, or its task never
   ran): :data:`INCOMPLETE`, no look (``ligwf slurm resubmit`` runs them again with a
   follow-up);
@@ -46,17 +48,15 @@ from typing import Callable, Sequence
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import report_study
 from ligwf.pipeline.prepare import Prepared
-from ligwf.pipeline.rounds import take_look, write_round
-from ligwf.eligibility import eligible, report_due
-from ligwf.local import LocalExecutor
+from ligwf.pipeline.rounds import (INCOMPLETE, LOOK_DUE, ROUND_DUE, RUNNING, STOPPED, Stand,
+                                   stand, take_look, write_round)
+from ligwf.eligibility import Eligible, eligible, report_due
+from ligwf.executors import LOCAL, build_executor
 from ligwf.pipeline.submit import rerun_jobs
 from ligwf.scheduler import Scheduler, queued_tasks
 from ligwf.study.rounds import Look, Rounds, read_rounds, rounds_lock
 from ligwf.study.study import Study
 
-#: where a sequential study on a scheduler stands (:func:`progress`)
-STOPPED, ROUND_DUE, RUNNING, INCOMPLETE, LOOK_DUE = (
-    "stopped", "round due", "running", "incomplete", "look due")
 #: the sub-command of the follow-up job (``ligwf <scheduler> next-round STUDY``)
 NEXT_ROUND = "next-round"
 
@@ -125,7 +125,7 @@ class Progress:
     cases a runner would run that no job holds, the cases not done, and the follow-up
     jobs still queued or running (besides the caller's own)."""
 
-    state: str
+    state: Stand
     looks: int
     round: int
     queued: tuple[str, ...] = ()
@@ -143,18 +143,15 @@ def progress(study_dir: Path, scheduler: Scheduler, retry_unstable: bool = False
     k, r = len(rounds.looks), submitted_round(st.jobs)
     follow = tuple(str(j["job_id"]) for j in st.jobs if j.get("kind") != "array"
                    and j.get("active") and str(j["job_id"]) != own_job)
-    if rounds.stopped:
+    needs = (eligible(Study.open(study_dir).cases, retry_unstable, queued_tasks(st))
+             if r == k + 1 and not rounds.stopped else Eligible(()))
+    state = stand(rounds, r, needs, study_dir)
+    if state == STOPPED:
         return Progress(STOPPED, k, k, follow_ups=follow, stop=rounds.looks[-1].stop)
-    if r > k + 1:
-        raise ConfigError(f"{study_dir}: the scheduler's record names round {r}, the rounds "
-                          f"record {k} look(s): round {r} cannot have been submitted before "
-                          f"look {r - 1}; was the rounds record replaced?")
-    if r <= k:
+    if state == ROUND_DUE:
         return Progress(ROUND_DUE, k, k + 1, follow_ups=follow)
-    needs = eligible(Study.open(study_dir).cases, retry_unstable, queued_tasks(st))
     queued = tuple(t.queued for t in needs.tasks if t.queued is not None)
     not_done = tuple(t.case.case_id for t in needs.not_done)
-    state = RUNNING if queued else INCOMPLETE if not_done else LOOK_DUE
     return Progress(state, k, r, queued, needs.indices, not_done, follow)
 
 
@@ -205,7 +202,7 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
                 time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
                 continue
             if take_looks and p.state == LOOK_DUE:
-                rounds = take_look(out, read_rounds(out), LocalExecutor())
+                rounds = take_look(out, read_rounds(out), build_executor(LOCAL))
                 looks.append(rounds.looks[-1])
                 if show is not None:
                     show(rounds.looks[-1], rounds)
@@ -213,7 +210,7 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
             if p.state == ROUND_DUE and prepared is not None:
                 moved = _submit_round(out, scheduler, how, prepared, p, take_looks)
                 if moved is None:           # nothing to run: look again at once
-                    rounds = take_look(out, read_rounds(out), LocalExecutor())
+                    rounds = take_look(out, read_rounds(out), build_executor(LOCAL))
                     looks.append(rounds.looks[-1])
                     if show is not None:
                         show(rounds.looks[-1], rounds)

@@ -21,7 +21,7 @@ import json
 import re
 import shutil
 import subprocess
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from datetime import datetime, timezone
 from pathlib import Path, PurePosixPath
 from typing import Callable, Iterable, Mapping, Sequence
@@ -39,7 +39,7 @@ from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_par
 from ligwf.slurm.script import (ScriptContext, analysis_array_script,
                                 analysis_merge_script, analysis_script, array_script,
                                 sbatch_command, scontrol_command, squeue_command)
-from ligwf.slurm.site import SlurmSite
+from ligwf.slurm.site import SlurmSite, load_slurm_site
 
 #: kinds of planned jobs that are arrays the job after them waits for
 ARRAY_KINDS = ("array", "analysis-array")
@@ -267,6 +267,18 @@ def recorded_site(study_dir: Path) -> dict:
     """Site settings of the latest array submission (resubmits reuse them), {} if none."""
     arrays = [s for s in read_record(study_dir) if s.get("kind") == "array" and s.get("site")]
     return dict(arrays[-1]["site"]) if arrays else {}
+
+
+def submitted_site(study_dir: Path) -> SlurmSite:
+    """The site settings of the study's latest array submission (a resubmit, a follow-up
+    job and ``cancel`` keep them); the site's own (:func:`load_slurm_site`) when it records
+    none."""
+    values = recorded_site(study_dir)
+    if not values:
+        return load_slurm_site()
+    names = {f.name for f in fields(SlurmSite)}
+    return SlurmSite(**{k: tuple(v) if isinstance(v, list) else v
+                        for k, v in values.items() if k in names})
 
 
 def next_round(study_dir: Path) -> int:

@@ -122,12 +122,14 @@ def test_resubmit_plans_the_missing_cases_again_on_the_recorded_cores(tmp_path, 
 
 
 def test_cli_cancel_says_what_it_cancelled(tmp_path, monkeypatch, capsys):
-    import ligwf.cli.slurm as cli_slurm
+    import ligwf.slurm.scheduler as slurm_scheduler
     from ligwf.cli.main import main
 
     out = _submitted_study(tmp_path, monkeypatch)
     run = Recorder((CAPTURED / "squeue_array_running.txt").read_text())
-    monkeypatch.setattr(cli_slurm, "SlurmScheduler", lambda site: SlurmScheduler(site, run))
+    # the registry (ligwf.executors) builds the scheduler: it gets the recorder here
+    monkeypatch.setattr(slurm_scheduler, "SlurmScheduler",
+                        lambda site: SlurmScheduler(site, run))
     assert main(["slurm", "cancel", str(out)]) == 0
     text = capsys.readouterr().out
     assert "cancelled job(s) 1, 2" in text and "ligwf slurm resubmit" in text

@@ -12,8 +12,9 @@ import pytest
 
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import prepare_workflow, write
-from ligwf.pipeline.submit_rounds import (INCOMPLETE, ROUND_DUE, RUNNING, FollowUp, keep_going,
-                                          progress, recorded_steps, submitted_round)
+from ligwf.pipeline.rounds import INCOMPLETE, ROUND_DUE, RUNNING
+from ligwf.pipeline.submit_rounds import (FollowUp, keep_going, progress, recorded_steps,
+                                          submitted_round)
 from ligwf.slurm.jobs import append_record, read_record
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite

@@ -3,7 +3,8 @@ byte for byte; a failed task is named by the merge, and re-running it completes 
 
 On the real single-node Slurm of tests/slurm/local_cluster.py: a tiny study (two CG3
 cases, ~200 particles, ``ligwf study`` locally: engine + analysis) is analysed again by
-``ligwf analyse STUDY --slurm 3`` (three array tasks, ``--part K/3``, and the merge job).
+``ligwf analyse STUDY --executor slurm --tasks 3`` (three array tasks, ``--part K/3``, and
+the merge job).
 Then ``--slurm 2`` with task 1 made to fail (its site set-up line exits 3): the merge job
 fails naming task 1 and the command that re-runs it, the outputs in place are untouched;
 that command and the merge, run by hand, give the same tables again.
@@ -71,8 +72,9 @@ def test_slurm_array_analysis_gives_the_local_tables(slurm_cluster, tmp_path):
     record = json.loads((study / "analysis" / "analysis.json").read_text())
     assert sum(c["analysed"] for c in record["cases"]) >= 4
 
-    # three tasks for two cases of ~3 frames: a case's frames split over tasks
-    out = ligwf("analyse", str(study), "--slurm", "3", env=env).stdout
+    # three tasks for two cases of ~3 frames: a case's frames split over tasks (--executor
+    # slurm --tasks 3; its old spelling --slurm N below)
+    out = ligwf("analyse", str(study), "--executor", "slurm", "--tasks", "3", env=env).stdout
     token = re.search(r"token (\w+)", out).group(1)
     subs = submissions(study, token)
     assert [s["kind"] for s in subs] == ["analysis-array", "analysis-merge"]

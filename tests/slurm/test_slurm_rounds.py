@@ -1,6 +1,7 @@
-"""A sequential study on a real one-node Slurm (``ligwf slurm submit --until-decided``):
-each round a dependent array whose follow-up job (``ligwf slurm next-round``) takes the
-look and submits the next round.
+"""A sequential study on a real one-node Slurm (``ligwf study --executor slurm
+--until-decided``, i.e. ``ligwf slurm submit --until-decided``): each round a dependent
+array whose follow-up job (``ligwf slurm next-round``) takes the look and submits the next
+round.
 
 The tiny rounds workflow (tests/workflows/rounds_tiny.yaml: a CG1 bed of ~490 particles and
 its We-CG1.5 twin, two seeds each) with two looks: after the jobs end the rounds record has
@@ -114,7 +115,9 @@ def env(tmp_path):
 def test_until_decided_runs_each_round_as_a_dependent_array(slurm_cluster, tmp_path, env):
     t0 = time.monotonic()
     study = tmp_path / "s"
-    ligwf("slurm", "submit", str(WORKFLOW), "--out", str(study), "--until-decided",
+    # ligwf study --executor slurm is ligwf slurm submit (tests/slurm/test_slurm_integration.py
+    # submits with the old spelling)
+    ligwf("study", str(WORKFLOW), "--out", str(study), "--executor", "slurm", "--until-decided",
           "--max-looks", "2", "--ntasks", "1", "--time", "00:20:00", "--no-snapshots", env=env)
     first = read_record(study)
     assert [(s["kind"], s.get("study_round")) for s in first] == [("array", 1), ("analysis", 1)]

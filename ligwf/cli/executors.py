@@ -1,0 +1,57 @@
+"""The command line's face of the executor registry (:mod:`ligwf.executors`): ``--executor
+NAME`` on ``ligwf study`` and ``ligwf analyse``, the options that set one executor's
+settings (refused in one line with another), and what a batch scheduler's sub-commands do
+for those two commands (``ligwf study --executor slurm`` is ``ligwf slurm submit``,
+``ligwf analyse --executor slurm --tasks N`` is ``ligwf analyse --slurm N``: the same code).
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Callable, Mapping
+
+from ligwf.cli import slurm
+from ligwf.errors import ConfigError
+from ligwf.executors import EXECUTORS, LOCAL, executor_kind
+
+#: the options of ``ligwf study`` that set one executor's settings: argparse dest ->
+#: (executor, the option, its value when not given)
+STUDY_OPTIONS: Mapping[str, tuple[str, str, object]] = {
+    "np": (LOCAL, "--np", None), "ensemble": (LOCAL, "--ensemble", 0),
+    "retry_unstable": (LOCAL, "--retry-unstable", False),
+    "extend_production": (LOCAL, "--extend-production", 0.0),
+    **{dest: (slurm.SLURM, flag, unset) for dest, flag, unset in (
+        ("partition", "--partition", None), ("account", "--account", None),
+        ("time", "--time", None), ("ntasks", "--ntasks", None),
+        ("cores_per_node", "--cores-per-node", None),
+        ("max_concurrent", "--max-concurrent", None), ("no_analysis", "--no-analysis", False),
+        ("analysis_tasks", "--analysis-tasks", 1), ("dry_run", "--dry-run", False))},
+}
+
+#: executor -> what ``ligwf study --executor NAME`` does (a batch scheduler: write the
+#: study and submit it); the local executor runs it here (:mod:`ligwf.cli.study`)
+SUBMIT_STUDY: Mapping[str, Callable[[argparse.Namespace], int]] = {
+    slurm.SLURM: slurm.cmd_submit}
+#: executor -> what ``ligwf analyse STUDY --executor NAME --tasks N`` does on a batch
+#: scheduler (submit the shares and their merge); the local executor runs them here
+SUBMIT_ANALYSIS: Mapping[str, Callable[[argparse.Namespace, int], int]] = {
+    slurm.SLURM: slurm.submit_analysis}
+
+
+def add_executor_arg(p: argparse.ArgumentParser, what: str) -> None:
+    """``--executor NAME`` (default ``local``); ``what`` says what it does for the command."""
+    names = "; ".join(f"{name}: {executor_kind(name).summary}" for name in EXECUTORS)
+    p.add_argument("--executor", default=LOCAL, metavar="NAME",
+                   help=f"what runs {what} ({names}; default {LOCAL})")
+
+
+def checked_executor(args: argparse.Namespace,
+                     options: Mapping[str, tuple[str, str, object]] = STUDY_OPTIONS) -> str:
+    """The executor ``args`` name, checked before anything is read or written: an unknown
+    name, or an option of another executor given, is refused in one line."""
+    name = executor_kind(args.executor).name
+    for dest, (owner, flag, unset) in options.items():
+        if owner != name and getattr(args, dest, unset) != unset:
+            raise ConfigError(f"{flag}: an option of --executor {owner}, not of --executor "
+                              f"{name}")
+    return name

@@ -1,0 +1,116 @@
+"""``--executor``: ``ligwf study --executor slurm`` is ``ligwf slurm submit`` and ``ligwf
+analyse --executor slurm --tasks N`` is ``ligwf analyse --slurm N`` (the same code, so the
+same scripts); the options of one executor are refused with another, in one line, before
+anything is written. (The real submissions: tests/slurm.)"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+import pytest
+
+from ligwf.cli.executors import STUDY_OPTIONS, SUBMIT_ANALYSIS, SUBMIT_STUDY
+from ligwf.cli.main import main
+from ligwf.executors import EXECUTORS, LOCAL
+
+from helpers import ROOT
+
+TINY = ROOT / "tests" / "slurm" / "tiny_drum.yaml"
+
+
+@dataclass(frozen=True)
+class Ran:
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+@pytest.fixture
+def ligwf(tmp_path, monkeypatch, capsys):
+    """``ligwf ARGS`` in this process, on no site file and a mesh cache of the test's own."""
+    monkeypatch.setenv("LIGWF_MESH_CACHE", str(tmp_path / "meshes"))
+    monkeypatch.setenv("LIGWF_SITE", str(tmp_path / "none.yaml"))
+    monkeypatch.setenv("LIGWF_SLURM_MODULES", "openmpi/4.1")
+
+    def run(*args) -> Ran:
+        capsys.readouterr()
+        code = main([str(a) for a in args])
+        out, err = capsys.readouterr()
+        return Ran(code, out, err)
+    return run
+
+
+@pytest.fixture
+def study(tmp_path, ligwf):
+    """The tiny drum rendered (four cases, nothing run)."""
+    folder = tmp_path / "study"
+    assert ligwf("render", TINY, "--out", folder).returncode == 0
+    return folder
+
+
+def test_every_scheduler_in_the_registry_has_its_command_line_face():
+    schedulers = set(EXECUTORS) - {LOCAL}
+    assert set(SUBMIT_STUDY) == schedulers and set(SUBMIT_ANALYSIS) == schedulers
+    assert {owner for owner, _, _ in STUDY_OPTIONS.values()} == set(EXECUTORS)
+
+
+@pytest.mark.parametrize("extra", [(), ("--until-decided", "--max-looks", "2")])
+def test_study_on_slurm_is_slurm_submit(tmp_path, ligwf, extra):
+    out = tmp_path / "study"
+    site = ("--partition", "debug", "--time", "00:05:00", "--max-concurrent", "2")
+    old = ligwf("slurm", "submit", TINY, "--out", out, "--dry-run", *site, *extra)
+    new = ligwf("study", TINY, "--out", out, "--executor", "slurm", "--dry-run",
+                 *site, *extra)
+    assert old.returncode == new.returncode == 0, old.stderr + new.stderr
+    assert new.stdout == old.stdout and new.stderr == old.stderr
+    assert "#SBATCH --array=0-3%2" in new.stdout and "#SBATCH --partition=debug" in new.stdout
+    assert ("slurm next-round" in new.stdout) == bool(extra)
+    assert not out.exists()
+
+
+def test_analyse_on_slurm_is_analyse_slurm(ligwf, study):
+    old = ligwf("analyse", study, "--slurm", "3", "--dry-run")
+    new = ligwf("analyse", study, "--executor", "slurm", "--tasks", "3",
+                 "--dry-run")
+    assert old.returncode == new.returncode == 0, old.stderr + new.stderr
+    tokens = [re.search(r"--token (\w+)", r.stdout).group(1) for r in (old, new)]
+    assert tokens[0] != tokens[1]           # each split draws its own staging token
+    assert new.stdout.replace(tokens[1], "TOKEN") == old.stdout.replace(tokens[0], "TOKEN")
+    assert new.stdout.count("--part") == 1 and "--merge 3 --token" in new.stdout
+    assert not (study / "slurm").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--executor", "pbs"), "ConfigError: --executor = 'pbs': no such executor (allowed: "
+                            "local, slurm)"),
+    (("--executor", "slurm", "--np", "2"), "--np: an option of --executor local, not of "
+                                           "--executor slurm"),
+    (("--executor", "slurm", "--extend-production", "1"), "--extend-production: an option "
+                                                          "of --executor local"),
+    (("--partition", "debug"), "--partition: an option of --executor slurm, not of "
+                               "--executor local"),
+    (("--dry-run",), "--dry-run: an option of --executor slurm"),
+])
+def test_another_executors_option_is_one_line_and_writes_nothing(tmp_path, ligwf, args,
+                                                                message):
+    out = tmp_path / "study"
+    res = ligwf("study", TINY, "--out", out, *args)
+    assert res.returncode == 2 and message in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1
+    assert not out.exists() and not (tmp_path / "meshes").exists()
+
+
+@pytest.mark.parametrize("args, message", [
+    (("--executor", "pbs"), "--executor = 'pbs': no such executor"),
+    (("--tasks", "0"), "--tasks = 0: number of analysis tasks, allowed range [1, "),
+    (("--tasks", "2", "--out", "elsewhere"), "--executor local --tasks 2 runs the study's own "
+                                             "analysis"),
+    (("--tasks", "2", "--dry-run"), "--dry-run: the local executor runs the shares now"),
+    (("--tasks", "2", "--part", "0/2", "--token", "abc"), "--part: one share or the merge"),
+    (("--executor", "slurm", "--token", "abc"), "--token: --tasks makes its own token"),
+])
+def test_analyse_refuses_what_its_executor_cannot_do(ligwf, study, args, message):
+    res = ligwf("analyse", study, *args)
+    assert res.returncode == 2 and message in res.stderr, res.stderr
+    assert not (study / "analysis").exists()
