@@ -13,7 +13,11 @@ core-hour cap. A round halves the width rather than doing what item 4's "what wo
 decide" names (an amount computed from the measured difference): amounts chosen from the
 difference bias the next look's test (on null synthetic studies, 10 % wrong fails at
 alpha 0.05; halving, which depends on the variances only, stays within 5 %:
-``benchmarks/bench_coverage.py``).
+``benchmarks/bench_coverage.py``). A level of the study's answer (every level with
+``--every-level``; else the levels that fail up to the one named) whose runs the verdict
+flags as too short -- their steady windows start at the cap, so nothing was shown steady --
+has those runs' arm extended by the planner's rule in the same round, before the study may
+stop, even when every level is decided (:func:`too_short`).
 
 Everything a round adds is first written into the study's rounds record
 (:mod:`ligwf.study.rounds`), then done; so the same command after a kill (of ligwf, an
@@ -50,7 +54,8 @@ from ligwf.pipeline.post import postprocess, report_study
 from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
 from ligwf.eligibility import HELD, Eligible, eligible
 from ligwf.pipeline.run import StudyRun, scheduled, site_engine
-from ligwf.inference.planning import calibration, run_costs
+from ligwf.analysis.records.flow import FlowRecord
+from ligwf.inference.planning import AT_CAP, LEAST_EXTENSION, calibration, noise_table, run_costs
 from ligwf.inference.verdict import FAILS, MEETS, Verdict, is_control_group
 from ligwf.inference.verdict_records import read_verdict
 from ligwf.scheduler import Executor
@@ -58,6 +63,7 @@ from ligwf.scene.workflow import CONTROL_KEY, apply_override, expand, parse_over
 from ligwf.study.case import group_of
 from ligwf.study.condition import Arm, Condition
 from ligwf.study.extension import write_extension
+from ligwf.study import layout
 from ligwf.study.ownership import check_own_folder
 from ligwf.study.rounds import (CAPPED, DECIDED, EXTEND, LOOKS_SPENT, REPLICAS, STUCK, Action,
                                 AddReplicas, ExtendProduction, Look, Rounds, read_rounds,
@@ -236,8 +242,56 @@ def _targets(group, every_level: bool) -> list:
     return [] if not open_ or open_[0].state == MEETS else open_[:1]
 
 
+def _answer_levels(group, every_level: bool) -> list:
+    """The conditions of a sweep group whose states make the study's answer: every level
+    with ``every_level``; else, fastest first, the levels that fail up to the first that
+    does not (the one named, or the one still open)."""
+    if every_level:
+        return list(group.conditions)
+    out = []
+    for c in sorted(group.conditions,
+                    key=lambda c: -c.speedup if math.isfinite(c.speedup) else math.inf):
+        out.append(c)
+        if c.state != FAILS:
+            break
+    return out
+
+
+def too_short(study: Study, verdict: Verdict, every_level: bool = False
+              ) -> dict[Condition, float]:
+    """Per arm (named by the condition whose runs it is) of a level in the study's answer
+    (:func:`_answer_levels`) that the verdict flags as too short (its steady windows start
+    at their cap), the production each of its capped runs needs at least
+    (:func:`ligwf.analysis.records.steady_window.least_extension`, the most any of them
+    needs). A decision on such runs is not shown steady, so a round extends them before
+    the study stops, whatever the level's state; control groups are left out."""
+    conditions = [Condition(g.group, c.cg, c.rule) for g in verdict.groups
+                  if not is_control_group(g.group)
+                  for c in _answer_levels(g, every_level) if c.too_short]
+    path = study.analysis_dir / layout.FLOW_PROFILES
+    if not conditions or not path.is_file():
+        return {}
+    flow = FlowRecord.read(path)
+    usable = [case for case in study.cases if case.case_id in flow.cases]   # those analysed
+    noise = noise_table(usable, flow, ())
+    needs: dict[Condition, float] = {}
+    for condition in conditions:
+        for arm in Arm:
+            side = condition.side(arm)
+            for case in usable:
+                if (not side.covers(case) or case.case_id not in noise.index
+                        or not bool(noise.at[case.case_id, AT_CAP])):
+                    continue
+                more = float(noise.at[case.case_id, LEAST_EXTENSION])
+                if math.isfinite(more) and more > 0:
+                    needs[side] = max(needs.get(side, 0.0), more)
+    return needs
+
+
 def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Look:
-    """The look ``number`` of ``verdict``: what the next round does, or why the study stops."""
+    """The look ``number`` of ``verdict``: what the next round does, or why the study stops.
+    Runs too short to show a steady state (:func:`too_short`) are extended first, in the
+    same round as the targets' needs, even when every level is decided."""
     base = dict(number=number, alpha=rounds.alpha_per_look,
                 core_hours=spent_core_hours(study), criteria=_criteria_rows(verdict))
     targets, needs, stuck = [], {}, []
@@ -252,6 +306,14 @@ def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Lo
             if planned:
                 _needs(planned, Condition(g.group, c.cg, c.rule), needs)
                 targets.append(c.name)
+    short = too_short(study, verdict, rounds.every_level)
+    for condition, more in short.items():
+        need = needs.setdefault(condition, [0.0, 0])
+        need[0] = max(need[0], more)
+    if short:
+        stuck = []          # the round that extends them is the planned way
+        targets += [f"{c.name} (runs too short)" for c in sorted(short, key=lambda c: c.key)
+                    if not any(t == c.name for t in targets)]
     actions, hours = _actions(study, needs)
     if not targets:
         why = ("decided: " + "; ".join(g.sentence for g in verdict.groups

@@ -251,3 +251,64 @@ def test_added_replicas_are_the_cases_of_a_workflow_written_with_them(tmp_path):
         assert (rc.files, rc.mesh_text, rc.scene_hash) == (ref.files, ref.mesh_text,
                                                            ref.scene_hash)
     assert added_cases(more, Rounds(3, looks=(look,))).rendered == more.rendered   # idempotent
+
+
+def _flow_with_windows(s, fractions: dict[str, float]) -> None:
+    """The study's flow record as the analysis writes it, with an automatic steady window
+    starting at ``fractions[case_id]`` of each case's production."""
+    from ligwf.analysis.records.flow import CaseFlow, FlowRecord
+    from ligwf.study import layout
+
+    cases = {c.case_id: CaseFlow(c.case_id, c.cg, c.rule, c.replica, c.group,
+                                 fractions[c.case_id], 0)
+             for c in s.cases}
+    s.analysis_dir.mkdir(parents=True, exist_ok=True)
+    (s.analysis_dir / layout.FLOW_PROFILES).write_text(FlowRecord("auto", (), cases).to_text())
+
+
+def too_short_verdict(state: str, note: str) -> Verdict:
+    """A one-level verdict (every criterion ``state``) whose runs are flagged too short."""
+    cond = ConditionVerdict("{}", 1.5, "weber", 2, 9.0, math.nan, math.nan, (angle(state),),
+                            too_short=note)
+    return Verdict((GroupVerdict("{}", (cond,), "sentence"),), {"angle_deg": 1.0})
+
+
+@pytest.mark.parametrize("state", ["fail", "pass"])
+def test_runs_too_short_are_extended_before_the_study_stops(study, state):
+    """Issue 45 item 3: a level decided on runs whose steady windows start at their cap is
+    not shown steady; the look extends exactly those runs' arms by the planner's rule (the
+    most any capped run of the arm needs) instead of stopping, whatever the level's state."""
+    from ligwf.analysis.records import steady_window
+
+    _, s = study
+    rounds = start_rounds(s.path, RoundPlan(3, None))
+    flagged = too_short_verdict(state, "runs too short to show a steady state: ...")
+    # no flow record yet: nothing to size the extension by, the study stops as decided
+    assert plan_look(flagged, s, rounds, 1).stop_kind == DECIDED
+    _flow_with_windows(s, {"cg1-none-r0": 0.1, "cg1-none-r1": 0.2,
+                           "cg1.5-weber-r0": 0.47, "cg1.5-weber-r1": 0.3})
+    look = plan_look(flagged, s, rounds, 1)
+    assert not look.stop and "cg1.5-weber (runs too short)" in look.target
+    (act,) = look.actions            # only the CG-n arm has a capped run
+    base = s.cases[2].scaled
+    production = base.numerics.run_steps * base.numerics.dt
+    more = steady_window.least_extension(0.47, production)
+    assert more == pytest.approx(2 * production)          # a capped run triples
+    assert isinstance(act, ExtendProduction) and act.arm == Arm.CG_N
+    assert act.seconds == pytest.approx(more)
+    assert act.case_ids == ("cg1.5-weber-r0", "cg1.5-weber-r1")
+    # the same verdict without the flag stops as before
+    assert plan_look(too_short_verdict(state, ""), s, rounds, 1).stop_kind == DECIDED
+    # the looks spent: it stops, naming the round it would have run
+    last = plan_look(flagged, s, rounds, 3)
+    assert last.stop_kind == LOOKS_SPENT and "runs too short" in last.stop
+
+
+def test_a_capped_cg1_run_extends_the_cg1_arm(study):
+    _, s = study
+    rounds = start_rounds(s.path, RoundPlan(3, None))
+    _flow_with_windows(s, {"cg1-none-r0": 0.49, "cg1-none-r1": 0.2,
+                           "cg1.5-weber-r0": 0.1, "cg1.5-weber-r1": 0.1})
+    look = plan_look(too_short_verdict("fail", "runs too short ..."), s, rounds, 1)
+    (act,) = look.actions
+    assert act.arm == Arm.CG1 and act.case_ids == ("cg1-none-r0", "cg1-none-r1")
