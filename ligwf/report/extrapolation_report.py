@@ -14,12 +14,13 @@ from ligwf.inference.reference import ANGLE_COLUMN, planned_cg1_speedup, size_ra
 from ligwf.inference.size_relation import expected_excess
 from ligwf.report.sections import Section
 from ligwf.study import layout
+from ligwf.study.condition import Condition
 from ligwf.study.study import Study
 
 
-def extrapolation_inputs(study: Study) -> tuple[float, dict]:
-    """(d / D of the study's drum, (group, cg, rule) -> the planner's CG1 cost over the
-    level's): read from the usable cases' scene records (nan / empty without one)."""
+def extrapolation_inputs(study: Study) -> tuple[float, dict[Condition, float]]:
+    """(d / D of the study's drum, condition -> the planner's CG1 cost over the level's):
+    read from the usable cases' scene records (nan / empty without one)."""
     ratio, speedups = math.nan, {}
     for case in study.usable_cases()[0]:
         try:
@@ -28,9 +29,8 @@ def extrapolation_inputs(study: Study) -> tuple[float, dict]:
             continue
         if not math.isfinite(ratio):
             ratio = size_ratio(scene)
-        key = (case.group, float(case.cg), str(case.rule))
-        if case.cg > 1.0 and key not in speedups:
-            speedups[key] = planned_cg1_speedup(scene, case.cg, case.rule)
+        if case.cg > 1.0 and case.condition not in speedups:
+            speedups[case.condition] = planned_cg1_speedup(scene, case.cg, case.rule)
     return ratio, speedups
 
 

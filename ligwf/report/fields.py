@@ -41,6 +41,7 @@ from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.inference.uncertainty import mark
 from ligwf.study import layout
 from ligwf.study.case import group_label
+from ligwf.study.condition import Condition
 from ligwf.study.group import SweepGroup
 from ligwf.study.study import Study
 
@@ -133,12 +134,11 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
                 cases.at[i, "field_solid_error"] = float(
                     ERRORS["field_solid_error"](condition_mean(refs), own[0].mean()))
     for i, row in conditions.iterrows():
-        sub = cases[(cases["group"] == row["group"]) & (cases["cg"] == row["cg"])
-                    & (cases["rule"] == row["rule"])]
-        ids = list(sub["case_id"])
-        ref_ids = groups.reference_cases(row["group"])
+        cond = Condition(row["group"], row["cg"], row["rule"])
+        ids = list(groups.cases.get(cond, ()))
+        ref_ids = groups.reference_cases(cond.group)
         members, refs = _members(ids, fields), _members(ref_ids, fields)
-        reference = bool(ids) and groups.condition(ids[0]).is_reference
+        reference = bool(ids) and cond.is_reference
         est = _criterion(whole_windows(members), whole_windows(refs), kernel, alpha)
         null = layer_error(*null_split(refs)[:2], kernel, alpha)
         values: dict = {}
