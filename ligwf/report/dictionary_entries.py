@@ -318,7 +318,8 @@ SPREADING = (
 EXTRAPOLATION = (
     ("column", "text", "metric", "the case-table column extrapolated (a signed criterion's)"),
     ("levels", "text", "CG levels", "the CG-n levels of the rule the line was fitted on"),
-    ("replicas", "text", "runs a level", "runs at each of those levels, in their order"),
+    ("replicas", "text", "runs a level", "replicas (one run each) at each of those levels, in "
+     "their order"),
     ("extrapolated", "metric", "extrapolated CG1", "the line through the level means at n = 1 "
      "(weber - bond rows: the two rules' difference)"),
     ("lo", "metric", "lo", "lower bound of its 95 % interval (noise and model term)"),
@@ -336,7 +337,7 @@ EXTRAPOLATION = (
     ("slope_per_level", "metric", "slope", "the fitted change per CG level"),
     ("cg1_measured", "metric", "measured CG1", "the mean of the group's CG1 runs, if any"),
     ("cg1_se", "metric", "CG1 se", "its standard error"),
-    ("cg1_replicas", "count", "CG1 runs", "CG1 runs of the group"),
+    ("cg1_replicas", "count", "CG1 runs", "CG1 replicas of the group (one run each)"),
     ("cg1_inside", "flag", "inside", "the measured CG1 mean lies in the 95 % interval"),
 )
 
