@@ -117,7 +117,7 @@ def halves_within_variance(series: np.ndarray) -> float:
     return float((series[:half].mean() - series[len(series) - half:].mean()) ** 2 / 4.0)
 
 
-def _arm(series: np.ndarray, within=sampling.within_variance) -> sampling.Arm:
+def _arm(series: np.ndarray, within=sampling.within_variance) -> sampling.ArmRuns:
     return sampling.arm(series.mean(axis=1), [within(s) for s in series],
                         [float(series.shape[1])] * len(series), steady_share=1.0)
 

@@ -55,7 +55,7 @@ WITHIN = {"planner": sampling.within_variance,
 
 
 def arm(series: list[np.ndarray], seconds: list[float], within=sampling.within_variance
-        ) -> sampling.Arm:
+        ) -> sampling.ArmRuns:
     values = [float(np.nanmean(s)) for s in series]
     return sampling.arm(values, [within(s) for s in series], seconds, steady_share=1.0)
 

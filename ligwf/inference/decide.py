@@ -31,6 +31,7 @@ from ligwf.inference.reference import extrapolation_rows, planned_cg1_speedup, s
 from ligwf.inference.verdict import Verdict
 from ligwf.inference.verdict_records import study_verdict, write_verdict
 from ligwf.study import layout
+from ligwf.study.condition import Condition
 from ligwf.study.rounds import Rounds, read_rounds
 from ligwf.study.study import Study
 
@@ -54,9 +55,9 @@ def look_level(rounds: Rounds) -> tuple[float, str]:
     return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH_BF)
 
 
-def extrapolation_inputs(study: Study) -> tuple[float, dict]:
-    """(d / D of the study's drum, (group, cg, rule) -> the planner's CG1 cost over the
-    level's): read from the usable cases' scene records (nan / empty without one)."""
+def extrapolation_inputs(study: Study) -> tuple[float, dict[Condition, float]]:
+    """(d / D of the study's drum, condition -> the planner's CG1 cost over the level's):
+    read from the usable cases' scene records (nan / empty without one)."""
     ratio, speedups = math.nan, {}
     for case in study.usable_cases()[0]:
         try:
@@ -65,9 +66,8 @@ def extrapolation_inputs(study: Study) -> tuple[float, dict]:
             continue
         if not math.isfinite(ratio):
             ratio = size_ratio(scene)
-        key = (case.group, float(case.cg), str(case.rule))
-        if case.cg > 1.0 and key not in speedups:
-            speedups[key] = planned_cg1_speedup(scene, case.cg, case.rule)
+        if case.cg > 1.0 and case.condition not in speedups:
+            speedups[case.condition] = planned_cg1_speedup(scene, case.cg, case.rule)
     return ratio, speedups
 
 

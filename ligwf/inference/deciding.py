@@ -35,8 +35,8 @@ def round_fields(o: "sampling.Option | None") -> dict:
                 round_core_hours=o.core_hours)
 
 
-def signed_plan(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
-                   alpha: float, unit: str, df_rule: str = eq.WELCH) -> tuple[dict, str]:
+def signed_plan(x: sampling.ArmRuns, y: sampling.ArmRuns, e: eq.Estimate, budget: float,
+                alpha: float, unit: str, df_rule: str = eq.WELCH) -> tuple[dict, str]:
     """What would decide an undecided signed criterion: the cheapest option's fields and
     its sentence (the arms' variances and the difference as measured)."""
     if x.n < 2 or y.n < 2:
@@ -45,12 +45,12 @@ def signed_plan(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
     best = sampling.cheapest(x, y, e.value, budget, alpha, df_rule)
     fields = round_fields(sampling.cheapest(x, y, budget + 0.5 * (e.hi - e.lo) / 2, budget,
                                              alpha, df_rule)) if e.has_interval else {}
-    seeds = cg1_seeds_text(x, y, e.value, budget, alpha, unit, df_rule)
+    cg1_replicas = cg1_replicas_text(x, y, e.value, budget, alpha, unit, df_rule)
     if best is None:
         return fields, "; ".join(p for p in (
             f"the difference sits near the budget for its spread: neither "
             f"{sampling.MOST_REPLICAS} replicas of an arm nor "
-            f"{sampling.MOST_EXTENSION:g}x longer runs would decide it", seeds) if p)
+            f"{sampling.MOST_EXTENSION:g}x longer runs would decide it", cg1_replicas) if p)
     fields |= dict(decide_by=best.kind, decide_arm=best.arm, decide_amount=best.amount,
                   decide_amount_cg1=(best.amount_cg1 if best.kind == sampling.REPLICAS
                                      else math.nan),
@@ -58,12 +58,13 @@ def signed_plan(x: sampling.Arm, y: sampling.Arm, e: eq.Estimate, budget: float,
                   decide_half_width=best.predicted_half_width)
     return fields, "; ".join(p for p in (
         f"cheapest to decide: {best.text(unit)}; the {sampling.dominant_arm(x, y)} scatter "
-        "dominates the width now", seeds) if p)
+        "dominates the width now", cg1_replicas) if p)
 
 
-def cg1_seeds_text(x: sampling.Arm, y: sampling.Arm, difference: float, budget: float,
-                   alpha: float, unit: str, df_rule: str = eq.WELCH) -> str:
-    """When the CG1 seeds bound the degrees of freedom, say so: CG1 is the smaller arm (Hsu's
+def cg1_replicas_text(x: sampling.ArmRuns, y: sampling.ArmRuns, difference: float,
+                      budget: float, alpha: float, unit: str, df_rule: str = eq.WELCH) -> str:
+    """When the CG1 replicas bound the degrees of freedom, say so (the note's words, "CG1
+    seeds", are kept as records hold them): CG1 is the smaller arm (Hsu's
     df are its runs - 1, and Welch's fall towards that as CG-n runs are added) and even the
     most CG-n replicas the planner tries would leave the half-width above the distance of
     the difference from the budget. Empty otherwise."""

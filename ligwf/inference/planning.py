@@ -37,6 +37,7 @@ from ligwf.analysis.records.statistics import MEAN, SHARE_ABOVE
 from ligwf.engine.plan import case_load, estimated_seconds
 from ligwf.scene.scaled import ScaledScene
 from ligwf.study.case import CaseFolder
+from ligwf.study.condition import Condition
 
 #: the columns of a noise table besides the per-criterion within-run variances
 WINDOW, STEADY_SHARE = "window_seconds", "steady_share"
@@ -103,13 +104,12 @@ def noise_table(cases: list[CaseFolder], flow: FlowRecord, columns: tuple[str, .
                 ) -> pd.DataFrame:
     """The noise and prices of every case (see the module docstring), indexed by case id."""
     rows = []
-    arms: dict[tuple, list[CaseFolder]] = {}
+    arms: dict[Condition, list[CaseFolder]] = {}
     for case in cases:
-        arms.setdefault((case.group, case.cg, case.rule), []).append(case)
-    rate = {key: calibration(arm) for key, arm in arms.items()}
+        arms.setdefault(case.condition, []).append(case)
+    rate = {condition: calibration(arm) for condition, arm in arms.items()}
     for case in cases:
-        replica, production = (rate[(case.group, case.cg, case.rule)] * x
-                               for x in run_costs(case.scaled))
+        replica, production = (rate[case.condition] * x for x in run_costs(case.scaled))
         c = flow.cases.get(case.case_id)
         share = 1.0 - float(c.steady_fraction) if c is not None else math.nan
         fraction = float(c.steady_fraction) if c is not None else math.nan

@@ -58,8 +58,9 @@ def within_variance(series) -> float:
 
 
 @dataclass(frozen=True)
-class Arm:
-    """One arm of a comparison as the planning sees it: per run its value (the
+class ArmRuns:
+    """The runs of one arm of a comparison (:class:`ligwf.study.condition.Arm` names the
+    side) as the planning sees them: per run its value (the
     steady-window mean), the within-run variance of that value, its window length (s), and
     the cost of a replica and of one second of production (core-seconds, per run), and the
     least extension its runs need to be steady (s of production per run,
@@ -83,23 +84,23 @@ class Arm:
         """Sample variance of the run values."""
         return float(np.var(self.values, ddof=1)) if self.n > 1 else math.nan
 
-    def scaled(self, factor: float) -> "Arm":
+    def scaled(self, factor: float) -> "ArmRuns":
         """The arm in another unit (values x factor, variances x factor^2)."""
-        return Arm(self.values * factor, self.within * factor**2, self.window,
+        return ArmRuns(self.values * factor, self.within * factor**2, self.window,
                    self.steady_share, self.replica_core_seconds, self.production_core_seconds,
                    self.least_extension)
 
 
-def arm(values, within=None, window=None, **kw) -> Arm:
-    """An :class:`Arm` from lists (``within``/``window`` nan when unknown)."""
+def arm(values, within=None, window=None, **kw) -> ArmRuns:
+    """An :class:`ArmRuns` from lists (``within``/``window`` nan when unknown)."""
     v = np.asarray(values, float)
     keep = np.isfinite(v)
     w = np.full(len(v), math.nan) if within is None else np.asarray(within, float)
     t = np.full(len(v), math.nan) if window is None else np.asarray(window, float)
-    return Arm(v[keep], w[keep], t[keep], **kw)
+    return ArmRuns(v[keep], w[keep], t[keep], **kw)
 
 
-def components(a: Arm) -> tuple[float, float]:
+def components(a: ArmRuns) -> tuple[float, float]:
     """(within, between) variance of one run value of ``a``: the mean of the runs' own
     within-run variances, at most the sample variance of the run values, and the rest of
     that variance (>= 0). Unknown within-run variances count as 0 (all of the scatter is
@@ -120,7 +121,7 @@ def components(a: Arm) -> tuple[float, float]:
     return w, total - w
 
 
-def run_variance(a: Arm, extend_seconds: float = 0.0) -> float:
+def run_variance(a: ArmRuns, extend_seconds: float = 0.0) -> float:
     """Predicted variance of one run value of ``a`` after ``extend_seconds`` more
     production on each run (the within part shrinks with the window); the sample
     variance when nothing is added."""
@@ -136,7 +137,7 @@ def run_variance(a: Arm, extend_seconds: float = 0.0) -> float:
     return between + shrunk
 
 
-def half_width(x: Arm, y: Arm, alpha: float = ALPHA, add: tuple[int, int] = (0, 0),
+def half_width(x: ArmRuns, y: ArmRuns, alpha: float = ALPHA, add: tuple[int, int] = (0, 0),
                extend: tuple[float, float] = (0.0, 0.0), df_rule: str = WELCH) -> float:
     """Half-width of the (1 - 2 alpha) interval of mean(x) - mean(y) after ``add``
     replicas and ``extend`` seconds of production on every run (of x, of y), with the
@@ -201,7 +202,7 @@ class Option:
         return f"{what} ({cost}; predicted half-width {self.predicted_half_width:.3g}{u})"
 
 
-def _replicas(x: Arm, y: Arm, gap: float, alpha: float, df_rule: str = WELCH
+def _replicas(x: ArmRuns, y: ArmRuns, gap: float, alpha: float, df_rule: str = WELCH
               ) -> Option | None:
     """The cheapest (kx, ky) replicas to add (unknown costs: the fewest in all): for each
     kx the fewest ky by bisection (the half-width falls with ky)."""
@@ -238,7 +239,7 @@ def _replicas(x: Arm, y: Arm, gap: float, alpha: float, df_rule: str = WELCH
                   half_width(x, y, alpha, add=(kx, ky), df_rule=df_rule), 0, ky)
 
 
-def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool],
+def _extension(x: ArmRuns, y: ArmRuns, gap: float, alpha: float, which: tuple[bool, bool],
                df_rule: str = WELCH) -> Option | None:
     arms = [a for a, on in zip((x, y), which) if on]
     if any(not np.isfinite(a.window).all() or a.n < 2 for a in arms):
@@ -266,7 +267,7 @@ def _extension(x: Arm, y: Arm, gap: float, alpha: float, which: tuple[bool, bool
     return Option(EXTEND, name, s, cost, h(s), sum(a.n for a in arms))
 
 
-def options(x: Arm, y: Arm, difference: float, budget: float, alpha: float = ALPHA,
+def options(x: ArmRuns, y: ArmRuns, difference: float, budget: float, alpha: float = ALPHA,
             df_rule: str = WELCH) -> list[Option]:
     """Every way that would decide the two one-sided tests of ``difference`` (CG-n - CG1,
     in the unit of the arms) against +-``budget``, with the variances as measured: more
@@ -283,13 +284,13 @@ def options(x: Arm, y: Arm, difference: float, budget: float, alpha: float = ALP
                   key=lambda o: (not math.isfinite(o.core_hours), o.core_hours, o.amount))
 
 
-def cheapest(x: Arm, y: Arm, difference: float, budget: float,
+def cheapest(x: ArmRuns, y: ArmRuns, difference: float, budget: float,
              alpha: float = ALPHA, df_rule: str = WELCH) -> Option | None:
     """The cheapest of :func:`options` (None: nothing within the planned limits decides)."""
     found = options(x, y, difference, budget, alpha, df_rule)
     return found[0] if found else None
 
 
-def dominant_arm(x: Arm, y: Arm) -> str:
+def dominant_arm(x: ArmRuns, y: ArmRuns) -> str:
     """The arm whose variance of the mean is the larger share of the difference's."""
     return "CG-n" if x.variance / x.n >= y.variance / y.n else "CG1"

@@ -29,7 +29,7 @@ def per_run(runs: pd.DataFrame | None, column: str) -> np.ndarray:
 
 
 def arm(runs: pd.DataFrame | None, column: str, noise: pd.DataFrame | None,
-        scale: float = 1.0) -> sampling.Arm:
+        scale: float = 1.0) -> sampling.ArmRuns:
     """The runs of one arm with their noise and prices (noise table rows by case id)."""
     values = per_run(runs, column)
     ids = list(runs["case_id"]) if runs is not None and "case_id" in runs else []
@@ -62,8 +62,9 @@ def decide_signed(spec: Criterion, tolerance: float, level: LevelData) -> Decisi
                     lambda alpha: holm_replan(spec, result, x, y, alpha, level.df_rule))
 
 
-def signed_result(spec: Criterion, tolerance: float, x: sampling.Arm, y: sampling.Arm,
-                  alpha: float, df_rule: str = eq.WELCH) -> tuple[CriterionResult, float]:
+def signed_result(spec: Criterion, tolerance: float, x: sampling.ArmRuns,
+                  y: sampling.ArmRuns, alpha: float, df_rule: str = eq.WELCH
+                  ) -> tuple[CriterionResult, float]:
     """The difference of run means CG-n - CG1 (relative to the CG1 mean for RELATIVE), two
     one-sided tests at alpha. Returns the result and the p-value of its fail test."""
     base = spec.base(tolerance)
@@ -96,8 +97,9 @@ def signed_result(spec: Criterion, tolerance: float, x: sampling.Arm, y: samplin
                            bound=bound, note=note, **decide), test.p_fail
 
 
-def all_zero(base: dict, zero: tuple[eq.Estimate, eq.Test], x: sampling.Arm,
-             y: sampling.Arm, tolerance: float, alpha: float) -> tuple[CriterionResult, float]:
+def all_zero(base: dict, zero: tuple[eq.Estimate, eq.Test], x: sampling.ArmRuns,
+             y: sampling.ArmRuns, tolerance: float, alpha: float
+             ) -> tuple[CriterionResult, float]:
     """A share whose runs all read 0 in an arm (:func:`shares.share_test`): the zero arm's mean
     is bounded over its runs (rule of three), never by a variance of 0."""
     e, test = zero
@@ -116,7 +118,7 @@ def all_zero(base: dict, zero: tuple[eq.Estimate, eq.Test], x: sampling.Arm,
                            bound=bound, note=note), test.p_fail
 
 
-def holm_replan(spec: Criterion, r: CriterionResult, x: sampling.Arm, y: sampling.Arm,
+def holm_replan(spec: Criterion, r: CriterionResult, x: sampling.ArmRuns, y: sampling.ArmRuns,
                 alpha: float, df_rule: str) -> CriterionResult:
     """What would decide a signed fail that Holm's step-down did not keep: the fail test
     must pass at ``alpha`` (the level's alpha over its family size, which Holm's first step

@@ -90,8 +90,8 @@ def welch_log_ratio(reference, level, confidence: float = LEVEL
     return ratio, float(np.exp(d - half)), float(np.exp(d + half)), float(df)
 
 
-def seed_spread(times) -> float:
-    """The largest ratio of two runs' times (1 for one run, nan for none)."""
+def replica_spread(times) -> float:
+    """The largest ratio of two replicas' times (1 for one run, nan for none)."""
     t = [x for x in times if x > 0 and math.isfinite(x)]
     return float(max(t) / min(t)) if t else math.nan
 
@@ -104,7 +104,7 @@ def level_rates(cases: pd.DataFrame, confidence: float = LEVEL) -> pd.DataFrame:
         return pd.DataFrame(columns=list(LEVEL_COLUMNS))
     for group, g in cases.groupby("group", sort=True):
         ref = g[g.cg == 1.0]
-        spread = seed_spread(ref.t_spread_rev)
+        spread = replica_spread(ref.t_spread_rev)
         for (rule, cg), lv in g[g.cg != 1.0].groupby(["rule", "cg"], sort=True):
             ratio, low, high, df = welch_log_ratio(ref.t_spread_rev, lv.t_spread_rev,
                                                    confidence)

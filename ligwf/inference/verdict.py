@@ -67,8 +67,13 @@ class ConditionVerdict:
     too_short: str = ""
 
     @property
+    def condition(self) -> Condition:
+        """The condition this verdict is on (its sweep group, CG level and rule)."""
+        return Condition(self.group, self.cg, self.rule)
+
+    @property
     def name(self) -> str:
-        return Condition(self.group, self.cg, self.rule).name
+        return self.condition.name
 
     @property
     def state(self) -> str:
@@ -184,7 +189,7 @@ def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[st
 
 def extrapolated_group(group: str, sub: pd.DataFrame, in_group: pd.DataFrame,
                        accept: AcceptSettings, alpha: float, size_ratio: float,
-                       speedups: dict, noise: pd.DataFrame | None = None) -> GroupVerdict:
+                       speedups: dict[Condition, float], noise: pd.DataFrame | None = None) -> GroupVerdict:
     """The verdict of a group without CG1: every CG-n level of a rule with two or more
     levels judged against that rule's extrapolated CG1."""
     out = []
@@ -194,7 +199,7 @@ def extrapolated_group(group: str, sub: pd.DataFrame, in_group: pd.DataFrame,
         if runs["cg"].nunique() < 2:
             continue
         results = extrapolated_criteria(accept, runs, float(row["cg"]), size_ratio, alpha)
-        speedup = speedups.get((group, float(row["cg"]), rule), math.nan)
+        speedup = speedups.get(Condition(group, float(row["cg"]), rule), math.nan)
         level = runs[runs["cg"] == float(row["cg"])]
         out.append(ConditionVerdict(group, float(row["cg"]), rule, int(row["replicas"]),
                                     speedup, math.nan, math.nan, results,
@@ -213,7 +218,8 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
            gates: dict[str, Gate] | None = None, cases: pd.DataFrame | None = None,
            profiles: dict | None = None, alpha: float = eq.ALPHA,
            noise: pd.DataFrame | None = None, df_rule: str = eq.WELCH,
-           size_ratio: float = math.nan, speedups: dict | None = None) -> Verdict:
+           size_ratio: float = math.nan, speedups: dict[Condition, float] | None = None
+           ) -> Verdict:
     """The verdict of every sweep group of a condition table (control groups left out);
     ``cases`` (one row per run) and ``profiles`` (case id -> mean velocity profile) hold
     the run values the signed and profile criteria are decided on; ``noise`` (by case id,
@@ -221,8 +227,8 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
     cost; ``alpha`` each test's level and ``df_rule`` its degrees of freedom (a sequential
     study's per-look level, Hsu's conservative df). A group without CG1 is judged against
     the CG1 value extrapolated from its CG-n levels (:mod:`ligwf.inference.extrapolated`;
-    ``size_ratio``: the drum's d / D, the model term's scale; ``speedups``: (group, cg,
-    rule) -> the planner's CG1 cost over the level's, the speedup it reports)."""
+    ``size_ratio``: the drum's d / D, the model term's scale; ``speedups``: condition
+    -> the planner's CG1 cost over the level's, the speedup it reports)."""
     gates, profiles = gates or {}, profiles or {}
     groups = []
     if conditions.empty:
@@ -242,11 +248,12 @@ def decide(conditions: pd.DataFrame, accept: AcceptSettings,
         gate = gates.get(group, Gate(None, "no cohesionless control ran"))
         out = []
         for _, row in sub[sub["cg"] != REFERENCE_CG].sort_values(["cg", "rule"]).iterrows():
-            runs = in_group[(in_group["cg"] == row["cg"])
-                            & (in_group["rule"].astype(str) == str(row["rule"]))]
+            cond = Condition(group, float(row["cg"]), str(row["rule"]))
+            runs = in_group[(in_group["cg"] == cond.cg)
+                            & (in_group["rule"].astype(str) == cond.rule)]
             results = condition_criteria(accept, row, runs, ref_runs, profiles, gate, alpha,
                                          noise, df_rule)
-            out.append(ConditionVerdict(group, float(row["cg"]), str(row["rule"]),
+            out.append(ConditionVerdict(cond.group, cond.cg, cond.rule,
                                         int(row["replicas"]), *band(row, "speedup_core"),
                                         results, too_short_note(runs, ref_runs, noise)))
         sentence, cheapest = group_sentence(out)

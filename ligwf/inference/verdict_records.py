@@ -18,15 +18,17 @@ from ligwf.inference.registry import CriterionResult
 from ligwf.inference.verdict import ConditionVerdict, GroupVerdict, Verdict, decide, granule_gates
 from ligwf.scene.accept import AcceptSettings
 from ligwf.study import layout
+from ligwf.study.condition import Condition
 
 
 def verdict_rows(verdict: Verdict) -> pd.DataFrame:
-    """One row per (group, CG level, rule, criterion): what verdict.csv holds."""
+    """One row per condition (group, CG level, rule) and criterion: what verdict.csv holds."""
     rows = []
     for g in verdict.groups:
         for c in g.conditions:
             for r in c.criteria:
-                rows.append({"group": g.group, "cg": c.cg, "rule": c.rule,
+                rows.append({"group": c.condition.group, "cg": c.condition.cg,
+                             "rule": c.condition.rule,
                              "condition": c.name, "replicas": c.replicas,
                              "condition_state": c.state, "speedup_core": c.speedup,
                              "speedup_core_lo": c.speedup_lo, "speedup_core_hi": c.speedup_hi,
@@ -90,11 +92,11 @@ def study_verdict(cases: pd.DataFrame, conditions: pd.DataFrame, accept: AcceptS
                   controls: pd.DataFrame | None, profiles: dict | None = None,
                   noise: pd.DataFrame | None = None, alpha: float = ALPHA,
                   df_rule: str = WELCH, size_ratio: float = math.nan,
-                  speedups: dict | None = None) -> Verdict:
+                  speedups: dict[Condition, float] | None = None) -> Verdict:
     """The verdict of a study's report tables, with its granule control verdicts
     (``controls``: the analysis' controls table, None without twins; ``noise``: the runs'
-    noise and prices, what would decide; ``alpha``: each test's level; ``size_ratio`` and ``speedups``: a sweep without CG1,
-    :func:`ligwf.inference.verdict.decide`)."""
+    noise and prices, what would decide; ``alpha``: each test's level; ``size_ratio`` and
+    ``speedups``: a sweep without CG1, :func:`ligwf.inference.verdict.decide`)."""
     if cases.empty or conditions.empty:
         return Verdict((), accept.model_dump(mode="json"))
     return decide(conditions, accept, granule_gates(cases, controls),

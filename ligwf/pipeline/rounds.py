@@ -265,7 +265,7 @@ def too_short(study: Study, verdict: Verdict, every_level: bool = False
     (:func:`ligwf.analysis.records.steady_window.least_extension`, the most any of them
     needs). A decision on such runs is not shown steady, so a round extends them before
     the study stops, whatever the level's state; control groups are left out."""
-    conditions = [Condition(g.group, c.cg, c.rule) for g in verdict.groups
+    conditions = [c.condition for g in verdict.groups
                   if not is_control_group(g.group)
                   for c in _answer_levels(g, every_level) if c.too_short]
     path = study.analysis_dir / layout.FLOW_PROFILES
@@ -304,7 +304,7 @@ def plan_look(verdict: Verdict, study: Study, rounds: Rounds, number: int) -> Lo
             stuck += [f"{c.name} {r.label}: {r.note}" for r in undecided if not r.round_by]
             stuck += [] if undecided else [f"{c.name}: no criterion of the budget assessed"]
             if planned:
-                _needs(planned, Condition(g.group, c.cg, c.rule), needs)
+                _needs(planned, c.condition, needs)
                 targets.append(c.name)
     short = too_short(study, verdict, rounds.every_level)
     for condition, more in short.items():

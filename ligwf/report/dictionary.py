@@ -330,7 +330,11 @@ def dictionary_markdown() -> str:
              "when it is out of date or a real table has a column missing here). Units are "
              "SI: `1` a ratio, share or fraction, `count` a whole number, `flag` true / "
              "false, `step` an engine time step; `shown` is the unit the report prints. "
-             "Report headers are the label with the shown unit.", ""]
+             "Report headers are the label with the shown unit. The words (case, run, "
+             "replica, seed, condition, arm, look, round, budget, core-hour cap) mean what "
+             "the [names](architecture.md#names) of the architecture page say: a column's "
+             "name is a public format and keeps its spelling, its meaning uses those words.",
+             ""]
     for name, t in TABLES.items():
         lines += [f"## `{t.folder}/{name}`", "", f"One row per {t.row}."
                   + (f" Columns may carry the suffixes {', '.join(f'`{f}`' for f in t.families)}"

@@ -17,7 +17,8 @@ from ligwf.study import layout
 #: (name, unit, label, meaning[, shown unit]) of the columns shared by the tables
 COMMON: tuple[tuple[str, ...], ...] = (
     # identity
-    ("case_id", "text", "case", "case folder name: cg<level>-<rule>-r<replica>[_<swept "
+    ("case_id", "text", "case", "case folder name (a case: one scene at one CG level, rule "
+     "and replica; its engine execution is a run): cg<level>-<rule>-r<replica>[_<swept "
      "values>][_<control>]"),
     ("group", "text", "group", "sweep group: the swept scene values as canonical JSON ({}: "
      "no scene value swept; a control twin has its own group); readable in the report as "
@@ -27,8 +28,9 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("cg", "1", "CG", "coarse-graining level n (particles n times the original diameter; 1: "
      "the original, the reference)"),
     ("rule", "text", "rule", "CG scaling rule of the bridge forces: none (CG1), weber, bond"),
-    ("replica", "count", "rep", "replica number (replicas differ by their insertion seeds)"),
-    ("replicas", "count", "replicas", "replicas pooled in this row"),
+    ("replica", "count", "rep", "replica number: which of its condition's cases this is "
+     "(replicas differ only by their insertion seeds)"),
+    ("replicas", "count", "replicas", "replicas (cases of the condition) pooled in this row"),
     ("condition", "text", "condition", "a condition: cg<level>[-<rule>] [group] (sweep group, "
      "CG level and rule; replicas pooled)"),
     ("reference", "text", "reference", "the CG1 condition this row is compared with (empty: "
@@ -145,7 +147,7 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("error_above_upper", "1", "GSD err above upper limit", "relative L1 error over the bins "
      "above the upper limit (no upper limit located: every bin)"),
     ("error_all", "1", "GSD err all bins", "relative L1 error of the volume-weighted GSD "
-     "against CG1 over all bins, no size limit: sum |cg - ref| / sum ref"),
+     "against CG1 over all bins, no size limit: sum |GSD_n - GSD_1| / sum GSD_1"),
     ("gsd_lower_limit", "m^3", "GSD lower limit", f"lower_limit of {layout.GSD_SUMMARY_TABLE} (granule "
      "volume; nan: none located)"),
     ("gsd_lower_limit_diameter", "m", "GSD lower limit d", "equivalent-sphere diameter of the "
@@ -191,8 +193,8 @@ COMMON: tuple[tuple[str, ...], ...] = (
      "criterion should find nothing) or cohesionless twin vs wet CG1"),
     ("control", "text", "compared group", "the sweep group of the compared runs (the "
      "cohesionless twins', or the CG1 group itself)"),
-    ("split", "text", "split", "how the two arms were formed (seeds against seeds, or the "
-     "first against the second half of every run's window)"),
+    ("split", "text", "split", "how the two arms were formed (replicas against replicas, or "
+     "the first against the second half of every run's window)"),
     ("runs", "count", "runs", "runs (or half windows) of the compared arm"),
     ("ref_runs", "count", "reference runs", "runs (or half windows) of the reference arm"),
     # controls (ligwf.analysis.granules.control_run)
@@ -255,14 +257,17 @@ VERDICT = (
     ("lo", "unit", "lo", "lower bound of its interval (signed criteria: the (1 - 2 alpha) "
      "interval, alpha in the verdict record's statistics)"),
     ("hi", "unit", "hi", "upper bound of its interval"),
-    ("budget", "unit", "budget", "the tolerance it is held to: the accept: value"),
+    ("budget", "unit", "budget", "the tolerance it is held to: its accept: value (its share "
+     "of the error budget; a sequential study's cost limit is the core-hour cap, not a "
+     "budget)"),
     ("shown_within", "unit", "shown within", "the largest |error| its interval allows (a "
      "one-sided (1 - alpha) bound): the error this level is shown to stay within"),
-    ("budget_source", "text", "budget from", "where the budget came from (the accept: block)"),
+    ("budget_source", "text", "budget from", "where the criterion's error budget came from "
+     "(the accept: block)"),
     ("decide_by", "text", "decide by", "undecided only: the cheapest way to decide it "
      "(extend: more production on the existing runs, continued from their restarts; "
-     "replicas: more runs), from the arms' variance components (ligwf.inference."
-     "sampling)"),
+     "replicas: more replicas, new cases of the arm), from the arms' variance components "
+     "(ligwf.inference.sampling)"),
     ("decide_arm", "text", "decide on", "the arm(s) to extend or add to: CG-n, CG1 or both"),
     ("decide_amount", "1", "decide amount", "extend: simulated seconds of production more "
      "per run; replicas: CG-n replicas to add"),
@@ -304,8 +309,8 @@ SPREADING = (
     ("contains_expected", "flag", "n^2 inside", "the interval contains n^2"),
     ("above_one", "flag", "faster", "the interval lies above 1: shown faster than CG1"),
     ("is_bound", "flag", "bound", "a run never reached the share: the ratio is a bound"),
-    ("cg1_spread", "1", "CG1 seeds' ratio", "the largest ratio of two CG1 runs' spreading "
-     "times (the null: CG1 against CG1)"),
+    ("cg1_spread", "1", "CG1 replicas' ratio", "the largest ratio of two CG1 replicas' "
+     "spreading times (the null: CG1 against CG1)"),
 )
 
 #: table file -> (name, unit, label, meaning[, shown]) that differ there from COMMON
@@ -313,7 +318,8 @@ SPREADING = (
 EXTRAPOLATION = (
     ("column", "text", "metric", "the case-table column extrapolated (a signed criterion's)"),
     ("levels", "text", "CG levels", "the CG-n levels of the rule the line was fitted on"),
-    ("replicas", "text", "runs a level", "runs at each of those levels, in their order"),
+    ("replicas", "text", "runs a level", "replicas (one run each) at each of those levels, in "
+     "their order"),
     ("extrapolated", "metric", "extrapolated CG1", "the line through the level means at n = 1 "
      "(weber - bond rows: the two rules' difference)"),
     ("lo", "metric", "lo", "lower bound of its 95 % interval (noise and model term)"),
@@ -331,7 +337,7 @@ EXTRAPOLATION = (
     ("slope_per_level", "metric", "slope", "the fitted change per CG level"),
     ("cg1_measured", "metric", "measured CG1", "the mean of the group's CG1 runs, if any"),
     ("cg1_se", "metric", "CG1 se", "its standard error"),
-    ("cg1_replicas", "count", "CG1 runs", "CG1 runs of the group"),
+    ("cg1_replicas", "count", "CG1 runs", "CG1 replicas of the group (one run each)"),
     ("cg1_inside", "flag", "inside", "the measured CG1 mean lies in the 95 % interval"),
 )
 

@@ -84,11 +84,11 @@ def field_map(ax, grid: FieldGrid, values: np.ndarray, title: str, vmin: float, 
     return ax
 
 
-def _fields(members: list[CaseFields]) -> dict[str, np.ndarray]:
+def _fields(runs: list[CaseFields]) -> dict[str, np.ndarray]:
     """The condition's fields for the maps: velocity and temperature only where the solid
     fraction reaches MATERIAL_SOLID (the field error's support; the dilute spray above
     the bed, a few fast particles, would set the colour scale otherwise)."""
-    f = fields_of(condition_mean(members))
+    f = fields_of(condition_mean(runs))
     dilute = ~(f["solid_fraction"] >= MATERIAL_SOLID)
     return {k: (np.where(dilute, np.nan, v) if k != "solid_fraction" else v)
             for k, v in f.items()}

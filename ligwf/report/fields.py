@@ -41,6 +41,7 @@ from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.inference.uncertainty import mark
 from ligwf.study import layout
 from ligwf.study.case import group_label
+from ligwf.study.condition import Condition
 from ligwf.study.group import SweepGroup
 from ligwf.study.study import Study
 
@@ -69,7 +70,7 @@ def case_fields(analysis_dir: Path) -> dict[str, CaseFields]:
                             "analyse` again") from None
 
 
-def _members(ids, fields: dict[str, CaseFields]) -> list[CaseFields]:
+def _fields_of(ids, fields: dict[str, CaseFields]) -> list[CaseFields]:
     return [fields[c] for c in ids if c in fields]
 
 
@@ -124,8 +125,8 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
         return cases, conditions
     groups = Conditions.of(cases.itertuples())
     for i, row in cases.iterrows():
-        refs = _members(groups.reference_cases(row["group"]), fields)
-        own = _members([row["case_id"]], fields)
+        refs = _fields_of(groups.reference_cases(row["group"]), fields)
+        own = _fields_of([row["case_id"]], fields)
         if refs and own:
             cases.at[i, "field_error"] = layer_error(whole_windows(own), whole_windows(refs),
                                                      kernel).raw
@@ -133,17 +134,16 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
                 cases.at[i, "field_solid_error"] = float(
                     ERRORS["field_solid_error"](condition_mean(refs), own[0].mean()))
     for i, row in conditions.iterrows():
-        sub = cases[(cases["group"] == row["group"]) & (cases["cg"] == row["cg"])
-                    & (cases["rule"] == row["rule"])]
-        ids = list(sub["case_id"])
-        ref_ids = groups.reference_cases(row["group"])
-        members, refs = _members(ids, fields), _members(ref_ids, fields)
-        reference = bool(ids) and groups.condition(ids[0]).is_reference
-        est = _criterion(whole_windows(members), whole_windows(refs), kernel, alpha)
+        cond = Condition(row["group"], row["cg"], row["rule"])
+        ids = list(groups.cases.get(cond, ()))
+        ref_ids = groups.reference_cases(cond.group)
+        runs, refs = _fields_of(ids, fields), _fields_of(ref_ids, fields)
+        reference = bool(ids) and cond.is_reference
+        est = _criterion(whole_windows(runs), whole_windows(refs), kernel, alpha)
         null = layer_error(*null_split(refs)[:2], kernel, alpha)
         values: dict = {}
         _criterion_row(values, est)
-        _noise_row(values, layer_components(whole_windows(members), whole_windows(refs),
+        _noise_row(values, layer_components(whole_windows(runs), whole_windows(refs),
                                             kernel))
         for col, v in values.items():
             conditions.at[i, col] = v
@@ -153,7 +153,7 @@ def add_field_errors(cases: pd.DataFrame, conditions: pd.DataFrame,
             "none" if not math.isfinite(null.value) else f"CG1 vs CG1: {null_split(refs)[2]}")
         conditions.at[i, "field_error_vs_floor"] = (
             "reference" if reference else mark(e.value, null.value, e.lo, e.hi, len(refs)))
-        iv = field_intervals(members, refs, draws, seed)["field_solid_error"]
+        iv = field_intervals(runs, refs, draws, seed)["field_solid_error"]
         fl = field_floor(refs, "field_solid_error")
         name = "field_solid_error"
         conditions.at[i, name], conditions.at[i, f"{name}_lo"] = iv.value, iv.lo
@@ -199,7 +199,7 @@ def null_check(cases: pd.DataFrame, fields: dict[str, CaseFields], draws: int, s
     for group in groups.groups():
         if _wet_group(group) is not None:
             continue
-        refs = _members(groups.reference_cases(group), fields)
+        refs = _fields_of(groups.reference_cases(group), fields)
         if not refs:
             continue
         a, b, how = null_split(refs)
@@ -211,8 +211,8 @@ def null_check(cases: pd.DataFrame, fields: dict[str, CaseFields], draws: int, s
         wet = _wet_group(cond.group)
         if wet is None or not cond.is_reference:
             continue
-        twins = _members(ids, fields)
-        refs = _members(groups.reference_cases(wet), fields) if wet in groups.groups() else []
+        twins = _fields_of(ids, fields)
+        refs = _fields_of(groups.reference_cases(wet), fields) if wet in groups.groups() else []
         if not twins or not refs:
             continue
         row = {"comparison": TWIN_VS_WET, "control": cond.group, "group": wet, "cg": cond.cg,
@@ -305,14 +305,15 @@ def fields_section(conditions: pd.DataFrame, null: pd.DataFrame, fields: dict[st
         "**Solid fraction field err** = sum |phi - phi_1| / sum phi_1 over the cross-section, "
         "95 % interval from a block bootstrap over frames and replicas; floor: CG1 against "
         "CG1.", ""]
-    cg = conditions[conditions["cg"] != 1.0] if "cg" in conditions else conditions
-    cg = cg[[_wet_group(gr) is None for gr in cg["group"]]] if not cg.empty else cg
-    if not cg.empty:
+    levels = conditions[conditions["cg"] != 1.0] if "cg" in conditions else conditions
+    levels = (levels[[_wet_group(gr) is None for gr in levels["group"]]] if not levels.empty
+              else levels)
+    if not levels.empty:
         name = "field_solid_error"
         lines += [f"| group | CG | rule | replicas | {_criterion_head(kernel)} | CG1 vs CG1 | "
                   f"{LABELS[name]} [95 % CI] | floor | vs floor |",
                   "|---|---|---|---|" + "---|" * _criterion_count(kernel) + "---|---|---|---|"]
-        for _, r in cg.iterrows():
+        for _, r in levels.iterrows():
             cells = [group_label(r["group"]), f"{r['cg']:g}", r["rule"], str(r["replicas"]),
                      *_criterion_cells(r, kernel), _num(r["field_error_floor"]),
                      _cell(r, name), f"{_num(r[f'{name}_floor'])} ({r[f'{name}_floor_source']})",

@@ -190,12 +190,12 @@ def condition_table(df: pd.DataFrame, stats: ConditionStats, columns: list[str]
     group's CG1 noise floor (``_floor``, ``_floor_source``) and its mark (``_vs_floor``)."""
     rows = []
     conditions = Conditions.of(df.itertuples())
-    for (group, cg, rule), sub in df.groupby(["group", "cg", "rule"], sort=True):
-        ids = list(sub["case_id"])
-        cond = conditions.condition(ids[0])
-        ref_ids = conditions.reference_cases(group)
-        row = {"group": group, "group_label": group_label(group), "cg": cg, "rule": rule,
-               "replicas": len(sub),
+    for cond in conditions.sorted():
+        ids = list(conditions.cases[cond])
+        sub = df[df["case_id"].isin(ids)]
+        ref_ids = conditions.reference_cases(cond.group)
+        row = {"group": cond.group, "group_label": group_label(cond.group), "cg": cond.cg,
+               "rule": cond.rule, "replicas": len(sub),
                "particles": int(sub["particles"].iloc[0]), "dt": float(sub["dt"].iloc[0]),
                "steps": int(sub["steps"].max())}
         for ph in PHASES:

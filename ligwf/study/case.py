@@ -29,6 +29,7 @@ from ligwf.scene.scaled import ScaledScene
 from ligwf.scene.scaling import scale
 from ligwf.scene.workflow import CONTROL_KEY
 from ligwf.study.extension import extension_steps
+from ligwf.study.condition import Condition
 from ligwf.study.group import SweepGroup
 from ligwf.study.layout import (ANALYSED_DUMP_RE, DUMP_RECORD, INPUT_NAME, MANIFEST_FILE, MESH_NAME,
                                 POST_DIR, SCENE_FILE, SCREEN_FILE, THERMO_FILE)
@@ -243,6 +244,16 @@ class CaseFolder:
         except (OSError, ValueError, KeyError, TypeError) as exc:
             raise ConfigError(f"{path}: not a readable case folder (scene record missing or "
                               f"invalid: {exc})") from None
+
+    @property
+    def condition(self) -> Condition:
+        """The condition this case is a replica of (its sweep group, CG level and rule)."""
+        return Condition.of(self)
+
+    @property
+    def sweep_group(self) -> SweepGroup:
+        """The case's sweep group as a value (:attr:`group` is its canonical JSON)."""
+        return self.condition.sweep_group
 
     @property
     def rendered_scaled(self) -> ScaledScene:

@@ -88,6 +88,8 @@ class Condition:
 
     @property
     def sweep_group(self) -> SweepGroup:
+        """The sweep group as a value (:attr:`group` is its canonical JSON, what tables and
+        records store; read once per distinct text, :meth:`SweepGroup.parse`)."""
         return SweepGroup.parse(self.group)
 
     @property

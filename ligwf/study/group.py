@@ -12,6 +12,7 @@ wet group a control twin is compared with are properties of the value.
 from __future__ import annotations
 
 import json
+from functools import lru_cache
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, Mapping
@@ -36,14 +37,9 @@ class SweepGroup:
 
     @classmethod
     def parse(cls, text: Any) -> "SweepGroup":
-        """The group a table or record holds (its canonical JSON)."""
-        try:
-            varied = json.loads(text)
-        except (TypeError, ValueError):
-            return cls(MappingProxyType({}), str(text))
-        if not isinstance(varied, dict):
-            return cls(MappingProxyType({}), str(text))
-        return cls.of(varied)
+        """The group a table or record holds (its canonical JSON), read once per distinct
+        text: every stage that meets a group's text gets the same read-only value."""
+        return _parsed(str(text))
 
     @property
     def text(self) -> str:
@@ -75,3 +71,14 @@ class SweepGroup:
         if self.control is not None:
             return ", ".join([f"{self.control} control", *parts])
         return ", ".join(parts) or ALL_CASES
+
+
+@lru_cache(maxsize=4096)
+def _parsed(text: str) -> SweepGroup:
+    try:
+        varied = json.loads(text)
+    except ValueError:
+        return SweepGroup(MappingProxyType({}), text)
+    if not isinstance(varied, dict):
+        return SweepGroup(MappingProxyType({}), text)
+    return SweepGroup.of(varied)

@@ -8,7 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from ligwf.inference.spreading import (case_times, level_rates, seed_spread,
+from ligwf.inference.spreading import (case_times, level_rates, replica_spread,
                                        welch_log_ratio)
 
 
@@ -60,10 +60,10 @@ def test_cases_without_placed_liquid_are_left_out():
     assert level_rates(case_times([dry])).empty
 
 
-def test_one_run_arms_give_no_interval_and_the_seed_spread_is_a_ratio():
+def test_one_run_arms_give_no_interval_and_the_replica_spread_is_a_ratio():
     ratio, low, high, df = welch_log_ratio([2.0], [1.0, 1.1])
     assert ratio == pytest.approx(2.0 / math.sqrt(1.1)) and math.isnan(low)
-    assert seed_spread([1.0, 3.0, 2.0]) == 3.0 and seed_spread([]) != seed_spread([])
+    assert replica_spread([1.0, 3.0, 2.0]) == 3.0 and replica_spread([]) != replica_spread([])
 
 
 def test_welch_interval_on_log_times_covers_near_its_level_with_three_runs_each():

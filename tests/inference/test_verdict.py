@@ -28,6 +28,7 @@ from ligwf.scene.accept import AcceptSettings, build_accept_settings
 from ligwf.scene.workflow import load_workflow
 from ligwf.yamlio import read_yaml_mapping
 from ligwf.study import layout
+from ligwf.study.condition import Condition
 from tests.helpers import ROOT
 
 DEMO = ROOT / "workflows" / "demo.yaml"
@@ -276,3 +277,17 @@ def test_report_set_re_decides_only_the_budget():
     arms = (CG1, runs(2, "weber", [42.0, 42.2, 41.9]))
     assert crit(verdict(*arms), "cg2-weber")["angle_deg"].state == FAIL
     assert crit(verdict(*arms, accept=a), "cg2-weber")["angle_deg"].state == PASS
+
+
+def test_a_sweep_without_cg1_reports_the_speedup_of_its_condition():
+    """The planner's CG1 speedups of a sweep without CG1 are keyed by Condition: each level
+    reports its own, a level without one reports none."""
+    arms = [runs(n, "weber", [40.0 + 0.3 * n + 0.1 * k for k in range(3)]) for n in (2, 3, 4)]
+    conditions, cases, profiles = study(*arms)
+    v = decide(conditions, AcceptSettings(), {GROUP: PASSING}, cases, profiles,
+               size_ratio=0.01, speedups={Condition(GROUP, 2.0, "weber"): 7.5,
+                                          Condition(GROUP, 3.0, "weber"): 20.0})
+    got = {c.condition: c.speedup for c in v.groups[0].conditions}
+    assert got[Condition(GROUP, 2.0, "weber")] == 7.5
+    assert got[Condition(GROUP, 3.0, "weber")] == 20.0
+    assert math.isnan(got[Condition(GROUP, 4.0, "weber")])

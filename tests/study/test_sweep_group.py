@@ -4,7 +4,10 @@ controls read."""
 
 from __future__ import annotations
 
+import pytest
+
 from ligwf.study.case import group_label, group_of
+from ligwf.study.condition import Condition
 from ligwf.study.group import ALL_CASES, SweepGroup
 
 
@@ -31,3 +34,14 @@ def test_text_that_is_no_group_record_stays_itself():
     for text in ("not json", "[1, 2]", None):
         g = SweepGroup.parse(text)
         assert g.label == str(text) and g.control is None and g.text == str(text)
+
+
+def test_a_group_text_is_read_once_and_its_value_is_read_only():
+    text = group_of({"process.rotation.rpm": 20.0})
+    first = SweepGroup.parse(text)
+    assert SweepGroup.parse(text) is first
+    assert Condition(text, 2.0, "weber").sweep_group is first
+    assert Condition(text, 2.0, "weber").reference.sweep_group is first
+    with pytest.raises(TypeError):
+        first.values["process.rotation.rpm"] = 30.0
+    assert SweepGroup.parse(text).values == {"process.rotation.rpm": 20.0}

@@ -19,7 +19,7 @@ from ligwf.analysis.granules.control_run import DEFAULT_CANDIDATES, control_rows
 from ligwf.analysis.granules.control_verdict import verdict
 from ligwf.scene.settings import AnalysisSettings
 from ligwf.study.case import CaseFolder
-from ligwf.study.group import SweepGroup
+from ligwf.study.condition import Condition
 
 #: the ``varied`` value (under CONTROL_KEY) of a cohesionless twin
 COHESIONLESS = "cohesionless"
@@ -30,16 +30,12 @@ FLOW_MATCHED = "flow_matched"
 def control_pairs(cases: list[CaseFolder]) -> list[tuple[CaseFolder, CaseFolder]]:
     """(wet case, its twin) for every control twin (cohesionless or flow-matched) whose wet
     case is among ``cases``, in case order."""
-    wet = {}
-    for c in cases:
-        group = SweepGroup.parse(c.group)
-        if group.control is None:
-            wet[(group.text, c.cg, c.rule, c.replica)] = c
+    wet = {(c.condition, c.replica): c for c in cases if c.sweep_group.control is None}
     out = []
     for c in cases:
-        group = SweepGroup.parse(c.group)
-        if group.control in (COHESIONLESS, FLOW_MATCHED):
-            w = wet.get((group.wet.text, c.cg, c.rule, c.replica))
+        if c.sweep_group.control in (COHESIONLESS, FLOW_MATCHED):
+            twin_of = Condition(c.sweep_group.wet.text, c.cg, c.rule)
+            w = wet.get((twin_of, c.replica))
             if w is not None:
                 out.append((w, c))
     return out
@@ -65,7 +61,7 @@ def study_controls(cases: list[CaseFolder], definition: AnalysisSettings,
         t0 = (steady_from or {}).get(wet.case_id, 0.5)
         sw = summarise(control_rows(load_series(wet.path), cands, steady_from=t0))
         st = summarise(control_rows(load_series(twin.path), cands, steady_from=t0))
-        kind = SweepGroup.parse(twin.group).control or COHESIONLESS
+        kind = twin.sweep_group.control or COHESIONLESS
         for (_, w), (_, t) in zip(sw.iterrows(), st.iterrows()):
             ok, sentence = verdict(w.to_dict(), t.to_dict(), w["definition"], kind)
             row = {"case_id": wet.case_id, "twin_id": twin.case_id, "definition": w["definition"],

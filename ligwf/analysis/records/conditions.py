@@ -39,13 +39,13 @@ class Conditions:
     def of(cls, cases: Iterable) -> "Conditions":
         """From objects with ``case_id``, ``group``, ``cg``, ``rule`` (cases, or the rows of
         a case table via ``itertuples()``)."""
-        members: dict[Condition, list[str]] = {}
+        cases_of: dict[Condition, list[str]] = {}
         of_case: dict[str, Condition] = {}
         for c in cases:
             cond = Condition.of(c)
-            members.setdefault(cond, []).append(c.case_id)
+            cases_of.setdefault(cond, []).append(c.case_id)
             of_case[c.case_id] = cond
-        return cls({k: tuple(v) for k, v in members.items()}, of_case)
+        return cls({k: tuple(v) for k, v in cases_of.items()}, of_case)
 
     def sorted(self) -> list[Condition]:
         """The conditions by group, CG level, rule."""
