@@ -71,7 +71,8 @@ BINS_SIMULATED = "correlated, simulated fail test"
 #: simulated on the same draws with the distance along the noise's largest direction
 #: (:meth:`ligwf.inference.profile_null.SimulatedNull.largest`): the two-moment F's lower
 #: tail is too long, which made the upper bound cover up to 0.997 on correlated bins
-#: (profiles_2.txt check 1); measured by the sixth run (profiles_3.txt), not the verdict's
+#: (profiles_2.txt check 1); measured by the sixth run (profiles_3.txt: 0.950-0.992, above
+#: 0.99 at offset 0 in 2 of 15 cells, check 1 failed), so not the verdict's
 BINS_SIMULATED_UPPER = "correlated, simulated fail test, smaller upper bound"
 BINS_RULE_TEXT = {BINS_INDEPENDENT: "depth bins counted as independent",
                   BINS_CORRELATED: "the depth bins' correlation measured on the runs' "
