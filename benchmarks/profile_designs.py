@@ -44,6 +44,9 @@ CORRELATION = (Path(__file__).resolve().parents[1] / "docs" / "results" / "profi
 RULES = (eq.BINS_CORRELATED, eq.BINS_INDEPENDENT)
 #: the second run's rules (profiles_2.txt): the rule checked first, the first run's beside
 RULES_2 = (eq.BINS_SIMULATED, eq.BINS_CORRELATED)
+#: the third run's rule (profiles_3.txt): the simulated fail test with the smaller upper
+#: bound, alone (the second run's rule is in profiles_2.txt; one rule keeps the run short)
+RULES_3 = (eq.BINS_SIMULATED_UPPER,)
 #: the second run counts a design in its checks from this many runs of both arms together
 #: (the verdict decides a profile from there: ligwf.inference.profile.MIN_PROFILE_RUNS)
 COUNTED_FROM = 6
@@ -140,21 +143,39 @@ def report_2(rng, trials: int) -> int:
     the simulated fail test (:data:`RULES_2`, first) beside the first run's correlated rule,
     on the same designs and draws; checks over designs of at least :data:`COUNTED_FROM` runs
     of both arms together (2 vs 2 printed, not counted). The number of checks that fail."""
+    return _report_counted(rng, trials, RULES_2, ("simulated", "correlated"))
+
+
+def report_3(rng, trials: int) -> int:
+    """The third profile run (registered in docs/results/verdict_rates/README.md before it):
+    the simulated fail test with the smaller upper bound (:data:`RULES_3`) alone, the second
+    run's designs and checks. The number of checks that fail."""
+    return _report_counted(rng, trials, RULES_3, ("smaller upper",))
+
+
+def _report_counted(rng, trials: int, rules: tuple[str, ...], names: tuple[str, ...]) -> int:
+    """Every cell of ``rules`` (the first is checked, a second printed beside it) and the
+    four checks over designs of at least :data:`COUNTED_FROM` runs; the number that fail."""
     width = kernel_width()
-    new, old = RULES_2
+    new = rules[0]
+    label = f"rule {names[0]}:"
     print(f"profile bounds with shared bin errors: {BINS} bins, triangular correlation "
           f"1 - k / {width} (from {CORRELATION.relative_to(CORRELATION.parents[3])}), "
           f"{trials} studies a cell, budget on the true distance")
-    print(f"{'bins':>11} {'design':>8} {'offset':>6} | rule simulated:  {'cover':>6} "
-          f"{'w.pass':>7} {'w.fail':>7} | rule correlated:  {'cover':>6} {'w.pass':>7} "
-          f"{'w.fail':>7}")
-    cells = profile_cells(rng, trials, width, RULES_2)
+    head = (f"{'bins':>11} {'design':>8} {'offset':>6} | {label}  {'cover':>6} "
+            f"{'w.pass':>7} {'w.fail':>7}")
+    if len(rules) > 1:
+        head += (f" | rule {names[1]}:  {'cover':>6} {'w.pass':>7} "
+                 f"{'w.fail':>7}")
+    print(head)
+    cells = profile_cells(rng, trials, width, rules)
     for c in cells:
-        n, i = c[new], c[old]
-        print(f"{c['bins']:>11} {c['design']:>8} {c['offset']:6.1f} | {'':16} "
-              f"{n['cover']:6.3f} {n['wrong pass']:7.4f} {n['wrong fail']:7.4f} | "
-              f"{'':16} {i['cover']:6.3f} {i['wrong pass']:7.4f} {i['wrong fail']:7.4f}",
-              flush=True)
+        line = f"{c['bins']:>11} {c['design']:>8} {c['offset']:6.1f}"
+        for rule in rules:
+            n = c[rule]
+            line += (f" | {'':16} {n['cover']:6.3f} {n['wrong pass']:7.4f} "
+                     f"{n['wrong fail']:7.4f}")
+        print(line, flush=True)
 
     def counted(c: dict) -> bool:
         return sum(int(r) for r in c["design"].split(" vs ")) >= COUNTED_FROM
@@ -167,10 +188,10 @@ def report_2(rng, trials: int) -> int:
         rates = [r[k] for r in rows for k in ("wrong pass", "wrong fail")]
         above = sum(lower_bound(v, trials) > ALPHA for v in rates)
         ok_cover, ok_rates = inside == len(cover), above == 0
-        print(f"check {number} ({bins} bins, rule simulated, designs of >= {COUNTED_FROM} "
+        print(f"check {number} ({bins} bins, rule {names[0]}, designs of >= {COUNTED_FROM} "
               f"runs) coverage: {inside} of {len(cover)} cells in [{LOW}, {HIGH}] "
               f"({min(cover):.3f}-{max(cover):.3f}): {'holds' if ok_cover else 'FAILS'}")
-        print(f"check {number + 1} ({bins} bins, rule simulated, designs of >= "
+        print(f"check {number + 1} ({bins} bins, rule {names[0]}, designs of >= "
               f"{COUNTED_FROM} runs) wrong pass and fail: at most {max(rates):.4f} (pass "
               f"{max(r['wrong pass'] for r in rows):.4f}, fail "
               f"{max(r['wrong fail'] for r in rows):.4f}); {above} of {len(rates)} shown "
@@ -182,10 +203,12 @@ def report_2(rng, trials: int) -> int:
               f"{min(r['cover'] for r in two):.3f}-{max(r['cover'] for r in two):.3f}, wrong "
               f"pass at most {max(r['wrong pass'] for r in two):.4f}, wrong fail at most "
               f"{max(r['wrong fail'] for r in two):.4f}")
-    rows = [c[old] for c in cells if c["bins"] == "correlated" and counted(c)]
-    print(f"beside (not a check): rule correlated on correlated bins, designs of >= "
-          f"{COUNTED_FROM} runs: wrong fail at most {max(r['wrong fail'] for r in rows):.4f}, "
-          f"{sum(lower_bound(r['wrong fail'], trials) > ALPHA for r in rows)} of {len(rows)} "
-          f"shown above {ALPHA}")
+    if len(rules) > 1:
+        rows = [c[rules[1]] for c in cells if c["bins"] == "correlated" and counted(c)]
+        print(f"beside (not a check): rule {names[1]} on correlated bins, designs of >= "
+              f"{COUNTED_FROM} runs: wrong fail at most "
+              f"{max(r['wrong fail'] for r in rows):.4f}, "
+              f"{sum(lower_bound(r['wrong fail'], trials) > ALPHA for r in rows)} of "
+              f"{len(rows)} shown above {ALPHA}")
     print(f"summary: {4 - failed} of 4 registered checks hold")
     return failed

@@ -225,3 +225,73 @@ def test_the_analysis_guide_quotes_both_profile_runs():
     assert (f"failed wrongly in up to {100 * worst_old:.1f} % of correlated studies, the "
             f"simulated test in at most {100 * fail:.1f} %") in guide
     assert f"over-covers there, up to {cover}," in guide
+
+
+def _profile_cells(name: str) -> dict:
+    """(bins, runs of both arms, design, offset) -> the first rule's cover, wrong pass and
+    wrong fail of a profiles_N.txt."""
+    rows = [line.split() for line in (HERE / name).read_text().splitlines()
+            if "|" in line and " vs " in line]
+    return {(r[0], int(r[1]) + int(r[3]), r[1] + " vs " + r[3], float(r[4])):
+            [float(v) for v in r[6:9]] for r in rows}
+
+
+def test_smaller_upper_bound_run_is_what_the_readme_says():
+    """profiles_3.txt (bench_coverage --profiles-3, registered before it): the registered
+    command on its first line, the check lines recomputed from its cells (designs of >= 6
+    runs, a rate shown above 0.05 by its lower 95 % Clopper-Pearson bound), the numbers the
+    README quotes beside the fifth run's on the same designs, and the verdict's rule left
+    unchanged because check 1 failed."""
+    from ligwf.inference import equivalence as eq
+    text = (HERE / "profiles_3.txt").read_text()
+    raw = (HERE / "README.md").read_text()
+    registered = re.search(r"^    (nice -n 19 .*--profiles-3.*) > docs/results/verdict_rates/"
+                           r"profiles_3\.txt$", raw, re.M).group(1)
+    assert text.splitlines()[0].startswith("# " + registered + " ")
+    assert "--trials 3000" in registered and "3000 studies a cell" in text
+    assert raw.index("## Sixth run") < raw.index("### Sixth run's result")
+    cells = _profile_cells("profiles_3.txt")
+    assert len(cells) == 36
+    holds = []
+    for bins in ("correlated", "independent"):
+        counted = [v for k, v in cells.items() if k[0] == bins and k[1] >= 6]
+        assert len(counted) == 15
+        cover = [1.0 - v[1] for v in counted]          # the printed cover is rounded
+        holds.append(all(0.92 <= c <= 0.99 for c in cover))
+        holds.append(not any(_lower(r, 3000) > 0.05 for v in counted for r in v[1:3]))
+    assert holds == [False, True, True, True]
+    checks = re.findall(r"^check (\d) .*: (holds|FAILS)$", text, re.M)
+    assert checks == [(str(i + 1), "holds" if h else "FAILS") for i, h in enumerate(holds)]
+    assert "summary: 3 of 4 registered checks hold" in text
+    result = " ".join(raw.split("### Sixth run's result", 1)[1].split())
+    assert "**3 of 4 registered checks hold.**" in result
+    corr = {k: v for k, v in cells.items() if k[0] == "correlated" and k[1] >= 6}
+    above = sorted((k[2], k[3], 1.0 - v[1]) for k, v in corr.items() if 1.0 - v[1] > 0.99)
+    assert above == [("24 vs 3", 0.0, 0.992), ("6 vs 6", 0.0, 0.991)]
+    assert "6 vs 6 (0.991) and 24 vs 3 (0.992)" in result
+    old = {k: v for k, v in _profile_cells("profiles_2.txt").items() if k in corr}
+    assert [old[k][0] for k in sorted(corr) if k[3] == 0.0 and k[2] in ("6 vs 6", "24 vs 3")
+            ] == [0.995, 0.997]                      # 6 vs 6, then 24 vs 3
+    assert "The fifth run's bound gave 0.995 and 0.997 in those two cells" in result
+    assert sum(1.0 - v[1] > 0.99 for v in old.values()) == 4 and len(above) == 2
+    assert "go from 4 of 15 to 2 of 15" in result
+    worst_pass = max(corr.items(), key=lambda kv: kv[1][1])
+    assert worst_pass[0][2:] == ("24 vs 3", 3.0)
+    assert f"Wrong pass at most {worst_pass[1][1]:.4f} (24 vs 3, offset 3" in result
+    assert f"wrong fail at most {max(v[2] for v in corr.values()):.4f}" in result
+    pooled = {k: (4000 * old[k][2] + 3000 * v[2]) / 7000 for k, v in corr.items()}
+    worst = max(pooled, key=pooled.get)
+    assert worst[2:] == ("6 vs 2", 1.0)
+    assert f"wrong fail is at most {pooled[worst]:.4f} (6 vs 2, offset 1)" in result
+    indep = [v for k, v in cells.items() if k[0] == "independent" and k[1] >= 6]
+    assert (f"({min(1 - v[1] for v in indep):.3f}-{max(1 - v[1] for v in indep):.3f}; "
+            "the fifth run's bound 0.955-0.979)") in result
+    assert (f"{max(v[1] for v in indep):.4f} (pass) and {max(v[2] for v in indep):.4f} "
+            "(fail)") in result
+    guide = " ".join((ROOT / "docs" / "guide" / "analysis.md").read_text().split())
+    cover = re.search(r"check 1 .*?\(([\d.]+-[\d.]+)\)", text).group(1)
+    assert (f"a smaller bound simulated along the noise's largest direction covered {cover}, "
+            "still above 0.99 at offset 0, and is not used: `profiles_3.txt`") in guide
+    # check 1 failed: the verdict keeps the fifth run's rule
+    assert eq.PROFILE_BINS == eq.BINS_SIMULATED != eq.BINS_SIMULATED_UPPER
+    assert "stays the fifth run's" in result
