@@ -1,11 +1,13 @@
-"""A study decided: the verdict record and the extrapolated CG1 table, computed once from
-the analysis' values and the report's case and condition tables, and written into the
-report folder before anything is rendered.
+"""A study decided: its tables (cases, conditions with their intervals, noise floors:
+:mod:`ligwf.inference.study_tables`), the verdict record and the extrapolated CG1 table,
+computed once from the analysis' values and written into the report folder before
+anything is rendered.
 
-This is the one place a study's statistics are decided: the report
+This is the one place a study's statistics are computed: the report
 (:func:`ligwf.report.write.write_report`) renders what :func:`decide_study` returns and
-wrote, and the API (:func:`ligwf.api.open_study`) reads the same record back
-(:func:`~ligwf.inference.verdict_records.read_verdict`). What it reads besides the tables:
+wrote, and the API (:func:`ligwf.api.open_study`) reads the same files back (the verdict
+through :func:`~ligwf.inference.verdict_records.read_verdict`). What it reads besides the
+analysis:
 the granule controls (:mod:`ligwf.analysis.records.controls`), the runs' noise and prices
 (:func:`~ligwf.inference.planning.noise_table`), the level each test is run at (a sequential
 study's looks: :func:`look_level`), and the drum's size ratio and the planner's CG1 speedup
@@ -28,6 +30,7 @@ from ligwf.inference.budget import signed_columns
 from ligwf.inference.equivalence import HSU, WELCH_BF
 from ligwf.inference.planning import noise_table
 from ligwf.inference.reference import extrapolation_rows, planned_cg1_speedup, size_ratio
+from ligwf.inference.study_tables import build_tables
 from ligwf.inference.verdict import Verdict
 from ligwf.inference.verdict_records import study_verdict, write_verdict
 from ligwf.study import layout
@@ -38,10 +41,14 @@ from ligwf.study.study import Study
 
 @dataclass(frozen=True)
 class Decided:
-    """What :func:`decide_study` wrote: the verdict (its record ``verdict.json`` /
-    ``verdict.csv``), the extrapolated CG1 rows (``extrapolation.csv``) and the drum's
-    d / D they were computed with (nan without a scene record)."""
+    """What :func:`decide_study` wrote: the case, condition and noise-floor tables
+    (``cases.csv``, ``conditions.csv``, ``noise_floor.csv``), the verdict (its record
+    ``verdict.json`` / ``verdict.csv``), the extrapolated CG1 rows (``extrapolation.csv``)
+    and the drum's d / D they were computed with (nan without a scene record)."""
 
+    cases: pd.DataFrame
+    conditions: pd.DataFrame
+    floors: pd.DataFrame
     verdict: Verdict
     extrapolated: pd.DataFrame
     size_ratio: float
@@ -71,10 +78,14 @@ def extrapolation_inputs(study: Study) -> tuple[float, dict[Condition, float]]:
     return ratio, speedups
 
 
-def decide_study(study: Study, flow: FlowRecord, cases: pd.DataFrame,
-                 conditions: pd.DataFrame, out: Path) -> Decided:
-    """Decide ``study`` from its analysis (``flow``) and its report tables (``cases``,
-    ``conditions``) and write the verdict record and ``extrapolation.csv`` into ``out``."""
+def decide_study(study: Study, flow: FlowRecord, out: Path) -> Decided:
+    """Decide ``study`` from its analysis (``flow``, and the tables beside it): build its
+    tables (:func:`~ligwf.inference.study_tables.build_tables`), decide the verdict and
+    write the tables, the verdict record and ``extrapolation.csv`` into ``out``."""
+    cases, conditions, _, floors = build_tables(study, flow)
+    atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
+    atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
+    atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
     ratio, speedups = extrapolation_inputs(study)
     verdict = study_verdict(cases, conditions, study.accept, read_controls(study.analysis_dir),
                             {cid: c.profile_v_mean for cid, c in flow.cases.items()},
@@ -84,4 +95,4 @@ def decide_study(study: Study, flow: FlowRecord, cases: pd.DataFrame,
     write_verdict(verdict, out)
     extrapolated = extrapolation_rows(cases, signed_columns(), ratio)
     atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
-    return Decided(verdict, extrapolated, ratio)
+    return Decided(cases, conditions, floors, verdict, extrapolated, ratio)

@@ -1,6 +1,6 @@
 """Per-condition values with intervals, and the CG1 noise floor every CG error is held to.
 
-Inputs: the case table (one row per usable case, :mod:`ligwf.report.tables`), the flow
+Inputs: the case table (one row per usable case, :mod:`ligwf.inference.study_tables`), the flow
 record (per-frame series of each case's steady window and the specification of every
 metric: series, statistic, range, :class:`~ligwf.analysis.records.flow.FlowRecord`) and
 the granule frame table (largest granule per frame).

@@ -1,6 +1,6 @@
 """Report figures: plotting functions that draw into a matplotlib ``Axes`` and return it.
 
-Each ``*_ax`` function takes tables already computed by :mod:`ligwf.report.tables` (or read
+Each ``*_ax`` function takes tables already computed by :mod:`ligwf.inference.study_tables` (or read
 from the analysis folder) and an ``Axes``; the report's figure functions (:func:`pareto`,
 :func:`gsd_overlay`, :func:`velocity_profiles`) lay them out on a
 :class:`matplotlib.figure.Figure` and :func:`save` writes the PNG atomically. No backend is

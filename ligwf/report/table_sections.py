@@ -1,7 +1,7 @@
 """The table sections of the report: cases, conditions, CG1 noise floor, GSD size limit,
 steady window, stability (markdown; the page renders the same text).
 
-Reads only tables the report stage built (:mod:`ligwf.report.tables`) or the analysis wrote;
+Reads only tables the report stage built (:mod:`ligwf.inference.study_tables`) or the analysis wrote;
 numbers are shown as value [95 % interval] with their mark against the CG1 noise floor.
 """
 

@@ -38,7 +38,6 @@ from ligwf.report.sections import (Figure, Section, figure_section, ordered, ren
                                    split_markdown)
 from ligwf.report.table_sections import (markdown_tables, noise_markdown, paraview_markdown,
                                          pooling_markdown, stability_markdown, steady_line)
-from ligwf.report.tables import build_tables
 from ligwf.report.extrapolation_report import extrapolation_section
 from ligwf.report.scale_section import scale_section
 from ligwf.report.spreading_section import spreading_section, spreading_tables
@@ -74,20 +73,17 @@ class ReportFigures:
 
 
 def write_report(study: Study, out: Path | None = None, snapshots: bool = True) -> Path:
-    """Build the tables from the analysis outputs and write the report folder; returns it.
+    """Decide the study (its tables and verdict, :func:`~ligwf.inference.decide.decide_study`) and write the report folder around them; returns it.
     Reads only: the flow metrics, steady windows and granule tables come from ``ligwf
     analyse`` (refused when missing or stale, :func:`checked_analysis`)."""
     out = Path(out) if out else study.report_dir
     flow = checked_analysis(study)
     nothing_to_report(study, flow)
     (out / layout.FIGURES_DIR).mkdir(parents=True, exist_ok=True)
-    cases, conditions, _, floors = build_tables(study, flow)
-    problems = study_problems(study)
-    atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
-    atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
-    atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
-    decided = decide_study(study, flow, cases, conditions, out)
+    decided = decide_study(study, flow, out)     # the numbers, written first
+    cases, conditions, floors = decided.cases, decided.conditions, decided.floors
     verdict, extrapolated, ratio = decided.verdict, decided.extrapolated, decided.size_ratio
+    problems = study_problems(study)
     spread_cases, spread_levels = spreading_tables(flow)     # no rows without placed liquid
     atomic_write_text(out / layout.SPREADING_REPORT, spread_levels.to_csv(index=False))
     figures = report_figures(study, flow, cases, conditions, out, snapshots, verdict)

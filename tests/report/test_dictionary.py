@@ -19,7 +19,7 @@ from ligwf.analysis.gsd.pooling import POOLING_COLUMNS
 from ligwf.analysis.gsd.tables import GSD_COLUMNS, SUMMARY_COLUMNS
 from ligwf.analysis.records.metrics import GRANULE_METRICS
 from ligwf.report import dictionary as dic
-from ligwf.report.tables import compare_to_cg1, condition_table, noise_floor_table
+from ligwf.inference.study_tables import compare_to_cg1, condition_table, noise_floor_table
 from ligwf.study import layout
 from ligwf.study.case import group_label
 

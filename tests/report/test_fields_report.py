@@ -16,7 +16,8 @@ import pytest
 
 from ligwf.analysis.flow.fields import case_fields
 from ligwf.report.field_figures import group_figures, rotation_sense
-from ligwf.report.fields import add_field_errors, fields_section, null_check, twin_cases
+from ligwf.inference.field_tables import add_field_errors, null_check, twin_cases
+from ligwf.report.fields import fields_section
 from ligwf.scene.axis import Axis
 from test_fields import D1, DRUM_R, HEAD, LENGTH, OMEGA, WIDTH, geometry, lattice_frame
 
@@ -139,7 +140,7 @@ def test_only_the_recorded_archive_is_read(study_fields, tmp_path):
     stale archive (not in the record) is ignored, an unreadable listed one is one line."""
     from ligwf.analysis.records.fields import fields_bytes
     from ligwf.analysis.records.provenance import StaleAnalysis
-    from ligwf.report.fields import case_fields
+    from ligwf.inference.field_tables import case_fields
     from ligwf.study import layout
 
     fields = study_fields[0]

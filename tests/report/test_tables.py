@@ -1,4 +1,4 @@
-"""ligwf.report.tables on hand-made case tables: speedups and errors against the CG1 cases
+"""ligwf.inference.study_tables on hand-made case tables: speedups and errors against the CG1 cases
 of the sweep group, the condition table (intervals, floors, marks, GSD bands, costs), the
 noise-floor table, and the granule columns restricted to the steady window.
 
@@ -17,7 +17,7 @@ import pytest
 from ligwf.analysis.records import statistics as st
 from ligwf.analysis.records.flow import CaseFlow, FlowRecord
 from ligwf.analysis.records.metrics import POSITIVE, MetricSpec
-from ligwf.report.tables import compare_to_cg1, condition_table, merge_analysis, \
+from ligwf.inference.study_tables import compare_to_cg1, condition_table, merge_analysis, \
     noise_floor_table
 from ligwf.inference.uncertainty import ConditionStats
 from ligwf.study import layout

@@ -18,7 +18,7 @@ import pandas as pd
 from ligwf.inference.field_errors import FIELD_ERRORS, field_floor
 from ligwf.analysis.records.fields import fields_of, read_fields
 from ligwf.cli.main import main
-from ligwf.report.fields import add_field_errors
+from ligwf.inference.field_tables import add_field_errors
 from ligwf.study import layout
 from wetdump import wet_study
 

@@ -22,7 +22,7 @@ from ligwf.analysis.records.metrics import POSITIVE, MetricSpec
 from ligwf.analysis.records.statistics import MEAN
 from ligwf.cli.main import main
 from ligwf.study import layout
-from ligwf.report.tables import compare_to_cg1, condition_table, merge_analysis, metric_columns
+from ligwf.inference.study_tables import compare_to_cg1, condition_table, merge_analysis, metric_columns
 from ligwf.inference.uncertainty import ConditionStats, case_series, report_metrics
 from ligwf.report.table_sections import markdown_tables
 from test_flow import bed

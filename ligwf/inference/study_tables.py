@@ -1,4 +1,6 @@
-"""Report stage: turn a finished study into the answer to "what error for what run time".
+"""A study's tables: the case table, the condition table and the noise floors, the numbers
+the verdict decides on and the report shows (``cases.csv``, ``conditions.csv``,
+``noise_floor.csv``, written by :func:`ligwf.inference.decide.decide_study`).
 
 Inputs (all already on disk): the study (its cases' scaled scenes and manifests, through
 :class:`ligwf.study.study.Study`) and the analysis outputs in its analysis folder (flow
@@ -32,7 +34,7 @@ from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import GSD_ERRORS, LOWER_LIMIT
 from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
 from ligwf.analysis.records.statistics import MEAN
-from ligwf.report.fields import add_field_errors, case_fields
+from ligwf.inference.field_tables import add_field_errors, case_fields
 from ligwf.inference.uncertainty import (ConditionStats, case_series, cost_interval, mark,
                                       report_metrics)
 from ligwf.study import layout
