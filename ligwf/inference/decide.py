@@ -28,8 +28,10 @@ from ligwf.analysis.records.flow import FlowRecord
 from ligwf.fsio import atomic_write_text
 from ligwf.inference.budget import signed_columns
 from ligwf.inference.equivalence import HSU, WELCH_BF
+from ligwf.inference.field_tables import case_fields, null_check
 from ligwf.inference.planning import noise_table
 from ligwf.inference.reference import extrapolation_rows, planned_cg1_speedup, size_ratio
+from ligwf.inference.spreading import case_times, level_rates
 from ligwf.inference.study_tables import build_tables
 from ligwf.inference.verdict import Verdict
 from ligwf.inference.verdict_records import study_verdict, write_verdict
@@ -44,7 +46,8 @@ class Decided:
     """What :func:`decide_study` wrote: the case, condition and noise-floor tables
     (``cases.csv``, ``conditions.csv``, ``noise_floor.csv``), the verdict (its record
     ``verdict.json`` / ``verdict.csv``), the extrapolated CG1 rows (``extrapolation.csv``)
-    and the drum's d / D they were computed with (nan without a scene record)."""
+    and the drum's d / D they were computed with (nan without a scene record), the field
+    null checks and placed liquid's spreading (no rows without fields / placed liquid)."""
 
     cases: pd.DataFrame
     conditions: pd.DataFrame
@@ -52,6 +55,9 @@ class Decided:
     verdict: Verdict
     extrapolated: pd.DataFrame
     size_ratio: float
+    field_null: pd.DataFrame        # the field criterion's null checks (field_null.csv)
+    spreading_cases: pd.DataFrame   # placed liquid's spreading time per case
+    spreading_levels: pd.DataFrame  # and per CG-n level against CG1 (spreading.csv)
 
 
 def look_level(rounds: Rounds) -> tuple[float, str]:
@@ -95,4 +101,12 @@ def decide_study(study: Study, flow: FlowRecord, out: Path) -> Decided:
     write_verdict(verdict, out)
     extrapolated = extrapolation_rows(cases, signed_columns(), ratio)
     atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
-    return Decided(cases, conditions, floors, verdict, extrapolated, ratio)
+    settings = study.analysis
+    null = null_check(cases, case_fields(study.analysis_dir), settings.bootstrap,
+                      settings.seed, settings.field_kernel)
+    atomic_write_text(out / layout.FIELD_NULL_REPORT, null.to_csv(index=False))
+    spread_cases = case_times(flow.cases.values())
+    spread_levels = level_rates(spread_cases)
+    atomic_write_text(out / layout.SPREADING_REPORT, spread_levels.to_csv(index=False))
+    return Decided(cases, conditions, floors, verdict, extrapolated, ratio, null,
+                   spread_cases, spread_levels)

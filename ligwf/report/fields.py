@@ -12,9 +12,8 @@ import numpy as np
 import pandas as pd
 
 from ligwf.analysis.records.fields import CaseFields
-from ligwf.fsio import atomic_write_text
 from ligwf.inference.field_errors import KERNEL_COLUMNS, LAYER_SPEED, MATERIAL_SOLID
-from ligwf.inference.field_tables import case_fields, null_check, twin_cases, wet_group
+from ligwf.inference.field_tables import case_fields, twin_cases, wet_group
 from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.study import layout
 from ligwf.study.case import group_label
@@ -138,16 +137,14 @@ def fields_section(conditions: pd.DataFrame, null: pd.DataFrame, fields: dict[st
     return "\n".join(lines)
 
 
-def fields_report(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame, out: Path
-                  ) -> tuple[str, list[tuple[str, Path]]]:
+def fields_report(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame,
+                  null: pd.DataFrame, out: Path) -> tuple[str, list[tuple[str, Path]]]:
     """The report's flow-field part of a study whose tables are built (``conditions``
-    with the field errors of :func:`add_field_errors`): the null-check table
-    (``layout.FIELD_NULL_REPORT`` in the report folder ``out``), the map figures (in its
-    figures folder) and the section's markdown; returns (markdown, figures)."""
+    with the field errors, ``null`` the null checks: written by
+    :func:`ligwf.inference.decide.decide_study`): the map figures (in the report folder
+    ``out``'s figures folder) and the section's markdown; returns (markdown, figures)."""
     fields = case_fields(study.analysis_dir)
     settings = study.analysis
-    null = null_check(cases, fields, settings.bootstrap, settings.seed, settings.field_kernel)
-    atomic_write_text(out / layout.FIELD_NULL_REPORT, null.to_csv(index=False))
     usable = study.usable_cases()[0]
     drum = usable[0].scaled.drum if usable else None
     sense = rotation_sense(drum.axis, drum.omega) if drum else "?"

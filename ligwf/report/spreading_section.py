@@ -5,7 +5,8 @@ placed liquid in a dry bed (``liquid.placement: granules``); nothing otherwise.
 The engine moves liquid only at bridge ruptures, so liquid spreads by a walk over contacts
 whose step is one particle: about n^2 times faster in physical space at CG-n, which no CG
 rule corrects. The section says how much faster it was measured
-(:mod:`ligwf.inference.spreading`), beside the CG1 seeds' own spread (the null).
+(:mod:`ligwf.inference.spreading`, its tables made by
+:func:`ligwf.inference.decide.decide_study`), beside the CG1 seeds' own spread (the null).
 """
 
 from __future__ import annotations
@@ -14,14 +15,8 @@ import math
 
 import pandas as pd
 
-from ligwf.inference.spreading import LEVEL, case_times, level_rates, spreading_time_meaning
+from ligwf.inference.spreading import LEVEL, spreading_time_meaning
 from ligwf.report.sections import Section
-
-
-def spreading_tables(flow) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(per case, per level) spreading tables of a flow record's cases."""
-    cases = case_times(flow.cases.values())
-    return cases, level_rates(cases)
 
 
 def _num(v, fmt: str = ".3g") -> str:

@@ -40,7 +40,7 @@ from ligwf.report.table_sections import (markdown_tables, noise_markdown, paravi
                                          pooling_markdown, stability_markdown, steady_line)
 from ligwf.report.extrapolation_report import extrapolation_section
 from ligwf.report.scale_section import scale_section
-from ligwf.report.spreading_section import spreading_section, spreading_tables
+from ligwf.report.spreading_section import spreading_section
 from ligwf.report.rounds import rounds_sections
 from ligwf.inference.verdict import Verdict
 from ligwf.inference.decide import decide_study
@@ -73,8 +73,9 @@ class ReportFigures:
 
 
 def write_report(study: Study, out: Path | None = None, snapshots: bool = True) -> Path:
-    """Decide the study (its tables and verdict, :func:`~ligwf.inference.decide.decide_study`) and write the report folder around them; returns it.
-    Reads only: the flow metrics, steady windows and granule tables come from ``ligwf
+    """Have the study decided (its tables and verdict:
+    :func:`~ligwf.inference.decide.decide_study`, written first) and render the report
+    folder around them; returns it. Reads only: the flow metrics, steady windows and granule tables come from ``ligwf
     analyse`` (refused when missing or stale, :func:`checked_analysis`)."""
     out = Path(out) if out else study.report_dir
     flow = checked_analysis(study)
@@ -84,14 +85,14 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
     cases, conditions, floors = decided.cases, decided.conditions, decided.floors
     verdict, extrapolated, ratio = decided.verdict, decided.extrapolated, decided.size_ratio
     problems = study_problems(study)
-    spread_cases, spread_levels = spreading_tables(flow)     # no rows without placed liquid
-    atomic_write_text(out / layout.SPREADING_REPORT, spread_levels.to_csv(index=False))
+    spread_cases, spread_levels = decided.spreading_cases, decided.spreading_levels
     figures = report_figures(study, flow, cases, conditions, out, snapshots, verdict)
     sections = report_sections(study, flow, cases, conditions, floors, problems, figures,
                                verdict, [*extrapolation_section(extrapolated, ratio, cases),
                                          *scale_section(study, conditions),
                                          *spreading_section(spread_cases, spread_levels),
-                                         *flow_field_sections(study, cases, conditions, out)])
+                                         *flow_field_sections(study, cases, conditions,
+                                                             decided.field_null, out)])
     title = f"{study.name}: error against run time"
     preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "
                 "relative to the CG1 cases of the same sweep group; speedup is CG1 production "
@@ -145,10 +146,10 @@ def verdict_sections(verdict: Verdict | None, figure: Figure | None = None) -> l
 
 
 def flow_field_sections(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame,
-                        out: Path) -> list[Section]:
+                        null: pd.DataFrame, out: Path) -> list[Section]:
     """The flow-field maps, errors and null check (:mod:`ligwf.report.fields`: writes its
-    figures and table into the report folder ``out``)."""
-    return split_markdown(fields_report(study, cases, conditions, out)[0])
+    figures into the report folder ``out``)."""
+    return split_markdown(fields_report(study, cases, conditions, null, out)[0])
 
 
 def report_figures(study: Study, flow: FlowRecord, cases: pd.DataFrame,
