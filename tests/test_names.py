@@ -25,9 +25,6 @@ from helpers import ROOT
 PACKAGE = ROOT / "ligwf"
 #: the packages where a seed is a random seed and nothing is a member
 DECIDING = ("inference", "report", "api", "study")
-#: not yet converted to Condition: the GSD stage is reworked on its own branch (issue 48);
-#: drop it from here once that is in
-CONDITION_PENDING = ("analysis/gsd",)
 #: the words of the glossary
 GLOSSARY = ("case", "run", "replica", "seed", "ensemble member", "sweep group", "condition",
             "arm", "look", "round", "budget", "core-hour cap", "Slurm wall-time table",
@@ -130,7 +127,7 @@ def test_a_seed_is_a_random_seed_and_a_run_no_member():
 
 def test_a_condition_is_a_condition_not_a_tuple():
     found = {_rel(p): lines for p in _sources()
-             if _rel(p) != "study/condition.py" and not _rel(p).startswith(CONDITION_PENDING)
+             if _rel(p) != "study/condition.py"
              and (lines := condition_tuples(ast.parse(p.read_text())))}
     assert not found, ("key by ligwf.study.condition.Condition (Condition.of(case), "
                        f"case.condition), not (group, cg, rule): {found}")

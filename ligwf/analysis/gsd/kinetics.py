@@ -63,8 +63,7 @@ def kinetics_summary(kin: pd.DataFrame, settings: AnalysisSettings) -> pd.DataFr
         return pd.DataFrame()
     rng = np.random.default_rng(settings.seed)
     out = []
-    conditions = {Condition(group, float(cg), rule) for group, cg, rule
-                  in kin[["group", "cg", "rule"]].itertuples(index=False)}
+    conditions = {Condition(r.group, float(r.cg), r.rule) for r in kin.itertuples(index=False)}
     for condition in sorted(conditions, key=lambda c: (c.name, *c.key)):
         d = kin[(kin["group"] == condition.group) & (kin["cg"] == condition.cg)
                 & (kin["rule"] == condition.rule)]
