@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ligwf.analysis.flow.registry import METRICS as FLOW_REGISTRY
+from ligwf.analysis.records.metrics import GRANULE_METRICS as GRANULE_SPECS, MetricSpec
 from ligwf.inference.budget import criteria
 from ligwf.inference.field_errors import FIELD_ERRORS
 from ligwf.report.dictionary_entries import COMMON, OVERRIDES
@@ -93,10 +95,13 @@ BAND = ("_lo", "_hi")
 CONDITION = ("_lo", "_hi", "_se", "_floor", "_floor_source", "_vs_floor")
 POOLED = ("_mean", "_min", "_max", "_nan_pools")
 
-#: the flow metrics ligwf registers (ligwf.analysis.flow.registry; a test keeps them in step)
-FLOW_METRICS = ("angle_of_repose", "angle_of_repose_std", "angle_error", "profile_error",
-                "rigid_frame_share", "rms_speed_rel_fluctuation", "flowing_layer_thickness_mean")
-GRANULE_METRICS = ("largest_cluster_fraction", "one_granule_frame_share")
+#: the flow metrics ligwf registers (ligwf.analysis.flow.registry), each documented by its
+#: own MetricSpec (unit, meaning); one registered later (a plug-in) is added where it is
+#: asked for (:func:`tables`)
+FLOW_METRICS = tuple(FLOW_REGISTRY)
+GRANULE_METRICS = tuple(m.name for m in GRANULE_SPECS)
+#: the tables that hold every metric (the flow table its frame metrics only)
+METRIC_TABLES = (layout.CASES_REPORT, layout.CONDITIONS_REPORT)
 #: the field criterion at each reported kernel width (field_errors.KERNEL_COLUMNS)
 FIELD_KERNEL_ERRORS = ("field_error_k1", "field_error_k2", "field_error_k4")
 #: the field criterion's noise pieces, from which its replica plan is made
@@ -209,8 +214,39 @@ TABLES: dict[str, Table] = {
 }
 
 
+def metric_column(spec: MetricSpec) -> Column | None:
+    """A metric's dictionary entry from its specification (None when it documents nothing):
+    its label without the unit the header adds back (``angle [deg]`` -> ``angle``)."""
+    if not spec.meaning:
+        return None
+    label = spec.label.rsplit(" [", 1)[0] if spec.label.endswith("]") else spec.label
+    return Column(spec.name, spec.unit or "1", label, spec.meaning, spec.shown)
+
+
+def _metric_specs() -> dict[str, MetricSpec]:
+    return {**{m.name: m for m in GRANULE_SPECS}, **FLOW_REGISTRY}
+
+
 def _base(table: str | None, name: str) -> Column | None:
-    return (_OVERRIDES.get(table or "", {}).get(name) or _COMMON.get(name))
+    found = _OVERRIDES.get(table or "", {}).get(name) or _COMMON.get(name)
+    if found is None and (spec := _metric_specs().get(name)) is not None:
+        found = metric_column(spec)
+    return found
+
+
+def tables() -> dict[str, Table]:
+    """:data:`TABLES` with the flow metrics registered after it was made (plug-ins):
+    each in the case and condition tables, a frame metric also in the flow table."""
+    later = [m for name, m in FLOW_REGISTRY.items() if name not in FLOW_METRICS]
+    if not later:
+        return TABLES
+    out = dict(TABLES)
+    for name in METRIC_TABLES:
+        out[name] = replace(out[name], columns=(*out[name].columns, *(m.name for m in later)))
+    flow = out[layout.FLOW_TABLE]
+    out[layout.FLOW_TABLE] = replace(flow, columns=(
+        *flow.columns, *(m.name for m in later if not m.is_error)))
+    return out
 
 
 def column(name: str, table: str | None = None) -> Column | None:
@@ -233,7 +269,7 @@ def column(name: str, table: str | None = None) -> Column | None:
 def documented(table: str, name: str) -> bool:
     """Whether ``docs/data_dictionary.md`` lists ``name`` in ``table``: one of its columns,
     or one of them with a suffix (prefix) of its families, and known to :func:`column`."""
-    t = TABLES[table]
+    t = tables()[table]
     if column(name, table) is None:
         return False
     if name in t.columns:
@@ -325,7 +361,8 @@ def dictionary_markdown() -> str:
     label and meaning; then the suffix rules."""
     lines = ["# Data dictionary", "",
              "Every column of every table ligwf writes, generated from "
-             "`ligwf/report/dictionary_entries.py` by `ligwf schema --dictionary "
+             "`ligwf/report/dictionary_entries.py` and the metrics' own specifications "
+             "(`ligwf/analysis/flow/registry.py`, `ligwf/analysis/records/metrics.py`) by `ligwf schema --dictionary "
              "docs/data_dictionary.md` (do not edit; `tests/report/test_dictionary.py` fails "
              "when it is out of date or a real table has a column missing here). Units are "
              "SI: `1` a ratio, share or fraction, `count` a whole number, `flag` true / "
@@ -335,7 +372,7 @@ def dictionary_markdown() -> str:
              "the [names](architecture.md#names) of the architecture page say: a column's "
              "name is a public format and keeps its spelling, its meaning uses those words.",
              ""]
-    for name, t in TABLES.items():
+    for name, t in tables().items():
         lines += [f"## `{t.folder}/{name}`", "", f"One row per {t.row}."
                   + (f" Columns may carry the suffixes {', '.join(f'`{f}`' for f in t.families)}"
                      " (see the end of this page)." if t.families else ""), "",

@@ -72,33 +72,15 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("steady_fraction", "1", "steady from", "share of production left out as start-up before "
      "the steady window"),
     ("steady_from_step", "step", "steady from step", "first step of the steady window"),
-    ("angle_of_repose", "deg", "angle", "dynamic angle of repose of the free surface (signed: "
-     "positive rising towards the wall that moves up): of a case, the mean of its steady "
-     "frames' angles (frames where a surface was fitted); of a condition, the mean over its "
-     "replicas"),
-    ("angle_of_repose_std", "deg", "angle std", "standard deviation of the angle of repose over "
-     "the steady frames"),
-    ("angle_error", "1", "angle err", "relative error of the angle of repose against the "
-     "group's CG1 mean, |a - a1| / a1"),
-    ("profile_error", "1", "profile err (L2)", "relative L2 error of the velocity profile along "
-     "the normalised depth against the group's CG1 profile"),
     ("com_angle_mean", "deg", "COM angle", "angle of the bed's centre of mass from the vertical, "
      "mean over the steady window"),
     ("com_angle_std", "deg", "COM angle std", "its standard deviation over the steady frames"),
-    ("rigid_frame_share", "1", "rigid frames", "share of steady frames in which most of the bed "
-     "turns with the drum as a rigid block"),
     ("rigid_fraction_mean", "1", "rigid share", "mean share of the bed moving rigidly with the "
      "drum"),
     ("rms_speed_mean", "m/s", "rms speed", "root-mean-square particle speed, mean over the "
      "steady window"),
-    ("rms_speed_rel_fluctuation", "1", "rms speed fluctuation", "relative fluctuation (std / "
-     "mean) of the rms speed over the steady frames"),
     ("kinetic_energy_mean", "J", "kinetic energy", "kinetic energy of the bed, mean over the "
      "steady window"),
-    ("flowing_layer_thickness_mean", "m", "flowing layer", "mass-equivalent thickness of the "
-     "flowing layer (the grains above the depth where the velocity profile changes sign, "
-     "over the packing of the bed below it: no fitted surface in it, so the same layer reads "
-     "the same at every grain size), mean over the steady window", "mm"),
     ("flowing_layer_speed_mean", "m/s", "flowing-layer speed", "mean speed in the flowing layer"),
     # granules
     ("contacts", "count", "contacts", "particle-particle contacts and bridges in the contact "
@@ -108,10 +90,6 @@ COMMON: tuple[tuple[str, ...], ...] = (
     ("largest_fraction", "1", "largest cluster", "share of the bed in the largest granule"),
     ("largest_percolates", "flag", "largest percolates", "the largest granule closes a cycle "
      "around the periodic axis (bed-spanning)"),
-    ("largest_cluster_fraction", "1", "largest cluster", "share of the bed in the largest "
-     "granule, mean over the steady frames"),
-    ("one_granule_frame_share", "1", "one-granule frames", "share of steady frames in which one "
-     "granule holds more than 99 % of the bed"),
     ("largest_granule", "1", "largest granule", "share of the bed in the largest counted "
      "(non-percolating) granule"),
     ("granule_share", "1", "bed in granules", "share of the bed's solid volume in counted "

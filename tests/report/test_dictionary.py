@@ -46,8 +46,7 @@ def test_declared_columns_of_the_analysis_tables_are_documented():
 def test_every_registered_metric_is_in_the_dictionary_and_the_report_tables():
     names = [*METRICS, *(m.name for m in GRANULE_METRICS)]
     assert set(names) == {*dic.FLOW_METRICS, *dic.GRANULE_METRICS}, (
-        "a metric without a dictionary entry: add (name, unit, label, meaning) to "
-        "ligwf/report/dictionary_entries.py COMMON and the name to dictionary.FLOW_METRICS, "
+        "a metric without a dictionary entry: give its MetricSpec a unit and a meaning, "
         "then `ligwf schema --dictionary docs/data_dictionary.md`")
     for name in names:
         assert dic.documented(layout.CONDITIONS_REPORT, name), name
@@ -189,3 +188,50 @@ def test_the_field_columns_of_the_dictionary_are_the_ones_the_report_writes():
     assert dic.FIELD_KERNEL_ERRORS == tuple(field_errors.KERNEL_COLUMNS.values())
     for column in (*dic.FIELD_NOISE, *dic.FIELD_KERNEL_ERRORS):
         assert not undocumented(layout.CONDITIONS_REPORT, [column]), column
+
+
+def test_a_metric_is_documented_by_its_own_declaration():
+    """Issue 48 item 4: a flow metric registered with a unit and a meaning is in the
+    dictionary's flow, case and condition tables with its header, and in the generated page,
+    with nothing else edited; one registered without a meaning is not documented (the
+    real-table check then names it); unregistered, it is gone again."""
+    from ligwf.analysis.flow import registry
+    from ligwf.analysis.records.metrics import POSITIVE, MetricSpec
+    from ligwf.analysis.records.statistics import MEAN
+
+    def top(frame, geo, flow):
+        return float(frame.positions[:, 2].max())
+
+    spec = MetricSpec("bed_top_doc", "bed top [m]", "bed_top_doc", MEAN, POSITIVE, unit="m",
+                      shown="mm", meaning="height of the highest particle centre")
+    registry.register(spec, top)
+    try:
+        for table in (layout.FLOW_TABLE, layout.CASES_REPORT, layout.CONDITIONS_REPORT):
+            assert dic.documented(table, "bed_top_doc"), table
+        assert dic.documented(layout.CONDITIONS_REPORT, "bed_top_doc_lo")
+        assert dic.header("bed_top_doc") == "bed top [mm]"
+        assert dic.shown_value("bed_top_doc", 0.002) == 2.0
+        page = dic.dictionary_markdown()
+        assert "| `bed_top_doc` | m | mm | bed top | height of the highest particle centre |" in page
+        assert not dic.documented(layout.GSD_TABLE, "bed_top_doc")
+    finally:
+        registry.unregister(spec.name)
+    assert not dic.documented(layout.CASES_REPORT, "bed_top_doc")
+    assert "bed_top_doc" not in dic.dictionary_markdown()
+    bare = MetricSpec("bed_top_bare", "bed top [m]", "bed_top_bare", MEAN, POSITIVE)
+    registry.register(bare, top)
+    try:
+        assert not dic.documented(layout.CASES_REPORT, "bed_top_bare")
+    finally:
+        registry.unregister(bare.name)
+
+
+def test_metric_documentation_is_not_stored_in_the_flow_record():
+    from ligwf.analysis.flow.registry import METRICS
+    from ligwf.analysis.records.metrics import MetricSpec
+
+    spec = METRICS["flowing_layer_thickness_mean"]
+    stored = spec.to_json()
+    assert not {"unit", "meaning", "shown"} & set(stored)
+    back = MetricSpec.from_json(stored)
+    assert back.meaning == "" and back.statistic == spec.statistic and back.label == spec.label

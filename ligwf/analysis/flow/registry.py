@@ -5,8 +5,12 @@ A flow metric is one function of a frame plus one registration line::
     def bed_height(frame, geo, flow):      # ParticleFrame, DrumGeometry, FrameFlow -> float
         return float(frame.positions[:, 2].max())
 
-    register(MetricSpec("bed_height", "bed height [m]", "bed_height", MEAN, POSITIVE),
+    register(MetricSpec("bed_height", "bed height [m]", "bed_height", MEAN, POSITIVE,
+                        unit="m", meaning="height of the highest particle centre"),
              bed_height)
+
+(``unit`` and ``meaning``: its entry in the data dictionary, which lists every registered
+metric in the flow, case and condition tables.)
 
 The analysis stage evaluates every registered series on every production frame that
 passed its checks, keeps the steady window's values per case in the flow record with the
@@ -85,15 +89,33 @@ def _profile(frame, geo, flow):
     return flow.profile_v
 
 
-register(MetricSpec("angle_of_repose", "angle [deg]", "angle", st.MEAN, (-90.0, 90.0)), _angle)
+register(MetricSpec("angle_of_repose", "angle [deg]", "angle", st.MEAN, (-90.0, 90.0),
+                    unit="deg", meaning=(
+        "dynamic angle of repose of the free surface (signed: positive rising towards the wall "
+        "that moves up): of a case, the mean of its steady frames' angles (frames where a surface"
+        " was fitted); of a condition, the mean over its replicas")), _angle)
 register(MetricSpec("angle_of_repose_std", "angle std [deg]", "angle", st.STD, POSITIVE,
-                    tables=(CASE_TABLE,)))
-register(MetricSpec("angle_error", "angle err", "angle", st.RELATIVE_ERROR, POSITIVE))
+                    tables=(CASE_TABLE,), unit="deg", meaning=(
+        "standard deviation of the angle of repose over the steady frames")))
+register(MetricSpec("angle_error", "angle err", "angle", st.RELATIVE_ERROR, POSITIVE,
+                    unit="1", meaning=(
+        "relative error of the angle of repose against the group's CG1 mean, |a - a1| / a1")))
 register(MetricSpec("profile_error", "profile err (L2)", "profile", st.RELATIVE_L2, POSITIVE,
-                    condition_label="profile err"), _profile)
+                    condition_label="profile err", unit="1", meaning=(
+        "relative L2 error of the velocity profile along the normalised depth against the group's"
+        " CG1 profile")), _profile)
 register(MetricSpec("rigid_frame_share", "rigid frames", "rigid", st.SHARE_ABOVE, UNIT,
-                    threshold=RIGID_FRAME_SHARE), _rigid)
+                    threshold=RIGID_FRAME_SHARE, unit="1", meaning=(
+        "share of steady frames in which most of the bed turns with the drum as a rigid block")),
+         _rigid)
 register(MetricSpec("rms_speed_rel_fluctuation", "rms speed fluctuation", "rms",
-                    st.RELATIVE_FLUCTUATION, POSITIVE, tables=()), _rms)
+                    st.RELATIVE_FLUCTUATION, POSITIVE, tables=(),
+                    unit="1", meaning=(
+        "relative fluctuation (std / mean) of the rms speed over the steady frames")), _rms)
 register(MetricSpec("flowing_layer_thickness_mean", "flowing layer [m]", "flowing_layer",
-                    st.MEAN, POSITIVE, tables=()), _flowing_layer)
+                    st.MEAN, POSITIVE, tables=(), unit="m", shown="mm", meaning=(
+        "mass-equivalent thickness of the flowing layer (the grains above the depth where the "
+        "velocity profile changes sign, over the packing of the bed below it: no fitted surface "
+        "in it, so the same layer reads the same at every grain size), mean over the steady "
+        "window")),
+         _flowing_layer)

@@ -33,7 +33,11 @@ class MetricSpec:
     gets the CG1 noise floor); ``bounds``: the quantity's range (intervals stay inside);
     ``threshold``: of ``share_above``; ``tables``: the markdown tables that show it (every
     metric is in the CSV tables); ``condition_label``: a shorter header in the condition
-    table.
+    table. ``unit`` (SI, as the data dictionary writes units: ``1`` for a ratio or share),
+    ``meaning`` and ``shown`` (the unit the report prints, empty: ``unit``) are the metric's
+    entry in the data dictionary (:mod:`ligwf.report.dictionary` reads them from the
+    registry, so a new metric is documented where it is declared); they are not stored in
+    the flow record.
     """
 
     name: str
@@ -44,6 +48,9 @@ class MetricSpec:
     threshold: float | None = None
     tables: tuple[str, ...] = (CASE_TABLE, CONDITION_TABLE)
     condition_label: str | None = None
+    unit: str = ""
+    meaning: str = ""
+    shown: str = ""
 
     def __post_init__(self) -> None:
         if self.statistic not in st.FRAME_STATISTICS + st.ERROR_STATISTICS:
@@ -68,7 +75,7 @@ class MetricSpec:
         return (self.condition_label or self.label) if table == CONDITION_TABLE else self.label
 
     def to_json(self) -> dict:
-        d = asdict(self)
+        d = {k: v for k, v in asdict(self).items() if k not in DOCUMENTATION}
         d["bounds"] = [None if math.isinf(b) else b for b in self.bounds]
         d["tables"] = list(self.tables)
         return d
@@ -81,12 +88,20 @@ class MetricSpec:
                       "tables": tuple(d.get("tables", ()))})
 
 
+#: the fields of a MetricSpec that document it (the data dictionary's), not stored with data
+DOCUMENTATION = ("unit", "meaning", "shown")
+#: the granule metrics' meanings (their data dictionary entries)
+LARGEST_MEANING = (
+    "share of the bed in the largest granule, mean over the steady frames")
+ONE_GRANULE_MEANING = (
+    "share of steady frames in which one granule holds more than 99 % of the bed")
 #: a frame where one granule holds more than this share of the bed
 ONE_GRANULE = 0.99
 #: the granule frame table's series (largest granule's share of the bed per frame)
 LARGEST_SERIES = "largest"
 GRANULE_METRICS = (
-    MetricSpec("largest_cluster_fraction", "largest cluster", LARGEST_SERIES, st.MEAN, UNIT),
+    MetricSpec("largest_cluster_fraction", "largest cluster", LARGEST_SERIES, st.MEAN, UNIT,
+               unit="1", meaning=LARGEST_MEANING),
     MetricSpec("one_granule_frame_share", "one-granule frames", LARGEST_SERIES, st.SHARE_ABOVE,
-               UNIT, threshold=ONE_GRANULE, tables=()),
+               UNIT, threshold=ONE_GRANULE, tables=(), unit="1", meaning=ONE_GRANULE_MEANING),
 )
