@@ -7,11 +7,12 @@ This is the one place a study's statistics are computed: the report
 (:func:`ligwf.report.write.write_report`) renders what :func:`decide_study` returns and
 wrote, and the API (:func:`ligwf.api.open_study`) reads the same files back (the verdict
 through :func:`~ligwf.inference.verdict_records.read_verdict`). What it reads besides the
-analysis:
-the granule controls (:mod:`ligwf.analysis.records.controls`), the runs' noise and prices
-(:func:`~ligwf.inference.planning.noise_table`), the level each test is run at (a sequential
-study's looks: :func:`look_level`), and the drum's size ratio and the planner's CG1 speedup
-per level (:func:`extrapolation_inputs`) for a sweep judged against an extrapolated CG1.
+analysis' flow record and tables: the granule controls
+(:mod:`ligwf.analysis.records.controls`), the field archive, the runs' noise and prices
+(:func:`~ligwf.inference.planning.noise_table`), the level each test is run at (a
+sequential study's looks: :func:`look_level`), and the drum's size ratio and the planner's
+CG1 speedup per level (:func:`extrapolation_inputs`) for a sweep judged against an
+extrapolated CG1.
 """
 
 from __future__ import annotations
