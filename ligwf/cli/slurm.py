@@ -55,7 +55,8 @@ from ligwf.engine.progress import shown_reason
 from ligwf.engine.site import EngineConfig
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import prepared_loads
-from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_submit
+from ligwf.pipeline.submit import (plan_resubmission, plan_split_analysis, plan_submission,
+                                   write_for_submit)
 from ligwf.slurm.assumptions import site_assumptions
 from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
                                 plan_rows, slab_note, slurm_time_seconds)
@@ -208,20 +209,16 @@ def submit_analysis(args: argparse.Namespace, count: int) -> int:
     """``ligwf analyse STUDY --executor slurm --tasks N`` (``--slurm N``): plan (and unless
     ``--dry-run`` submit) the analysis array of ``count`` shares and its merge job; returns
     once they are submitted (the token and the logs printed)."""
-    from ligwf.analysis.outputs import new_token
-
-    study = Study.open(args.run_dir)
-    token = new_token()
     scheduler = build_executor(SLURM)
-    planned = scheduler.plan_analysis(study.path, study.path.name, count, token)
+    split = plan_split_analysis(Study.open(args.run_dir), scheduler, count)
     if args.dry_run:
-        print(scheduler.dry_run_text(planned))
+        print(scheduler.dry_run_text(list(split.jobs)))
         return 0
     scheduler.require()
-    entries = scheduler.submit(study.path, planned)
+    entries = split.submit(scheduler)
     array, merge = entries[0]["job_id"], entries[-1]["job_id"]
     print(f"submitted analysis array {array} ({count} task(s)) and merge job {merge} "
-          f"(token {token}); logs in {study.path / layout.SLURM_LOG_DIR}")
+          f"(token {split.token}); logs in {split.study_dir / layout.SLURM_LOG_DIR}")
     return 0
 
 
