@@ -247,8 +247,14 @@ def status_table(study_dir: Path) -> tuple[Table, dict]:
 
 
 def cmd_status(args: argparse.Namespace) -> int:
-    table, data = status_table(args.study_dir)
-    if args.json:
+    return show_status(args.study_dir, args.json)       # = ligwf status --executor slurm
+
+
+def show_status(study_dir: Path, as_json: bool = False) -> int:
+    """Each case's manifest, its Slurm task and what it needs next, the follow-up jobs,
+    the counts and whether the analysis is due (``as_json``: all of it as JSON)."""
+    table, data = status_table(study_dir)
+    if as_json:
         print(json.dumps(data, indent=2, default=str))
         return 0
     console.print(table)
@@ -306,13 +312,19 @@ def cmd_next_round(args: argparse.Namespace) -> int:
 
 
 def cmd_cancel(args: argparse.Namespace) -> int:
-    study_dir: Path = args.study_dir.resolve()
+    return cancel_study(args.study_dir)                 # = ligwf cancel --executor slurm
+
+
+def cancel_study(study: Path) -> int:
+    """scancel the study's queued and running jobs and say which (the cases resume on
+    ``resubmit``)."""
+    study_dir = Path(study).resolve()
     ids = study_executor(SLURM, study_dir).cancel(study_dir)
     if not ids:
         console.print("nothing to cancel: no job of this study is queued or running")
         return 0
     console.print(f"cancelled job(s) {', '.join(ids)}: running cases write their forced "
-                  f"restarts and are marked killed; 'ligwf slurm resubmit {args.study_dir}' "
+                  f"restarts and are marked killed; 'ligwf slurm resubmit {study}' "
                   "resumes them")
     return 0
 
