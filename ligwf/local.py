@@ -41,6 +41,7 @@ from ligwf.study import layout
 from ligwf.study.case import CaseFolder
 from ligwf.study.manifest import (MISSING, RUNNING, case_busy, case_lock, effective_status,
                                   runner_alive)
+from ligwf.scheduler import wait_for
 from ligwf.study.study import Study
 
 #: Seconds between looks at cases another runner holds.
@@ -272,9 +273,8 @@ class LocalExecutor:
                          f"{index}/{tasks}", "--token", token],
                         stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                         env=env))
-            while any(p.poll() is None for p in procs):
-                if stop.wait(WAIT_SECONDS):
-                    return None
+            if wait_for(lambda: any(p.poll() is None for p in procs), stop, WAIT_SECONDS):
+                return None
         finally:            # stopped, or an error here: no share computes on for nobody
             for p in procs:
                 if p.poll() is None:

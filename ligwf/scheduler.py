@@ -33,17 +33,20 @@ Which cases a resubmit runs again is not the scheduler's to say: it is what
 :func:`ligwf.eligibility.eligible` says of the case folders, with the cases whose task the
 scheduler still has queued or running held.
 
-The case's outcome is always its manifest: the scheduler only says whether a task is still
-queued or running. The Slurm implementation is :class:`ligwf.slurm.scheduler.SlurmScheduler`;
+Where an executor waits (a scheduler for the arrays it submitted, this machine for the
+analysis shares it started) it waits in :func:`wait_for`. The case's outcome is always its
+manifest: the scheduler only says whether a task is still queued or running. The Slurm implementation is :class:`ligwf.slurm.scheduler.SlurmScheduler`;
 the pipeline (:mod:`ligwf.pipeline.submit`) chains preparation, rank plan and scheduler.
 """
 
 from __future__ import annotations
 
+import threading
+import time
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import Iterable, Mapping, Protocol, Sequence, runtime_checkable
+from typing import Callable, Iterable, Mapping, Protocol, Sequence, runtime_checkable
 
 
 class CaseView(Protocol):
@@ -78,6 +81,26 @@ def queued_tasks(status: StudyStatus) -> dict[int, str]:
     """Case index -> the task still holding it (pending or running), for
     :func:`ligwf.eligibility.eligible`."""
     return {c.index: c.job or "?" for c in status.cases if c.queued}
+
+
+def wait_for(pending: Callable[[], bool], stop: threading.Event, poll_seconds: float,
+             on_stop: Callable[[], object] | None = None) -> bool:
+    """The one wait loop of the executors: ask ``pending()`` every ``poll_seconds`` until
+    it says nothing is pending. The first time ``stop`` is set, ``on_stop`` runs once
+    (cancel what runs: the wait then goes on until it has ended) or, without one, the wait
+    returns at once. Whether ``stop`` ended or interrupted it."""
+    stopped = False
+    while pending():
+        if stop.is_set() and not stopped:
+            stopped = True
+            if on_stop is None:
+                return True
+            on_stop()
+        if stopped:             # stop stays set: pace the looks until what runs has ended
+            time.sleep(poll_seconds)
+        else:
+            stop.wait(poll_seconds)
+    return stopped
 
 
 @runtime_checkable

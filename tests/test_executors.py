@@ -1,16 +1,19 @@
 """The executor registry (ligwf.executors): executors are picked by name, each from its own
-frozen settings; an unknown name or another executor's settings is one line."""
+frozen settings; an unknown name or another executor's settings is one line; and the one
+wait loop of the executors."""
 
 from __future__ import annotations
 
 import dataclasses
+import threading
+import time
 
 import pytest
 
 from ligwf.errors import ConfigError
 from ligwf.executors import EXECUTORS, LOCAL, build_executor, executor_kind, study_executor
 from ligwf.local import LocalExecutor, RunSettings
-from ligwf.scheduler import Executor, Scheduler
+from ligwf.scheduler import Executor, Scheduler, wait_for
 from ligwf.slurm.jobs import append_record
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite
@@ -74,3 +77,27 @@ def test_a_study_keeps_the_slurm_settings_it_was_submitted_with(monkeypatch, tmp
     site = study_executor("slurm", study).site
     assert (site.partition, site.modules, site.ntasks) == ("recorded", ("openmpi/4.1",), 4)
     assert type(study_executor(LOCAL, study)) is LocalExecutor
+
+
+def test_the_one_wait_loop_asks_until_nothing_is_pending():
+    answers = iter([True, True, False])
+    assert wait_for(lambda: next(answers), threading.Event(), 0.001) is False
+    # stopped without a way to cancel: returns at once, asked once
+    stop = threading.Event()
+    stop.set()
+    asked = []
+    assert wait_for(lambda: asked.append(1) or True, stop, 0.001) is True and asked == [1]
+    # stopped with one: cancels once, then waits until what ran has ended
+    left, cancelled = [5], []
+
+    def pending() -> bool:
+        left[0] -= 1
+        return left[0] > 0
+    assert wait_for(pending, stop, 0.001, lambda: cancelled.append(1)) is True
+    assert cancelled == [1] and left == [0]
+    # a stop set while it waits interrupts the wait (no full poll interval slept)
+    later = threading.Event()
+    threading.Timer(0.05, later.set).start()
+    t0 = time.monotonic()
+    assert wait_for(lambda: True, later, 30.0) is True
+    assert time.monotonic() - t0 < 10

@@ -1,13 +1,15 @@
 """The command line's face of the executor registry (:mod:`ligwf.executors`): ``--executor
-NAME`` on ``ligwf study`` and ``ligwf analyse``, the options that set one executor's
+NAME`` on ``ligwf study``, ``analyse``, ``status`` and ``cancel``, the options that set one executor's
 settings (refused in one line with another), and what a batch scheduler's sub-commands do
-for those two commands (``ligwf study --executor slurm`` is ``ligwf slurm submit``,
-``ligwf analyse --executor slurm --tasks N`` is ``ligwf analyse --slurm N``: the same code).
+for them (``ligwf study --executor slurm`` is ``ligwf slurm submit``, ``ligwf analyse
+--executor slurm --tasks N`` is ``ligwf analyse --slurm N``, ``ligwf status|cancel
+--executor slurm`` are ``ligwf slurm status|cancel``: the same code).
 """
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Callable, Mapping
 
 from ligwf.cli import slurm
@@ -36,6 +38,12 @@ SUBMIT_STUDY: Mapping[str, Callable[[argparse.Namespace], int]] = {
 #: scheduler (submit the shares and their merge); the local executor runs them here
 SUBMIT_ANALYSIS: Mapping[str, Callable[[argparse.Namespace, int], int]] = {
     slurm.SLURM: slurm.submit_analysis}
+
+
+#: executor -> what ``ligwf status STUDY --executor NAME`` shows (``ligwf slurm status``)
+SHOW_STATUS: Mapping[str, Callable[[Path], int]] = {slurm.SLURM: slurm.show_status}
+#: executor -> what ``ligwf cancel STUDY --executor NAME`` does (``ligwf slurm cancel``)
+CANCEL: Mapping[str, Callable[[Path], int]] = {slurm.SLURM: slurm.cancel_study}
 
 
 def add_executor_arg(p: argparse.ArgumentParser, what: str) -> None:

@@ -25,7 +25,8 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
                               folder_to_write, plan_table, prepare_from_args,
                               print_warning, rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
-from ligwf.executors import LOCAL, build_executor
+from ligwf.cli.executors import CANCEL, SHOW_STATUS, add_executor_arg
+from ligwf.executors import LOCAL, build_executor, executor_kind
 from ligwf.local import run_settings
 from ligwf.pipeline.run import StudyRun, run_case_of, start_run
 from ligwf.study.study import Study
@@ -104,6 +105,8 @@ def cmd_run_case(args: argparse.Namespace) -> int:
 
 
 def cmd_status(args: argparse.Namespace) -> int:
+    if (name := executor_kind(args.executor).name) != LOCAL:
+        return SHOW_STATUS[name](args.study)
     study = Study.open(args.study)
     console.print(summary_table(study.cases, f"{args.study}: {len(study.cases)} case(s)"))
     for case in study.cases:             # an edited record: its results are not used
@@ -118,7 +121,10 @@ def cmd_status(args: argparse.Namespace) -> int:
 
 
 def cmd_cancel(args: argparse.Namespace) -> int:
-    """SIGTERM the live runners of a study on this machine (the local executor's cancel)."""
+    """SIGTERM the live runners of a study on this machine (the local executor's cancel);
+    another executor's cancel with ``--executor``."""
+    if (name := executor_kind(args.executor).name) != LOCAL:
+        return CANCEL[name](args.study)
     Study.open(args.study)          # a folder that is no study: one line, nothing sent
     sent = build_executor(LOCAL).cancel(args.study)
     if not sent:
@@ -172,10 +178,12 @@ def register(subparsers) -> None:
 
     p = subparsers.add_parser("status", help="list the cases of a study folder and their state")
     p.add_argument("study", type=Path, help="study folder")
+    add_executor_arg(p, "the cases: whose view is shown beside the manifests")
     p.set_defaults(func=cmd_status)
 
     p = subparsers.add_parser("cancel", help="stop the ligwf runners of a study folder on this "
                               "machine (SIGTERM: forced restarts, cases killed; the same run "
                               "command resumes them)")
     p.add_argument("study", type=Path, help="study folder")
+    add_executor_arg(p, "the cases: what is stopped")
     p.set_defaults(func=cmd_cancel)

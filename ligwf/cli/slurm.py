@@ -55,7 +55,8 @@ from ligwf.engine.progress import shown_reason
 from ligwf.engine.site import EngineConfig
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import prepared_loads
-from ligwf.pipeline.submit import plan_resubmission, plan_submission, write_for_submit
+from ligwf.pipeline.submit import (plan_resubmission, plan_split_analysis, plan_submission,
+                                   write_for_submit)
 from ligwf.slurm.assumptions import site_assumptions
 from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
                                 plan_rows, slab_note, slurm_time_seconds)
@@ -208,20 +209,16 @@ def submit_analysis(args: argparse.Namespace, count: int) -> int:
     """``ligwf analyse STUDY --executor slurm --tasks N`` (``--slurm N``): plan (and unless
     ``--dry-run`` submit) the analysis array of ``count`` shares and its merge job; returns
     once they are submitted (the token and the logs printed)."""
-    from ligwf.analysis.outputs import new_token
-
-    study = Study.open(args.run_dir)
-    token = new_token()
     scheduler = build_executor(SLURM)
-    planned = scheduler.plan_analysis(study.path, study.path.name, count, token)
+    split = plan_split_analysis(Study.open(args.run_dir), scheduler, count)
     if args.dry_run:
-        print(scheduler.dry_run_text(planned))
+        print(scheduler.dry_run_text(list(split.jobs)))
         return 0
     scheduler.require()
-    entries = scheduler.submit(study.path, planned)
+    entries = split.submit(scheduler)
     array, merge = entries[0]["job_id"], entries[-1]["job_id"]
     print(f"submitted analysis array {array} ({count} task(s)) and merge job {merge} "
-          f"(token {token}); logs in {study.path / layout.SLURM_LOG_DIR}")
+          f"(token {split.token}); logs in {split.study_dir / layout.SLURM_LOG_DIR}")
     return 0
 
 
@@ -250,8 +247,14 @@ def status_table(study_dir: Path) -> tuple[Table, dict]:
 
 
 def cmd_status(args: argparse.Namespace) -> int:
-    table, data = status_table(args.study_dir)
-    if args.json:
+    return show_status(args.study_dir, args.json)       # = ligwf status --executor slurm
+
+
+def show_status(study_dir: Path, as_json: bool = False) -> int:
+    """Each case's manifest, its Slurm task and what it needs next, the follow-up jobs,
+    the counts and whether the analysis is due (``as_json``: all of it as JSON)."""
+    table, data = status_table(study_dir)
+    if as_json:
         print(json.dumps(data, indent=2, default=str))
         return 0
     console.print(table)
@@ -309,13 +312,19 @@ def cmd_next_round(args: argparse.Namespace) -> int:
 
 
 def cmd_cancel(args: argparse.Namespace) -> int:
-    study_dir: Path = args.study_dir.resolve()
+    return cancel_study(args.study_dir)                 # = ligwf cancel --executor slurm
+
+
+def cancel_study(study: Path) -> int:
+    """scancel the study's queued and running jobs and say which (the cases resume on
+    ``resubmit``)."""
+    study_dir = Path(study).resolve()
     ids = study_executor(SLURM, study_dir).cancel(study_dir)
     if not ids:
         console.print("nothing to cancel: no job of this study is queued or running")
         return 0
     console.print(f"cancelled job(s) {', '.join(ids)}: running cases write their forced "
-                  f"restarts and are marked killed; 'ligwf slurm resubmit {args.study_dir}' "
+                  f"restarts and are marked killed; 'ligwf slurm resubmit {study}' "
                   "resumes them")
     return 0
 

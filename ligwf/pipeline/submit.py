@@ -1,10 +1,12 @@
 """The pipeline on a batch scheduler: prepare, plan the ranks, write, submit.
 
-``ligwf slurm submit`` = :func:`~ligwf.pipeline.prepare.prepare_workflow` (the same
-validation, rendering and pre-flight as ``ligwf study``, before anything is written or
-submitted) + :func:`plan_submission` + :func:`write_for_submit` +
-:meth:`Submission.submit`; ``ligwf slurm resubmit`` =
-:func:`plan_resubmission` + :meth:`Resubmission.submit`. The ranks of every case come from
+``ligwf study --executor slurm`` (``ligwf slurm submit``) =
+:func:`~ligwf.pipeline.prepare.prepare_workflow` (the same validation, rendering and
+pre-flight as ``ligwf study``, before anything is written or submitted) +
+:func:`plan_submission` + :func:`write_for_submit` + :meth:`Submission.submit`; ``ligwf
+slurm resubmit`` = :func:`plan_resubmission` + :meth:`Resubmission.submit`; ``ligwf
+analyse STUDY --executor slurm --tasks N`` = :func:`plan_split_analysis` +
+:meth:`SplitAnalysis.submit`. The ranks of every case come from
 the same planner as a local run (:func:`ligwf.engine.plan.allocation_schedule`: each case
 in an allocation of its own, at most ``cores`` ranks if given), or ``--ntasks`` / the
 site's fixed task count; the scheduler (:class:`ligwf.scheduler.Scheduler`) builds one
@@ -151,3 +153,29 @@ def rerun_jobs(study: Study, scheduler: Scheduler, indices: Sequence[int], cores
     return scheduler.plan_jobs(study.path, study.name, JobRound(
         tuple(indices), scheduler.next_round(study.path), ranks, tuple(steps), cores,
         analysis_tasks, _token(analysis_tasks), study_round))
+
+
+@dataclass(frozen=True)
+class SplitAnalysis:
+    """A written study's analysis as a scheduler's array of ``tasks`` shares staged under
+    ``token`` and the job that merges them: the scripts."""
+
+    study_dir: Path
+    token: str
+    tasks: int
+    jobs: tuple[BatchJob, ...]
+
+    def submit(self, scheduler: Scheduler) -> list[dict]:
+        """Submit the array and the merge job after it; the recorded entries."""
+        return scheduler.submit(self.study_dir, self.jobs)
+
+
+def plan_split_analysis(study: Study, scheduler: Scheduler, tasks: int) -> SplitAnalysis:
+    """The analysis of ``study`` split into ``tasks`` shares on ``scheduler`` (pure apart
+    from drawing a fresh staging token): each array task computes one share (``ligwf
+    analyse --part K/N``), the merge job writes the same tables as one analysis."""
+    from ligwf.analysis.outputs import new_token
+
+    token = new_token()
+    jobs = scheduler.plan_analysis(study.path, study.path.name, tasks, token)
+    return SplitAnalysis(study.path, token, tasks, tuple(jobs))

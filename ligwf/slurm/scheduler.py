@@ -7,7 +7,6 @@ cancel) and of any executor (run cases and wait for them), with the site setting
 from __future__ import annotations
 
 import threading
-import time
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, ClassVar, Sequence
@@ -15,7 +14,7 @@ from typing import Callable, ClassVar, Sequence
 from ligwf.engine.plan import allocation_schedule, case_load
 from ligwf.errors import SubmitError
 from ligwf.eligibility import eligible
-from ligwf.scheduler import JobRound
+from ligwf.scheduler import JobRound, wait_for
 from ligwf.slurm.jobs import (PlannedJob, Runner, StudyStatus, dry_run_text, next_round,
                               plan_analysis_array, plan_jobs, read_record, recorded_plan,
                               require_scheduler, run_command, study_status, submit_jobs)
@@ -78,13 +77,8 @@ class SlurmScheduler:
         """Look at the queue every ``poll_seconds`` while ``pending(status)``; ``stop`` set:
         cancel the study's jobs once and go on waiting until Slurm has ended them.
         Whether it cancelled."""
-        cancelled = False
-        while pending(self.status(study_dir)):
-            if stop.is_set() and not cancelled:
-                self.cancel(study_dir)
-                cancelled = True
-            time.sleep(self.poll_seconds)
-        return cancelled
+        return wait_for(lambda: pending(self.status(study_dir)), stop, self.poll_seconds,
+                        lambda: self.cancel(study_dir))
 
     def analyse(self, study, tasks: int = 1,
                 stop: threading.Event | None = None) -> dict | None:

@@ -6,13 +6,16 @@ anything is written. (The real submissions: tests/slurm.)"""
 from __future__ import annotations
 
 import re
+import subprocess
 from dataclasses import dataclass
 
 import pytest
 
-from ligwf.cli.executors import STUDY_OPTIONS, SUBMIT_ANALYSIS, SUBMIT_STUDY
+from ligwf.cli.executors import (CANCEL, SHOW_STATUS, STUDY_OPTIONS, SUBMIT_ANALYSIS,
+                                 SUBMIT_STUDY)
 from ligwf.cli.main import main
 from ligwf.executors import EXECUTORS, LOCAL
+from ligwf.slurm.jobs import append_record
 
 from helpers import ROOT
 
@@ -51,7 +54,8 @@ def study(tmp_path, ligwf):
 
 def test_every_scheduler_in_the_registry_has_its_command_line_face():
     schedulers = set(EXECUTORS) - {LOCAL}
-    assert set(SUBMIT_STUDY) == schedulers and set(SUBMIT_ANALYSIS) == schedulers
+    for face in (SUBMIT_STUDY, SUBMIT_ANALYSIS, SHOW_STATUS, CANCEL):
+        assert set(face) == schedulers
     assert {owner for owner, _, _ in STUDY_OPTIONS.values()} == set(EXECUTORS)
 
 
@@ -114,3 +118,42 @@ def test_analyse_refuses_what_its_executor_cannot_do(ligwf, study, args, message
     res = ligwf("analyse", study, *args)
     assert res.returncode == 2 and message in res.stderr, res.stderr
     assert not (study / "analysis").exists()
+
+
+class Queue:
+    """Slurm's commands: task 2 of array 1 running; scancel recorded."""
+
+    def __init__(self) -> None:
+        self.cancelled: list[list[str]] = []
+
+    def __call__(self, argv):
+        if argv[0] == "squeue":
+            return subprocess.CompletedProcess(argv, 0, stdout="1_2|1|2|RUNNING|None\n",
+                                               stderr="")
+        if argv[0] == "scancel":
+            self.cancelled.append(list(argv))
+            return subprocess.CompletedProcess(argv, 0, stdout="", stderr="")
+        return subprocess.CompletedProcess(argv, 1, stdout="", stderr=(
+            "slurm_load_jobs error: Invalid job id specified"))
+
+
+def test_status_and_cancel_on_slurm_are_the_slurm_commands(ligwf, study, monkeypatch):
+    import ligwf.cli.slurm as cli_slurm
+    import ligwf.slurm.scheduler as slurm_scheduler
+    from ligwf.slurm.jobs import study_status
+    from ligwf.slurm.scheduler import SlurmScheduler
+
+    append_record(study, {"kind": "array", "job_id": "1", "indices": [0, 1, 2, 3]})
+    queue = Queue()
+    monkeypatch.setattr(cli_slurm, "study_status", lambda path, tolerant: study_status(
+        path, queue, tolerant=tolerant))
+    monkeypatch.setattr(slurm_scheduler, "SlurmScheduler",
+                        lambda site: SlurmScheduler(site, queue))
+    old, new = ligwf("slurm", "status", study), ligwf("status", study, "--executor", "slurm")
+    assert old == new and old.returncode == 0
+    assert "1_2" in new.stdout and "RUNNING" in new.stdout
+    old, new = ligwf("slurm", "cancel", study), ligwf("cancel", study, "--executor", "slurm")
+    assert old == new and "cancelled job(s) 1" in new.stdout
+    assert queue.cancelled == [["scancel", "1"], ["scancel", "1"]]
+    local = ligwf("cancel", study)                   # this machine: no runner holds a case
+    assert local.returncode == 0 and "no live ligwf runner" in local.stdout
