@@ -12,7 +12,7 @@ count and axial slab rule, at most ``--cores`` if given): one array per rank cou
 analysis job after all of them; ``--ntasks`` or the site's ``ntasks`` put every case on that
 many ranks in one array, as before. With ``--cores-per-node`` (or the site's
 ``cores_per_node``) a planned case also asks for ceil(ranks / cores per node) nodes. The
-plan is printed (:mod:`ligwf.slurm.budget`): per case (replicas alike share a row) its
+plan is printed (:mod:`ligwf.slurm.walltime`): per case (replicas alike share a row) its
 particles, steps, ranks and what bound them, nodes, the estimated wall time against
 ``--time``, with a warning for each case the estimate says would outlive its ``--time``.
 ``--dry-run`` prints the plan, what it assumed about the site (MPI launcher, cores per node,
@@ -58,7 +58,7 @@ from ligwf.pipeline.prepare import prepared_loads
 from ligwf.pipeline.submit import (plan_resubmission, plan_split_analysis, plan_submission,
                                    write_for_submit)
 from ligwf.slurm.assumptions import site_assumptions
-from ligwf.slurm.budget import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
+from ligwf.slurm.walltime import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
                                 plan_rows, slab_note, slurm_time_seconds)
 from ligwf.pipeline.submit_rounds import is_sequential
 from ligwf.executors import build_executor, executor_kind, study_executor

@@ -33,7 +33,7 @@ from ligwf.scheduler import JobRound
 from ligwf.study import layout
 from ligwf.study.manifest import MISSING, read_manifest
 from ligwf.study.study import Study
-from ligwf.slurm.budget import nodes_for
+from ligwf.slurm.walltime import nodes_for
 from ligwf.slurm.parse import (FINISHED_STATES, is_unknown_job, parse_sbatch_parsable,
                                parse_squeue, task_records)
 from ligwf.slurm.script import (ScriptContext, analysis_array_script,

@@ -39,7 +39,7 @@ from ligwf.errors import ConfigError
 
 _NAME = re.compile(r"^[A-Za-z0-9_.,+-]+$")
 _MODULE = re.compile(r"^[A-Za-z0-9_./+-]+$")
-#: Slurm --time: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S (read by ligwf.slurm.budget)
+#: Slurm --time: M, M:S, H:M:S, D-H, D-H:M, D-H:M:S (read by ligwf.slurm.walltime)
 SLURM_TIME = re.compile(r"^(\d+|\d+:\d{1,2}|\d+:\d{1,2}:\d{1,2}|\d+-\d{1,2}(:\d{1,2}){0,2})$")
 _UNSAFE = re.compile(r"[\n\r\x00]")
 #: longest wall time accepted (a longer one is a typo: Slurm sites cap far below a year)

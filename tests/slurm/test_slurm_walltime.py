@@ -1,5 +1,5 @@
 """Nodes per case, wall time against --time, and the Slurm plan table of ``slurm submit``
-(``ligwf.slurm.budget``; no scheduler, no engine)."""
+(``ligwf.slurm.walltime``; no scheduler, no engine)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from helpers import ROOT
 from ligwf.cli.main import main
 from ligwf.engine.plan import CaseLoad, fixed_ranks, plan_ranks
 from ligwf.errors import ConfigError
-from ligwf.slurm.budget import (hours_minutes, nodes_for, over_time_warning, plan_rows,
+from ligwf.slurm.walltime import (hours_minutes, nodes_for, over_time_warning, plan_rows,
                                 slab_note, slurm_time_seconds)
 from ligwf.scheduler import JobRound
 from ligwf.slurm.jobs import plan_jobs
