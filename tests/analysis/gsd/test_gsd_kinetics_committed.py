@@ -9,6 +9,7 @@ import json
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from helpers import ROOT
 from ligwf.analysis.gsd.kinetics import kinetics_summary
@@ -23,6 +24,7 @@ def _read(name: str) -> pd.DataFrame:
     return pd.read_csv(ANALYSIS / name, keep_default_na=False, na_values=[""])
 
 
+@pytest.mark.slow      # the committed summary's 300 rows, each bootstrapped again: ~11 s
 def test_the_summary_recomputes_from_the_committed_kinetics():
     settings = json.loads((ANALYSIS / layout.ANALYSIS_RECORD).read_text())["settings"]
     again = kinetics_summary(_read(layout.KINETICS_TABLE),
