@@ -25,6 +25,7 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf.analysis.records.controls import read_controls
+from ligwf.analysis.records.fields import CaseFields
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.fsio import atomic_write_text
 from ligwf.inference.budget import signed_columns
@@ -59,6 +60,7 @@ class Decided:
     field_null: pd.DataFrame        # the field criterion's null checks (field_null.csv)
     spreading_cases: pd.DataFrame   # placed liquid's spreading time per case
     spreading_levels: pd.DataFrame  # and per CG-n level against CG1 (spreading.csv)
+    fields: dict[str, CaseFields]   # the cases' fields they were computed from (the maps')
 
 
 def look_level(rounds: Rounds) -> tuple[float, str]:
@@ -89,7 +91,8 @@ def decide_study(study: Study, flow: FlowRecord, out: Path) -> Decided:
     """Decide ``study`` from its analysis (``flow``, and the tables beside it): build its
     tables (:func:`~ligwf.inference.study_tables.build_tables`), decide the verdict and
     write the tables, the verdict record and ``extrapolation.csv`` into ``out``."""
-    cases, conditions, _, floors = build_tables(study, flow)
+    fields = case_fields(study.analysis_dir)           # the field archive, read once
+    cases, conditions, _, floors = build_tables(study, flow, fields)
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
@@ -103,11 +106,10 @@ def decide_study(study: Study, flow: FlowRecord, out: Path) -> Decided:
     extrapolated = extrapolation_rows(cases, signed_columns(), ratio)
     atomic_write_text(out / layout.EXTRAPOLATION_REPORT, extrapolated.to_csv(index=False))
     settings = study.analysis
-    null = null_check(cases, case_fields(study.analysis_dir), settings.bootstrap,
-                      settings.seed, settings.field_kernel)
+    null = null_check(cases, fields, settings.bootstrap, settings.seed, settings.field_kernel)
     atomic_write_text(out / layout.FIELD_NULL_REPORT, null.to_csv(index=False))
     spread_cases = case_times(flow.cases.values())
     spread_levels = level_rates(spread_cases)
     atomic_write_text(out / layout.SPREADING_REPORT, spread_levels.to_csv(index=False))
     return Decided(cases, conditions, floors, verdict, extrapolated, ratio, null,
-                   spread_cases, spread_levels)
+                   spread_cases, spread_levels, fields)

@@ -34,7 +34,8 @@ from ligwf.analysis.records.flow import FlowRecord
 from ligwf.analysis.records.gsd import GSD_ERRORS, LOWER_LIMIT
 from ligwf.analysis.records.metrics import GRANULE_METRICS, MetricSpec
 from ligwf.analysis.records.statistics import MEAN
-from ligwf.inference.field_tables import add_field_errors, case_fields
+from ligwf.analysis.records.fields import CaseFields
+from ligwf.inference.field_tables import add_field_errors
 from ligwf.inference.uncertainty import (ConditionStats, case_series, cost_interval, mark,
                                       report_metrics)
 from ligwf.study import layout
@@ -244,10 +245,13 @@ def noise_floor_table(df: pd.DataFrame, stats: ConditionStats) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def build_tables(study: Study, flow: FlowRecord, granules: bool = True
+def build_tables(study: Study, flow: FlowRecord, fields: dict[str, CaseFields],
+                 granules: bool = True
                  ) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], pd.DataFrame]:
     """(case table, condition table, skipped cases, noise-floor table) of a finished study
-    from its flow record (``granules`` False: without the granule analysis' tables)."""
+    from its flow record and its cases' fields (read once by the caller:
+    :func:`~ligwf.inference.field_tables.case_fields`; ``granules`` False: without the
+    granule analysis' tables)."""
     cases, skipped = case_rows(study)
     analysis_dir = study.analysis_dir
     if cases.empty:
@@ -259,7 +263,7 @@ def build_tables(study: Study, flow: FlowRecord, granules: bool = True
                            settings.bootstrap, settings.seed, report_metrics(flow))
     df = compare_to_cg1(merged, stats, list(flow.error_metrics))
     df, conditions = add_field_errors(df, condition_table(df, stats, metric_columns(flow)),
-                                      case_fields(analysis_dir), settings.bootstrap,
+                                      fields, settings.bootstrap,
                                       settings.seed, settings.field_kernel,
                                       read_rounds(study.path).alpha_per_look)
     return df, conditions, skipped, noise_floor_table(df, stats)

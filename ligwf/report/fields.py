@@ -13,7 +13,7 @@ import pandas as pd
 
 from ligwf.analysis.records.fields import CaseFields
 from ligwf.inference.field_errors import KERNEL_COLUMNS, LAYER_SPEED, MATERIAL_SOLID
-from ligwf.inference.field_tables import case_fields, twin_cases, wet_group
+from ligwf.inference.field_tables import twin_cases, wet_group
 from ligwf.report.field_figures import group_figures, rotation_sense
 from ligwf.study import layout
 from ligwf.study.case import group_label
@@ -138,12 +138,12 @@ def fields_section(conditions: pd.DataFrame, null: pd.DataFrame, fields: dict[st
 
 
 def fields_report(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame,
-                  null: pd.DataFrame, out: Path) -> tuple[str, list[tuple[str, Path]]]:
+                  null: pd.DataFrame, fields: dict[str, CaseFields], out: Path
+                  ) -> tuple[str, list[tuple[str, Path]]]:
     """The report's flow-field part of a study whose tables are built (``conditions``
-    with the field errors, ``null`` the null checks: written by
+    with the field errors, ``null`` the null checks, from the cases' ``fields``: all of
     :func:`ligwf.inference.decide.decide_study`): the map figures (in the report folder
     ``out``'s figures folder) and the section's markdown; returns (markdown, figures)."""
-    fields = case_fields(study.analysis_dir)
     settings = study.analysis
     usable = study.usable_cases()[0]
     drum = usable[0].scaled.drum if usable else None

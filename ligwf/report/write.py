@@ -43,7 +43,7 @@ from ligwf.report.scale_section import scale_section
 from ligwf.report.spreading_section import spreading_section
 from ligwf.report.rounds import rounds_sections
 from ligwf.inference.verdict import Verdict
-from ligwf.inference.decide import decide_study
+from ligwf.inference.decide import Decided, decide_study
 from ligwf.report.verdict_text import verdict_section
 from ligwf.study import layout
 from ligwf.study.case import CaseFolder
@@ -91,8 +91,7 @@ def write_report(study: Study, out: Path | None = None, snapshots: bool = True) 
                                verdict, [*extrapolation_section(extrapolated, ratio, cases),
                                          *scale_section(study, conditions),
                                          *spreading_section(spread_cases, spread_levels),
-                                         *flow_field_sections(study, cases, conditions,
-                                                             decided.field_null, out)])
+                                         *flow_field_sections(study, decided, out)])
     title = f"{study.name}: error against run time"
     preamble = (f"Study folder `{study.path}`; report by ligwf {__version__}. Errors are "
                 "relative to the CG1 cases of the same sweep group; speedup is CG1 production "
@@ -145,11 +144,11 @@ def verdict_sections(verdict: Verdict | None, figure: Figure | None = None) -> l
     return split_markdown(verdict_section(verdict, where))
 
 
-def flow_field_sections(study: Study, cases: pd.DataFrame, conditions: pd.DataFrame,
-                        null: pd.DataFrame, out: Path) -> list[Section]:
+def flow_field_sections(study: Study, decided: Decided, out: Path) -> list[Section]:
     """The flow-field maps, errors and null check (:mod:`ligwf.report.fields`: writes its
     figures into the report folder ``out``)."""
-    return split_markdown(fields_report(study, cases, conditions, null, out)[0])
+    return split_markdown(fields_report(study, decided.cases, decided.conditions,
+                                        decided.field_null, decided.fields, out)[0])
 
 
 def report_figures(study: Study, flow: FlowRecord, cases: pd.DataFrame,
