@@ -181,10 +181,9 @@ def too_short_note(runs, ref_runs, noise) -> str:
     for name, arm in (("CG-n", runs), ("CG1", ref_runs)):
         ids = [i for i in (arm["case_id"] if arm is not None and "case_id" in arm else [])
                if i in noise.index]
-        capped = [i for i in ids if bool(noise.at[i, planning.AT_CAP])]
+        capped, more = planning.capped_runs(noise, ids)
         if capped:
             parts.append(f"{len(capped)} of {len(ids)} {name} runs")
-            more = max(float(noise.at[i, planning.LEAST_EXTENSION]) for i in capped)
             fixes.append(f"{more:.3g} s more production on each of those {name} runs")
     if not parts:
         return ""

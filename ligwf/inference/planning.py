@@ -124,3 +124,12 @@ def noise_table(cases: list[CaseFolder], flow: FlowRecord, columns: tuple[str, .
                     for col in columns})
         rows.append(row)
     return pd.DataFrame(rows).set_index("case_id") if rows else pd.DataFrame()
+
+
+def capped_runs(noise: pd.DataFrame, ids) -> tuple[list[str], float]:
+    """Of the runs ``ids`` that the noise table has, the ones whose steady window starts at
+    its cap (:data:`AT_CAP`), and the production each of them needs at least: the most
+    :data:`LEAST_EXTENSION` any of them needs (0 when none is capped). What the verdict's
+    "too short" note says and what a round of a sequential study extends by."""
+    capped = [i for i in ids if i in noise.index and bool(noise.at[i, AT_CAP])]
+    return capped, max((float(noise.at[i, LEAST_EXTENSION]) for i in capped), default=0.0)

@@ -55,7 +55,7 @@ from ligwf.pipeline.prepare import Prepared, prepare, render_case, write
 from ligwf.eligibility import HELD, Eligible, eligible
 from ligwf.pipeline.run import StudyRun, scheduled, site_engine
 from ligwf.analysis.records.flow import FlowRecord
-from ligwf.inference.planning import AT_CAP, LEAST_EXTENSION, calibration, noise_table, run_costs
+from ligwf.inference.planning import calibration, capped_runs, noise_table, run_costs
 from ligwf.inference.verdict import FAILS, MEETS, Verdict, is_control_group
 from ligwf.inference.verdict_records import read_verdict
 from ligwf.scheduler import Executor
@@ -275,16 +275,10 @@ def too_short(study: Study, verdict: Verdict, every_level: bool = False
     usable = [case for case in study.cases if case.case_id in flow.cases]   # those analysed
     noise = noise_table(usable, flow, ())
     needs: dict[Condition, float] = {}
-    for condition in conditions:
-        for arm in Arm:
-            side = condition.side(arm)
-            for case in usable:
-                if (not side.covers(case) or case.case_id not in noise.index
-                        or not bool(noise.at[case.case_id, AT_CAP])):
-                    continue
-                more = float(noise.at[case.case_id, LEAST_EXTENSION])
-                if math.isfinite(more) and more > 0:
-                    needs[side] = max(needs.get(side, 0.0), more)
+    for side in {c.side(arm) for c in conditions for arm in Arm}:
+        _, more = capped_runs(noise, [case.case_id for case in usable if side.covers(case)])
+        if more > 0:
+            needs[side] = more
     return needs
 
 
