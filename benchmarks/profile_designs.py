@@ -73,17 +73,24 @@ def profile_runs(rng, trials: int, runs: int, offset: float, width: int) -> np.n
     return (c[..., width:] - c[..., :-width]) / math.sqrt(width)
 
 
+def shifted_studies(rng, trials: int, nx: int, ny: int, offset: float, width: int
+                    ) -> tuple[np.ndarray, np.ndarray, float]:
+    """``trials`` studies of ``nx`` CG-n against ``ny`` CG1 runs (:func:`profile_runs`)
+    whose true profiles differ by SHIFT in the top SHIFTED_BINS bins, and the true
+    distance (relative to the reference's true mean profile, all ones)."""
+    shift = np.zeros(BINS)
+    shift[:SHIFTED_BINS] = SHIFT
+    a = profile_runs(rng, trials, nx, offset, width) + 1.0 + shift
+    b = profile_runs(rng, trials, ny, offset, width) + 1.0
+    return a, b, float(np.sqrt(np.sum(shift ** 2)) / math.sqrt(BINS))
+
+
 def profile_cells(rng, trials: int, width: int, rules: tuple[str, ...] = RULES) -> list[dict]:
     """One row per (bins' correlation, design, offset) with each rule's coverage and errors;
     both rules decide the same studies."""
-    shift = np.zeros(BINS)
-    shift[:SHIFTED_BINS] = SHIFT
     out = []
     for w, (nx, ny), offset in itertools.product((width, 1), DESIGNS, OFFSETS):
-        a = profile_runs(rng, trials, nx, offset, w) + 1.0 + shift
-        b = profile_runs(rng, trials, ny, offset, w) + 1.0
-        # the truth is relative to the reference's true mean profile (all ones)
-        truth = float(np.sqrt(np.sum(shift ** 2)) / math.sqrt(BINS))
+        a, b, truth = shifted_studies(rng, trials, nx, ny, offset, w)
         row = {"bins": "correlated" if w > 1 else "independent", "design": f"{nx} vs {ny}",
                "offset": offset}
         for rule in rules:

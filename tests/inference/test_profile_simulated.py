@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from benchmarks.profile_designs import profile_runs
+from benchmarks.profile_designs import profile_runs, shifted_studies
 from ligwf.inference import equivalence as eq
 from tests.inference.test_never_crash import CRASH, forty_six_against_forty_six
 from ligwf.inference.deciding import profile_plan
@@ -52,12 +52,8 @@ def test_correlated_bins_on_the_budget_fail_wrongly_less_often_than_the_old_rule
     distance on the budget: the correlated rule's fail p is below alpha more often than
     alpha (the fourth run: up to 0.065), the simulated one's is not."""
     rng = np.random.default_rng(20261207)
-    shift = np.zeros(16)
-    shift[:4] = 0.3
-    truth = float(np.sqrt(np.sum(shift ** 2)) / 4.0)
     trials = 600
-    a = profile_runs(rng, trials, 3, 3.0, 12) + 1.0 + shift
-    b = profile_runs(rng, trials, 3, 3.0, 12) + 1.0
+    a, b, truth = shifted_studies(rng, trials, 3, 3, 3.0, 12)
     old = sum(eq.norm_fail_p(a[i], b[i], truth, eq.BINS_CORRELATED) <= eq.ALPHA
               for i in range(trials))
     new = sum(eq.norm_fail_p(a[i], b[i], truth, eq.BINS_SIMULATED) <= eq.ALPHA

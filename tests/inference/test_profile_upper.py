@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy import optimize, stats
 
-from benchmarks.profile_designs import profile_runs
+from benchmarks.profile_designs import profile_runs, shifted_studies
 from ligwf.inference import equivalence as eq
 from ligwf.inference.profile_null import simulated_null
 from tests.inference.test_never_crash import CRASH, forty_six_against_forty_six
@@ -57,12 +57,8 @@ def test_it_covers_less_where_the_correlated_bound_over_covers():
     correlated rule's upper bound covered 0.991 in profiles_2.txt; the smaller one covers
     less there and still at least 0.92 (300 studies: the bound is a Monte Carlo share)."""
     rng = np.random.default_rng(20261207)
-    shift = np.zeros(16)
-    shift[:4] = 0.3
-    truth = float(np.sqrt(np.sum(shift ** 2)) / 4.0)
     trials = 300
-    a = profile_runs(rng, trials, 6, 1.0, 12) + 1.0 + shift
-    b = profile_runs(rng, trials, 6, 1.0, 12) + 1.0
+    a, b, truth = shifted_studies(rng, trials, 6, 6, 1.0, 12)
     old = new = 0
     for i in range(trials):
         old += eq.norm_estimate(a[i], b[i], bins=eq.BINS_SIMULATED).hi >= truth

@@ -188,16 +188,7 @@ def test_simulated_fail_test_run_is_what_the_readme_says():
     assert len(rows) == 36
     cells = {(r[0], int(r[1]) + int(r[3]), r[1] + " vs " + r[3], float(r[4])):
              [float(v) for v in (r[6], r[7], r[8], r[10], r[11], r[12])] for r in rows}
-    holds = []
-    for bins in ("correlated", "independent"):
-        counted = [v for k, v in cells.items() if k[0] == bins and k[1] >= 6]
-        assert len(counted) == 15
-        cover = [1.0 - v[1] for v in counted]          # the printed cover is rounded
-        holds.append(all(0.92 <= c <= 0.99 for c in cover))
-        holds.append(not any(_lower(r, 4000) > 0.05 for v in counted for r in v[1:3]))
-    assert holds == [False, True, True, True]
-    checks = re.findall(r"^check (\d) .*: (holds|FAILS)$", text, re.M)
-    assert checks == [(str(i + 1), "holds" if h else "FAILS") for i, h in enumerate(holds)]
+    assert _profile_checks(cells, text, 4000) == [False, True, True, True]
     assert "summary: 3 of 4 registered checks hold" in text
     assert "**3 of 4 registered checks hold.**" in README
     corr = [v for k, v in cells.items() if k[0] == "correlated" and k[1] >= 6]
@@ -227,6 +218,23 @@ def test_the_analysis_guide_quotes_both_profile_runs():
     assert f"over-covers there, up to {cover}," in guide
 
 
+def _profile_checks(cells: dict, text: str, trials: int) -> list[bool]:
+    """The four registered checks of a profiles_N.txt recomputed from its cells (designs of
+    >= 6 runs counted; per bins, coverage in [0.92, 0.99] and no wrong pass or wrong fail
+    shown above 0.05 by its lower 95 % Clopper-Pearson bound over ``trials``), held to the
+    file's own check lines."""
+    holds = []
+    for bins in ("correlated", "independent"):
+        counted = [v for k, v in cells.items() if k[0] == bins and k[1] >= 6]
+        assert len(counted) == 15
+        cover = [1.0 - v[1] for v in counted]          # the printed cover is rounded
+        holds.append(all(0.92 <= c <= 0.99 for c in cover))
+        holds.append(not any(_lower(r, trials) > 0.05 for v in counted for r in v[1:3]))
+    checks = re.findall(r"^check (\d) .*: (holds|FAILS)$", text, re.M)
+    assert checks == [(str(i + 1), "holds" if h else "FAILS") for i, h in enumerate(holds)]
+    return holds
+
+
 def _profile_cells(name: str) -> dict:
     """(bins, runs of both arms, design, offset) -> the first rule's cover, wrong pass and
     wrong fail of a profiles_N.txt."""
@@ -252,16 +260,7 @@ def test_smaller_upper_bound_run_is_what_the_readme_says():
     assert raw.index("## Sixth run") < raw.index("### Sixth run's result")
     cells = _profile_cells("profiles_3.txt")
     assert len(cells) == 36
-    holds = []
-    for bins in ("correlated", "independent"):
-        counted = [v for k, v in cells.items() if k[0] == bins and k[1] >= 6]
-        assert len(counted) == 15
-        cover = [1.0 - v[1] for v in counted]          # the printed cover is rounded
-        holds.append(all(0.92 <= c <= 0.99 for c in cover))
-        holds.append(not any(_lower(r, 3000) > 0.05 for v in counted for r in v[1:3]))
-    assert holds == [False, True, True, True]
-    checks = re.findall(r"^check (\d) .*: (holds|FAILS)$", text, re.M)
-    assert checks == [(str(i + 1), "holds" if h else "FAILS") for i, h in enumerate(holds)]
+    assert _profile_checks(cells, text, 3000) == [False, True, True, True]
     assert "summary: 3 of 4 registered checks hold" in text
     result = " ".join(raw.split("### Sixth run's result", 1)[1].split())
     assert "**3 of 4 registered checks hold.**" in result
