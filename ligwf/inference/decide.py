@@ -38,6 +38,7 @@ from ligwf.inference.study_tables import build_tables
 from ligwf.inference.verdict import Verdict
 from ligwf.inference.verdict_records import study_verdict, write_verdict
 from ligwf.study import layout
+from ligwf.study.case import CaseFolder
 from ligwf.study.condition import Condition
 from ligwf.study.rounds import Rounds, read_rounds
 from ligwf.study.study import Study
@@ -71,11 +72,11 @@ def look_level(rounds: Rounds) -> tuple[float, str]:
     return rounds.alpha_per_look, (HSU if rounds.max_looks > 1 else WELCH_BF)
 
 
-def extrapolation_inputs(study: Study) -> tuple[float, dict[Condition, float]]:
+def extrapolation_inputs(usable: list[CaseFolder]) -> tuple[float, dict[Condition, float]]:
     """(d / D of the study's drum, condition -> the planner's CG1 cost over the level's):
-    read from the usable cases' scene records (nan / empty without one)."""
+    read from the ``usable`` cases' scene records (nan / empty without one)."""
     ratio, speedups = math.nan, {}
-    for case in study.usable_cases()[0]:
+    for case in usable:
         try:
             scene = json.loads((case.path / layout.SCENE_FILE).read_text())["scene"]
         except (OSError, ValueError, KeyError):
@@ -96,10 +97,11 @@ def decide_study(study: Study, flow: FlowRecord, out: Path) -> Decided:
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))
     atomic_write_text(out / layout.NOISE_FLOOR_REPORT, floors.to_csv(index=False))
-    ratio, speedups = extrapolation_inputs(study)
+    usable = study.usable_cases()[0]
+    ratio, speedups = extrapolation_inputs(usable)
     verdict = study_verdict(cases, conditions, study.accept, read_controls(study.analysis_dir),
                             {cid: c.profile_v_mean for cid, c in flow.cases.items()},
-                            noise_table(study.usable_cases()[0], flow, signed_columns()),
+                            noise_table(usable, flow, signed_columns()),
                             *look_level(read_rounds(study.path)), size_ratio=ratio,
                             speedups=speedups)
     write_verdict(verdict, out)

@@ -230,12 +230,17 @@ def _actions(study: Study, needs: dict[Condition, list[float]]) -> tuple[list[Ac
     return actions, hours
 
 
+def _by_speed(group) -> list:
+    """A sweep group's conditions, fastest first (a level without a speedup last)."""
+    return sorted(group.conditions,
+                  key=lambda c: -c.speedup if math.isfinite(c.speedup) else math.inf)
+
+
 def _targets(group, every_level: bool) -> list:
     """The conditions of a sweep group a round works on: the cheapest level that can still
     pass (none once it meets the budget), or with ``every_level`` each level with an
     undecided criterion."""
-    by_speed = sorted(group.conditions, key=lambda c: -c.speedup
-                      if math.isfinite(c.speedup) else math.inf)
+    by_speed = _by_speed(group)
     if every_level:
         return [c for c in by_speed if any(r.state == UNDECIDED for r in c.criteria)]
     open_ = [c for c in by_speed if c.state != FAILS]
@@ -249,8 +254,7 @@ def _answer_levels(group, every_level: bool) -> list:
     if every_level:
         return list(group.conditions)
     out = []
-    for c in sorted(group.conditions,
-                    key=lambda c: -c.speedup if math.isfinite(c.speedup) else math.inf):
+    for c in _by_speed(group):
         out.append(c)
         if c.state != FAILS:
             break
