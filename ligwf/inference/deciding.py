@@ -1,5 +1,5 @@
 """What would decide an undecided criterion of the verdict, and what a sequential round
-does instead (:mod:`ligwf.inference.criteria` decides; this module plans).
+does instead (:func:`ligwf.inference.verdict.condition_criteria` decides; this module plans).
 
 Two plans per undecided criterion, both from the variance components as measured
 (:mod:`ligwf.inference.sampling`): the cheapest way to **decide** it (longer

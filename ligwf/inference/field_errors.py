@@ -235,7 +235,7 @@ class LayerNoise:
     mean fields (sqrt(D^2), units of omega R), each arm's per-run noise (sum_x w s^2 over
     its runs, units of (omega R)^2) and its number of runs. Its bounds at other run counts
     are what more replicas would give, the distance and the per-run scatter as measured
-    (what would decide the criterion, :mod:`ligwf.inference.criteria`)."""
+    (what would decide the criterion, :mod:`ligwf.inference.deciding`)."""
 
     distance: float
     run_variance: float

@@ -11,7 +11,7 @@ A criterion (:class:`Criterion`) declares
   the analysis' own interval);
 * its **decision**: ``decide(criterion, tolerance, level) -> Decision`` -- the state, the
   interval, the bound it is shown within, and the p-value of its fail test for Holm's
-  step-down over the level (:func:`ligwf.inference.criteria.condition_criteria`);
+  step-down over the level (:func:`ligwf.inference.verdict.condition_criteria`);
 * its **plan**: what would decide it when undecided (:mod:`ligwf.inference.deciding`).
 
 The built-in criteria are registered by :mod:`ligwf.inference.budget` (each reader of the

@@ -23,7 +23,11 @@ The CG1 noise floor no longer widens a budget: each signed criterion says whethe
 difference is distinguishable from CG1 seed noise at the replicas run. Family rule: a
 level meets the budget when every assessed criterion passes (an intersection-union test,
 each at alpha); it fails when a criterion fails after Holm's step-down over every criterion
-the level was tested on (each with its own p-value). The alpha, levels and rules travel with
+the level was tested on (:func:`condition_criteria`): each registered criterion
+(:func:`ligwf.inference.budget.criteria`) decides itself and gives the p-value of its fail
+test (:class:`~ligwf.inference.registry.Decision`), decided or not, so the family's size
+does not depend on the outcome; a fail Holm does not keep becomes undecided, planned at the
+family's alpha. The alpha, levels and rules travel with
 the verdict (``Verdict.statistics``). Every criterion also carries ``bound``: the largest error its interval allows
 (the error the level is shown to stay within), so a user with another budget reads the
 answer without a rerun. Written by :mod:`ligwf.inference.verdict_records`, shown by
@@ -33,16 +37,17 @@ answer without a rerun. Written by :mod:`ligwf.inference.verdict_records`, shown
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import pandas as pd
 
+from ligwf.inference import budget
 from ligwf.inference import equivalence as eq
 from ligwf.study.condition import REFERENCE_CG, Condition
 from ligwf.inference.equivalence import FAIL, PASS, UNDECIDED
-from ligwf.inference.criteria import condition_criteria
-from ligwf.inference.registry import CriterionResult, Gate, band
-from ligwf.inference.deciding import too_short_note
+from ligwf.inference.registry import (NO_DECIDE, NOT_ASSESSED, CriterionResult, Decision, Gate,
+                                      LevelData, band)
+from ligwf.inference.deciding import decide_text, too_short_note
 from ligwf.inference.extrapolated import extrapolated_criteria
 from ligwf.inference.verdict_statistics import statistics_record
 from ligwf.scene.accept import AcceptSettings
@@ -185,6 +190,46 @@ def granule_gates(cases: pd.DataFrame, controls: pd.DataFrame | None) -> dict[st
         else:
             gates[g] = Gate(False, "granules did not beat their cohesionless control")
     return gates
+
+
+def condition_criteria(accept: AcceptSettings, row, runs: pd.DataFrame, ref_runs: pd.DataFrame,
+                       profiles: dict, gate: Gate, alpha: float = eq.ALPHA,
+                       noise: pd.DataFrame | None = None, df_rule: str = eq.WELCH
+                       ) -> tuple[CriterionResult, ...]:
+    """Every criterion of the budget for one CG-n condition (``row`` of the condition table,
+    ``runs`` its cases, ``ref_runs`` its group's CG1 cases), with Holm's step-down over the
+    fail tests of every criterion tested (an interval or bounds): a criterion fails only if
+    its fail test survives Holm."""
+    level = LevelData(row, runs, ref_runs, profiles, gate, alpha, noise, df_rule)
+    decisions: list[Decision] = []
+    for spec in budget.criteria():
+        tol = accept.tolerance(spec.name)
+        if tol is None:
+            continue
+        if spec.gated and gate.passes is not True:
+            decisions.append(Decision(CriterionResult(**spec.base(), state=NOT_ASSESSED,
+                                                      note=f"not assessed: {gate.reason}")))
+        else:
+            decisions.append(spec.decide(spec, tol, level))
+    p_fail = [d.p_fail for d in decisions]
+    rejected = eq.holm_rejects(p_fail, alpha)
+    family = sum(math.isfinite(p) for p in p_fail)
+    out = [d.replan(alpha / family) if d.result.state == FAIL and not ok and d.replan
+           else d.result for d, ok in zip(decisions, rejected)]
+    return tuple(after_holm(r, ok, family) for r, ok in zip(out, rejected))
+
+
+def after_holm(r: CriterionResult, rejected: bool, family: int) -> CriterionResult:
+    """A fail that Holm's step-down does not keep becomes undecided (saying what would
+    decide it); a decided criterion carries no decide option."""
+    if r.state == FAIL and not rejected:
+        note = "; ".join(p for p in (f"outside the budget on its own, not after Holm over "
+                                     f"the level's {family} tested criteria", decide_text(r),
+                                     r.note) if p)
+        return replace(r, state=UNDECIDED, note=note)
+    if r.state in (PASS, FAIL):
+        return replace(r, **NO_DECIDE)
+    return r
 
 
 def extrapolated_group(group: str, sub: pd.DataFrame, in_group: pd.DataFrame,
