@@ -25,12 +25,12 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf.analysis.records.controls import read_controls
-from ligwf.analysis.records.fields import CaseFields
+from ligwf.analysis.records.fields import CaseFields, recorded_fields
 from ligwf.analysis.records.flow import FlowRecord
 from ligwf.fsio import atomic_write_text
 from ligwf.inference.budget import signed_columns
 from ligwf.inference.equivalence import HSU, WELCH_BF
-from ligwf.inference.field_tables import case_fields, null_check
+from ligwf.inference.field_tables import null_check
 from ligwf.inference.planning import noise_table
 from ligwf.inference.reference import extrapolation_rows, planned_cg1_speedup, size_ratio
 from ligwf.inference.spreading import case_times, level_rates
@@ -92,7 +92,7 @@ def decide_study(study: Study, flow: FlowRecord, out: Path) -> Decided:
     """Decide ``study`` from its analysis (``flow``, and the tables beside it): build its
     tables (:func:`~ligwf.inference.study_tables.build_tables`), decide the verdict and
     write the tables, the verdict record and ``extrapolation.csv`` into ``out``."""
-    fields = case_fields(study.analysis_dir)           # the field archive, read once
+    fields = recorded_fields(study.analysis_dir)       # the field archive, read once
     cases, conditions, _, floors = build_tables(study, flow, fields)
     atomic_write_text(out / layout.CASES_REPORT, cases.to_csv(index=False))
     atomic_write_text(out / layout.CONDITIONS_REPORT, conditions.to_csv(index=False))

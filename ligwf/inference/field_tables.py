@@ -1,7 +1,7 @@
 """The field columns of a study's case and condition tables, and the field null checks.
 
-Reads the field archive of the analysis (:func:`case_fields`,
-:func:`ligwf.analysis.records.fields.read_fields`) and computes statistics of it
+From the cases' fields (the archive the analysis recorded,
+:func:`ligwf.analysis.records.fields.recorded_fields`) it computes statistics
 (:mod:`ligwf.inference.field_errors`): per condition the field criterion (drum-frame
 velocity in the flowing layer, noise-corrected, with bounds; at every width of
 ``CRITERION_KERNELS`` as ``field_error_k<w>``, and at the study's ``analysis.field_kernel``
@@ -19,43 +19,22 @@ flow, that difference should be found. The report shows them (:mod:`ligwf.report
 from __future__ import annotations
 
 import math
-import zipfile
-from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.records.analysis_record import AnalysisRecord
 from ligwf.analysis.records.conditions import Conditions
-from ligwf.analysis.records.fields import CaseFields, read_fields
-from ligwf.analysis.records.provenance import StaleAnalysis
+from ligwf.analysis.records.fields import CaseFields
 from ligwf.inference.equivalence import ALPHA, NormEstimate
 from ligwf.inference.field_errors import (ERRORS, FIELD_NOISE_COLUMNS, KERNEL_COLUMNS,
                                           condition_mean, field_floor, field_intervals,
                                           layer_components, layer_error, null_split,
                                           same_grid, whole_windows)
 from ligwf.inference.uncertainty import mark
-from ligwf.study import layout
 from ligwf.study.condition import Condition
 from ligwf.study.group import SweepGroup
 
 #: the control whose fields the null check compares with the wet CG1 fields
 COHESIONLESS = "cohesionless"
-
-
-def case_fields(analysis_dir: Path) -> dict[str, CaseFields]:
-    """The fields of every case the analysis recorded ({} when its record lists no field
-    archive: an analysis from before the fields, or without a measured case; a stale
-    archive an older analysis left is never read). StaleAnalysis (one line) when the
-    listed archive cannot be read."""
-    path = Path(analysis_dir) / layout.FIELDS_DATA
-    record = AnalysisRecord.read(analysis_dir)
-    if record is None or not record.wrote(layout.FIELDS_DATA) or not path.is_file():
-        return {}
-    try:
-        return read_fields(path)
-    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
-        raise StaleAnalysis(f"{path}: not a field archive ligwf wrote ({exc}); run `ligwf "
-                            "analyse` again") from None
 
 
 def _fields_of(ids, fields: dict[str, CaseFields]) -> list[CaseFields]:

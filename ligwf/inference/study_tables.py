@@ -250,7 +250,7 @@ def build_tables(study: Study, flow: FlowRecord, fields: dict[str, CaseFields],
                  ) -> tuple[pd.DataFrame, pd.DataFrame, list[dict], pd.DataFrame]:
     """(case table, condition table, skipped cases, noise-floor table) of a finished study
     from its flow record and its cases' fields (read once by the caller:
-    :func:`~ligwf.inference.field_tables.case_fields`; ``granules`` False: without the
+    :func:`~ligwf.analysis.records.fields.recorded_fields`; ``granules`` False: without the
     granule analysis' tables)."""
     cases, skipped = case_rows(study)
     analysis_dir = study.analysis_dir

@@ -138,18 +138,17 @@ def test_rotation_sense_on_the_maps():
 def test_only_the_recorded_archive_is_read(study_fields, tmp_path):
     """The report reads the field archive the analysis record lists, nothing else: a
     stale archive (not in the record) is ignored, an unreadable listed one is one line."""
-    from ligwf.analysis.records.fields import fields_bytes
+    from ligwf.analysis.records.fields import fields_bytes, recorded_fields
     from ligwf.analysis.records.provenance import StaleAnalysis
-    from ligwf.inference.field_tables import case_fields
     from ligwf.study import layout
 
     fields = study_fields[0]
     (tmp_path / layout.FIELDS_DATA).write_bytes(fields_bytes(list(fields.values())[:2]))
     (tmp_path / layout.ANALYSIS_RECORD).write_text(json.dumps({"outputs": {}}))
-    assert case_fields(tmp_path) == {}
+    assert recorded_fields(tmp_path) == {}
     (tmp_path / layout.ANALYSIS_RECORD).write_text(
         json.dumps({"outputs": {layout.FIELDS_DATA: [0, ""]}}))
-    assert set(case_fields(tmp_path)) == {"cg1-none-r0", "cg1-none-r1"}
+    assert set(recorded_fields(tmp_path)) == {"cg1-none-r0", "cg1-none-r1"}
     (tmp_path / layout.FIELDS_DATA).write_bytes(b"not a zip")
     with pytest.raises(StaleAnalysis, match="not a field archive"):
-        case_fields(tmp_path)
+        recorded_fields(tmp_path)

@@ -3,9 +3,10 @@
 Written by ``ligwf analyse`` (the flow stage, :mod:`ligwf.analysis.flow.fields` computes
 them) into the analysis folder as one compressed numpy archive (``layout.FIELDS_DATA``,
 listed with its digest in the analysis record) and, per case, a VTK ImageData file of the
-time-averaged fields that ParaView opens (``layout.field_image``). The report reads the
-archive through :func:`read_fields` and computes only statistics of it (the field error,
-its interval and its CG1 floor: :mod:`ligwf.inference.field_errors`).
+time-averaged fields that ParaView opens (``layout.field_image``). The inference layer
+reads the archive the analysis record lists through :func:`recorded_fields` and computes
+only statistics of it (the field error, its interval and its CG1 floor:
+:mod:`ligwf.inference.field_errors`).
 
 Per case and steady frame, the kernel sums ``MOMENTS`` on the grid nodes (units: phi
 dimensionless, the fluxes m/s, the fluctuation m^2/s^2, all per unit solid fraction
@@ -32,7 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ligwf.analysis.records.analysis_record import AnalysisRecord
+from ligwf.analysis.records.provenance import StaleAnalysis
 from ligwf.scene.axis import Axis
+from ligwf.study import layout
 
 #: per-frame kernel sums on the grid, in this order (axis 1 of ``CaseFields.moments``)
 MOMENTS = ("solid_fraction", "flux_u", "flux_v", "flux_axial", "fluctuation")
@@ -186,6 +190,22 @@ def read_fields(path: Path) -> dict[str, CaseFields]:
                 omega=float(d.get("omega", math.nan)), radius=float(d.get("radius", math.nan)),
                 window_means=means)
     return out
+
+
+def recorded_fields(analysis_dir: Path) -> dict[str, CaseFields]:
+    """The fields of every case the analysis in ``analysis_dir`` recorded ({} when its
+    record lists no field archive: an analysis from before the fields, or without a
+    measured case; a stale archive an older analysis left is never read). StaleAnalysis
+    (one line) when the listed archive cannot be read."""
+    path = Path(analysis_dir) / layout.FIELDS_DATA
+    record = AnalysisRecord.read(analysis_dir)
+    if record is None or not record.wrote(layout.FIELDS_DATA) or not path.is_file():
+        return {}
+    try:
+        return read_fields(path)
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+        raise StaleAnalysis(f"{path}: not a field archive ligwf wrote ({exc}); run `ligwf "
+                            "analyse` again") from None
 
 
 def _binary(a: np.ndarray) -> str:
