@@ -6,7 +6,6 @@ returns a copy. Plots go through :mod:`ligwf.api.plots` (the report's figure fun
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -126,7 +125,9 @@ class StudyResults:
     def figures(self) -> dict[str, Path]:
         """file name -> path of every figure the report wrote."""
         folder = self.report_dir / layout.FIGURES_DIR
-        return {p.name: p for p in sorted(folder.glob(layout.FIGURE_GLOB))} if folder.is_dir() else {}
+        if not folder.is_dir():
+            return {}
+        return {p.name: p for p in sorted(folder.glob(layout.FIGURE_GLOB))}
 
     # ------------------------------------------------------------- tables
     @property
@@ -158,10 +159,18 @@ class StudyResults:
                                 f"run `{REPORT} {self.path}`")
         return found
 
-    extrapolation = property(lambda s: s.table("extrapolation"), doc="CG1 from CG-n levels")
+    @property
+    def extrapolation(self) -> pd.DataFrame:
+        """CG1 from CG-n levels: per sweep group, rule and signed criterion with two or
+        more CG-n levels, the CG1 value extrapolated from them with its 95 % interval
+        beside the measured CG1 mean."""
+        return self.table("extrapolation")
 
-    spreading = property(lambda s: s.table("spreading"), doc="placed liquid's spreading "
-                         "rate per CG-n level against CG1 (no rows without placed liquid)")
+    @property
+    def spreading(self) -> pd.DataFrame:
+        """Placed liquid's spreading rate per CG-n level against CG1 (no rows without
+        placed liquid)."""
+        return self.table("spreading")
 
     @property
     def noise_floor(self) -> pd.DataFrame:
@@ -300,10 +309,14 @@ class StudyResults:
                                    "v_mean": float, "v_std": float}))
 
     def check(self) -> Problems:
-        """Refuse (one line) what ``ligwf report`` would: analysis missing or stale (re-run
-        cases, settings, edited tables or dumps), a report older than it or whose tables
-        changed (SHA-256). Returns what the report lists as not used (skipped or unlisted
-        cases, frames, outputs: ``study_problems``). Tables are read without this check."""
+        """Refuse (one line, a LigwfError) what ``ligwf report`` would refuse: analysis
+        outputs missing or no longer matching the study (re-run or re-rendered cases,
+        changed settings, an edited table, dumps changed since: this hashes the dumps), a
+        report older than the analysis it was built from, and report files changed since
+        the report wrote them (their SHA-256 against the report's digest record). Returns
+        what the report lists as not used (skipped or unlisted cases, frames, outputs:
+        :func:`ligwf.report.problems.study_problems`). The tables are read without this
+        check; call it when the study may have changed since."""
         checked_analysis(self.study)
         record = self.analysis_dir / layout.ANALYSIS_RECORD
         report = self.report_dir / layout.CONDITIONS_REPORT

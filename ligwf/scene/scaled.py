@@ -131,7 +131,9 @@ class ScaledLiquidValues:
     max_separation_ratio: float              # the cut the engine applies (a setting may
     #                                          make it its own: engine_separation_ratio)
     contact_angle_compensation: bool         # 3.8.0's 0.5 theta_i theta_j compensated
-    # placed liquid (ligwf.scene.placement): wet spheres (axial, across, vertical, r), m
+    # placed liquid (liquid.placement: granules, ligwf.scene.placement): (axial, across,
+    # vertical, radius) per wet sphere, m, and their liquid content; empty for a
+    # uniformly wetted bed
     wet_spheres: tuple[tuple[float, float, float, float], ...] = ()
     wet_sphere_content: float = 0.0
     # the model's own settings as the engine applies them (its settings_type; unchanged by
