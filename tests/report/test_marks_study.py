@@ -35,7 +35,7 @@ from helpers import ROOT
 pytestmark = [pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
 
 TINY = ROOT / "tests" / "workflows" / "tiny_study.yaml"
-#: two CG1 seeds (a measured floor), two per CG2 rule; a production long enough to be hit
+#: two CG1 replicas (a measured floor), two per CG2 rule; a production long enough to be hit
 SETS = ["--no-snapshots", "--set", "sweep.replicas={1: 2, 2: 2}",
         "--set", "scene.process.run_time=0.4"]
 

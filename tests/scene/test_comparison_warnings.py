@@ -26,7 +26,7 @@ def test_one_cg1_replica_warns_and_its_twin_does_not_count():
 
 
 def test_two_cg1_replicas_or_cg1_alone_do_not_warn():
-    assert warnings_for() == []          # granules.yaml: 2 CG1 seeds
+    assert warnings_for() == []          # granules.yaml: 2 CG1 replicas
     assert warnings_for(replicas={1: 2, 2: 2}) == []
     assert warnings_for(cg_levels=[1], replicas=1, controls=[]) == []
 

@@ -85,7 +85,7 @@ def test_cohesionless_twin_keeps_everything_but_the_bridge_forces():
     assert (a.fill, a.particles, a.numerics, a.contact_dumps) == (b.fill, b.particles,
                                                                    b.numerics, b.contact_dumps)
     assert a.liquid_values.liquid_content == b.liquid_values.liquid_content
-    # granules.yaml: 2 CG1 seeds, each with its twin; 2 seeds of each CG2 rule
+    # granules.yaml: 2 CG1 replicas, each with its twin; 2 replicas of each CG2 rule
     assert sum(c.cg == 1 for c in cases) == 4 and sum(c.cg == 2 for c in cases) == 4
     assert sum(CONTROL_KEY in dict(c.varied) for c in cases) == 2
 

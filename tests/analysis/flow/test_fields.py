@@ -146,7 +146,7 @@ def test_fast_deposit_matches_direct_kernel_sum():
 
 def test_solid_error_interval_and_floor():
     """A CG-n bed whose solid fraction is 1.1 times CG1's everywhere (the CG1 sums with
-    phi scaled): solid error 0.1, an interval that holds it; two CG1 seeds of one lattice
+    phi scaled): solid error 0.1, an interval that holds it; two CG1 runs of one lattice
     (the noise is in the velocities only): a measured floor of 0."""
     geo, spacing = geometry(D1), 2e-3
 
