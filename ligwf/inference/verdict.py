@@ -27,10 +27,10 @@ the level was tested on (:func:`condition_criteria`): each registered criterion
 (:func:`ligwf.inference.budget.criteria`) decides itself and gives the p-value of its fail
 test (:class:`~ligwf.inference.registry.Decision`), decided or not, so the family's size
 does not depend on the outcome; a fail Holm does not keep becomes undecided, planned at the
-family's alpha. The alpha, levels and rules travel with
-the verdict (``Verdict.statistics``). Every criterion also carries ``bound``: the largest error its interval allows
-(the error the level is shown to stay within), so a user with another budget reads the
-answer without a rerun. Written by :mod:`ligwf.inference.verdict_records`, shown by
+family's alpha. The alpha, levels and rules travel with the verdict
+(``Verdict.statistics``). Every criterion also carries ``bound``: the largest error its
+interval allows (the error the level is shown to stay within), so a user with another
+budget reads the answer without a rerun. Written by :mod:`ligwf.inference.verdict_records`, shown by
 :mod:`ligwf.report.verdict_text`.
 """
 
@@ -234,7 +234,8 @@ def after_holm(r: CriterionResult, rejected: bool, family: int) -> CriterionResu
 
 def extrapolated_group(group: str, sub: pd.DataFrame, in_group: pd.DataFrame,
                        accept: AcceptSettings, alpha: float, size_ratio: float,
-                       speedups: dict[Condition, float], noise: pd.DataFrame | None = None) -> GroupVerdict:
+                       speedups: dict[Condition, float], noise: pd.DataFrame | None = None
+                       ) -> GroupVerdict:
     """The verdict of a group without CG1: every CG-n level of a rule with two or more
     levels judged against that rule's extrapolated CG1."""
     out = []
