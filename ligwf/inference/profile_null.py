@@ -8,7 +8,7 @@ was too thin, so the fail test erred up to 0.065 on bins correlated like real pr
 (docs/results/verdict_rates/profiles.txt). Simulated under the runs' sample covariance, whose
 eigenvalues spread more than the truth's, the fail side errs at most 0.044 there and is
 conservative on independent bins (profiles_2.txt). :func:`ligwf.inference.equivalence.norm_estimate`
-takes the lower bound from here under ``bins="correlated, simulated fail test"``.
+takes the lower bound from here under the simulated rules (``equivalence.SIMULATED_RULES``).
 
 The same draws also give a candidate upper bound (the sixth verdict_rates run, profiles_3.txt):
 the distance along the noise's largest direction (:meth:`SimulatedNull.largest`), where
@@ -17,13 +17,15 @@ covered 0.86-0.92 on correlated bins at offset 0 (profiles_2's registration), so
 direction is not used for it. Measured, the smaller of it and the correlated rule's covered
 0.950-0.992, still above 0.99 at offset 0 (profiles_3.txt check 1 failed): not the verdict's.
 
-And a third (the seventh run, profiles_4.txt): in each draw the distance along its own
+A third (the seventh run, profiles_4.txt): in each draw the distance along its own
 direction drawn from the difference's fiducial distribution, the observed difference of the
 mean profiles less an independent draw of the noise (:meth:`SimulatedNull.fiducial`). The
 true difference's direction is the null's nuisance; the observed direction leans towards
 quiet bins exactly when the distance looks small (the studies an upper bound must not
 miss), the largest direction is the least favourable one; the fiducial draw averages over
-the directions the runs leave possible.
+the directions the runs leave possible. Measured, all four registered checks held
+(0.955-0.972 on correlated bins, 0.950-0.981 on independent ones): the verdict's upper bound
+since, the smaller of it and the correlated rule's.
 """
 
 from __future__ import annotations

@@ -80,9 +80,12 @@ def test_the_crash_inputs_and_no_noise_give_bounds():
     assert e.lo == e.hi == pytest.approx(e.raw)
 
 
-def test_the_verdict_keeps_its_rule_until_the_seventh_run_says():
-    """The verdict's profile rule stays the fifth run's until profiles_4.txt (registered
-    before the run) holds all four checks and no committed verdict table changes
-    (docs/results/verdict_rates)."""
-    assert eq.PROFILE_BINS == eq.BINS_SIMULATED
-    assert "profiles_4.txt" in eq.BINS_RULE_TEXT[RULE]
+def test_the_verdict_uses_it_and_says_so():
+    """profiles_4.txt (registered before the run) held all four checks and re-deciding the
+    committed verdict tables changed none (docs/results/verdict_rates): the verdict's
+    profile rule is this one, and its method sentence names the run."""
+    from ligwf.inference.verdict_statistics import method_text, statistics_record
+    stats = statistics_record(0.05, eq.WELCH_BF)
+    assert eq.PROFILE_BINS == RULE == stats["profile_bins"]
+    text = method_text(stats)
+    assert "fiducial distribution" in text and "profiles_4.txt" in text
