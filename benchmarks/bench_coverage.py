@@ -30,7 +30,8 @@ Every coverage cell must lie in [0.92, 0.99]; the summary line says how many do.
 ``--profiles`` measures the profile's bounds when depth bins share their errors, sized from
 real profiles (:mod:`benchmarks.profile_designs`, registered in docs/results/verdict_rates/).
 ``--profiles-2`` measures the profile's simulated fail test (the second registered run),
-``--profiles-3`` the same with the smaller upper bound (the third).
+``--profiles-3`` the same with the smaller upper bound (the third), ``--profiles-4`` with the
+upper bound simulated along fiducial directions (the fourth).
 ``--designs`` measures instead the designs users run under the verdict's single-look rules
 (unequal arms, all-zero shares, a level's family of criteria, the cheapest of several
 levels: :mod:`benchmarks.verdict_designs`, registered in docs/results/verdict_rates/); the
@@ -277,6 +278,10 @@ def main(argv=None) -> int:
     ap.add_argument("--profiles-3", action="store_true",
                     help="only the profile's simulated fail test with the smaller upper bound "
                          "(benchmarks/profile_designs.py report_3; docs/results/verdict_rates)")
+    ap.add_argument("--profiles-4", action="store_true",
+                    help="only the profile's simulated fail test with the upper bound simulated "
+                         "along fiducial directions (benchmarks/profile_designs.py report_4; "
+                         "docs/results/verdict_rates)")
     ap.add_argument("--level-trials", type=int, default=2000,
                     help="studies a cell of the family and levels designs (--designs)")
     ap.add_argument("--recheck", type=int, default=0, metavar="N",
@@ -284,6 +289,9 @@ def main(argv=None) -> int:
                     "fresh null studies (Welch's and Hsu's df)")
     args = ap.parse_args(argv)
     rng = np.random.default_rng(args.seed)
+    if args.profiles_4:
+        from benchmarks.profile_designs import report_4
+        return 1 if report_4(rng, args.trials) else 0
     if args.profiles_3:
         from benchmarks.profile_designs import report_3
         return 1 if report_3(rng, args.trials) else 0

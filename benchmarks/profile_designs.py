@@ -47,6 +47,9 @@ RULES_2 = (eq.BINS_SIMULATED, eq.BINS_CORRELATED)
 #: the third run's rule (profiles_3.txt): the simulated fail test with the smaller upper
 #: bound, alone (the second run's rule is in profiles_2.txt; one rule keeps the run short)
 RULES_3 = (eq.BINS_SIMULATED_UPPER,)
+#: the fourth run's rule (profiles_4.txt): the simulated fail test with the upper bound
+#: lowered to the one simulated along fiducial directions, alone
+RULES_4 = (eq.BINS_SIMULATED_FIDUCIAL,)
 #: the second run counts a design in its checks from this many runs of both arms together
 #: (the verdict decides a profile from there: ligwf.inference.profile.MIN_PROFILE_RUNS)
 COUNTED_FROM = 6
@@ -158,6 +161,14 @@ def report_3(rng, trials: int) -> int:
     the simulated fail test with the smaller upper bound (:data:`RULES_3`) alone, the second
     run's designs and checks. The number of checks that fail."""
     return _report_counted(rng, trials, RULES_3, ("smaller upper",))
+
+
+def report_4(rng, trials: int) -> int:
+    """The fourth profile run (registered in docs/results/verdict_rates/README.md before it):
+    the simulated fail test with the upper bound simulated along fiducial directions
+    (:data:`RULES_4`) alone, the second run's designs and checks. The number of checks that
+    fail."""
+    return _report_counted(rng, trials, RULES_4, ("fiducial upper",))
 
 
 def _report_counted(rng, trials: int, rules: tuple[str, ...], names: tuple[str, ...]) -> int:

@@ -71,7 +71,7 @@ def test_shared_errors_widen_the_upper_bound_to_cover():
 def test_the_verdict_uses_the_correlated_rule_and_says_so():
     from ligwf.inference.verdict_statistics import method_text, statistics_record
     stats = statistics_record(0.05, eq.WELCH_BF)
-    assert eq.PROFILE_BINS == eq.BINS_SIMULATED == stats["profile_bins"]
+    assert eq.PROFILE_BINS == eq.BINS_SIMULATED_FIDUCIAL == stats["profile_bins"]
     assert "correlation measured on the runs' residuals" in method_text(stats)
 
 

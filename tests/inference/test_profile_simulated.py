@@ -89,6 +89,6 @@ def test_no_noise_and_identical_profiles_never_give_nan():
 def test_the_verdict_uses_the_simulated_fail_test_and_says_so():
     from ligwf.inference.verdict_statistics import method_text, statistics_record
     stats_record = statistics_record(0.05, eq.WELCH_BF)
-    assert stats_record["profile_bins"] == eq.PROFILE_BINS == eq.BINS_SIMULATED
+    assert stats_record["profile_bins"] == eq.PROFILE_BINS == eq.BINS_SIMULATED_FIDUCIAL
     text = method_text(stats_record)
-    assert "null simulated" in text and "profiles_2.txt" in text
+    assert "null simulated" in text and "profiles_4.txt" in text

@@ -291,6 +291,55 @@ def test_smaller_upper_bound_run_is_what_the_readme_says():
     cover = re.search(r"check 1 .*?\(([\d.]+-[\d.]+)\)", text).group(1)
     assert (f"a smaller bound simulated along the noise's largest direction covered {cover}, "
             "still above 0.99 at offset 0, and is not used: `profiles_3.txt`") in guide
-    # check 1 failed: the verdict keeps the fifth run's rule
-    assert eq.PROFILE_BINS == eq.BINS_SIMULATED != eq.BINS_SIMULATED_UPPER
+    # check 1 failed: the verdict kept the fifth run's rule (the seventh run's since)
+    assert eq.PROFILE_BINS != eq.BINS_SIMULATED_UPPER
     assert "stays the fifth run's" in result
+
+
+def test_fiducial_upper_bound_run_is_what_the_readme_says():
+    """profiles_4.txt (bench_coverage --profiles-4, registered before it): the registered
+    command on its first line and its commit, the check lines recomputed from its cells
+    (designs of >= 6 runs, a rate shown above 0.05 by its lower 95 % Clopper-Pearson bound),
+    the numbers the README and the verdict's method sentence quote, and the verdict's rule
+    switched to it because all four checks held."""
+    from ligwf.inference import equivalence as eq
+    text = (HERE / "profiles_4.txt").read_text()
+    raw = (HERE / "README.md").read_text()
+    registered = re.search(r"^    (OPENBLAS_NUM_THREADS=1 nice -n 19 .*--profiles-4.*) > "
+                           r"docs/results/verdict_rates/profiles_4\.txt$", raw, re.M).group(1)
+    assert text.splitlines()[0].startswith("# " + registered + " ")
+    assert "--trials 3000 --seed 20261217" in registered and "3000 studies a cell" in text
+    assert "registered in README.md before the run, commit b5648e7" in text.splitlines()[0]
+    assert raw.index("## Seventh run") < raw.index("### Seventh run's result")
+    cells = _profile_cells("profiles_4.txt")
+    assert len(cells) == 36
+    assert _profile_checks(cells, text, 3000) == [True, True, True, True]
+    assert "summary: 4 of 4 registered checks hold" in text
+    result = " ".join(raw.split("### Seventh run's result", 1)[1].split("\n## ", 1)[0].split())
+    assert "**4 of 4 registered checks hold.**" in result
+    corr = {k: v for k, v in cells.items() if k[0] == "correlated" and k[1] >= 6}
+    indep = {k: v for k, v in cells.items() if k[0] == "independent" and k[1] >= 6}
+    cover = sorted(1.0 - v[1] for v in corr.values())
+    span = f"{cover[0]:.3f}-{cover[-1]:.3f}"
+    assert f"({span})" in result and span == "0.955-0.972"
+    at0 = {k[2]: 1.0 - v[1] for k, v in corr.items() if k[3] == 0.0}
+    assert f"cover {at0['6 vs 6']:.3f} (6 vs 6;" in result
+    assert f"and {at0['24 vs 3']:.3f} (24 vs 3;" in result
+    worst_pass = max(corr.items(), key=lambda kv: kv[1][1])
+    worst_fail = max(corr.items(), key=lambda kv: kv[1][2])
+    assert (f"Wrong pass at most {worst_pass[1][1]:.4f} ({worst_pass[0][2]}, offset "
+            f"{worst_pass[0][3]:.0f})") in result
+    assert (f"wrong fail at most {worst_fail[1][2]:.4f} ({worst_fail[0][2]}, offset "
+            f"{worst_fail[0][3]:.0f})") in result
+    assert (f"({min(1 - v[1] for v in indep.values()):.3f}-"
+            f"{max(1 - v[1] for v in indep.values()):.3f}; the sixth run's bound") in result
+    assert f"At most {max(v[1] for v in indep.values()):.4f} (pass" in result
+    assert f"and {max(v[2] for v in indep.values()):.4f} (fail)" in result
+    # all four held and no committed table changed: the verdict's rule is this one
+    assert eq.PROFILE_BINS == eq.BINS_SIMULATED_FIDUCIAL
+    assert "`ligwf.inference.equivalence.PROFILE_BINS`" in result
+    said = " ".join(eq.BINS_RULE_TEXT[eq.PROFILE_BINS].split())
+    assert (f"covers {span} there and it errs at most {worst_pass[1][1]:.3f} (pass) and "
+            f"{worst_fail[1][2]:.3f} (fail): docs/results/verdict_rates/profiles_4.txt") in said
+    guide = " ".join((ROOT / "docs" / "guide" / "analysis.md").read_text().split())
+    assert f"which covered {span} on correlated bins: `profiles_4.txt`" in guide
