@@ -69,7 +69,7 @@ def test_every_table_reads_with_its_rows(reported):
     assert set(s.conditions["cg"]) == {1.0, 2.0}
     verdict = s.verdict
     assert set(verdict["state"]) <= {"pass", "fail", "undecided", "not assessed", "not measured"}
-    assert verdict["cheapest"].dtype == "boolean" and set(verdict["condition"]) == {"cg2-weber"}
+    assert verdict["cheapest"].dtype == "boolean" and set(verdict["condition"]) == {"cg2-weber", "cg2-bond"}
     groups = s.verdict_result.groups
     assert groups and all(g.sentence for g in groups)
     assert s.cases is not s.cases                          # a copy each time
@@ -120,7 +120,7 @@ def test_settings_paths_profiles_and_flow_record(reported):
     s = ligwf.open_study(reported)
     s.check()                                   # analysis and report match the study
     assert s.name == "tiny-study" and s.settings.bootstrap == 50
-    assert s.workflow["sweep"]["rules"] == ["weber"]
+    assert s.workflow["sweep"]["rules"] == ["weber", "bond"]
     assert s.accept.angle_deg > 0                  # the verdict's budget (defaults here)
     assert s.summary.is_file() and s.html.is_file() and s.report_dir == reported / "report"
     assert set(s.paraview) == set(s.cases["case_id"])

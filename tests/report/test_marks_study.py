@@ -30,6 +30,7 @@ from ligwf.inference import equivalence as eq
 from ligwf.study import layout
 from ligwf.study.manifest import read_manifest
 
+from apistudy import api_study, api_study_stdout
 from helpers import ROOT
 
 pytestmark = [pytest.mark.engine, pytest.mark.mpi, pytest.mark.slow]
@@ -60,9 +61,11 @@ def _text(path: Path) -> str:
 
 
 @pytest.fixture(scope="module")
-def fresh(tmp_path_factory):
-    out = tmp_path_factory.mktemp("marks") / "fresh"
-    return out, run_study(out)
+def fresh(engine, tmp_path_factory):
+    """The session's fresh tiny study under both rules (tests/apistudy.py: two CG1 and two
+    CG2 replicas a rule, the CG1 runs' cohesionless twins) and what ``ligwf study`` printed."""
+    return (api_study(engine, tmp_path_factory),
+            api_study_stdout(engine, tmp_path_factory))
 
 
 @pytest.fixture(scope="module")
@@ -175,11 +178,11 @@ def check_pages(report: Path, stdout: str) -> None:
 
 
 def test_fresh_study_marks_and_verdict_agree_with_their_intervals(fresh):
-    out, r = fresh
+    out, stdout = fresh
     assert check_marks(out / "report") > 0
     verdict = check_verdict(out / "report")
     assert set(verdict["condition"]) == {"cg2-weber", "cg2-bond"}
-    check_pages(out / "report", r.stdout)
+    check_pages(out / "report", stdout)
 
 
 def test_resumed_study_marks_and_verdict_agree_with_their_intervals(resumed):
