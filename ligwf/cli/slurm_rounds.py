@@ -35,10 +35,14 @@ from ligwf.study.rounds import read_rounds
 SETTLE_SECONDS = 60.0
 
 
-def add_next_round_parser(sub, add_mesh_cache) -> argparse.ArgumentParser:
-    p = sub.add_parser(NEXT_ROUND, help="the follow-up job of a study submitted "
-                       "--until-decided: analyse, report and take the look, then submit the "
-                       "next round (or write the final report); safe to run again")
+#: what ``next-round`` does, for its help (``ligwf next-round`` and ``ligwf slurm next-round``)
+NEXT_ROUND_HELP = ("the follow-up job of a study submitted --until-decided: analyse, report "
+                   "and take the look, then submit the next round (or write the final "
+                   "report); safe to run again")
+
+
+def add_next_round_args(p: argparse.ArgumentParser, add_mesh_cache) -> argparse.ArgumentParser:
+    """The follow-up job's arguments (STUDY and the options the first submission had)."""
     p.add_argument("study_dir", type=Path, help="study folder")
     p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR",
                    help="user template folder the study was written with (repeatable)")
