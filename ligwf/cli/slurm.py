@@ -62,7 +62,7 @@ from ligwf.slurm.walltime import (PlanRow, estimate_basis, hours_minutes, over_t
                                 plan_rows, slab_note, slurm_time_seconds)
 from ligwf.pipeline.submit_rounds import NEXT_ROUND, is_sequential
 from ligwf.executors import build_executor, executor_kind, study_executor
-from ligwf.slurm.jobs import PlannedJob, read_record, study_status
+from ligwf.slurm.jobs import PlannedJob, dry_run_text, read_record, study_status
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
 from ligwf.scheduler import queued_tasks
 from ligwf.study import layout
@@ -191,7 +191,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
         engine = EngineConfig.from_site()
         print("\n".join(site_assumptions(site, jobs, shlex.join([engine.mpirun,
                                                                   *engine.mpirun_args]))))
-        print(scheduler.dry_run_text(jobs))
+        print(dry_run_text(jobs))
         if rounds:
             print(dry_run_note(args, submission.out))
         return 0
@@ -212,7 +212,7 @@ def submit_analysis(args: argparse.Namespace, count: int) -> int:
     scheduler = build_executor(SLURM)
     split = plan_split_analysis(Study.open(args.run_dir), scheduler, count)
     if args.dry_run:
-        print(scheduler.dry_run_text(list(split.jobs)))
+        print(dry_run_text(list(split.jobs)))
         return 0
     scheduler.require()
     entries = split.submit(scheduler)
@@ -298,7 +298,7 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
                                  is EXTEND else ")")
                               for c in again.cases if c.index in again.indices))
     if args.dry_run:
-        print(scheduler.dry_run_text(list(again.jobs)))
+        print(dry_run_text(list(again.jobs)))
         return 0
     print_submitted(again.submit(scheduler))
     return 0
