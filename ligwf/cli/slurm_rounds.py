@@ -27,7 +27,7 @@ from ligwf.pipeline.rounds import (INCOMPLETE, STOPPED, RoundPlan, prepare_study
 from ligwf.pipeline.submit_rounds import (NEXT_ROUND, FollowUp, Moved, keep_going, progress,
                                           recorded_steps)
 from ligwf.scheduler import Scheduler
-from ligwf.study.layout import REPORT_DIR
+from ligwf.study.layout import REPORT_DIR, ROUNDS_FILE
 from ligwf.study.rounds import read_rounds
 
 #: how long a follow-up job waits for case tasks Slurm still shows (a task that has just
@@ -105,7 +105,13 @@ def submit_until_decided(args: argparse.Namespace, prepared: Prepared, out: Path
 
 def next_round(args: argparse.Namespace, study_dir: Path, scheduler: Scheduler,
                planned: bool, cores: int | None) -> int:
-    """``ligwf slurm next-round``: 1 when the round did not finish (no look taken)."""
+    """``ligwf slurm next-round``: 1 when the round did not finish (no look taken). A
+    study with no rounds record (never run ``--until-decided``) is refused in one line
+    before anything is written or submitted: its first round would be submitted."""
+    if not (study_dir / ROUNDS_FILE).is_file():
+        raise ConfigError(f"{study_dir}: no rounds record ({ROUNDS_FILE}): next-round is the "
+                          "follow-up job of a study run --until-decided; 'ligwf resubmit "
+                          "STUDY --executor slurm' runs what a plain study still needs")
     how = FollowUp("slurm", planned, cores, not args.no_snapshots,
                    tuple(Path(t).resolve() for t in args.templates), args.allow_unstable,
                    mesh_cache=args.mesh_cache)

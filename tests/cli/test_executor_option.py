@@ -194,7 +194,12 @@ def test_resubmit_and_next_round_on_slurm_are_the_slurm_commands(ligwf, study, m
         assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
         assert f"--executor = 'local': ligwf {command} hands a study" in res.stderr
         assert here in res.stderr
-    assert not list((study / "slurm").glob("*.sh"))          # dry runs: no script written
+    # a study never run --until-decided: next-round refuses (it would submit a round 1)
+    for words in (("slurm", "next-round", study), ("next-round", study, "--executor", "slurm")):
+        res = ligwf(*words)
+        assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
+        assert "no rounds record (rounds.json)" in res.stderr, res.stderr
+    assert not list((study / "slurm").glob("*.sh"))   # dry runs and refusals: no script
 
 
 @pytest.mark.parametrize("executor", ["local", "slurm"])
