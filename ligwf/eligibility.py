@@ -26,8 +26,8 @@ The tasks and their postconditions:
 :func:`eligible` answers for a study's cases: ``ligwf run`` / ``study`` schedule the
 cases it names (:mod:`ligwf.local`), ``ligwf slurm resubmit`` submits them again
 (:mod:`ligwf.pipeline.submit`), the rounds on a scheduler read where a round stands from
-it (:mod:`ligwf.pipeline.submit_rounds`) and ``ligwf slurm status`` shows each case's
-need beside its manifest. So an extended done case, whose manifest still reads ``done``,
+it (:mod:`ligwf.pipeline.submit_rounds`) and ``ligwf status`` (``--executor slurm`` too)
+shows each case's need beside its manifest. So an extended done case, whose manifest still reads ``done``,
 is run by all of them alike.
 """
 

@@ -2,41 +2,37 @@
 (:class:`ligwf.local.LocalExecutor`) or a batch scheduler (Slurm, or PBS, LSF, ...).
 
 Every :class:`Executor` runs cases (:meth:`Executor.run_cases`: on this machine now; on a
-scheduler as a job array it waits for), says where each case stands
-(:meth:`Executor.status`: its manifest beside the executor's own view of it, a live runner
-or a queued task), stops them (:meth:`Executor.cancel`) and analyses what they wrote
-(:meth:`Executor.analyse`: shares side by side, merged). The pipeline runs cases and the
-analysis only through this interface (:func:`ligwf.pipeline.run.run_study`,
+scheduler as job arrays it waits for), analyses what they wrote (:meth:`Executor.analyse`:
+shares side by side, merged), says where each case stands (:meth:`Executor.status`: its
+manifest beside the executor's own view of it, a live runner or a queued task) and stops
+them (:meth:`Executor.cancel`); :meth:`Executor.require` refuses, before anything is
+written, an executor that cannot run anything. The pipeline runs cases and the analysis
+only through these five (:func:`ligwf.pipeline.run.run_study`,
 :func:`ligwf.pipeline.post.postprocess`).
 
-A batch scheduler (:class:`Scheduler`) is an executor that can also hand a whole study to
-the queue and return at once: job arrays and a follow-up job, as below.
-
-A scheduler runs a written study as job arrays: one task per case (each runs ``ligwf
+A batch scheduler (:class:`Scheduler`) implements job verbs instead, as snakemake's
+executor plugins do (run a job, check the active ones, cancel): :meth:`Scheduler.plan_jobs`
+builds the scripts of a submission (pure: one task per case, each running ``ligwf
 run-case STUDY --index I``, the local runner with its manifests, health checks and
-resume), one array per rank count of the rank plan (the phases of
-:func:`ligwf.engine.plan.allocation_schedule`), and a follow-up job after all of them
-that runs the pipeline's post-processing commands. Four things differ between
-schedulers, and a :class:`Scheduler` implements them:
-
-* **script building** (:meth:`Scheduler.plan_jobs`, pure): the batch scripts and what
-  each one covers; :meth:`Scheduler.dry_run_text` shows them without submitting;
-* **submit** (:meth:`Scheduler.submit`): write the scripts, submit them in order (the
-  follow-up job depends on the arrays), record every submission in the study folder;
-* **status** (:meth:`Scheduler.status`): each case's manifest beside the scheduler's view
-  of its latest task (:class:`StudyStatus`);
-* **cancel** (:meth:`Scheduler.cancel`): stop the study's queued and running jobs (array
-  tasks get the scheduler's signal, so the runner writes forced restarts and marks the
-  case ``killed``; a resubmit resumes it).
+resume; one array per rank count of the rank plan, the phases of
+:func:`ligwf.engine.plan.allocation_schedule`; and a follow-up job after them running the
+pipeline's post-processing, its analysis split into shares and a merge when asked),
+:meth:`Scheduler.submit` writes and submits them in order and records each in the study
+folder, :meth:`Scheduler.status` polls (each case's manifest beside its latest task, each
+recorded job's state) and :meth:`Scheduler.cancel` stops the study's jobs (array tasks get
+the scheduler's signal, so the runner writes forced restarts and marks the case
+``killed``; a resubmit resumes it); :meth:`Scheduler.require` checks its commands.
+:class:`SubmitAndWait`, written once, makes any scheduler an executor: its
+``run_cases`` and ``analyse`` submit and then wait in :func:`wait_for`, the one wait loop
+(this machine's analysis shares wait in it too). What a scheduler shows in a dry run is
+its own command line's business (:mod:`ligwf.cli.slurm`), not the pipeline's.
 
 Which cases a resubmit runs again is not the scheduler's to say: it is what
 :func:`ligwf.eligibility.eligible` says of the case folders, with the cases whose task the
-scheduler still has queued or running held.
-
-Where an executor waits (a scheduler for the arrays it submitted, this machine for the
-analysis shares it started) it waits in :func:`wait_for`. The case's outcome is always its
-manifest: the scheduler only says whether a task is still queued or running. The Slurm implementation is :class:`ligwf.slurm.scheduler.SlurmScheduler`;
-the pipeline (:mod:`ligwf.pipeline.submit`) chains preparation, rank plan and scheduler.
+scheduler still has queued or running held. The case's outcome is always its manifest:
+the scheduler only says whether a task is still queued or running. The Slurm
+implementation is :class:`ligwf.slurm.scheduler.SlurmScheduler`; the pipeline
+(:mod:`ligwf.pipeline.submit`) chains preparation, rank plan and scheduler.
 """
 
 from __future__ import annotations
@@ -63,9 +59,10 @@ class CaseView(Protocol):
 
 
 class StudyStatus(Protocol):
-    """Every case's status, the recorded jobs (with their ``state``; a job after the
-    arrays also with ``active``: still queued or running) and, in tolerant mode, why the
-    scheduler's view is missing."""
+    """Every case's status, the recorded jobs (with their ``state``, the scheduler's word;
+    a job after the arrays also with ``active``: still queued or running, and
+    ``completed``: ended well) and, in tolerant mode, why the scheduler's view is
+    missing."""
 
     cases: list
     jobs: list[dict]
@@ -142,13 +139,15 @@ class JobRound:
     -> MPI ranks from the rank plan (None: the site's fixed task count), planned on
     ``plan_cores`` cores (recorded, so a resubmit plans again on as many);
     ``post_steps``: the ``ligwf <step> STUDY`` commands of the follow-up job, in order;
-    ``analysis_tasks`` > 1: its ``analyse`` step as an array of that many tasks staged
-    under ``token``, then a merge job running the other steps; ``round_no``: the
-    submission round the scripts are numbered by; ``study_round``: the round of a
-    sequential study the jobs run (recorded with them)."""
+    ``analysis_tasks`` > 1 (or a ``token``): its ``analyse`` step as an array of that many
+    tasks staged under ``token``, then a merge job running the other steps (no
+    ``indices`` and ``post_steps`` ``("analyse",)``: a written study's split analysis);
+    ``round_no``: the submission round the scripts are numbered by (None: the one after
+    the submissions the study folder records); ``study_round``: the round of a sequential
+    study the jobs run (recorded with them)."""
 
     indices: tuple[int, ...] = ()
-    round_no: int = 1
+    round_no: int | None = None
     ranks: Mapping[int, int] | None = None
     post_steps: tuple[str, ...] = ()
     plan_cores: int | None = None
@@ -175,29 +174,118 @@ class BatchJob(Protocol):
 
 
 @runtime_checkable
-class Scheduler(Executor, Protocol):
-    """A batch scheduler ligwf submits studies to (see the module docstring)."""
+class Scheduler(Protocol):
+    """A batch scheduler ligwf submits studies to (see the module docstring): the job
+    verbs a new one implements (snakemake's executor plugins: run a job, check the active
+    ones, cancel). :class:`SubmitAndWait` makes one an :class:`Executor`."""
+
+    #: the name shown to users and recorded with submissions (``slurm``)
+    name: str
+
+    def require(self) -> None:
+        """A one-line error unless the scheduler's commands are usable (checked before
+        anything is written or submitted)."""
 
     def plan_jobs(self, study_dir: Path, study_name: str, request: JobRound
                   ) -> Sequence[BatchJob]:
-        """The scripts of one submission round (pure): one array per rank count of
-        ``request.ranks`` and, with ``request.post_steps``, the follow-up job (see
+        """The scripts of one submission (pure apart from reading the study folder's
+        record to number them): one array per rank count of ``request.ranks`` and, with
+        ``request.post_steps``, the follow-up job, its analysis split when asked (see
         :class:`JobRound`)."""
 
-    def plan_analysis(self, study_dir: Path, study_name: str, tasks: int, token: str
-                      ) -> Sequence[BatchJob]:
-        """The scripts of a split analysis of a written study (pure): an array of ``tasks``
-        analysis tasks, each one share of the study's (case, frame) tasks staged under
-        ``token``, and the job that merges them into the analysis folder."""
-
-    def dry_run_text(self, jobs: Sequence[BatchJob]) -> str:
-        """Every script and the command that would submit it."""
-
     def submit(self, study_dir: Path, jobs: Sequence[BatchJob]) -> list[dict]:
-        """Write and submit ``jobs`` in order, recording each; the new record entries."""
+        """Write and submit ``jobs`` in order (a follow-up job after the arrays before
+        it), recording each in the study folder; the new record entries."""
 
-    def next_round(self, study_dir: Path) -> int:
-        """1 + the submission rounds recorded in the study folder so far."""
+    def status(self, study_dir: Path, tolerant: bool = False) -> StudyStatus:
+        """The poll: every case's manifest beside the state of its latest task, and every
+        recorded job with its state (a job after the arrays also with ``active``)."""
 
-    def recorded(self, study_dir: Path) -> bool:
-        """Whether the study folder records a submission of this scheduler."""
+    def cancel(self, study_dir: Path) -> list[str]:
+        """Stop the study's queued and running jobs; their ids."""
+
+
+class SubmitAndWait:
+    """What makes a :class:`Scheduler` an :class:`Executor`, written once for every
+    scheduler over its job verbs and :func:`wait_for`: :meth:`run_cases` submits the cases
+    as arrays and waits for them, :meth:`analyse` submits the split analysis and waits for
+    its merge. A scheduler class inherits it and sets ``poll_seconds`` (seconds between
+    polls) and ``forget_polls`` (polls in a row in which the scheduler does not know a job
+    it was given before the wait gives up on it: one that ended before the first poll,
+    with no accounting)."""
+
+    poll_seconds: float = 5.0
+    forget_polls: int = 3
+
+    def _wait(self: Scheduler, study_dir: Path, stop: threading.Event,
+              pending: Callable[[StudyStatus], bool]) -> bool:
+        """Poll every ``poll_seconds`` while ``pending(status)``; ``stop`` set: cancel the
+        study's jobs once and go on waiting until they have ended. Whether it cancelled."""
+        return wait_for(lambda: pending(self.status(study_dir)), stop, self.poll_seconds,
+                        lambda: self.cancel(study_dir))
+
+    def run_cases(self, study, cases: Sequence, monitor=None,
+                  stop: threading.Event | None = None) -> bool:
+        """Submit ``cases`` as job arrays (ranks from the allocation rank plan, each case
+        in an allocation of its own; no follow-up job) and wait until none of them is
+        queued or running; whether all of them are done. ``stop`` set: the arrays are
+        cancelled (the runners write forced restarts, the cases end ``killed``) and the
+        wait goes on until the scheduler has ended them. ``monitor`` is not fed: the
+        engines run on other nodes (``ligwf status --executor NAME`` shows them)."""
+        from ligwf.eligibility import eligible
+        from ligwf.engine.plan import allocation_schedule, case_load
+
+        stop = stop or threading.Event()
+        cases = list(cases)
+        if not cases:
+            return True
+        schedule = allocation_schedule([case_load(c.path.name, c.scaled) for c in cases])
+        ranks = {c.index: schedule.ranks_of(c.path.name) for c in cases}
+        indices = {c.index for c in cases}
+        self.require()
+        self.submit(study.path, self.plan_jobs(study.path, study.name,
+                                               JobRound(tuple(indices), ranks=ranks)))
+        self._wait(study.path, stop,
+                   lambda st: any(c.queued for c in st.cases if c.index in indices))
+        return eligible(cases).settled
+
+    def analyse(self, study, tasks: int = 1,
+                stop: threading.Event | None = None) -> dict | None:
+        """The study's analysis as a job array of ``tasks`` shares and the merge job after
+        it (what ``ligwf analyse --executor NAME --tasks N`` submits), waited for; the
+        merged analysis record. ``stop`` set: both jobs are cancelled and None is returned
+        once they have ended. SubmitError when the merge job ends without a record (its
+        log, in the study's scheduler log folder, says why: a share that failed is named
+        there with the command that re-runs it)."""
+        from ligwf.analysis.outputs import new_token
+        from ligwf.analysis.records.analysis_record import AnalysisRecord
+        from ligwf.errors import SubmitError
+        from ligwf.study import layout
+
+        stop = stop or threading.Event()
+        self.require()
+        jobs = self.plan_jobs(study.path, study.name, JobRound(
+            post_steps=("analyse",), analysis_tasks=max(1, tasks), token=new_token()))
+        merge = str(self.submit(study.path, jobs)[-1]["job_id"])
+        looks: list[str | None] = []         # the merge job's state at each poll
+        ended_well = False
+
+        def pending(st: StudyStatus) -> bool:
+            nonlocal ended_well
+            entry = next(j for j in st.jobs if str(j["job_id"]) == merge)
+            looks.append(entry.get("state"))
+            ended_well = bool(entry.get("completed"))
+            if looks[-1] is not None:
+                return bool(entry["active"])
+            # unknown to the scheduler: waited for until so forget_polls + 1 polls in a row
+            return looks[-self.forget_polls - 1:] != [None] * (self.forget_polls + 1)
+
+        if self._wait(study.path, stop, pending):
+            return None
+        state = looks[-1]
+        if state is None or not ended_well:
+            raise SubmitError(f"the analysis merge job {merge} ended "
+                              f"{state or 'unknown to ' + self.name}: its log in "
+                              f"{study.path / layout.SLURM_LOG_DIR} says why")
+        record = AnalysisRecord.read(study.analysis_dir)
+        return record.data if record is not None else None

@@ -140,3 +140,19 @@ def test_slurm_status_shows_each_case_need_beside_its_manifest(study, monkeypatc
     assert [(c["manifest"], c["next"]) for c in data["cases"]] == [
         ("done", "done"), ("done", "extend"), ("killed", "resume"), ("missing", "fresh")]
     assert data["analysis_due"] == "not analysed yet"
+
+
+def test_local_status_says_what_each_case_needs_next(study, capsys):
+    """``ligwf status`` (this machine) names the same need as the Slurm status and a run:
+    the extended done case is to be extended, the killed one resumed; a live runner's case
+    is held."""
+    from ligwf.cli.main import main
+    from ligwf.cli.run import needs_lines
+
+    assert main(["status", str(study)]) == 0
+    shown = capsys.readouterr().out
+    assert "extend (production extended to step" in shown
+    assert "next resume (killed at step 10)" in shown and "next fresh (not run yet)" in shown
+    assert "analysis due: not analysed yet" in shown
+    lines = needs_lines(Study.open(study), {2: "123@here"})
+    assert lines[1].endswith(": next held (queued or running as 123@here)"), lines

@@ -22,7 +22,7 @@ from rich.text import Text
 from ligwf.engine.plan import MAX_RANKS, RankPlan, Schedule, particle_steps
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import Prepared, mesh_cache_lines, prepare_workflow
-from ligwf.study.layout import STUDY_FILE
+from ligwf.study.layout import STUDY_FILE, is_study_folder
 from ligwf.study.paths import path_text_problem, resolved, shown
 
 console = Console(width=None if sys.stdout.isatty() else 160)
@@ -185,15 +185,27 @@ def add_mesh_cache(p: argparse.ArgumentParser) -> None:
 
 def prepare_from_args(args: argparse.Namespace) -> Prepared:
     """Validate, render and pre-flight the workflow of ``args``; print the warnings.
-    Raises (nothing written) on a bad value or a refused case, or when ``--out`` is the
-    workflow file's own folder (a study would mix its case folders with the workflows)."""
+    WORKFLOW may be a study folder with ``--until-decided`` (on any executor: the workflow
+    it stores goes on in rounds), and is refused in one line without. Raises (nothing
+    written) on a bad value or a refused case, or when ``--out`` is the workflow file's own
+    folder (a study would mix its case folders with the workflows)."""
     out = getattr(args, "out", None)
-    if out is not None and Path(out).resolve() == Path(args.workflow).resolve().parent:
+    if is_study_folder(args.workflow):
+        if not getattr(args, "until_decided", False):
+            raise ConfigError(f"WORKFLOW = {args.workflow}: a study folder, not a workflow "
+                              "file; only 'ligwf study STUDY --out STUDY --until-decided' "
+                              "goes on from one (the workflow it stores)")
+        from ligwf.pipeline.rounds import prepare_study_folder    # loads the inference
+
+        prepared = prepare_study_folder(args.workflow, args.overrides, args.templates,
+                                        args.allow_unstable)
+    elif out is not None and Path(out).resolve() == Path(args.workflow).resolve().parent:
         raise ConfigError(f"--out {out} is the folder of the workflow file {args.workflow}: "
                           f"a study writes {STUDY_FILE} and one folder per case there; name a "
                           "folder of the study's own")
-    prepared = prepare_workflow(args.workflow, args.overrides, args.templates,
-                                args.allow_unstable)
+    else:
+        prepared = prepare_workflow(args.workflow, args.overrides, args.templates,
+                                    args.allow_unstable)
     case_ids = [rc.case.case_id for rc in prepared.rendered]
     for line in grouped_warnings(prepared.warnings, case_ids):
         print_warning(line)

@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 
 from ligwf import __version__
-from ligwf.cli import (analyse, analyse_dumps, calibrate, report, run, schema, slurm,
-                       stability, study)
+from ligwf.cli import (analyse, analyse_dumps, calibrate, executors, report, run, schema,
+                       slurm, stability, study)
 from ligwf.cli.common import (Parser, add_cores_arg, add_mesh_cache, add_replace_arg,
                               add_workflow_args,
                               case_table, console, err_console, folder_to_write, plan_table,
@@ -30,8 +30,8 @@ from ligwf.pipeline.run import Interrupted, planned_schedule, site_engine
 from ligwf.study.case import granules_absent
 
 #: Modules that add their stage's sub-commands: each has ``register(subparsers)``.
-COMMAND_MODULES = (run, slurm, analyse, analyse_dumps, stability, report, study, schema,
-                   calibrate)
+COMMAND_MODULES = (run, slurm, executors, analyse, analyse_dumps, stability, report, study,
+                   schema, calibrate)
 
 
 def cmd_check(args: argparse.Namespace) -> int:

@@ -26,9 +26,11 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
                               print_warning, rank_count, stop_on_signals)
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.cli.executors import CANCEL, SHOW_STATUS, add_executor_arg
+from ligwf.eligibility import HELD, analysis_due, eligible
 from ligwf.executors import LOCAL, build_executor, executor_kind
 from ligwf.local import run_settings
 from ligwf.pipeline.run import StudyRun, run_case_of, start_run
+from ligwf.scheduler import queued_tasks
 from ligwf.study.study import Study
 
 
@@ -58,14 +60,8 @@ def start_from_args(args: argparse.Namespace) -> StudyRun:
 
 def elsewhere(cases, retry_unstable: bool) -> list[str]:
     """The cases another live ligwf process is running (left to it, not in the plan)."""
-    from ligwf.engine.resume import Why, plan_case
-
-    out = []
-    for c in cases:
-        plan = plan_case(c, retry_unstable)
-        if plan.why is Why.HELD:
-            out.append(f"{c.path.name}: {plan.reason}: left to that runner")
-    return out
+    return [f"{t.case.path.name}: {t.reason}: left to that runner"
+            for t in eligible(cases, retry_unstable).tasks if t.need is HELD]
 
 
 def skipped_restarts(cases, retry_unstable: bool) -> list[str]:
@@ -112,12 +108,26 @@ def cmd_status(args: argparse.Namespace) -> int:
     for case in study.cases:             # an edited record: its results are not used
         if (why := case.record_problem(check_hash=False)) is not None:
             print_warning(f"{case.case_id}: {why}")
-    held = [c for c in build_executor(LOCAL).status(args.study).cases if c.queued]
+    st = build_executor(LOCAL).status(args.study)
+    held = [c for c in st.cases if c.queued]
     for runner in sorted({c.job for c in held}):
         names = [c.case_id for c in held if c.job == runner]
         console.print(f"running in ligwf process {runner}: {', '.join(names)}",
                       highlight=False, soft_wrap=True)
+    for line in needs_lines(study, queued_tasks(st)):
+        console.print(line, highlight=False, soft_wrap=True)
     return 0
+
+
+def needs_lines(study: Study, queued: dict[int, str]) -> list[str]:
+    """What each case that is not done needs next (:func:`ligwf.eligibility.eligible`: the
+    same word ``ligwf status --executor slurm`` shows, and what the same run command does
+    with it; ``queued``: the cases a runner holds) and whether the analysis is due."""
+    lines = [f"{t.case.case_id}: next {t.need} ({t.reason})"
+             for t in eligible(study.cases, queued=queued).not_done]
+    why = analysis_due(study)
+    return lines + [f"analysis due: {why}" if why else
+                    "analysis: holds for the study (its record, cases, dumps, settings)"]
 
 
 def cmd_cancel(args: argparse.Namespace) -> int:

@@ -46,9 +46,9 @@ from ligwf.cli.common import (add_cores_arg, add_mesh_cache, add_replace_arg,
                               console, duration, err_console, folder_to_write, positive_int,
                               prepare_from_args, print_warning, rank_count)
 from ligwf.cli.report import add_snapshots
-from ligwf.cli.slurm_rounds import (add_next_round_parser, dry_run_note, follow_up_of,
-                                    next_round, print_submitted, resubmit_rounds,
-                                    submit_until_decided)
+from ligwf.cli.slurm_rounds import (NEXT_ROUND_HELP, add_next_round_args, dry_run_note,
+                                    follow_up_of, next_round, print_submitted,
+                                    resubmit_rounds, submit_until_decided)
 from ligwf.eligibility import EXTEND, analysis_due, eligible
 from ligwf.engine.plan import RankPlan
 from ligwf.engine.progress import shown_reason
@@ -60,9 +60,9 @@ from ligwf.pipeline.submit import (plan_resubmission, plan_split_analysis, plan_
 from ligwf.slurm.assumptions import site_assumptions
 from ligwf.slurm.walltime import (PlanRow, estimate_basis, hours_minutes, over_time_warning,
                                 plan_rows, slab_note, slurm_time_seconds)
-from ligwf.pipeline.submit_rounds import is_sequential
+from ligwf.pipeline.submit_rounds import NEXT_ROUND, is_sequential
 from ligwf.executors import build_executor, executor_kind, study_executor
-from ligwf.slurm.jobs import PlannedJob, read_record, study_status
+from ligwf.slurm.jobs import PlannedJob, dry_run_text, read_record, study_status
 from ligwf.slurm.site import SlurmSite, load_slurm_site, ntasks_configured
 from ligwf.scheduler import queued_tasks
 from ligwf.study import layout
@@ -191,7 +191,7 @@ def cmd_submit(args: argparse.Namespace) -> int:
         engine = EngineConfig.from_site()
         print("\n".join(site_assumptions(site, jobs, shlex.join([engine.mpirun,
                                                                   *engine.mpirun_args]))))
-        print(scheduler.dry_run_text(jobs))
+        print(dry_run_text(jobs))
         if rounds:
             print(dry_run_note(args, submission.out))
         return 0
@@ -212,7 +212,7 @@ def submit_analysis(args: argparse.Namespace, count: int) -> int:
     scheduler = build_executor(SLURM)
     split = plan_split_analysis(Study.open(args.run_dir), scheduler, count)
     if args.dry_run:
-        print(scheduler.dry_run_text(list(split.jobs)))
+        print(dry_run_text(list(split.jobs)))
         return 0
     scheduler.require()
     entries = split.submit(scheduler)
@@ -298,7 +298,7 @@ def cmd_resubmit(args: argparse.Namespace) -> int:
                                  is EXTEND else ")")
                               for c in again.cases if c.index in again.indices))
     if args.dry_run:
-        print(scheduler.dry_run_text(list(again.jobs)))
+        print(dry_run_text(list(again.jobs)))
         return 0
     print_submitted(again.submit(scheduler))
     return 0
@@ -329,6 +329,18 @@ def cancel_study(study: Path) -> int:
     return 0
 
 
+#: what ``resubmit`` does, for its help (``ligwf resubmit`` and ``ligwf slurm resubmit``)
+RESUBMIT_HELP = ("submit a new array with exactly the cases that are missing, failed, killed "
+                 "or extended")
+
+
+def add_resubmit_args(p) -> None:
+    """The options of ``resubmit`` besides STUDY (``p``: a parser or an argument group)."""
+    p.add_argument("--include-unstable", action="store_true",
+                   help="also rerun cases the health checks marked unstable")
+    add_site_args(p)
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add ``ligwf slurm submit|status|resubmit|cancel`` to the top-level parser."""
     slurm = subparsers.add_parser("slurm", help="run a study as Slurm job arrays")
@@ -350,17 +362,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(func=cmd_status)
 
-    p = sub.add_parser("resubmit", help="submit a new array with exactly the cases that are "
-                                        "missing, failed, killed or extended")
+    p = sub.add_parser("resubmit", help=RESUBMIT_HELP)
     p.add_argument("study_dir", type=Path, help="study folder")
-    p.add_argument("--include-unstable", action="store_true",
-                   help="also rerun cases the health checks marked unstable")
-    add_site_args(p)
-    p.set_defaults(func=cmd_resubmit)
+    add_resubmit_args(p)
+    p.set_defaults(func=cmd_resubmit)      # = ligwf resubmit --executor slurm
 
     p = sub.add_parser("cancel", help="scancel the study's queued and running jobs (the "
                                       "cases resume on 'ligwf slurm resubmit')")
     p.add_argument("study_dir", type=Path, help="study folder")
     p.set_defaults(func=cmd_cancel)
 
-    add_next_round_parser(sub, add_mesh_cache).set_defaults(func=cmd_next_round)
+    add_next_round_args(sub.add_parser(NEXT_ROUND, help=NEXT_ROUND_HELP), add_mesh_cache
+                        ).set_defaults(func=cmd_next_round)     # = ligwf next-round --executor slurm

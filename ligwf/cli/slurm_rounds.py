@@ -27,7 +27,7 @@ from ligwf.pipeline.rounds import (INCOMPLETE, STOPPED, RoundPlan, prepare_study
 from ligwf.pipeline.submit_rounds import (NEXT_ROUND, FollowUp, Moved, keep_going, progress,
                                           recorded_steps)
 from ligwf.scheduler import Scheduler
-from ligwf.study.layout import REPORT_DIR
+from ligwf.study.layout import REPORT_DIR, ROUNDS_FILE
 from ligwf.study.rounds import read_rounds
 
 #: how long a follow-up job waits for case tasks Slurm still shows (a task that has just
@@ -35,10 +35,14 @@ from ligwf.study.rounds import read_rounds
 SETTLE_SECONDS = 60.0
 
 
-def add_next_round_parser(sub, add_mesh_cache) -> argparse.ArgumentParser:
-    p = sub.add_parser(NEXT_ROUND, help="the follow-up job of a study submitted "
-                       "--until-decided: analyse, report and take the look, then submit the "
-                       "next round (or write the final report); safe to run again")
+#: what ``next-round`` does, for its help (``ligwf next-round`` and ``ligwf slurm next-round``)
+NEXT_ROUND_HELP = ("the follow-up job of a study submitted --until-decided: analyse, report "
+                   "and take the look, then submit the next round (or write the final "
+                   "report); safe to run again")
+
+
+def add_next_round_args(p: argparse.ArgumentParser, add_mesh_cache) -> argparse.ArgumentParser:
+    """The follow-up job's arguments (STUDY and the options the first submission had)."""
     p.add_argument("study_dir", type=Path, help="study folder")
     p.add_argument("--templates", action="append", default=[], type=Path, metavar="DIR",
                    help="user template folder the study was written with (repeatable)")
@@ -101,7 +105,13 @@ def submit_until_decided(args: argparse.Namespace, prepared: Prepared, out: Path
 
 def next_round(args: argparse.Namespace, study_dir: Path, scheduler: Scheduler,
                planned: bool, cores: int | None) -> int:
-    """``ligwf slurm next-round``: 1 when the round did not finish (no look taken)."""
+    """``ligwf slurm next-round``: 1 when the round did not finish (no look taken). A
+    study with no rounds record (never run ``--until-decided``) is refused in one line
+    before anything is written or submitted: its first round would be submitted."""
+    if not (study_dir / ROUNDS_FILE).is_file():
+        raise ConfigError(f"{study_dir}: no rounds record ({ROUNDS_FILE}): next-round is the "
+                          "follow-up job of a study run --until-decided; 'ligwf resubmit "
+                          "STUDY --executor slurm' runs what a plain study still needs")
     how = FollowUp("slurm", planned, cores, not args.no_snapshots,
                    tuple(Path(t).resolve() for t in args.templates), args.allow_unstable,
                    mesh_cache=args.mesh_cache)

@@ -8,7 +8,7 @@ failed (they are listed, not used). With ``--until-decided`` it goes on in round
 (:mod:`ligwf.pipeline.rounds`): after each look it extends the runs or adds the replicas
 that decide the cheapest level that can still pass, until it is decided, the looks
 (``--max-looks``) are spent or the cap (``--max-core-hours``) is reached; WORKFLOW may
-then also be a study folder (its stored workflow is used). ``--executor`` picks what runs
+then also be a study folder (its stored workflow is used), on any executor. ``--executor`` picks what runs
 it (:mod:`ligwf.executors`): ``local`` (the default) runs it here and now; a batch
 scheduler (``--executor slurm``, also spelt ``ligwf slurm submit``) writes the study and
 submits it with its post-processing, or its first round and the follow-up job that takes
@@ -20,8 +20,7 @@ from __future__ import annotations
 import argparse
 
 from ligwf.cli.common import (add_until_decided_args, add_workflow_args, console,
-                              grouped_warnings, prepare_from_args, print_warning,
-                              stop_on_signals)
+                              prepare_from_args, stop_on_signals)
 from ligwf.cli.executors import SUBMIT_STUDY, add_executor_arg, checked_executor
 from ligwf.cli.report import add_snapshots, print_report, show_look
 from ligwf.cli.slurm import add_site_args
@@ -29,11 +28,11 @@ from ligwf.cli.run import add_run_args, run_with_progress, start_from_args
 from ligwf.engine.progress import RichMonitor, summary_table
 from ligwf.errors import ConfigError
 from ligwf.pipeline.post import postprocess
-from ligwf.pipeline.rounds import RoundPlan, prepare_study_folder, until_decided
+from ligwf.pipeline.rounds import RoundPlan, until_decided
 from ligwf.executors import LOCAL, build_executor
 from ligwf.local import run_settings
 from ligwf.pipeline.run import StudyRun
-from ligwf.study.layout import REPORT_DIR, is_study_folder
+from ligwf.study.layout import REPORT_DIR
 
 
 def cmd_study(args: argparse.Namespace) -> int:
@@ -54,14 +53,7 @@ def cmd_until_decided(args: argparse.Namespace) -> int:
         raise ConfigError(f"--extend-production = {args.extend_production:g}: not with "
                           "--until-decided (its rounds choose the production); run "
                           "'ligwf study' without it first")
-    if is_study_folder(args.workflow):
-        prepared = prepare_study_folder(args.workflow, args.overrides, args.templates,
-                                        args.allow_unstable)
-        for line in grouped_warnings(prepared.warnings,
-                                     [rc.case.case_id for rc in prepared.rendered]):
-            print_warning(line)
-    else:
-        prepared = prepare_from_args(args)
+    prepared = prepare_from_args(args)      # WORKFLOW, or a study folder's stored one
     settings = run_settings(args.np, args.ensemble, args.cores, args.retry_unstable,
                             args.templates)
 

@@ -30,10 +30,11 @@ continued case keeps its manifest, thermo table and frame series
 Where a sequential study stands is decided once, for every executor (:func:`stand`), from
 the rounds record, the round the executor was handed and what each case needs
 (:func:`ligwf.eligibility.eligible`): stopped, a round due, running, incomplete, a look
-due. The loop here (:func:`until_decided`, on any :class:`~ligwf.scheduler.Executor` that
-runs cases to their end) does what that says and asks again until the study stops; on a
-batch scheduler the follow-up job (:mod:`ligwf.pipeline.submit_rounds`) asks once, does
-it, and submits the next round with another follow-up job.
+due. One loop acts on it (:func:`drive`): here (:func:`until_decided`, on any
+:class:`~ligwf.scheduler.Executor` that runs cases to their end) it runs each round and
+asks again until the study stops; on a batch scheduler the follow-up job
+(:mod:`ligwf.pipeline.submit_rounds`) drives the same loop with acts that submit the next
+round with another follow-up job and end there.
 
 Repeated looks: every look tests at alpha / max_looks (Bonferroni spending, stated in the
 record and the report).
@@ -46,7 +47,7 @@ import math
 from dataclasses import dataclass
 from enum import StrEnum
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Mapping
 
 from ligwf.inference.equivalence import UNDECIDED
 from ligwf.errors import ConfigError
@@ -371,6 +372,20 @@ def stand(rounds: Rounds, handed: int, needs: Eligible, where: Path) -> Stand:
     return INCOMPLETE if needs.not_done else LOOK_DUE
 
 
+def drive(state: Callable[[], Stand], act: Mapping[Stand, Callable[[], bool]]) -> Stand:
+    """The one loop of rounds, for every executor: ask where the study stands (``state``,
+    read afresh each turn from the records: :func:`stand`), do what ``act`` does in that
+    state, and ask again, until the study stops. An act returns False to end the loop
+    there (a round handed to a scheduler that runs it on its own, a case that did not
+    finish): the state it ended in is returned, else :data:`STOPPED`. The local loop
+    (:func:`until_decided`) and a scheduler's follow-up job
+    (:func:`ligwf.pipeline.submit_rounds.keep_going`) differ only in their acts."""
+    while (now := state()) != STOPPED:
+        if not act[now]():
+            return now
+    return STOPPED
+
+
 def until_decided(prepared: Prepared, out: Path, executor: Executor, plan: RoundPlan,
                   run_round: Callable[[StudyRun], bool], show: Callable[[Look, Rounds], None],
                   mesh_cache: Path | None = None, snapshots: bool = True,
@@ -378,29 +393,42 @@ def until_decided(prepared: Prepared, out: Path, executor: Executor, plan: Round
     """Run, analyse and judge the study in rounds until it decides (module docstring), its
     cases and analysis on ``executor`` (one that runs them to their end: this machine, or a
     scheduler that waits); ``run_round`` runs the due cases of a round (the CLI's progress
-    display), ``show`` prints a look. Each turn acts on :func:`stand`: a due round is
-    written (:func:`write_round`), a round whose cases are not done is run, a due look is
-    taken (:func:`take_look`), until the study stops (then the final report). Returns the
-    rounds record; stops early (no look recorded) when a case did not finish (the same
-    command resumes it). Another study in ``out`` is refused before the rounds record is
-    touched, unless ``replace``."""
+    display), ``show`` prints a look. The loop (:func:`drive`) acts on :func:`stand`: a
+    due round is written (:func:`write_round`), a round whose cases are not done is run, a
+    due look is taken (:func:`take_look`), until the study stops (then the final report).
+    Returns the rounds record; stops early (no look recorded) when a case did not finish
+    (the same command resumes it). Another study in ``out`` is refused before the rounds
+    record is touched, unless ``replace``."""
     check_own_folder(out, prepared.workflow.name, prepared.workflow.raw,
                      [rc.case.case_id for rc in prepared.rendered], (), replace)
     rounds = start_rounds(out, plan)
     handed = len(rounds.looks)      # each call writes its round first (idempotent)
     identity = None
-    while (now := stand(rounds, handed, eligible(Study.open(out).cases)
-                        if handed > len(rounds.looks) else Eligible(()), out)) != STOPPED:
-        if now == ROUND_DUE:
-            _, identity = site_engine()             # refused before anything is written
-            write_round(prepared, out, rounds, mesh_cache, replace)
-            handed = len(rounds.looks) + 1
-        elif now == LOOK_DUE:
-            rounds = take_look(out, rounds, executor)
-            show(rounds.looks[-1], rounds)
-        elif not run_round(scheduled(Study.open(out), executor, identity)):
-            return rounds                           # RUNNING elsewhere, or INCOMPLETE
-    report_study(out, snapshots=snapshots)
+
+    def state() -> Stand:
+        needs = (eligible(Study.open(out).cases) if handed > len(rounds.looks)
+                 else Eligible(()))
+        return stand(rounds, handed, needs, out)
+
+    def hand_out() -> bool:
+        nonlocal handed, identity
+        _, identity = site_engine()                 # refused before anything is written
+        write_round(prepared, out, rounds, mesh_cache, replace)
+        handed = len(rounds.looks) + 1
+        return True
+
+    def look() -> bool:
+        nonlocal rounds
+        rounds = take_look(out, rounds, executor)
+        show(rounds.looks[-1], rounds)
+        return True
+
+    def run() -> bool:                              # RUNNING elsewhere, or INCOMPLETE
+        return run_round(scheduled(Study.open(out), executor, identity))
+
+    if drive(state, {ROUND_DUE: hand_out, LOOK_DUE: look, RUNNING: run,
+                     INCOMPLETE: run}) == STOPPED:
+        report_study(out, snapshots=snapshots)
     return rounds
 
 

@@ -27,6 +27,7 @@ from ligwf.pipeline.prepare import Prepared, prepared_loads, write
 from ligwf.eligibility import Eligible, eligible
 from ligwf.scheduler import (BatchJob, CaseView, JobRound, Scheduler, active_tasks,
                              queued_tasks)
+from ligwf.study.layout import is_study_folder
 from ligwf.study.study import Study
 
 
@@ -70,8 +71,8 @@ def plan_submission(prepared: Prepared, out: Path, scheduler: Scheduler, cores: 
     steps = (list(post_steps) if post_steps is not None
              else list(POSTPROCESS_COMMANDS) if analysis else [])
     jobs = scheduler.plan_jobs(out, prepared.workflow.name, JobRound(
-        tuple(rc.case.index for rc in prepared.rendered), scheduler.next_round(out), ranks,
-        tuple(steps), cores, analysis_tasks, _token(analysis_tasks), study_round))
+        tuple(rc.case.index for rc in prepared.rendered), None, ranks, tuple(steps), cores,
+        analysis_tasks, _token(analysis_tasks), study_round))
     return Submission(out, schedule, tuple(jobs))
 
 
@@ -90,7 +91,7 @@ def write_for_submit(prepared: Prepared, submission: Submission, scheduler: Sche
     still runs, then write the study folder (:meth:`Submission.submit` submits it)."""
     scheduler.require()
     out = submission.out
-    if scheduler.recorded(out):
+    if is_study_folder(out):        # a study submitted before: none of its cases queued
         busy = active_tasks(scheduler.status(out).cases)
         if busy:
             raise SubmitError(f"{out} still has {len(busy)} queued or running case(s) "
@@ -151,8 +152,8 @@ def rerun_jobs(study: Study, scheduler: Scheduler, indices: Sequence[int], cores
                                        cores, None)
         ranks = {c.index: schedule.ranks_of(c.path.name) for c in again}
     return scheduler.plan_jobs(study.path, study.name, JobRound(
-        tuple(indices), scheduler.next_round(study.path), ranks, tuple(steps), cores,
-        analysis_tasks, _token(analysis_tasks), study_round))
+        tuple(indices), None, ranks, tuple(steps), cores, analysis_tasks,
+        _token(analysis_tasks), study_round))
 
 
 @dataclass(frozen=True)
@@ -177,5 +178,6 @@ def plan_split_analysis(study: Study, scheduler: Scheduler, tasks: int) -> Split
     from ligwf.analysis.outputs import new_token
 
     token = new_token()
-    jobs = scheduler.plan_analysis(study.path, study.path.name, tasks, token)
+    jobs = scheduler.plan_jobs(study.path, study.path.name, JobRound(
+        post_steps=("analyse",), analysis_tasks=tasks, token=token))
     return SplitAnalysis(study.path, token, tasks, tuple(jobs))

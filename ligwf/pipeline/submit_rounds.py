@@ -1,5 +1,7 @@
-"""A sequential study on a batch scheduler (``ligwf slurm submit --until-decided``): the
-rounds of :func:`ligwf.pipeline.rounds.until_decided`, each a dependent array.
+"""A sequential study on a batch scheduler (``ligwf study --executor slurm
+--until-decided``): the rounds of :func:`ligwf.pipeline.rounds.until_decided`, each a
+dependent array, driven by the same loop of rounds (:func:`ligwf.pipeline.rounds.drive`)
+with a scheduler's acts (:func:`keep_going`).
 
 The first submission writes the study and its rounds record
 (:func:`~ligwf.pipeline.rounds.start_rounds`) and submits round 1: the case arrays and,
@@ -49,7 +51,7 @@ from ligwf.errors import ConfigError
 from ligwf.pipeline.post import report_study
 from ligwf.pipeline.prepare import Prepared
 from ligwf.pipeline.rounds import (INCOMPLETE, LOOK_DUE, ROUND_DUE, RUNNING, STOPPED, Stand,
-                                   stand, take_look, write_round)
+                                   drive, stand, take_look, write_round)
 from ligwf.eligibility import Eligible, eligible, report_due
 from ligwf.executors import LOCAL, build_executor
 from ligwf.pipeline.submit import rerun_jobs
@@ -179,7 +181,8 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
                take_looks: bool = False, show: Callable[[Look, Rounds], None] | None = None,
                wait_seconds: float = 0.0, own_job: str | None = None) -> Moved:
     """Move the sequential study in ``out`` on by what its state asks for (module
-    docstring), under the rounds lock.
+    docstring), under the rounds lock: the loop of rounds of every executor
+    (:func:`ligwf.pipeline.rounds.drive`) with a scheduler's acts.
 
     ``take_looks`` (the follow-up job): a due look is taken (``show`` prints it), a stopped
     study gets its final report, an incomplete round is left for ``resubmit``; cases still
@@ -196,28 +199,45 @@ def keep_going(out: Path, scheduler: Scheduler, how: FollowUp,
                          note="another ligwf process is moving this study on: nothing done")
         looks: list[Look] = []
         deadline = time.monotonic() + wait_seconds
-        while True:
-            p = progress(out, scheduler, how.retry_unstable, own_job)
-            if p.state == RUNNING and take_looks and time.monotonic() < deadline:
-                time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
-                continue
-            if take_looks and p.state == LOOK_DUE:
-                rounds = take_look(out, read_rounds(out), build_executor(LOCAL))
-                looks.append(rounds.looks[-1])
-                if show is not None:
-                    show(rounds.looks[-1], rounds)
-                continue
-            if p.state == ROUND_DUE and prepared is not None:
-                moved = _submit_round(out, scheduler, how, prepared, p, take_looks)
-                if moved is None:           # nothing to run: look again at once
-                    rounds = take_look(out, read_rounds(out), build_executor(LOCAL))
-                    looks.append(rounds.looks[-1])
-                    if show is not None:
-                        show(rounds.looks[-1], rounds)
-                    continue
-                return Moved(moved.progress, tuple(looks), moved.submitted, moved.indices,
-                             moved.note)
-            return _settle(out, scheduler, how, p, take_looks, tuple(looks))
+        now: Progress | None = None
+        submitted: Moved | None = None
+
+        def state() -> Stand:
+            nonlocal now
+            now = progress(out, scheduler, how.retry_unstable, own_job)
+            return now.state
+
+        def look() -> bool:
+            if not take_looks:
+                return False                # a login-node call: the follow-up job looks
+            rounds = take_look(out, read_rounds(out), build_executor(LOCAL))
+            looks.append(rounds.looks[-1])
+            if show is not None:
+                show(rounds.looks[-1], rounds)
+            return True
+
+        def hand_out() -> bool:
+            nonlocal submitted
+            if prepared is None:
+                return False                # a follow-up job writes and submits it
+            submitted = _submit_round(out, scheduler, how, prepared, now, take_looks)
+            if submitted is None:           # nothing to run: look again at once
+                return look()
+            return False
+
+        def settle() -> bool:
+            # a task that has just ended may still show as queued: wait a little for it
+            if not take_looks or time.monotonic() >= deadline:
+                return False
+            time.sleep(min(5.0, max(0.0, deadline - time.monotonic())))
+            return True
+
+        drive(state, {LOOK_DUE: look, ROUND_DUE: hand_out, RUNNING: settle,
+                      INCOMPLETE: lambda: False})
+        if submitted is not None:
+            return Moved(submitted.progress, tuple(looks), submitted.submitted,
+                         submitted.indices, submitted.note)
+        return _settle(out, scheduler, how, now, take_looks, tuple(looks))
 
 
 def _submit_round(out: Path, scheduler: Scheduler, how: FollowUp,

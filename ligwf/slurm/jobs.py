@@ -137,7 +137,8 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite,
     ceil(ntasks / ``site.cores_per_node``) nodes when the cores per node are known; an
     array on ``--ntasks`` / the site's ntasks asks for tasks only, as before."""
     study = PurePosixPath(Path(study_dir).resolve())
-    idx, ranks, round_no = request.indices, request.ranks, request.round_no
+    idx, ranks = request.indices, request.ranks
+    round_no = request.round_no if request.round_no is not None else next_round(study_dir)
     analysis_steps, study_round = request.post_steps, request.study_round
     plan_cores, analysis_tasks, token = (request.plan_cores, request.analysis_tasks,
                                          request.token)
@@ -164,7 +165,7 @@ def plan_jobs(study_dir: Path, study_name: str, site: SlurmSite,
                                site=job_site, planned=ranks is not None,
                                plan_cores=plan_cores if ranks is not None else None,
                                nodes=nodes, study_round=study_round))
-    if analysis_steps and analysis_tasks > 1 and "analyse" in analysis_steps:
+    if analysis_steps and (analysis_tasks > 1 or token) and "analyse" in analysis_steps:
         if token is None:
             raise ConfigError("a split analysis needs a staging token")
         rest = [step for step in analysis_steps if step != "analyse"]
@@ -380,5 +381,6 @@ def study_status(study_dir: Path, run: Runner = run_command, user: str | None = 
             state = states.get((str(sub["job_id"]), None))
             entry["state"] = state
             entry["active"] = state is not None and state.split()[0] not in FINISHED_STATES
+            entry["completed"] = state is not None and state.split()[0] == "COMPLETED"
         jobs.append(entry)
     return StudyStatus(cases, jobs, scheduler_error)

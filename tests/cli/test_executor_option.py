@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import pytest
 
-from ligwf.cli.executors import (CANCEL, SHOW_STATUS, STUDY_OPTIONS, SUBMIT_ANALYSIS,
-                                 SUBMIT_STUDY)
+from ligwf.cli.executors import (CANCEL, FOLLOW_UP, RESUBMIT, SHOW_STATUS, STUDY_OPTIONS,
+                                 SUBMIT_ANALYSIS, SUBMIT_STUDY)
 from ligwf.cli.main import main
 from ligwf.executors import EXECUTORS, LOCAL
 from ligwf.slurm.jobs import append_record
@@ -54,7 +54,7 @@ def study(tmp_path, ligwf):
 
 def test_every_scheduler_in_the_registry_has_its_command_line_face():
     schedulers = set(EXECUTORS) - {LOCAL}
-    for face in (SUBMIT_STUDY, SUBMIT_ANALYSIS, SHOW_STATUS, CANCEL):
+    for face in (SUBMIT_STUDY, SUBMIT_ANALYSIS, SHOW_STATUS, CANCEL, RESUBMIT, FOLLOW_UP):
         assert set(face) == schedulers
     assert {owner for owner, _, _ in STUDY_OPTIONS.values()} == set(EXECUTORS)
 
@@ -157,3 +157,62 @@ def test_status_and_cancel_on_slurm_are_the_slurm_commands(ligwf, study, monkeyp
     assert queue.cancelled == [["scancel", "1"], ["scancel", "1"]]
     local = ligwf("cancel", study)                   # this machine: no runner holds a case
     assert local.returncode == 0 and "no live ligwf runner" in local.stdout
+
+
+def test_resubmit_and_next_round_on_slurm_are_the_slurm_commands(ligwf, study, monkeypatch):
+    """``ligwf resubmit|next-round STUDY --executor slurm`` are ``ligwf slurm
+    resubmit|next-round``: the same scripts for the same cases; on this machine both are
+    refused in one line that names the command doing it here."""
+    import ligwf.slurm.scheduler as slurm_scheduler
+    from ligwf.slurm.scheduler import SlurmScheduler
+
+    append_record(study, {"kind": "array", "job_id": "1", "indices": [0, 1, 2, 3]})
+    queue = Queue()
+    monkeypatch.setattr(slurm_scheduler, "SlurmScheduler",
+                        lambda site: SlurmScheduler(site, queue))
+    site = ("--partition", "debug", "--dry-run")
+    old = ligwf("slurm", "resubmit", study, *site)
+    new = ligwf("resubmit", study, "--executor", "slurm", *site)
+    assert old == new and old.returncode == 0, old.stderr
+    assert "1 case(s) still queued or running" in new.stdout      # task 2 runs
+    (line,) = [x for x in new.stdout.splitlines() if x.startswith("resubmitting")]
+    assert line.startswith("resubmitting 3 case(s): 0 ") and " 2 " not in line, line
+    # the follow-up job: the same function on the same options
+    from ligwf.cli.main import build_parser
+    from ligwf.cli.slurm import cmd_next_round
+
+    words = [str(study), "--no-snapshots", "--templates", str(study), "--allow-unstable"]
+    old_args = vars(build_parser().parse_args(["slurm", "next-round", *words]))
+    new_args = vars(build_parser().parse_args(["next-round", *words, "--executor", "slurm"]))
+    assert FOLLOW_UP["slurm"] is old_args["func"] is cmd_next_round
+    options = {"study_dir", "no_snapshots", "templates", "allow_unstable", "mesh_cache"}
+    assert options <= set(old_args) and new_args["executor"] == "slurm"
+    assert {k: new_args[k] for k in options} == {k: old_args[k] for k in options}
+    for command, here in (("resubmit", "the command that ran the study resumes"),
+                          ("next-round", "--until-decided' takes the looks")):
+        res = ligwf(command, study)
+        assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
+        assert f"--executor = 'local': ligwf {command} hands a study" in res.stderr
+        assert here in res.stderr
+    # a study never run --until-decided: next-round refuses (it would submit a round 1)
+    for words in (("slurm", "next-round", study), ("next-round", study, "--executor", "slurm")):
+        res = ligwf(*words)
+        assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1
+        assert "no rounds record (rounds.json)" in res.stderr, res.stderr
+    assert not list((study / "slurm").glob("*.sh"))   # dry runs and refusals: no script
+
+
+@pytest.mark.parametrize("executor", ["local", "slurm"])
+def test_a_study_folder_as_workflow_goes_on_in_rounds_only(ligwf, study, executor):
+    """WORKFLOW may be a study folder with --until-decided on either executor (its stored
+    workflow); without it, one line and nothing written."""
+    plain = ligwf("study", study, "--out", study, "--executor", executor,
+                  *(["--dry-run"] if executor == "slurm" else []))
+    assert plain.returncode == 2 and len(plain.stderr.strip().splitlines()) == 1
+    assert "a study folder, not a workflow file" in plain.stderr
+    if executor == "slurm":
+        rounds = ligwf("study", study, "--out", study, "--executor", "slurm",
+                       "--until-decided", "--dry-run")
+        assert rounds.returncode == 0, rounds.stderr
+        assert "#SBATCH --array=0-3" in rounds.stdout and "slurm next-round" in rounds.stdout
+    assert not (study / "slurm").exists()

@@ -21,7 +21,7 @@ from ligwf.local import LocalCase, LocalExecutor, LocalStatus
 from ligwf.pipeline.post import postprocess
 from ligwf.pipeline.prepare import prepare_workflow, write
 from ligwf.pipeline.run import Interrupted, run_study
-from ligwf.scheduler import Executor, Scheduler
+from ligwf.scheduler import Executor, JobRound, Scheduler, SubmitAndWait
 from ligwf.slurm.scheduler import SlurmScheduler
 from ligwf.slurm.site import SlurmSite
 from ligwf.study import layout
@@ -184,3 +184,66 @@ def test_shares_end_with_a_sigkilled_ligwf_and_leave_no_part(tmp_path):
         time.sleep(0.1)
     assert not list(study.analysis_dir.parent.rglob("part-*")), "a share finished its part"
     assert not (study.analysis_dir / layout.ANALYSIS_RECORD).exists()
+
+
+@dataclass
+class ToyQueue(SubmitAndWait):
+    """A batch scheduler with the job verbs only (plan, submit, status, cancel, require):
+    a job runs when it is submitted (an array replays its cases, an analysis job analyses
+    here in its shares), so nothing is ever queued. Running and waiting come from
+    SubmitAndWait, as for Slurm."""
+
+    asked: list = field(default_factory=list)
+    record: list = field(default_factory=list)
+    name = "toy"
+    poll_seconds: float = 0.01
+
+    def require(self) -> None:
+        pass
+
+    def plan_jobs(self, study_dir, study_name, request: JobRound) -> list[dict]:
+        self.asked.append(request)
+        jobs = [{"kind": "array", "indices": request.indices}] if request.indices else []
+        if request.post_steps:
+            jobs.append({"kind": "analysis", "tasks": request.analysis_tasks})
+        return jobs
+
+    def submit(self, study_dir, jobs) -> list[dict]:
+        study = Study.open(study_dir)
+        entries = []
+        for job in jobs:
+            if job["kind"] == "array":
+                ReplayExecutor().run_cases(study, [study.case(i) for i in job["indices"]])
+            else:
+                LocalExecutor().analyse(study, job["tasks"])
+            entries.append({**job, "job_id": str(len(self.record) + 1)})
+            self.record.append(entries[-1])
+        return entries
+
+    def status(self, study_dir, tolerant: bool = False) -> LocalStatus:
+        cases = [LocalCase(c.index, c.case_id, m.status if (m := c.manifest()) else MISSING)
+                 for c in Study.open(study_dir).cases]
+        return LocalStatus(cases, [{**j, "state": "ENDED", "active": False,
+                                    "completed": True} for j in self.record])
+
+    def cancel(self, study_dir) -> list[str]:
+        return []
+
+
+def test_a_scheduler_with_the_job_verbs_only_runs_the_whole_pipeline(tmp_path):
+    """Issue 48 item 1: a new scheduler implements plan, submit, status, cancel and
+    require; running the cases and the analysis and waiting for them are SubmitAndWait's,
+    written once. The study runs, is analysed in 2 shares and reported through it."""
+    queue = ToyQueue()
+    assert isinstance(queue, Scheduler) and isinstance(queue, Executor)
+    study = write(prepare_workflow(DRUM, SCENE), tmp_path / "study", tmp_path / "meshes")
+    (case,) = study.cases
+    assert run_study(study, study.cases, queue)
+    cases_round, = queue.asked
+    assert cases_round.indices == (case.index,) and set(cases_round.ranks) == {case.index}
+    assert not cases_round.post_steps                   # the cases alone, no follow-up job
+    record, report = postprocess(study.path, queue, snapshots=False, analysis_tasks=2)
+    split = queue.asked[-1]
+    assert (split.indices, split.post_steps, split.analysis_tasks) == ((), ("analyse",), 2)
+    assert split.token and record is not None and record["cases"]
+    assert (report / "summary.md").is_file()

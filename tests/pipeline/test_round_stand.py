@@ -15,7 +15,7 @@ from ligwf.eligibility import Eligible, eligible
 from ligwf.errors import ConfigError
 from ligwf.pipeline.prepare import prepare_workflow, write
 from ligwf.pipeline.rounds import (INCOMPLETE, LOOK_DUE, ROUND_DUE, RUNNING, STOPPED,
-                                   RoundPlan, start_rounds, stand)
+                                   RoundPlan, drive, start_rounds, stand)
 from ligwf.pipeline.submit_rounds import progress
 from ligwf.slurm.jobs import append_record
 from ligwf.slurm.scheduler import SlurmScheduler
@@ -130,3 +130,40 @@ def test_the_follow_up_job_and_the_local_loop_decide_alike(study):
     assert progress(study, busy).state == RUNNING
     write_rounds(study, read_rounds(study).with_look(Look(1, 0.025, 0.1)))
     assert progress(study, idle).state == local_stand(study, 1) == ROUND_DUE
+
+
+def test_one_loop_acts_on_each_state_until_the_study_stops_or_an_act_ends_it(study):
+    """rounds.drive, the loop the local rounds and the follow-up job both run: on this
+    folder a due round is handed out, its cases done, the look taken and the study
+    stopped, each act on the state stand gives, read afresh each turn; an act that
+    returns False (a round handed to a scheduler) ends the loop in its state."""
+    done: list = []
+    handed = [0]
+
+    def state():
+        rounds = read_rounds(study)
+        return stand(rounds, handed[0], eligible(Study.open(study).cases)
+                     if handed[0] > len(rounds.looks) else Eligible(()), study)
+
+    def hand_out():
+        done.append(ROUND_DUE)
+        handed[0] = len(read_rounds(study).looks) + 1
+        return True
+
+    def run():
+        done.append(INCOMPLETE)
+        for case in Study.open(study).cases:
+            set_manifest(case, "done")
+        return True
+
+    def look():
+        done.append(LOOK_DUE)
+        write_rounds(study, read_rounds(study).with_look(Look(
+            1, 0.025, 0.1, stop="decided: met", stop_kind=DECIDED)))
+        return True
+
+    assert drive(state, {ROUND_DUE: hand_out, INCOMPLETE: run, RUNNING: run,
+                         LOOK_DUE: look}) == STOPPED
+    assert done == [ROUND_DUE, INCOMPLETE, LOOK_DUE]
+    # a round handed to a scheduler that runs it on its own: the loop ends in its state
+    assert drive(lambda: ROUND_DUE, {ROUND_DUE: lambda: False}) == ROUND_DUE
