@@ -28,7 +28,8 @@ from ligwf.analysis.granules.controls import bed_share
 from ligwf.analysis.granules.growth import (GrowthSettings, HeldAt, frames_spanning,
                                             growth_rows, hac_slope)
 from ligwf.study.case import CaseFolder
-from ligwf.study.layout import CALIBRATION_TABLE, PARTICLE_DUMP_RE, POST_DIR, is_case_folder
+from ligwf.study.layout import (CALIBRATION_TABLE, GROWTH_CACHE, PARTICLE_DUMP_RE, POST_DIR,
+                                is_case_folder)
 
 
 #: a particle carrying more liquid than this fraction of its volume counts as wet
@@ -213,10 +214,6 @@ def cadence_table(shares: pd.DataFrame) -> pd.DataFrame:
             .reset_index())
 
 
-#: a run's measures (growth rows, shares per cadence, flow per frame), pickled beside it
-CACHE = ("growth-rows.pkl", "growth-shares.pkl", "growth-flow.pkl")
-
-
 @dataclass(frozen=True)
 class GrowthTables:
     """What :func:`measure_study` measures: every start frame of every run (``rows``), the
@@ -233,13 +230,13 @@ class GrowthTables:
 
 
 def measured(case_dir: Path) -> tuple[pd.DataFrame, ...]:
-    """:func:`measure_case` of a run, cached beside it (:data:`CACHE`; a run measured while
-    others still ran is not measured again)."""
-    if all((case_dir / n).exists() for n in CACHE):
-        return tuple(pd.read_pickle(case_dir / n) for n in CACHE)
+    """:func:`measure_case` of a run, cached beside it (``layout.GROWTH_CACHE``; a run
+    measured while others still ran is not measured again)."""
+    if all((case_dir / n).exists() for n in GROWTH_CACHE):
+        return tuple(pd.read_pickle(case_dir / n) for n in GROWTH_CACHE)
     print(f"measuring {case_dir.name} ...", flush=True)
     tables = measure_case(case_dir)
-    for n, t in zip(CACHE, tables):
+    for n, t in zip(GROWTH_CACHE, tables):
         tmp = case_dir / (n + ".tmp")
         t.to_pickle(tmp)
         tmp.replace(case_dir / n)
