@@ -24,7 +24,8 @@ sys.path.insert(0, str(ROOT))
 
 import pandas as pd  # noqa: E402
 
-from benchmarks import bench_null_splits  # noqa: E402
+from benchmarks import bench_null_splits, bench_steady  # noqa: E402
+from ligwf.analysis.records.steady_window import at_cap  # noqa: E402
 from ligwf.api.results_folder import ResultsFolder, from_template, results_command  # noqa: E402
 from ligwf.study import layout  # noqa: E402
 
@@ -234,7 +235,87 @@ def we_vs_bo_fields(folder: ResultsFolder) -> dict[str, object]:
 
 WE_VS_BO = kept("we_vs_bo", we_vs_bo_fields)
 
-FOLDERS = (GRANULES, NULL_SPLITS, WE_VS_BO)
+# ----------------------------------------------------------------------------- steady
+#: the benchmark runs (their output, the command on the first line) and the long check's
+#: tables, per steady rule (``band``: the rule before, ``mser``: MSER-5 from 80 frames on)
+STEADY_BENCH, STEADY_HYBRID = "bench_steady.txt", "bench_steady_hybrid.txt"
+STEADY_EXTENSIONS = ("bench_steady_extension.txt", "bench_steady_extension_2.txt")
+STEADY_RULES = ("band", "mser")
+LONG_CASES, LONG_VERDICT = "long_cases_{}.csv", "long_verdict_{}.csv"
+LONG_PREDICTION = "long_prediction_check_mser.csv"
+#: registered in the README before each run
+HYBRID_CAPPED, HYBRID_BIAS = 0.20, 0.25
+
+
+
+
+def _cells_span(cells: list[dict], key: str, spec: str = ".2f") -> str:
+    return _span([float(c[key]) for c in cells], spec)
+
+
+def _each(values: list[str]) -> str:
+    return ", ".join(values[:-1]) + f" and {values[-1]}"
+
+
+def steady_fields(folder: ResultsFolder) -> dict[str, object]:
+    """The steady README's numbers: each benchmark run's cells and hypotheses (its
+    committed output), the long check's capped windows, decisions and extension rows."""
+    text = (folder.path / STEADY_BENCH).read_text()
+    cells = bench_steady.read_cells(text)
+    still = [c for c in cells if not c["startup"]]
+    at = {n: [c for c in still if c["frames"] == n] for n in (40, 80, 160)}
+    said = {True: "holds", False: "does not hold"}
+    h = bench_steady.hypotheses(text)
+    out = {f"band_{n}": _cells_span(at[n], "current") for n in at}
+    out |= {f"mser_{n}": _cells_span(at[n], "mser") for n in at}
+    out |= {"h1": said[h["H1"]], "h2": said[h["H2"]],
+            "band_low": f"{min(c['current'] for c in at[160]):.2f}",
+            "bias": f"{max(max(abs(c['current_bias']), abs(c['mser_bias'])) for c in cells):.2f}"}
+    hybrid = bench_steady.read_cells((folder.path / STEADY_HYBRID).read_text())
+    long_still = [c for c in hybrid if not c["startup"] and c["frames"] >= 80]
+    worst = max(c["current"] for c in long_still)
+    bias = max(abs(c["current_bias"]) for c in hybrid)
+    out |= {"hybrid_worst": f"{worst:.2f}", "hybrid_bias": f"{bias:.2f}",
+            "hybrid_met": "met" if worst <= HYBRID_CAPPED and bias <= HYBRID_BIAS else "not met"}
+    out |= {f"hybrid_{n}": _cells_span([c for c in long_still if c["frames"] == n], "current")
+            for n in (80, 160)}
+    for rule in STEADY_RULES:
+        cases = folder.table(LONG_CASES.format(rule))
+        verdict = folder.table(LONG_VERDICT.format(rule))
+        assessed = verdict[verdict["state"] != "not assessed"]
+        out[f"capped_{rule}"] = int(cases["steady_fraction"].map(at_cap).sum())
+        out[f"runs_{rule}"] = len(cases)
+        out[f"decided_{rule}"] = (f"{int(assessed['state'].isin(['pass', 'fail']).sum())} of "
+                                  f"{len(assessed)}")
+    check = folder.table(LONG_PREDICTION)
+    extension = check[check["kind"] == "extension"]
+    out |= {"ext_holds": int(extension["within_30_percent"].sum()),
+            "ext_rows": int(extension["measured_over_predicted"].notna().sum())}
+    for k, name in enumerate(STEADY_EXTENSIONS, 1):
+        text = (folder.path / name).read_text()
+        rows = bench_steady.read_extension_cells(text)
+        reg = [r for r in rows if r["phi"] == 0.5]          # the registered cells
+        beside = [r for r in rows if r["phi"] == 0.8]
+        h = bench_steady.hypotheses(text)
+        extended = [r["extended"] for r in reg]
+        biases = sorted(float(r["bias"]) for r in reg)
+        out |= {f"e{k}_before": _cells_span(reg, "before", ".3f"),
+                f"e{k}_extended": f"{min(extended)}-{max(extended)}",
+                f"e{k}_after": _each([r["after"] for r in reg]),
+                f"e{k}_median": _each([r["median"] for r in reg]),
+                f"e{k}_late": _each([r["late"] for r in reg]),
+                f"e{k}_bias": f"{biases[0]:.2f} to {biases[-1]:.2f}",
+                f"e{k}_beside_after": _cells_span(beside, "after", ".3f"),
+                f"e{k}_beside_median": _cells_span(beside, "median", ".4f"),
+                **{f"e{k}_h{i}": "met" if h[f"H-ext{i}"] else "not met" for i in (1, 2, 3)}}
+        if k == 1:
+            out["e1_excess"] = f"{float(reg[1]['after']) - bench_steady.EXT_STILL_CAPPED:.3f}"
+    return out
+
+
+STEADY = kept("steady", steady_fields)
+
+FOLDERS = (GRANULES, NULL_SPLITS, WE_VS_BO, STEADY)
 
 
 def make(args) -> ResultsFolder:
