@@ -32,6 +32,7 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from ligwf.analysis.records.steady_window import at_cap  # noqa: E402
 from ligwf.api.report_compare import (beside, changed, decided, repeated_runs,  # noqa: E402
                                       wall_minutes)
 from ligwf.api.results_folder import (ResultsFolder, number as _n, results_command,  # noqa: E402
@@ -210,8 +211,9 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
     return "\n".join(lines) + "\n"
 
 
-#: a steady window that starts at or after this fraction of production is at the 50 % cap
-AT_CAP = 0.45
+def capped(cases: pd.DataFrame) -> int:
+    """How many runs' steady window starts at its cap (steady_window.at_cap)."""
+    return int(cases["steady_fraction"].map(at_cap).sum())
 
 
 def reanalysed_lines(verdict: pd.DataFrame, cases: pd.DataFrame, verdict_again: pd.DataFrame,
@@ -225,8 +227,8 @@ def reanalysed_lines(verdict: pd.DataFrame, cases: pd.DataFrame, verdict_again: 
              "`steady_after: auto` to MSER-5 from 80 production frames on "
              "([../../steady/README.md](../../steady/README.md)); not the registered analysis "
              "of this ladder, whose tables are above. Windows starting at the 50 % cap: "
-             f"{int((cases['steady_fraction'] >= AT_CAP).sum())} of {len(cases)} runs before, "
-             f"{int((cases_again['steady_fraction'] >= AT_CAP).sum())} of {len(cases_again)} "
+             f"{capped(cases)} of {len(cases)} runs before, "
+             f"{capped(cases_again)} of {len(cases_again)} "
              f"now. Flow criteria decided: {d0} of {n0} before, {d1} of {n1} now. States that "
              "change:", ""]
     lines += [f"- {r['condition']} {r['label']}: {r['state']} -> {r['state_new']} "
