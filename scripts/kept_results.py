@@ -91,7 +91,6 @@ NULL_STUDY = ("ligwf study workflows/demo.yaml --out runs/null8 --set 'sweep.cg_
               "--set 'sweep.replicas={2: 8}' --np 1 --no-snapshots")
 
 
-
 def null_splits_tables(folder: ResultsFolder) -> dict[str, str]:
     """splits.txt: benchmarks/bench_null_splits.py's output on the committed runs, under
     the command line that made it."""
@@ -136,8 +135,6 @@ def we_vs_bo_rows(conditions: pd.DataFrame) -> str:
                     f"{r['angle_of_repose_std']:.1f} | {rigid} | "
                     f"{r['rms_speed_rel_fluctuation']:.3f} |")
     return "\n".join(rows)
-
-
 
 
 def we_vs_bo_fields(folder: ResultsFolder) -> dict[str, object]:
@@ -247,13 +244,13 @@ LONG_PREDICTION = "long_prediction_check_mser.csv"
 HYBRID_CAPPED, HYBRID_BIAS = 0.20, 0.25
 
 
-
-
 def _cells_span(cells: list[dict], key: str, spec: str = ".2f") -> str:
+    """:func:`_span` of the benchmark cells' ``key``."""
     return _span([float(c[key]) for c in cells], spec)
 
 
 def _each(values: list[str]) -> str:
+    """``a, b and c``: one value per registered cell, in the file's order."""
     return ", ".join(values[:-1]) + f" and {values[-1]}"
 
 
