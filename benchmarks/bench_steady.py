@@ -37,6 +37,10 @@ the second the rule of :data:`~ligwf.analysis.records.steady_window.CAPPED_TRUNC
 
     .venv/bin/python -m benchmarks.bench_steady --extension --trials 20000 --seed 20261208 --capped-truncation 0.5
     .venv/bin/python -m benchmarks.bench_steady --extension --trials 20000 --seed 20261209
+
+:func:`read_cells`, :func:`read_extension_cells` and :func:`hypotheses` read a printed run
+back: the committed outputs in docs/results/steady, whose README scripts/kept_results.py
+renders from them.
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import math
+import re
 import sys
 
 import numpy as np
@@ -167,6 +172,49 @@ def extension_main(rng, trials: int, capped_truncation: float = CAPPED_TRUNCATIO
     }
     for line, met in verdict.items():
         print(f"{line}: {'met' if met else 'not met'}")
+
+
+#: a row of the main table as :func:`main` prints it
+_CELL = re.compile(r"^\s*(\d+)\s+([\d.]+)\s+([\d.]+)\s+(yes|no) \|\s+([\d.]+)\s+[\d.]+\s+"
+                   r"(-?[\d.]+) \|\s+([\d.]+)\s+[\d.]+\s+(-?[\d.]+)$")
+#: a row of the extension table as :func:`extension_main` prints it
+_EXTENSION_CELL = re.compile(r"^\s*([\d.]+)\s+(\d+) \|\s+(\d+)\s+([\d.]+) \|\s+(\d+)\s+"
+                             r"([\d.]+)\s+([\d.]+)\s+([\d.]+)\s+(-?[\d.]+)$")
+
+
+def read_cells(text: str) -> list[dict]:
+    """The cells of a printed :func:`main` run: frames, phi, start-up, and per rule the
+    share capped and the bias (``current``, ``current_bias``, ``mser``, ``mser_bias``)."""
+    rows = []
+    for line in text.splitlines():
+        m = _CELL.match(line)
+        if m:
+            rows.append({"frames": int(m.group(1)), "phi": float(m.group(2)),
+                         "startup": m.group(4) == "yes",
+                         "current": float(m.group(5)), "current_bias": float(m.group(6)),
+                         "mser": float(m.group(7)), "mser_bias": float(m.group(8))})
+    return rows
+
+
+def read_extension_cells(text: str) -> list[dict]:
+    """The cells of a printed :func:`extension_main` run: phi, tau and trials (numbers),
+    and as printed (text): the share capped before, the runs extended (a number), the share
+    still capped after, the median and late truncation and the bias."""
+    rows = []
+    for line in text.splitlines():
+        m = _EXTENSION_CELL.match(line)
+        if m:
+            rows.append({"phi": float(m.group(1)), "tau": int(m.group(2)),
+                         "trials": int(m.group(3)), "before": m.group(4),
+                         "extended": int(m.group(5)), "after": m.group(6),
+                         "median": m.group(7), "late": m.group(8), "bias": m.group(9)})
+    return rows
+
+
+def hypotheses(text: str) -> dict[str, bool]:
+    """The verdict lines of a printed run: hypothesis -> holds (``holds`` / ``met``)."""
+    found = re.findall(r"^(H[\w-]*) .*: (does not hold|holds|not met|met)$", text, re.M)
+    return {name: verdict in ("holds", "met") for name, verdict in found}
 
 
 def main(argv=None) -> int:

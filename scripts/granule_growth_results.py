@@ -21,12 +21,10 @@ from pathlib import Path
 import pandas as pd
 
 from ligwf.analysis.granules.growth import GrowthSettings
-from ligwf.analysis.granules.growth_study import (CRITERIA, cadence_table, measure_case,
-                                                  seed_table, verdict)
+from ligwf.analysis.granules.growth_study import (CRITERIA, calibration_rounds,
+                                                  measure_finished, measure_study)
 from ligwf.api.results_folder import ResultsFolder, csv_text, results_command
-from ligwf.study.case import CaseFolder
-from ligwf.study.layout import (CALIBRATION_TABLE, PARTICLE_DUMP_RE, POST_DIR,
-                                 is_case_folder)
+from ligwf.study.layout import CALIBRATION_TABLE
 
 OUT = Path(__file__).resolve().parents[1] / "docs" / "results" / "granule_growth"
 #: the tables this script measures (a results folder's own, not a study's)
@@ -36,8 +34,6 @@ FRAME_FLOW = "flow.csv"              # angle of repose per frame
 SEEDS = "seeds.csv"                  # one row per wet seed beside its control
 SEED_VERDICT = "controls_verdict.csv"   # k of n seeds per criterion
 RUNS = "cases.csv"                   # the runs
-#: the candidates' pickled measures, cached beside each run
-CACHE = ("growth-rows.pkl", "growth-shares.pkl", "growth-flow.pkl")
 
 COMMAND = ("ligwf run workflows/granule_growth.yaml --out runs/granule_growth\n"
            "ligwf calibrate-control workflows/granule_growth.yaml --out runs/cal1 "
@@ -199,36 +195,6 @@ def reading(seeds: pd.DataFrame, ver: pd.DataFrame, cad: pd.DataFrame) -> list[s
     return out
 
 
-def case_table(run_dir: Path, case_ids: list[str]) -> pd.DataFrame:
-    """One row per run: its particles, production, particle dumps and status."""
-    rows = []
-    for cid in case_ids:
-        case = CaseFolder.open(run_dir / cid)
-        m = case.manifest()
-        post = run_dir / cid / POST_DIR
-        rows.append({"case_id": cid, "particles": int(case.scaled.particles.count),
-                     "production_s": round(case.scaled.numerics.run_steps
-                                           * case.scaled.numerics.dt, 3),
-                     "frames": sum(bool(PARTICLE_DUMP_RE.match(p.name)) for p in
-                                   (post.iterdir() if post.is_dir() else ())),
-                     "status": m.status if m is not None else "not run"})
-    return pd.DataFrame(rows)
-
-
-def measured(case_dir: Path) -> tuple[pd.DataFrame, ...]:
-    """The case's measures, cached beside its run (``growth-*.csv``; a case measured while
-    others still ran is not measured again)."""
-    if all((case_dir / n).exists() for n in CACHE):
-        return tuple(pd.read_pickle(case_dir / n) for n in CACHE)
-    print(f"measuring {case_dir.name} ...", flush=True)
-    tables = measure_case(case_dir)
-    for n, t in zip(CACHE, tables):
-        tmp = case_dir / (n + ".tmp")
-        t.to_pickle(tmp)
-        tmp.replace(case_dir / n)
-    return tables
-
-
 def render(folder: ResultsFolder) -> str:
     """The README of a granule-growth folder from its committed tables."""
     return readme(folder.table(SEEDS), folder.table(SEED_VERDICT), folder.table(CADENCE),
@@ -239,43 +205,21 @@ FOLDER = ResultsFolder(OUT, render, "scripts/granule_growth_results.py runs/gran
                        "docs/results/granule_growth runs/cal1 runs/cal2")
 
 
-def measure(run: Path, out: Path, calibrations: tuple[str, ...] = (),
-            processes: int = 2) -> ResultsFolder:
-    """Measure every case of the run folder ``run`` into the tables of ``out``."""
-    from multiprocessing import Pool
-
+def measure(run: Path, out: Path, calibrations: tuple[str, ...] = ()) -> ResultsFolder:
+    """Measure every run of the study folder ``run`` into the tables of ``out``."""
     folder = ResultsFolder(out, render, FOLDER.remake)
     out.mkdir(parents=True, exist_ok=True)
-    case_ids = sorted(p.name for p in run.iterdir() if is_case_folder(p))
-    with Pool(processes) as pool:
-        results = pool.map(measured, [run / c for c in case_ids])
-    rows_df, shares_df, flows_df = (pd.concat([r[i] for r in results], ignore_index=True)
-                                    for i in range(3))
-    seeds = seed_table(rows_df, flows_df)
-    tables = {GROWTH_ROWS: rows_df, CADENCE: cadence_table(shares_df), FRAME_FLOW: flows_df,
-              SEEDS: seeds}
-    for name, table in tables.items():
+    measured = measure_study(run)
+    for name, table in {GROWTH_ROWS: measured.rows, CADENCE: measured.cadence,
+                        FRAME_FLOW: measured.flow, SEEDS: measured.seeds}.items():
         (out / name).write_text(csv_text(table))
-    verdict(seeds).to_csv(out / SEED_VERDICT, index=False)
-    case_table(run, case_ids).to_csv(out / RUNS, index=False)
+    measured.verdict.to_csv(out / SEED_VERDICT, index=False)
+    measured.runs.to_csv(out / RUNS, index=False)
     if calibrations:
-        cal = pd.concat([pd.read_csv(Path(c) / CALIBRATION_TABLE).assign(round=k + 1)
-                         for k, c in enumerate(calibrations)], ignore_index=True)
-        ref = cal[cal["role"] == "wet reference"].drop_duplicates("case_id")
-        cal = pd.concat([ref, cal[cal["role"] == "candidate"]], ignore_index=True)
-        (out / CALIBRATION_TABLE).write_text(csv_text(cal))
+        (out / CALIBRATION_TABLE).write_text(
+            csv_text(calibration_rounds(tuple(Path(c) for c in calibrations))))
     print(folder.table(SEED_VERDICT).to_string(index=False))
     return folder
-
-
-def measure_finished(run_dir: str) -> int:
-    """Measure (and cache) every case whose run is done, one at a time: the study's cases
-    can be measured while the last ones still run."""
-    for p in sorted(Path(run_dir).iterdir()):
-        m = CaseFolder.open(p).manifest() if is_case_folder(p) else None
-        if m is not None and m.status == "done":
-            measured(p)
-    return 0
 
 
 def arguments(ap) -> None:

@@ -18,20 +18,14 @@ committed tables (a ResultsFolder: ``--check`` recomputes both and fails when on
 
 from __future__ import annotations
 
-import json
-import math
-import os
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import pandas as pd
 
-from ligwf.analysis.granules.growth_study import measure_case
-from ligwf.analysis.granules.screen import (POINTS, REGISTERED, SEEDS, SETTINGS, condition_row,
-                                            phase2_seeds, phase2_verdict, ranked)
+from ligwf.analysis.granules.screen import POINTS, REGISTERED, SEEDS, SETTINGS, phase2_verdict
+from ligwf.analysis.granules.screen_study import measure_phase1, measure_phase2
 from ligwf.api.results_folder import ResultsFolder, csv_text, number, results_command
-from ligwf.study import layout
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -43,19 +37,6 @@ PHASE2_VERDICT = "phase2_verdict.csv"
 #: phase 1's conditions (criterion.md): (liquid model, how the liquid is placed)
 CONDITIONS = {"S1": ("washino", "placed nuclei"), "S2": ("washino", "uniform"),
               "S3": ("easo", "placed nuclei"), "S4": ("easo", "uniform")}
-
-
-def case_folder(study: Path, name: str) -> Path | None:
-    """The one case folder of condition ``name`` (its seed r0), or None when not run."""
-    found = sorted(p.parent for p in (study / name).glob(f"cg1-*/{layout.MANIFEST_FILE}"))
-    return found[0] if found else None
-
-
-def status_of(case: Path) -> tuple[str, float, str]:
-    """(status, core seconds, the manifest's reason) of a run."""
-    m = json.loads((case / layout.MANIFEST_FILE).read_text())
-    return (str(m.get("status")), float(m.get("core_seconds") or math.nan),
-            str(m.get("reason") or ""))
 
 
 def phase1_lines(cond: pd.DataFrame) -> list[str]:
@@ -126,43 +107,9 @@ def ingredient(r) -> str:
     return f"granules formed, survived, moved together and grew{wet}"
 
 
-#: phase 2 (criterion.md): the pick's study, its uniform twin, and the twin's content
-PHASE2, PHASE2_UNIFORM = "P2", "P2U"
+#: phase 2 (criterion.md): the uniform twin's content and the item's budget
 UNIFORM_CONTENT = 0.012
 BUDGET_CORE_MIN = 480.0
-
-
-def phase2_measure(study: Path) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame] | None:
-    """(every start frame of every phase-2 run, one row per run: status and core-minutes,
-    one row per registered seed: its measures, both nulls' and the criteria), or None when
-    phase 2 has not run. A uniform twin's case id gets the suffix ``_uniform``."""
-    if not (study / PHASE2).is_dir():
-        return None
-    all_rows, all_flows, runs, done = [], [], [], []
-    for folder, suffix in ((PHASE2, ""), (PHASE2_UNIFORM, "_uniform")):
-        for manifest in sorted((study / folder).glob(f"cg1-*/{layout.MANIFEST_FILE}")):
-            case = manifest.parent
-            status, core_s, reason = status_of(case)
-            runs.append({"case_id": case.name + suffix, "status": status,
-                         "reason": "" if status == "done" else reason,
-                         "core_minutes": core_s / 60.0})
-            if status == "done":
-                done.append((case, case.name + suffix))
-    # the cases are independent: two at a time (the machine's cores), in case order
-    with ProcessPoolExecutor(max_workers=min(2, os.cpu_count() or 1)) as pool:
-        measured = list(pool.map(_measure, [case for case, _ in done]))
-    for (_, case_id), (rows, flows) in zip(done, measured):
-        rows["case_id"], flows["case_id"] = case_id, case_id
-        all_rows.append(rows)
-        all_flows.append(flows)
-    rows = pd.concat(all_rows) if all_rows else pd.DataFrame()
-    flows = pd.concat(all_flows) if all_flows else pd.DataFrame()
-    return rows, pd.DataFrame(runs), phase2_seeds(rows, flows)
-
-
-def _measure(case: Path) -> tuple[pd.DataFrame, pd.DataFrame]:
-    rows, _, flows = measure_case(case, SETTINGS, cadences=(SETTINGS.cadence,))
-    return rows, flows
 
 
 def phase2_lines(folder: "ResultsFolder") -> list[str]:
@@ -296,24 +243,15 @@ def make(args) -> ResultsFolder:
     """Measure phase 1's conditions (and phase 2 when it ran) into the folder's tables."""
     if args.study is None:
         args.error("the screen's folder is required (or --check)")
-    all_rows, table = [], []
-    for name in () if args.phase2_only else CONDITIONS:
-        case = case_folder(args.study, name)
-        if case is None:
-            continue
-        status, core_s, reason = status_of(case)
-        rows, _, flows = measure_case(case, SETTINGS, cadences=(SETTINGS.cadence,))
-        rows.insert(0, "condition", name)
-        all_rows.append(rows)
-        table.append(condition_row(name, *CONDITIONS[name], rows, flows, status, core_s, reason))
     OUT.mkdir(parents=True, exist_ok=True)
-    if table:
-        (OUT / GROWTH_ROWS).write_text(csv_text(pd.concat(all_rows)))
-        (OUT / CONDITIONS_TABLE).write_text(csv_text(ranked(pd.DataFrame(table))))
-    phase2 = phase2_measure(args.study)
+    phase1 = None if args.phase2_only else measure_phase1(args.study, CONDITIONS)
+    if phase1 is not None:
+        (OUT / GROWTH_ROWS).write_text(csv_text(phase1.rows))
+        (OUT / CONDITIONS_TABLE).write_text(csv_text(phase1.conditions))
+    phase2 = measure_phase2(args.study)
     if phase2 is not None:
-        rows, runs, seeds = phase2
-        for name, t in ((PHASE2_ROWS, rows), (PHASE2_RUNS, runs), (PHASE2_SEEDS, seeds)):
+        for name, t in ((PHASE2_ROWS, phase2.rows), (PHASE2_RUNS, phase2.runs),
+                        (PHASE2_SEEDS, phase2.seeds)):
             (OUT / name).write_text(csv_text(t))
     return FOLDER
 

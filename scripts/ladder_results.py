@@ -22,7 +22,6 @@ from its table.
 
 from __future__ import annotations
 
-import re
 import sys
 from dataclasses import dataclass
 from functools import partial
@@ -33,6 +32,9 @@ import pandas as pd
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from ligwf.analysis.records.steady_window import at_cap  # noqa: E402
+from ligwf.api.report_compare import (beside, changed, decided, repeated_runs,  # noqa: E402
+                                      wall_minutes)
 from ligwf.api.results_folder import (ResultsFolder, number as _n, results_command,  # noqa: E402
                                       runs_rows, verdict_rows)
 from ligwf.report.rounds import look_line  # noqa: E402
@@ -130,17 +132,6 @@ def rounds_lines(rounds) -> list[str]:
     return lines
 
 
-def wall_minutes(text: str) -> float:
-    """Minutes of wall time in a ``/usr/bin/time -v`` report (its ``Elapsed`` line)."""
-    found = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): ([\d:.]+)", text)
-    if found is None:
-        raise ValueError("no 'Elapsed (wall clock) time' line")
-    seconds = 0.0
-    for part in found.group(1).split(":"):
-        seconds = seconds * 60 + float(part)
-    return seconds / 60
-
-
 def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
            ladder: Ladder = LADDERS["continuation"], wall: str | None = None,
            repeated: pd.DataFrame | None = None, replanned: pd.DataFrame | None = None,
@@ -186,8 +177,7 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
     lines += verdict_rows(verdict)
     lines += ["", "## Reading", ""]
     flow = verdict[verdict["criterion"].isin(REGISTERED)]
-    decided = flow[flow["state"].isin(["pass", "fail"])]
-    lines.append(f"- Flow criteria decided: {len(decided)} of {len(flow)} "
+    lines.append("- Flow criteria decided: {} of {} ".format(*decided(verdict, REGISTERED)) +
                  "(angle, velocity profile, rigid-block share, flowing layer of every level).")
     meets = verdict[verdict["cheapest"].astype(str) == "True"]
     if len(meets):
@@ -221,40 +211,30 @@ def readme(verdict: pd.DataFrame, cases: pd.DataFrame, rounds=None,
     return "\n".join(lines) + "\n"
 
 
-def beside(verdict: pd.DataFrame, other: pd.DataFrame) -> pd.DataFrame:
-    """``verdict``'s rows with the same condition and criterion of ``other`` beside them
-    (its columns suffixed ``_new``)."""
-    return verdict.merge(other, on=["condition", "criterion"], suffixes=("", "_new"))
-
-
-#: a steady window that starts at or after this fraction of production is at the 50 % cap
-AT_CAP = 0.45
+def capped(cases: pd.DataFrame) -> int:
+    """How many runs' steady window starts at its cap (steady_window.at_cap)."""
+    return int(cases["steady_fraction"].map(at_cap).sum())
 
 
 def reanalysed_lines(verdict: pd.DataFrame, cases: pd.DataFrame, verdict_again: pd.DataFrame,
                      cases_again: pd.DataFrame) -> list[str]:
     """The same runs re-analysed with the steady window of a1377ba (MSER-5 from 80 frames
     on): windows at the cap, flow criteria decided, and each state that changed."""
-    def decided(v):
-        f = v[v["criterion"].isin(REGISTERED)]
-        return int(f["state"].isin(["pass", "fail"]).sum()), len(f)
-
-    both = beside(verdict, verdict_again)
-    changed = both[both["state"] != both["state_new"]]
-    (d0, n0), (d1, n1) = decided(verdict), decided(verdict_again)
+    (d0, n0), (d1, n1) = decided(verdict, REGISTERED), decided(verdict_again, REGISTERED)
     lines = ["", f"## The same runs re-analysed with today's steady window (`{REANALYSED[0]}`, "
              f"`{REANALYSED[1]}`)", "",
              "A copy of the run folder analysed and reported again after a1377ba changed "
              "`steady_after: auto` to MSER-5 from 80 production frames on "
              "([../../steady/README.md](../../steady/README.md)); not the registered analysis "
              "of this ladder, whose tables are above. Windows starting at the 50 % cap: "
-             f"{int((cases['steady_fraction'] >= AT_CAP).sum())} of {len(cases)} runs before, "
-             f"{int((cases_again['steady_fraction'] >= AT_CAP).sum())} of {len(cases_again)} "
+             f"{capped(cases)} of {len(cases)} runs before, "
+             f"{capped(cases_again)} of {len(cases_again)} "
              f"now. Flow criteria decided: {d0} of {n0} before, {d1} of {n1} now. States that "
              "change:", ""]
     lines += [f"- {r['condition']} {r['label']}: {r['state']} -> {r['state_new']} "
               f"({_n(r['value_new'])} [{_n(r['lo_new'])}, {_n(r['hi_new'])}], budget "
-              f"{_n(r['budget_new'])})." for _, r in changed.iterrows()] or ["- none."]
+              f"{_n(r['budget_new'])})."
+              for _, r in changed(verdict, verdict_again, "state").iterrows()] or ["- none."]
     return lines
 
 
@@ -262,24 +242,23 @@ def replanned_lines(verdict: pd.DataFrame, replanned: pd.DataFrame) -> list[str]
     """What the same stored analysis says under the plans of 5c72b39 (the within-run part
     bounded by the run-mean variance): the states, and each plan that changed."""
     both = beside(verdict, replanned)
-    same = int((both["state"] == both["state_new"]).sum())
+    same = len(both) - len(changed(verdict, replanned, "state"))
     lines = ["", f"## Plans re-made with the bounded within-run part (`{REPLANNED}`)", "",
              "The same stored analysis re-reported after 5c72b39 bounded the within-run part "
              "of each arm's variance by the run-mean variance "
              "([../../prediction_check/README.md](../../prediction_check/README.md)): "
              f"{same} of {len(both)} rows keep their state (the intervals do not use the "
              "bound); the looks above were planned before it. Plans that change:", ""]
-    changed = both[both["note"].fillna("") != both["note_new"].fillna("")]
     lines += [f"- {r['condition']} {r['label']}: {r['note_new']} (was: {r['note']})."
-              for _, r in changed.iterrows()] or ["- none."]
+              for _, r in changed(verdict, replanned, "note").iterrows()] or ["- none."]
     return lines
 
 
 def repeat_lines(cases: pd.DataFrame, repeated: pd.DataFrame) -> list[str]:
     """How many runs of the same seed (CG level, rule, replica) in both studies give the
     same angle of repose (exactly, as cases.csv stores it), and which do not."""
-    both = cases.merge(repeated, on=["cg", "rule", "replica"], suffixes=("", "_then"))
-    same = both["angle_of_repose"] == both["angle_of_repose_then"]
+    both = repeated_runs(cases, repeated, "angle_of_repose")
+    same = both["same"]
     differ = "; ".join(f"cg{r['cg']:g}-{r['rule']} r{int(r['replica'])} "
                        f"({r['angle_of_repose']:.2f} deg here, "
                        f"{r['angle_of_repose_then']:.2f} in the continuation)"

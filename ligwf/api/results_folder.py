@@ -23,6 +23,8 @@ its README from its tables, which command remakes it -- and the folder does the 
 Table names come from :mod:`ligwf.study.layout` (a copied report table keeps its name);
 a table a script measures itself is named by that script. :func:`number` and
 :func:`csv_text` are how a README prints a value and how a measured table is written.
+:func:`from_template` renders a README whose prose was written by hand: the prose is the
+template, each number a committed table holds one of its fields.
 """
 
 from __future__ import annotations
@@ -30,10 +32,11 @@ from __future__ import annotations
 import argparse
 import math
 import shutil
+import string
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Iterable, Sequence
+from typing import Callable, Iterable, Mapping, Sequence
 
 import pandas as pd
 
@@ -162,6 +165,24 @@ class ResultsFolder:
         study keeps beside its report (``layout.ROUNDS_FILE``) or a file a run left."""
         self.path.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(source / name, self.path / (as_name or name))
+
+
+def from_template(template: Path, fields: Callable[["ResultsFolder"], Mapping[str, object]]
+                  ) -> Callable[["ResultsFolder"], str]:
+    """A folder's ``render``: the text of ``template`` (``{name}`` fields, ``{{`` for a
+    brace) filled with ``fields(folder)``, the values read from the folder's committed
+    tables. Both sides must agree: a field the template names and ``fields`` does not give,
+    or one given and never named (a number read for nothing), is a ConfigError naming it."""
+    def render(folder: "ResultsFolder") -> str:
+        text = template.read_text()
+        named = {name for _, name, _, _ in string.Formatter().parse(text) if name}
+        values = dict(fields(folder))
+        if named != set(values):
+            raise ConfigError(f"{template}: fields named but not given: "
+                              f"{sorted(named - set(values)) or 'none'}; given but not named: "
+                              f"{sorted(set(values) - named) or 'none'}")
+        return text.format_map(values)
+    return render
 
 
 def check_all(folders: Iterable[ResultsFolder]) -> list[str]:

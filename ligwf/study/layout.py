@@ -308,6 +308,9 @@ def drum_frame(step: int) -> str:
 
 #: a committed results folder's README, rendered from its tables (ligwf.api.results_folder)
 RESULTS_README = "README.md"
+#: a granule-growth run's measures (growth rows, shares per cadence, flow per frame),
+#: pickled beside it by ligwf.analysis.granules.growth_study.measured
+GROWTH_CACHE = ("growth-rows.pkl", "growth-shares.pkl", "growth-flow.pkl")
 
 
 def is_study_folder(path: Path) -> bool:

@@ -12,8 +12,8 @@ import pytest
 
 from helpers import ROOT
 from ligwf.api import MissingOutput
-from ligwf.api.results_folder import (ResultsFolder, check_all, csv_text, number,
-                                      results_command, runs_rows, verdict_rows)
+from ligwf.api.results_folder import (ResultsFolder, check_all, csv_text, from_template,
+                                      number, results_command, runs_rows, verdict_rows)
 from ligwf.cli.main import main
 from ligwf.errors import ConfigError
 from ligwf.study import layout
@@ -79,6 +79,25 @@ def test_a_stale_table_is_one_line_not_a_traceback(folder):
 
 def doubled(folder: ResultsFolder) -> dict[str, str]:
     return {"d.csv": csv_text(folder.table("t.csv") * 2)}
+
+
+def test_a_template_is_filled_from_the_tables_and_checked(folder, tmp_path):
+    """Hand-written prose as a template: its fields come from the committed table, a
+    changed table makes the README stale, and a field named but not given (or given and
+    never named) is refused by name."""
+    template = tmp_path / "readme.md"
+    template.write_text("The {n} rows sum to {total} (a set: {{x}}).\n")
+    def sums(f):
+        return {"n": len(f.table("t.csv")), "total": number(f.table("t.csv")["x"].sum())}
+    filled = ResultsFolder(folder.path, from_template(template, sums), "scripts/make_t.py")
+    assert filled.write() == "The 2 rows sum to 1.67 (a set: {x}).\n"
+    assert filled.check() == []
+    (folder.path / "t.csv").write_text(csv_text(pd.DataFrame({"x": [1.0]})))
+    assert filled.check() == [f"{filled.readme} differs from its tables: run scripts/make_t.py"]
+    template.write_text("The {n} rows sum to {sum}.\n")
+    with pytest.raises(ConfigError, match=r"named but not given: \['sum'\]; given but not "
+                                          r"named: \['total'\]"):
+        filled.text()
 
 
 def test_a_derived_table_is_written_and_checked_byte_for_byte(folder):

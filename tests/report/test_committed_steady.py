@@ -1,5 +1,7 @@
-"""docs/results/steady: the README's numbers are those of the committed bench outputs
-(bench_steady.txt, bench_steady_hybrid.txt, bench_steady_extension.txt and the long check's tables)."""
+"""docs/results/steady: the README is the text scripts/kept_results.py renders from the
+committed bench outputs (bench_steady.txt, bench_steady_hybrid.txt, the extension runs) and
+the long check's tables, and its numbers and hypotheses are those files' (read here with the
+bench's own readers, the hypotheses recomputed from the cells)."""
 
 from __future__ import annotations
 
@@ -8,6 +10,8 @@ import re
 
 import pandas as pd
 
+from benchmarks.bench_steady import read_cells, read_extension_cells
+from scripts import kept_results
 from tests.helpers import ROOT
 
 HERE = ROOT / "docs" / "results" / "steady"
@@ -15,18 +19,16 @@ HERE = ROOT / "docs" / "results" / "steady"
 
 def _rows(name: str = "bench_steady.txt") -> list[dict]:
     """The cells of a committed bench_steady run."""
-    lines = (HERE / name).read_text().splitlines()
-    assert lines[0].startswith("# ") and "bench_steady" in lines[0]
-    rows = []
-    for line in lines:
-        m = re.match(r"^\s*(\d+)\s+([\d.]+)\s+([\d.]+)\s+(yes|no) \|\s+([\d.]+)\s+[\d.]+\s+"
-                     r"(-?[\d.]+) \|\s+([\d.]+)\s+[\d.]+\s+(-?[\d.]+)$", line)
-        if m:
-            rows.append({"frames": int(m.group(1)), "startup": m.group(4) == "yes",
-                         "current": float(m.group(5)), "current_bias": float(m.group(6)),
-                         "mser": float(m.group(7)), "mser_bias": float(m.group(8))})
+    text = (HERE / name).read_text()
+    assert text.startswith("# ") and "bench_steady" in text.splitlines()[0]
+    rows = read_cells(text)
     assert len(rows) == 24
     return rows
+
+
+def test_readme_is_what_its_files_give():
+    assert kept_results.main(["--check"]) == 0
+    assert kept_results.STEADY.check() == []
 
 
 def test_readme_numbers_are_the_benchmark():
@@ -102,15 +104,7 @@ def _extension_rows(name: str = "bench_steady_extension.txt", seed: int = 202612
     first = text.splitlines()[0]
     assert first.startswith("# ") and "bench_steady --extension" in first
     assert f"--trials 20000 --seed {seed}" in first
-    rows = []
-    for line in text.splitlines():
-        m = re.match(r"^\s*([\d.]+)\s+(\d+) \|\s+(\d+)\s+([\d.]+) \|\s+(\d+)\s+([\d.]+)\s+"
-                     r"([\d.]+)\s+([\d.]+)\s+(-?[\d.]+)$", line)
-        if m:
-            rows.append({"phi": float(m.group(1)), "tau": int(m.group(2)),
-                         "trials": int(m.group(3)), "before": m.group(4),
-                         "extended": int(m.group(5)), "after": m.group(6),
-                         "median": m.group(7), "late": m.group(8), "bias": m.group(9)})
+    rows = read_extension_cells(text)
     assert [(r["phi"], r["tau"]) for r in rows] == [(phi, tau) for phi in (0.5, 0.8)
                                                     for tau in (12, 16, 24)]
     assert all(r["trials"] == 20000 for r in rows)

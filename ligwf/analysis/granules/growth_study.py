@@ -7,11 +7,16 @@ cadences (is the definition invariant to how often the run dumped?) and the flow
 frames (angle of repose: does the control flow like the wet bed?). :func:`seed_table` pairs
 each wet seed with its control and evaluates every criterion per seed; :func:`verdict`
 counts the seeds. The functions after :func:`measure_case` are pure (tables in, tables out).
+:func:`measure_study` measures every run of a study folder into :class:`GrowthTables` (each
+run's measures cached beside it, so runs done early can be measured while others still run:
+:func:`measure_finished`); :func:`calibration_rounds` joins the rounds of
+``ligwf calibrate-control``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from multiprocessing import Pool
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +28,8 @@ from ligwf.analysis.granules.controls import bed_share
 from ligwf.analysis.granules.growth import (GrowthSettings, HeldAt, frames_spanning,
                                             growth_rows, hac_slope)
 from ligwf.study.case import CaseFolder
+from ligwf.study.layout import (CALIBRATION_TABLE, GROWTH_CACHE, PARTICLE_DUMP_RE, POST_DIR,
+                                is_case_folder)
 
 
 #: a particle carrying more liquid than this fraction of its volume counts as wet
@@ -205,3 +212,79 @@ def cadence_table(shares: pd.DataFrame) -> pd.DataFrame:
     common = shares.groupby(["case_id", "time"]).filter(lambda g: g.cadence.nunique() == cadences)
     return (common.groupby(["case_id", "cadence"], sort=True)["share_10"].mean()
             .reset_index())
+
+
+@dataclass(frozen=True)
+class GrowthTables:
+    """What :func:`measure_study` measures: every start frame of every run (``rows``), the
+    held share at each window cadence (``cadence``), the angle of repose per frame
+    (``flow``), one row per wet seed beside its control (``seeds``), k of n seeds per
+    criterion (``verdict``) and one row per run (``runs``)."""
+
+    rows: pd.DataFrame
+    cadence: pd.DataFrame
+    flow: pd.DataFrame
+    seeds: pd.DataFrame
+    verdict: pd.DataFrame
+    runs: pd.DataFrame
+
+
+def measured(case_dir: Path) -> tuple[pd.DataFrame, ...]:
+    """:func:`measure_case` of a run, cached beside it (``layout.GROWTH_CACHE``; a run
+    measured while others still ran is not measured again)."""
+    if all((case_dir / n).exists() for n in GROWTH_CACHE):
+        return tuple(pd.read_pickle(case_dir / n) for n in GROWTH_CACHE)
+    print(f"measuring {case_dir.name} ...", flush=True)
+    tables = measure_case(case_dir)
+    for n, t in zip(GROWTH_CACHE, tables):
+        tmp = case_dir / (n + ".tmp")
+        t.to_pickle(tmp)
+        tmp.replace(case_dir / n)
+    return tables
+
+
+def run_table(run_dir: Path, case_ids: list[str]) -> pd.DataFrame:
+    """One row per run: its particles, production [s], particle dumps and status."""
+    rows = []
+    for cid in case_ids:
+        case = CaseFolder.open(run_dir / cid)
+        m = case.manifest()
+        post = run_dir / cid / POST_DIR
+        rows.append({"case_id": cid, "particles": int(case.scaled.particles.count),
+                     "production_s": round(case.scaled.numerics.run_steps
+                                           * case.scaled.numerics.dt, 3),
+                     "frames": sum(bool(PARTICLE_DUMP_RE.match(p.name)) for p in
+                                   (post.iterdir() if post.is_dir() else ())),
+                     "status": m.status if m is not None else "not run"})
+    return pd.DataFrame(rows)
+
+
+def measure_study(run_dir: Path, processes: int = 2) -> GrowthTables:
+    """Every run of the study folder ``run_dir`` measured (``processes`` at a time, each
+    cached beside its run), its seeds paired and judged."""
+    case_ids = sorted(p.name for p in run_dir.iterdir() if is_case_folder(p))
+    with Pool(processes) as pool:
+        results = pool.map(measured, [run_dir / c for c in case_ids])
+    rows, shares, flows = (pd.concat([r[i] for r in results], ignore_index=True)
+                           for i in range(3))
+    seeds = seed_table(rows, flows)
+    return GrowthTables(rows, cadence_table(shares), flows, seeds, verdict(seeds),
+                        run_table(run_dir, case_ids))
+
+
+def measure_finished(run_dir: Path) -> None:
+    """Measure (and cache) every run of ``run_dir`` that is done, one at a time: the
+    study's runs can be measured while the last ones still run."""
+    for p in sorted(run_dir.iterdir()):
+        m = CaseFolder.open(p).manifest() if is_case_folder(p) else None
+        if m is not None and m.status == "done":
+            measured(p)
+
+
+def calibration_rounds(folders: tuple[Path, ...]) -> pd.DataFrame:
+    """The ``calibration.csv`` of each ``ligwf calibrate-control`` folder, in order (their
+    ``round``: 1, 2, ...): the wet reference once, then every candidate."""
+    cal = pd.concat([pd.read_csv(Path(c) / CALIBRATION_TABLE).assign(round=k + 1)
+                     for k, c in enumerate(folders)], ignore_index=True)
+    ref = cal[cal["role"] == "wet reference"].drop_duplicates("case_id")
+    return pd.concat([ref, cal[cal["role"] == "candidate"]], ignore_index=True)

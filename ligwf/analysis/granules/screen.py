@@ -5,7 +5,8 @@ pick on :data:`SEEDS` seeds, each beside its cohesionless twin and a uniform twi
 judges it by the registered per-seed criteria, >= 4 of 5 seeds (:func:`phase2_seeds`,
 :func:`phase2_verdict`). Pure: growth rows and frame flows in
 (:func:`ligwf.analysis.granules.growth_study.measure_case`), tables out;
-``scripts/granule_screen_results.py`` measures the runs and writes the folder.
+:mod:`ligwf.analysis.granules.screen_study` measures the screen's runs and
+``scripts/granule_screen_results.py`` writes the folder.
 """
 
 from __future__ import annotations

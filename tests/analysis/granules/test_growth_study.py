@@ -99,3 +99,24 @@ def test_the_results_readme_reads_the_verdict_from_the_tables(tmp_path):
     assert "| survival |" in text and "3 of 5 | no |" in text
     assert "The regime does not pass: it fails survival (3 of 5)" in text
     assert "GSD transfer across CG levels stays unvalidated" in text
+
+
+def test_calibration_rounds_keep_one_wet_reference_then_every_candidate(tmp_path):
+    """Two calibrate-control folders: the wet reference both measured counts once (round 1),
+    the candidates of both follow in round order."""
+    from ligwf.analysis.granules.growth_study import calibration_rounds
+    from ligwf.study.layout import CALIBRATION_TABLE
+
+    folders = []
+    for k, frictions in enumerate(((0.8, 1.0), (0.65,))):
+        folder = tmp_path / f"cal{k + 1}"
+        folder.mkdir()
+        pd.DataFrame([{"case_id": "wet-r0", "role": "wet reference", "friction": 0.5}]
+                     + [{"case_id": f"c{k}{i}", "role": "candidate", "friction": f}
+                        for i, f in enumerate(frictions)]).to_csv(folder / CALIBRATION_TABLE,
+                                                                  index=False)
+        folders.append(folder)
+    cal = calibration_rounds(tuple(folders))
+    assert list(cal["role"]) == ["wet reference", "candidate", "candidate", "candidate"]
+    assert list(cal["round"]) == [1, 1, 1, 2]
+    assert list(cal["friction"]) == [0.5, 0.8, 1.0, 0.65]
