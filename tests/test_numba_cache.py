@@ -110,6 +110,7 @@ def _first_and_second(tmp_path, models: tuple[str, ...], which: str) -> tuple[di
     return first, second
 
 
+@pytest.mark.slow
 def test_second_process_loads_the_bond_kernels_from_the_cache(tmp_path):
     """The kernels that take a liquid law (the ones that recompiled in every process)."""
     _first_and_second(tmp_path, ("washino",), "law")

@@ -138,6 +138,7 @@ def test_a_mostly_zero_arm_gets_a_binomial_bound_not_a_t_bound():
         stats.beta.ppf(0.95, 3.0 + 1, 60 - 3.0))
 
 
+@pytest.mark.slow
 def test_unequal_arms_leave_welch_where_it_passes_wrongly():
     """6 CG-n runs (sd 0.5) against 2 CG1 runs (sd 1), the truth on the budget (3): Welch
     passes in ~0.077 of studies (issue 45: 0.060-0.078), Hsu's df in ~0.01, the

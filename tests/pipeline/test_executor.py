@@ -1,6 +1,7 @@
 """The pipeline runs cases only through the executor interface (issue 33 item 1): a study
 written, run by an executor that is not this machine's, analysed and reported, in the
-fast lane. The executor here replays the committed real engine output of
+fast lane (the analysis split into share processes, their kill -9 and the toy scheduler,
+a few seconds of subprocesses each, run in the slow lane). The executor here replays the committed real engine output of
 ``tests/data/cg3_slice`` (its dumps are what the committed input of that scene wrote,
 ``tests/data/README.md``) into the case it is asked to run, so the analysis and the report
 read real LIGGGHTS dumps; the local and Slurm executors satisfy the same interface."""
@@ -119,6 +120,7 @@ def test_a_case_the_executor_cannot_run_is_not_done_and_nothing_else_runs_after_
         run_study(study, study.cases, ReplayExecutor(), None, stop)
 
 
+@pytest.mark.slow
 def test_a_local_analysis_split_into_shares_writes_the_same_bytes(tmp_path):
     """LocalExecutor.analyse in 2 shares (2 processes, then the merge) against 1, on the
     replayed real dumps: every table byte for byte, the share screens kept."""
@@ -155,6 +157,7 @@ def _shares_of(study: Path) -> list[int]:
     return pids
 
 
+@pytest.mark.slow
 def test_shares_end_with_a_sigkilled_ligwf_and_leave_no_part(tmp_path):
     """kill -9 of the process running LocalExecutor.analyse(study, 2): its shares end with
     it (the kernel's parent-death signal) instead of computing on for nobody: no share
@@ -230,6 +233,7 @@ class ToyQueue(SubmitAndWait):
         return []
 
 
+@pytest.mark.slow
 def test_a_scheduler_with_the_job_verbs_only_runs_the_whole_pipeline(tmp_path):
     """Issue 48 item 1: a new scheduler implements plan, submit, status, cancel and
     require; running the cases and the analysis and waiting for them are SubmitAndWait's,
