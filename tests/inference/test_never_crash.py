@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from scipy import stats
 
 from ligwf.inference import equivalence as eq
@@ -69,3 +70,20 @@ def test_forty_six_runs_against_forty_six_get_bounds_and_a_decision():
     assert e.has_interval and e.lo <= e.raw <= e.hi
     assert eq.norm_decision(e, 0.1) in (eq.PASS, eq.FAIL, eq.UNDECIDED)
     assert 0.0 <= eq.norm_fail_p(x, y, 0.1) <= 1.0
+
+
+@pytest.mark.parametrize("rule", [eq.BINS_SIMULATED_UPPER, eq.BINS_SIMULATED_FIDUCIAL])
+def test_the_crash_inputs_and_no_noise_give_bounds_under_the_simulated_upper_bounds(rule):
+    """The measured upper-bound rules (the sixth run's smaller bound, the seventh run's
+    fiducial one) on the same inputs: the repro and 46 against 46 get bounds, and two arms
+    without noise get the observed distance as both bounds."""
+    d = np.load(CRASH)
+    x, y, k = d["x"], d["y"], int(d["k"])
+    p = eq.norm_estimate(x, y, 0.05, add=(k, k), bins=rule)
+    assert p.has_interval and p.lo <= p.hi
+    x, y = forty_six_against_forty_six()
+    e = eq.norm_estimate(x, y, 0.05, bins=rule)
+    assert e.has_interval and e.lo <= e.raw <= e.hi
+    x = np.tile(np.arange(16.0, 0.0, -1.0), (3, 1))
+    e = eq.norm_estimate(x, x + 1.0, bins=rule)
+    assert e.lo == e.hi == pytest.approx(e.raw)

@@ -14,7 +14,7 @@ import pytest
 from benchmarks.profile_designs import profile_runs, shifted_studies
 from ligwf.inference import equivalence as eq
 from ligwf.inference.profile_null import simulated_null
-from tests.inference.test_never_crash import CRASH, forty_six_against_forty_six
+from tests.inference.test_profile_upper import upper_covers
 
 RULE = eq.BINS_SIMULATED_FIDUCIAL
 
@@ -54,10 +54,7 @@ def test_it_covers_less_where_the_largest_direction_over_covers():
     rng = np.random.default_rng(20261207)
     trials = 300
     a, b, truth = shifted_studies(rng, trials, 6, 6, 0.0, 12)
-    old = new = 0
-    for i in range(trials):
-        old += eq.norm_estimate(a[i], b[i], bins=eq.BINS_SIMULATED_UPPER).hi >= truth
-        new += eq.norm_estimate(a[i], b[i], bins=RULE).hi >= truth
+    old, new = (upper_covers(a, b, truth, rule) for rule in (eq.BINS_SIMULATED_UPPER, RULE))
     assert new < old and new / trials >= 0.92
 
 
@@ -65,19 +62,6 @@ def test_without_the_fiducial_directions_drawn_it_says_so():
     null = simulated_null(np.eye(3)[:2] + 1.0, np.eye(3)[1:] + 1.0, 2, 2)
     with pytest.raises(ValueError, match="a_fiducial"):
         type(null)(null.a, null.b, null.v, null.observed).fiducial()
-
-
-def test_the_crash_inputs_and_no_noise_give_bounds():
-    d = np.load(CRASH)
-    x, y, k = d["x"], d["y"], int(d["k"])
-    p = eq.norm_estimate(x, y, 0.05, add=(k, k), bins=RULE)
-    assert p.has_interval and p.lo <= p.hi
-    x, y = forty_six_against_forty_six()
-    e = eq.norm_estimate(x, y, 0.05, bins=RULE)
-    assert e.has_interval and e.lo <= e.raw <= e.hi
-    x = np.tile(np.arange(16.0, 0.0, -1.0), (3, 1))
-    e = eq.norm_estimate(x, x + 1.0, bins=RULE)
-    assert e.lo == e.hi == pytest.approx(e.raw)
 
 
 def test_the_verdict_uses_it_and_says_so():

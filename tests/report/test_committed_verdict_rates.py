@@ -175,15 +175,24 @@ def test_profile_bins_run_is_what_the_readme_says():
     assert "**2 of 4 registered checks hold.**" in README
 
 
+def _registered_run(name: str, command: str) -> tuple[str, str, str]:
+    """A profiles run's file, the README and the command registered for it (the README's
+    indented line matching ``command`` whose output is ``name``); the file's first line is
+    that command, followed by when and where it ran."""
+    text = (HERE / name).read_text()
+    raw = (HERE / "README.md").read_text()
+    registered = re.search(rf"^    ({command}) > docs/results/verdict_rates/{re.escape(name)}$",
+                           raw, re.M).group(1)
+    assert text.splitlines()[0].startswith("# " + registered + " ")
+    return text, raw, registered
+
+
 def test_simulated_fail_test_run_is_what_the_readme_says():
     """profiles_2.txt (bench_coverage --profiles-2, registered before it): the registered
     command on its first line, the check lines recomputed from its cells (designs of >= 6
     runs counted, a rate shown above 0.05 by its lower 95 % Clopper-Pearson bound) and the
     numbers the README quotes."""
-    text = (HERE / "profiles_2.txt").read_text()
-    registered = re.search(r"^    (nice -n 19 .*--profiles-2.*) > docs/results/verdict_rates/"
-                           r"profiles_2\.txt$", (HERE / "README.md").read_text(), re.M).group(1)
-    assert text.splitlines()[0].startswith("# " + registered + " ")
+    text, _, registered = _registered_run("profiles_2.txt", r"nice -n 19 .*--profiles-2.*")
     rows = [line.split() for line in text.splitlines() if "|" in line and " vs " in line]
     assert len(rows) == 36
     cells = {(r[0], int(r[1]) + int(r[3]), r[1] + " vs " + r[3], float(r[4])):
@@ -251,11 +260,7 @@ def test_smaller_upper_bound_run_is_what_the_readme_says():
     README quotes beside the fifth run's on the same designs, and the verdict's rule left
     unchanged because check 1 failed."""
     from ligwf.inference import equivalence as eq
-    text = (HERE / "profiles_3.txt").read_text()
-    raw = (HERE / "README.md").read_text()
-    registered = re.search(r"^    (nice -n 19 .*--profiles-3.*) > docs/results/verdict_rates/"
-                           r"profiles_3\.txt$", raw, re.M).group(1)
-    assert text.splitlines()[0].startswith("# " + registered + " ")
+    text, raw, registered = _registered_run("profiles_3.txt", r"nice -n 19 .*--profiles-3.*")
     assert "--trials 3000" in registered and "3000 studies a cell" in text
     assert raw.index("## Sixth run") < raw.index("### Sixth run's result")
     cells = _profile_cells("profiles_3.txt")
@@ -303,11 +308,8 @@ def test_fiducial_upper_bound_run_is_what_the_readme_says():
     the numbers the README and the verdict's method sentence quote, and the verdict's rule
     switched to it because all four checks held."""
     from ligwf.inference import equivalence as eq
-    text = (HERE / "profiles_4.txt").read_text()
-    raw = (HERE / "README.md").read_text()
-    registered = re.search(r"^    (OPENBLAS_NUM_THREADS=1 nice -n 19 .*--profiles-4.*) > "
-                           r"docs/results/verdict_rates/profiles_4\.txt$", raw, re.M).group(1)
-    assert text.splitlines()[0].startswith("# " + registered + " ")
+    text, raw, registered = _registered_run(
+        "profiles_4.txt", r"OPENBLAS_NUM_THREADS=1 nice -n 19 .*--profiles-4.*")
     assert "--trials 3000 --seed 20261217" in registered and "3000 studies a cell" in text
     assert "registered in README.md before the run, commit b5648e7" in text.splitlines()[0]
     assert raw.index("## Seventh run") < raw.index("### Seventh run's result")
